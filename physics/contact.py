@@ -153,7 +153,7 @@ def damping_alpha(restitution: float, model: str = "exact",
 # Pointwise contact force (one contact), compiled
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, history, dt_history,
                         kn, kt, alpha, gamma_t, mu, limit_damping):
     """Forces of one Hertz–Mindlin contact.

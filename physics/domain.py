@@ -30,7 +30,7 @@ BOX_DEFORM, BOX_C0, BOX_RATE, BOX_T0, BOX_LX0, BOX_LY0, BOX_AXES = 4, 5, 6, 7, 8
 BOX_SIZE = 11
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def minimum_image(d, length, periodic):
     """Minimum-image component of a displacement ``d`` along an axis [m]."""
     if periodic:
@@ -38,7 +38,7 @@ def minimum_image(d, length, periodic):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def wrap_coordinate(x, length, periodic):
     """Map a coordinate into [0, length) along a periodic axis."""
     if periodic:
@@ -220,7 +220,7 @@ class DeformingPeriodicBox(PeriodicBox):
         return b
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def box_lengths_at(box, time):
     """Side lengths of a (possibly deforming) box at model time ``time``.
 

@@ -55,7 +55,7 @@ def choose_cell_size(radius: np.ndarray, lx: float, ly: float, skin: float,
     return max(c, c_min_for_memory, 1e-12)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def build_cells(pos, lx, ly, cell_size):
     """Counting-sort floes into a grid of cells.
 
@@ -87,7 +87,7 @@ def build_cells(pos, lx, ly, cell_size):
     return ncx, ncy, cell_start, cell_floes, cell_of
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _axis_range(c, reach, cell_width, ncell, periodic):
     """First cell offset and count of cells to scan along one axis."""
     k = int(math.ceil(reach / cell_width))
@@ -102,7 +102,7 @@ def _axis_range(c, reach, cell_width, ncell, periodic):
     return lo, hi - lo + 1, True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _scan_floe(i, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
                cell_floes, cell_of, out, write_at):
     """Partners of floe i of lower rank within r_i + r_j + skin.
@@ -143,7 +143,7 @@ def _scan_floe(i, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
     return count
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     """Verlet list of all pairs with centre distance < r_i + r_j + skin.
 
@@ -187,7 +187,7 @@ def brute_force_pairs(pos, radius, box, skin):
     return np.stack([i, j], axis=1)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def transfer_history(old_start, old_nbr, old_hist, new_start, new_nbr, ncomp):
     """Carry per-pair history (``old_hist`` (M_old, ncomp)) to a new list by a
     merge of the sorted slices; pairs new to the list start from zero."""
@@ -206,7 +206,7 @@ def transfer_history(old_start, old_nbr, old_hist, new_start, new_nbr, ncomp):
     return new_hist
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def reverse_incidence(start, nbr, n):
     """For each floe j, the pair slots where j is the (non-owner) partner.
 
@@ -229,7 +229,7 @@ def reverse_incidence(start, nbr, n):
     return rev_start, rev_pair
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def owners_of(start):
     """Owner floe of every pair slot (the i of slot p)."""
     n = start.shape[0] - 1

@@ -1,0 +1,369 @@
+"""The Hertzian soft-contact engine of Herman (2013): :class:`HertzSimulation`.
+
+Floes are discs moving under the forcing of :mod:`physics.forcing` and the
+Hertz–Mindlin contacts of :mod:`physics.contact`, integrated with
+velocity-Verlet (:mod:`physics.hertz_kernels`) over Verlet lists with a skin
+(:mod:`physics.neighbors`), in a box of :mod:`physics.domain`.
+
+Example
+-------
+>>> from physics import make_floe_field, HertzSimulation, ContactParams, Forcing, HERMAN2013
+>>> field, box = make_floe_field(500, concentration=0.7, alpha=1.8, mean_diameter=8.0, seed=1)
+>>> sim = HertzSimulation(field, box, HERMAN2013.contact, Forcing(HERMAN2013.forcing), dt=0.002)
+>>> sim.advance(10.0)                       # model seconds
+>>> forces, torques = sim.contact_forces()
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from . import hertz_kernels as K
+from .contact import contact_time, hertz_stiffness
+from .domain import Box
+from .floes import FloeField, max_overlap
+from .forcing import Forcing
+from .neighbors import choose_cell_size, radius_rank
+from .params import ContactParams, check_range
+
+__all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
+
+
+@dataclass
+class Contacts:
+    """Contacts at one instant, one row per touching pair (i < j not implied).
+
+    Attributes
+    ----------
+    i, j : (K,) int — the two floes
+    normal : (K, 2) — unit vector from the centre of i to the centre of j
+    overlap : (K,) — δ [m]
+    normal_force : (K,) — magnitude of the repulsive normal force [N]
+    tangential_force : (K,) — tangential force on i along t = k × n [N]
+    force : (K, 2) — total contact force on i (−force acts on j) [N]
+    contact_point : (K, 2) — midpoint of the overlap, r_i − δ/2 from i along n [m]
+        (in the box's coordinates, possibly outside [0, L) near a periodic edge)
+    branch_i, branch_j : (K, 2) — vectors from the centres of i and j to the
+        contact point [m]
+    """
+
+    i: np.ndarray
+    j: np.ndarray
+    normal: np.ndarray
+    overlap: np.ndarray
+    normal_force: np.ndarray
+    tangential_force: np.ndarray
+    force: np.ndarray
+    contact_point: np.ndarray
+    branch_i: np.ndarray
+    branch_j: np.ndarray
+
+    def __len__(self):
+        return int(self.i.size)
+
+
+def minimum_contact_time(radius, thickness, density, contact: ContactParams, speed: float) -> float:
+    """Shortest undamped Hertz contact time among equal-floe pairs at impact
+    speed ``speed`` [s]: t_c = 3.2181 (m*/k)^{2/5} v^{−1/5} with m* = m/2,
+    R* = r/2 for each floe (the smallest floes collide fastest)."""
+    r = np.asarray(radius, dtype=float)
+    m = density * np.asarray(thickness, dtype=float) * math.pi * r ** 2
+    k = hertz_stiffness(contact.effective_modulus, 0.5 * r)
+    return float(np.min(contact_time(0.5 * m, k, speed)))
+
+
+class HertzSimulation:
+    """Soft-contact discrete-element simulation of floes (Herman 2013).
+
+    Parameters
+    ----------
+    field : FloeField
+        Initial state; copied, never modified.
+    box : Box
+        ``PeriodicBox``, ``DeformingPeriodicBox``, ``ChannelBox`` or
+        ``WalledBox``. The simulation owns and updates it (a deforming box
+        shrinks or grows).
+    contact : ContactParams, optional
+        Contact law (default: Herman 2013 values, e = 0.5).
+    forcing : Forcing or None
+        Drag, wind, current and Coriolis; ``None`` means no external forces.
+    dt : float
+        Time step [s]; must be below a tenth of the shortest contact time at
+        ``impact_speed``.
+    impact_speed : float
+        Largest relative speed expected at impact [m/s], used only for the
+        time-step check (default 0.1 m/s: relative speeds of neighbouring
+        floes in the wind- and convergence-driven set-ups of Herman (2013),
+        whose Δt = 0.002 s it admits; raise it for violent impacts).
+    skin : float, optional
+        Verlet-list skin [m] (default 0.1 × the mean radius).
+    parallel : bool, optional
+        Use the multi-threaded kernels (default: when N ≥ 5000 and Numba has
+        more than one thread). Both paths give the same result to rounding.
+    allow_overlap : bool
+        Accept initial overlaps above 1 % of the smaller radius (e.g. when
+        restoring a saved, compressed state).
+
+    Attributes
+    ----------
+    time : float — model time [s]
+    positions, velocities, angular_velocities : arrays of the current state
+    n_steps, n_rebuilds : counters
+    """
+
+    def __init__(self, field: FloeField, box: Box, contact: ContactParams | None = None,
+                 forcing: Forcing | None = None, dt: float = 0.002, *,
+                 impact_speed: float = 0.1, skin: float | None = None,
+                 parallel: bool | None = None, allow_overlap: bool = False):
+        if not isinstance(field, FloeField):
+            raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
+        if not isinstance(box, Box):
+            raise TypeError(f"box must be a Box (e.g. PeriodicBox(L)), got {type(box).__name__}")
+        contact = ContactParams() if contact is None else contact
+        if not isinstance(contact, ContactParams):
+            raise TypeError(f"contact must be a ContactParams, got {type(contact).__name__}")
+        if forcing is not None and not isinstance(forcing, Forcing):
+            raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
+        check_range("dt", dt, 0.0, None, low_open=True)
+        check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
+        self.field = field.copy()
+        self.box = box
+        self.contact = contact
+        self.forcing = forcing
+        self.dt = float(dt)
+        f = self.field
+        self.radius = f.radii
+        n = f.n
+
+        # time step against the shortest contact time
+        t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed)
+        if self.dt > 0.1 * t_c:
+            raise ValueError(
+                f"dt={self.dt:g} s is above a tenth of the shortest contact time "
+                f"({t_c:.4g} s for the smallest floes at impact speed {impact_speed:g} m/s); "
+                f"use dt <= {0.1 * t_c:.3g} s")
+        self.min_contact_time = t_c
+
+        # neighbour-list sizing
+        self.skin = 0.1 * float(np.mean(f.radii)) if skin is None else float(skin)
+        check_range("skin", self.skin, 0.0, None, low_open=True)
+        self.max_cut = 2.0 * float(f.radii.max()) + self.skin
+        for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
+            if per and self.max_cut >= 0.5 * length:
+                raise ValueError(
+                    f"the box is too small along {axis} ({length:.4g} m) for the largest floe "
+                    f"(radius {f.radii.max():.4g} m): periodic sides must exceed "
+                    f"2 (2 r_max + skin) = {2 * self.max_cut:.4g} m")
+        if parallel is None:
+            parallel = n >= 5000 and numba.get_num_threads() > 1
+        self.parallel = bool(parallel)
+
+        # positions inside the box; walls must not cut floes deeply
+        self.positions = box.wrap(f.positions)
+        if not np.all(box.contains(self.positions)):
+            bad = int(np.argmin(box.contains(self.positions)))
+            raise ValueError(f"floe {bad} at {self.positions[bad]} is outside the walled box {box}")
+        if not allow_overlap:
+            worst = max_overlap(self.positions, f.radii, box)
+            if worst > 0.01:
+                raise ValueError(
+                    f"initial overlap of {worst:.3g} of the smaller radius exceeds 1 %; separate "
+                    f"the floes (physics.floes.place_floes) or pass allow_overlap=True")
+
+        # state arrays
+        self.velocities = f.velocities.copy()
+        self.angular_velocities = f.angular_velocities.copy()
+        mass = f.masses
+        mobile = ~f.frozen
+        self.inv_mass = np.where(mobile, 1.0 / mass, 0.0)
+        self.inv_inertia = np.where(mobile, 1.0 / f.inertia, 0.0)
+        self.rank = radius_rank(f.radii)
+        self.cell_size = choose_cell_size(f.radii, box.lx, box.ly, self.skin)
+        box.bind(f.total_area)
+        self.max_concentration = getattr(box, "max_concentration", 1.0)
+        self._cp = np.array([
+            4.0 / 3.0 * contact.effective_modulus, 8.0 * contact.effective_shear_modulus,
+            contact.damping_alpha, contact.tangential_damping, contact.friction,
+            float(contact.limit_damping),
+            4.0 / 3.0 * contact.wall_effective_modulus, 8.0 * contact.wall_effective_shear_modulus,
+        ])
+        self._set_drag()
+        self.force = np.zeros((n, 2))
+        self.torque = np.zeros(n)
+        self._wall_hist = np.zeros((n, 4))
+        self._centre = np.zeros(2)
+        self._ref_lengths = np.array([box.lx, box.ly])
+        self.time = 0.0
+        self.n_steps = 0
+        self.n_rebuilds = 0
+        self._build_list(np.zeros(0, dtype=np.int64), np.zeros(n + 1, dtype=np.int64), np.zeros(0))
+        self._compute_forces(history_step=0.0)
+
+    # -- set-up helpers ------------------------------------------------------
+    def _set_drag(self):
+        f = self.field
+        n = f.n
+        self._drag = np.zeros((n, 4))
+        if self.forcing is not None:
+            k = self.forcing.coefficients(f.radii, f.thickness, f.masses)
+            mobile = ~f.frozen
+            for col, a in enumerate((k.wind, k.water, k.rotation, k.coriolis_mass)):
+                self._drag[:, col] = np.where(mobile, a, 0.0)
+
+    def _forcing_vector(self) -> np.ndarray:
+        if self.forcing is None:
+            return np.zeros(4)
+        return self.forcing.kernel_vector()
+
+    def _build_list(self, old_nbr, old_start, old_hist):
+        b = self.box
+        (self._start, self._nbr, self._hist, self._rev_start, self._rev_pair,
+         self._ref) = K.rebuild(self.positions, self.radius, self.rank, b.lx, b.ly,
+                                b.periodic[0], b.periodic[1], self.skin, self.cell_size,
+                                old_start, old_nbr, old_hist)
+        self._ref_lengths[:] = (b.lx, b.ly)
+        self._centre[:] = 0.0
+
+    def _compute_forces(self, history_step: float):
+        """Forces at the current state; ``history_step`` 0 leaves the Mindlin
+        history unchanged (set-up, as LAMMPS does at ``run 0``)."""
+        K.forces_serial(self.positions, self.velocities, self.angular_velocities, self.radius,
+                        self.inv_mass, self._drag, self._forcing_vector(), self._cp,
+                        self.box.kernel_array(self.time), self._start, self._nbr,
+                        self._hist if history_step else self._hist.copy(),
+                        self._wall_hist if history_step else self._wall_hist.copy(),
+                        history_step, self.force, self.torque)
+
+    # -- running -------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance by ``n`` time steps."""
+        check_range("n", n, 0, None)
+        n = int(n)
+        if n == 0:
+            return
+        if self.forcing is not None:
+            self._set_drag_if_changed()
+        box_arr = self.box.kernel_array(self.time)
+        (done, status, nreb, self._start, self._nbr, self._hist, self._rev_start,
+         self._rev_pair, self._ref) = K.run_steps(
+            n, self.dt, self.time, self.positions, self.velocities, self.angular_velocities,
+            self.force, self.torque, self.radius, self.rank, self.inv_mass, self.inv_inertia,
+            self._drag, self._forcing_vector(), self._cp, box_arr, self.max_concentration,
+            self.skin, self.cell_size, self.max_cut, self._start, self._nbr, self._hist,
+            self._rev_start, self._rev_pair, self._ref, self._ref_lengths, self._centre,
+            self._wall_hist, self.parallel)
+        self.time += done * self.dt
+        self.n_steps += done
+        self.n_rebuilds += nreb
+        self.box.update_from_kernel(box_arr)
+        if status == K.STATUS_CONCENTRATION:
+            raise RuntimeError(
+                f"the deforming box reached its concentration limit at t = {self.time:.6g} s "
+                f"(A = {self.concentration:.4f})")
+        if status == K.STATUS_UNSTABLE:
+            raise FloatingPointError(
+                f"the integration became unstable at t = {self.time:.6g} s (step {self.n_steps}): "
+                f"a floe moved more than half the Verlet skin in one step. The time step is too "
+                f"large for the impact speeds, or the ice was compressed far beyond jamming")
+        if status == K.STATUS_NONFINITE or not (np.all(np.isfinite(self.positions))
+                                                 and np.all(np.isfinite(self.velocities))):
+            raise FloatingPointError(
+                f"non-finite floe state at t = {self.time:.6g} s (step {self.n_steps}); "
+                f"the time step is probably too large for the impact speeds")
+
+    def _set_drag_if_changed(self):
+        # the coefficients depend only on the floes and ForcingParams; the
+        # coriolis parameter may be changed by the user between calls
+        key = (id(self.forcing), self.forcing.coriolis, id(self.forcing.params))
+        if getattr(self, "_drag_key", None) != key:
+            self._set_drag()
+            self._drag_key = key
+
+    def advance(self, duration: float, *, progress: bool = False, chunk: float | None = None) -> None:
+        """Advance by ``duration`` model seconds (rounded to whole steps).
+
+        ``progress=True`` shows a progress bar (the run is done in chunks of
+        ``chunk`` model seconds, default 1 % of the duration).
+        """
+        check_range("duration", duration, 0.0, None)
+        n = int(round(duration / self.dt))
+        if not progress:
+            self.step(n)
+            return
+        from tqdm.auto import tqdm
+
+        per = max(1, int(round((chunk or duration / 100.0) / self.dt)))
+        with tqdm(total=n, unit="step", desc="Hertz", dynamic_ncols=True) as bar:
+            left = n
+            while left > 0:
+                k = min(per, left)
+                self.step(k)
+                left -= k
+                bar.update(k)
+
+    # -- observation ---------------------------------------------------------
+    @property
+    def concentration(self) -> float:
+        """Ice concentration A = F / S [-]."""
+        return self.field.total_area / self.box.area
+
+    @property
+    def n_floes(self) -> int:
+        return self.field.n
+
+    @property
+    def mass(self) -> np.ndarray:
+        return self.field.masses
+
+    def contact_forces(self):
+        """Contact forces (N, 2) [N] and torques (N,) [N m] on every floe from
+        contacts only (floes and walls), at the current positions and
+        velocities, without advancing the contact history."""
+        force = np.zeros((self.n_floes, 2))
+        torque = np.zeros(self.n_floes)
+        K.forces_serial(self.positions, self.velocities, self.angular_velocities, self.radius,
+                        self.inv_mass, np.zeros((self.n_floes, 4)), np.zeros(4), self._cp,
+                        self.box.kernel_array(self.time), self._start, self._nbr, self._hist.copy(),
+                        self._wall_hist.copy(), 0.0, force, torque)
+        return force, torque
+
+    def contacts(self) -> Contacts:
+        """Every touching floe pair at the current state (see :class:`Contacts`)."""
+        i, j, d = K.contact_list(self.positions, self.velocities, self.angular_velocities,
+                                 self.radius, self.inv_mass, self._cp,
+                                 self.box.kernel_array(self.time), self._start, self._nbr,
+                                 self._hist)
+        normal = d[:, 0:2].copy()
+        delta = d[:, 2]
+        arm_i = (self.radius[i] - 0.5 * delta)[:, None] * normal
+        arm_j = -(self.radius[j] - 0.5 * delta)[:, None] * normal
+        return Contacts(i=i, j=j, normal=normal, overlap=delta.copy(), normal_force=d[:, 3].copy(),
+                        tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
+                        contact_point=self.positions[i] + arm_i, branch_i=arm_i, branch_j=arm_j)
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy of mobile floes [J]."""
+        m = self.field.masses
+        mobile = self.inv_mass > 0
+        e_t = 0.5 * np.sum(m[mobile] * np.sum(self.velocities[mobile] ** 2, axis=1))
+        e_r = 0.5 * np.sum(self.field.inertia[mobile] * self.angular_velocities[mobile] ** 2)
+        return float(e_t + e_r)
+
+    def momentum(self) -> np.ndarray:
+        """Total linear momentum of mobile floes (2,) [kg m/s]."""
+        mobile = self.inv_mass > 0
+        return (self.field.masses[mobile, None] * self.velocities[mobile]).sum(axis=0)
+
+    def state(self) -> FloeField:
+        """A copy of the current state as a FloeField."""
+        f = self.field
+        return FloeField(self.positions.copy(), f.radii.copy(), f.thickness.copy(),
+                         self.velocities.copy(), self.angular_velocities.copy(), f.density,
+                         f.frozen.copy())
+
+    def __repr__(self):
+        return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "
+                f"time={self.time:.6g}, parallel={self.parallel})")
