@@ -87,60 +87,85 @@ def build_cells(pos, lx, ly, cell_size):
     return ncx, ncy, cell_start, cell_floes, cell_of
 
 
+N_CHUNKS = 64
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _axis_range(c, reach, cell_width, ncell, periodic):
-    """First cell offset and count of cells to scan along one axis."""
+    """First cell and number of cells to scan along one axis. The first cell
+    may be negative on a periodic axis (the caller wraps); a range longer
+    than the axis is cut to the whole axis, visited once."""
     k = int(math.ceil(reach / cell_width))
     if 2 * k + 1 >= ncell:
-        if periodic:
-            return 0, ncell, True          # whole axis once, absolute indices
-        return 0, ncell, True
+        return 0, ncell
     if periodic:
-        return c - k, 2 * k + 1, False
+        return c - k, 2 * k + 1
     lo = max(c - k, 0)
     hi = min(c + k, ncell - 1)
-    return lo, hi - lo + 1, True
+    return lo, hi - lo + 1
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _scan_floe(i, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
-               cell_floes, cell_of, out, write_at):
-    """Partners of floe i of lower rank within r_i + r_j + skin.
+@njit(cache=True, error_model="numpy")
+def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+                cell_start, cell_floes, cell_of, counts, start, out, write):
+    """Partners of lower rank within r_i + r_j + skin of floes
+    i_lo, i_lo + i_step, ... < i_hi.
 
-    Writes them at ``out[write_at:]`` when ``write_at >= 0``; returns the count.
+    Counting pass (``write`` False): counts[i + 1] = number of partners.
+    Filling pass: partners of i written at out[start[i]:], sorted by index.
     """
-    xi = pos[i, 0]
-    yi = pos[i, 1]
-    ri = radius[i]
-    reach = 2.0 * ri + skin
-    ci = cell_of[i]
-    cx = ci % ncx
-    cy = ci // ncx
-    x0, nx_, absx = _axis_range(cx, reach, lx / ncx, ncx, px)
-    y0, ny_, absy = _axis_range(cy, reach, ly / ncy, ncy, py)
-    count = 0
-    rank_i = rank[i]
-    for oy in range(ny_):
-        gy = y0 + oy
-        if not absy:
-            gy = gy % ncy
-        for ox in range(nx_):
-            gx = x0 + ox
-            if not absx:
-                gx = gx % ncx
-            c = gy * ncx + gx
-            for q in range(cell_start[c], cell_start[c + 1]):
-                j = cell_floes[q]
-                if rank[j] >= rank_i:
-                    continue
-                dx = minimum_image(pos[j, 0] - xi, lx, px)
-                dy = minimum_image(pos[j, 1] - yi, ly, py)
-                cut = ri + radius[j] + skin
-                if dx * dx + dy * dy < cut * cut:
-                    if write_at >= 0:
-                        out[write_at + count] = j
-                    count += 1
-    return count
+    wx = lx / ncx
+    wy = ly / ncy
+    for i in range(i_lo, i_hi, i_step):
+        xi = pos[i, 0]
+        yi = pos[i, 1]
+        ri = radius[i]
+        rank_i = rank[i]
+        reach = 2.0 * ri + skin
+        ci = cell_of[i]
+        x0, nxc = _axis_range(ci % ncx, reach, wx, ncx, px)
+        y0, nyc = _axis_range(ci // ncx, reach, wy, ncy, py)
+        if x0 < 0:
+            x0 += ncx
+        if y0 < 0:
+            y0 += ncy
+        count = 0
+        at = start[i] if write else 0
+        gy = y0
+        for _ in range(nyc):
+            if gy >= ncy:
+                gy -= ncy
+            row = gy * ncx
+            gx = x0
+            for _ in range(nxc):
+                if gx >= ncx:
+                    gx -= ncx
+                c = row + gx
+                for q in range(cell_start[c], cell_start[c + 1]):
+                    j = cell_floes[q]
+                    if rank[j] >= rank_i:
+                        continue
+                    dx = minimum_image(pos[j, 0] - xi, lx, px)
+                    dy = minimum_image(pos[j, 1] - yi, ly, py)
+                    cut = ri + radius[j] + skin
+                    if dx * dx + dy * dy < cut * cut:
+                        if write:
+                            out[at + count] = j
+                        count += 1
+                gx += 1
+            gy += 1
+        if write:
+            # insertion sort of the slice by partner index (slices are short)
+            s0 = at
+            for a in range(s0 + 1, s0 + count):
+                v = out[a]
+                b = a - 1
+                while b >= s0 and out[b] > v:
+                    out[b + 1] = out[b]
+                    b -= 1
+                out[b + 1] = v
+        else:
+            counts[i + 1] = count
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -156,23 +181,16 @@ def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
     counts = np.zeros(n + 1, dtype=np.int64)
     dummy = np.empty(0, dtype=np.int64)
-    for i in prange(n):
-        counts[i + 1] = _scan_floe(i, pos, radius, rank, lx, ly, px, py, skin,
-                                   ncx, ncy, cell_start, cell_floes, cell_of, dummy, -1)
+    # interleaved chunks: the few large floes, whose scans cost most, are
+    # spread over all threads whatever their indices
+    for c in prange(N_CHUNKS):
+        _scan_floes(c, n, N_CHUNKS, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+                    cell_start, cell_floes, cell_of, counts, counts, dummy, False)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
-    for i in prange(n):
-        s = start[i]
-        m = _scan_floe(i, pos, radius, rank, lx, ly, px, py, skin,
-                       ncx, ncy, cell_start, cell_floes, cell_of, nbr, s)
-        # insertion sort of the slice by partner index (slices are short)
-        for a in range(s + 1, s + m):
-            v = nbr[a]
-            b = a - 1
-            while b >= s and nbr[b] > v:
-                nbr[b + 1] = nbr[b]
-                b -= 1
-            nbr[b + 1] = v
+    for c in prange(N_CHUNKS):
+        _scan_floes(c, n, N_CHUNKS, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+                    cell_start, cell_floes, cell_of, counts, start, nbr, True)
     return start, nbr
 
 

@@ -1,0 +1,228 @@
+"""Benchmarks of the physics engines: ``python -m physics.bench hertz``.
+
+Hertz engine (Herman 2013 material table, α = 1.8 floe sizes with mean
+radius 4 m, no external forcing):
+
+* Ā = 0.7 with random velocities of 3 cm/s per component;
+* jammed ice, Ā ≈ 0.92: placed at 0.85, compressed to 0.92 by the engine
+  itself (deforming box), then measured at fixed box. The prepared states
+  are cached (``--cache-dir``) because the compression takes a minute or two.
+
+Each case is timed with the serial kernels, the parallel kernels on one
+thread and the parallel kernels on all threads, each in a fresh process,
+after a warm-up that compiles everything (compile time is excluded). Figures are floe-steps per
+second (floes × steps / wall time). The peak memory of a run with
+N = 100000 floes is measured in a fresh process.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from .domain import DeformingPeriodicBox, PeriodicBox
+from .floes import FloeField, make_floe_field
+from .hertz import HertzSimulation
+from .params import HERMAN2013
+
+ALPHA = HERMAN2013.fsd_exponent
+MEAN_DIAMETER = HERMAN2013.mean_diameter
+
+
+def _save_state(path: Path, field: FloeField, box) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, positions=field.positions, radii=field.radii,
+                        velocities=field.velocities, angular_velocities=field.angular_velocities,
+                        lx=box.lx, ly=box.ly)
+
+
+def _load_state(path: Path):
+    d = np.load(path)
+    field = FloeField(d["positions"], d["radii"], HERMAN2013.thickness, d["velocities"],
+                      d["angular_velocities"], density=HERMAN2013.forcing.ice_density)
+    return field, PeriodicBox(float(d["lx"]), float(d["ly"]))
+
+
+def _time_child(path: str, parallel: bool, steps: int, dt: float) -> None:
+    """Run in a fresh process (its thread count set by NUMBA_NUM_THREADS):
+    print rate, contacts per floe and list rebuilds as JSON."""
+    field, box = _load_state(Path(path))
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=parallel,
+                          allow_overlap=True)
+    sim.step(5)                                   # compile / load from cache, warm up
+    rebuilds0 = sim.n_rebuilds
+    t0 = time.perf_counter()
+    sim.step(steps)
+    wall = time.perf_counter() - t0
+    print(json.dumps(dict(rate=field.n * steps / wall, contacts_per_floe=2.0 * len(sim.contacts()) / field.n,
+                          rebuilds=sim.n_rebuilds - rebuilds0)))
+
+
+def _timed_steps(path: Path, dt: float, steps: int, parallel: bool, threads: int) -> dict:
+    """Time ``steps`` steps of the saved state in a fresh process, so that the
+    thread pool has exactly ``threads`` threads and nothing else is running."""
+    env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
+    out = subprocess.run([sys.executable, "-m", "physics.bench", "_time", str(path),
+                          "1" if parallel else "0", str(steps), repr(dt)],
+                         check=True, capture_output=True, text=True, env=env)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool):
+    """Path of a jammed state: placed at 0.85, compressed by the engine to
+    Ā = 0.92 (dA/dt = 0.07 / 40 s, Δt = 1 ms) with the velocities quenched
+    every second (as in preparing a jammed packing: the compression is far
+    faster than in the paper, and the quench removes the kinetic energy it
+    injects), then relaxed 2 s at fixed box. Returns (path, seconds spent)."""
+    path = cache_dir / f"hertz_jammed_n{n}_seed{seed}_v2.npz"
+    if path.exists():
+        return path, 0.0
+    t0 = time.perf_counter()
+    field, box0 = make_floe_field(n, concentration=0.85, alpha=ALPHA, mean_diameter=MEAN_DIAMETER,
+                                  seed=seed)
+    box = DeformingPeriodicBox(box0.lx, box0.ly, concentration_rate=0.07 / 40.0)
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=1e-3,
+                          parallel=numba.get_num_threads() > 1)
+    seconds = range(42)
+    if not quiet:
+        from tqdm.auto import tqdm
+        seconds = tqdm(seconds, desc="compressing to 0.92", unit="model s")
+    for k in seconds:
+        if k == 40:
+            box.set_rate(0.0)
+        sim.advance(1.0)
+        sim.velocities[:] = 0.0
+        sim.angular_velocities[:] = 0.0
+    _save_state(path, sim.state(), PeriodicBox(box.lx, box.ly))
+    return path, time.perf_counter() - t0
+
+
+def _memory_child(n: int) -> None:
+    field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA, mean_diameter=MEAN_DIAMETER,
+                                 seed=1, velocity_std=0.03)
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=HERMAN2013.time_step)
+    sim.step(200)
+    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+
+
+def peak_memory(n: int) -> int:
+    """Peak resident memory [bytes] of a fresh process that builds and runs
+    an N-floe Hertz simulation at Ā = 0.7 (Numba and NumPy included)."""
+    out = subprocess.run([sys.executable, "-m", "physics.bench", "_memory", str(n)],
+                         check=True, capture_output=True, text=True)
+    return int(out.stdout.strip().splitlines()[-1])
+
+
+def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Path | None = None,
+                memory_floes: int = 100000, quiet: bool = False) -> list[dict]:
+    """Time every case and kernel (see the module docstring); one row each."""
+    threads_all = numba.config.NUMBA_NUM_THREADS
+    cache_dir = Path(cache_dir) if cache_dir is not None else Path.cwd() / ".bench_cache"
+    rows = []
+
+    def log(msg):
+        if not quiet:
+            print(msg, flush=True)
+
+    loose_path = cache_dir / f"hertz_a070_n{n}_seed{seed}_v1.npz"
+    if not loose_path.exists():
+        field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA,
+                                     mean_diameter=MEAN_DIAMETER, seed=seed, velocity_std=0.03)
+        _save_state(loose_path, field, box)
+    log(f"jammed ice (N = {n}) ...")
+    jam_path, prep = _jammed_state(n, seed, cache_dir, quiet)
+    jam, jam_box = _load_state(jam_path)
+    conc = jam.total_area / jam_box.area
+    log(f"  ready (prepared in {prep:.0f} s), Ā = {conc:.4f}")
+    cases = [("Ā = 0.70", loose_path, HERMAN2013.time_step),
+             (f"jammed, Ā = {conc:.3f}", jam_path, 1e-3)]
+    configs = [("serial", False, 1), ("parallel", True, 1)]
+    if threads_all > 1:
+        configs.append(("parallel", True, threads_all))
+    for name, path, dt in cases:
+        for label, parallel, threads in configs:
+            r = _timed_steps(path, dt, steps, parallel, threads)
+            rows.append(dict(case=name, kernel=label, threads=threads, dt=dt, steps=steps, **r))
+            log(f"  {name:22s} {label:8s} {threads} thread(s): {r['rate']:.3g} floe-steps/s")
+    if memory_floes:
+        mem = peak_memory(memory_floes)
+        rows.append(dict(case=f"memory, N = {memory_floes}", kernel="", threads=0, rate=mem,
+                         contacts_per_floe=float("nan"), dt=HERMAN2013.time_step, rebuilds=0,
+                         steps=200))
+    return rows
+
+
+def format_table(rows: list[dict], n: int) -> str:
+    lines = [f"Hertz engine, N = {n}, Herman (2013) material table, {platform.processor() or platform.machine()}, "
+             f"{os.cpu_count()} cores, numba {numba.__version__}",
+             "",
+             "| case | kernels | threads | floe-steps/s | contacts per floe | Δt [s] | list rebuilds |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["case"].startswith("memory"):
+            continue
+        lines.append(f"| {r['case']} | {r['kernel']} | {r['threads']} | {r['rate']:.3g} | "
+                     f"{r['contacts_per_floe']:.2f} | {r['dt']:g} | {r['rebuilds']} |")
+    for r in rows:
+        if r["case"].startswith("memory"):
+            lines.append("")
+            lines.append(f"Peak resident memory of a whole process running N = "
+                         f"{r['case'].split('= ')[1]} floes: {r['rate'] / 2 ** 20:.0f} MiB")
+    by = {(r["case"], r["kernel"], r["threads"]): r["rate"] for r in rows}
+    for case in dict.fromkeys(r["case"] for r in rows if not r["case"].startswith("memory")):
+        one = by.get((case, "parallel", 1))
+        ser = by.get((case, "serial", 1))
+        allt = [v for (c, k, t), v in by.items() if c == case and k == "parallel" and t > 1]
+        if one and allt:
+            lines.append(f"{case}: all threads / one thread (parallel kernels) = {allt[0] / one:.2f}; "
+                         f"all threads / serial kernels = {allt[0] / ser:.2f}")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m physics.bench", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="engine", required=True)
+    h = sub.add_parser("hertz", help="floe-steps per second of the Hertz engine")
+    h.add_argument("--floes", type=int, default=20000)
+    h.add_argument("--steps", type=int, default=2000, help="timed steps per case")
+    h.add_argument("--seed", type=int, default=1)
+    h.add_argument("--memory-floes", type=int, default=100000,
+                   help="floes of the memory measurement (0: skip)")
+    h.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
+                   help="where the prepared floe fields are kept (default ./.bench_cache)")
+    h.add_argument("--quiet", action="store_true")
+    m = sub.add_parser("_memory")
+    m.add_argument("n", type=int)
+    t = sub.add_parser("_time")
+    t.add_argument("path")
+    t.add_argument("parallel", type=int)
+    t.add_argument("steps", type=int)
+    t.add_argument("dt", type=float)
+    args = p.parse_args(argv)
+    if args.engine == "_memory":
+        _memory_child(args.n)
+        return 0
+    if args.engine == "_time":
+        _time_child(args.path, bool(args.parallel), args.steps, args.dt)
+        return 0
+    if args.floes < 100 or args.steps < 1:
+        p.error("--floes must be >= 100 and --steps >= 1")
+    rows = bench_hertz(args.floes, args.steps, args.seed, args.cache_dir, args.memory_floes,
+                       args.quiet)
+    print()
+    print(format_table(rows, args.floes))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
