@@ -8,6 +8,7 @@ State and set-up
 
 This package never imports gymnasium or torch.
 """
+from . import _jit_cache  # noqa: F401  (first: sets where compiled kernels are cached)
 from .contact import damping_alpha
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
 from .floes import (FloeField, PlacementError, domain_size, make_floe_field, place_floes,

@@ -12,13 +12,22 @@ Conventions (one contact between floes i and j)
   ``v_n = (u_i − u_j)·n`` (positive while approaching) and
   ``η = α √(m* (4/3) E* √(R* δ))`` (the LAMMPS ``coeff_restitution`` form; α
   from :func:`damping_alpha`). Optionally clipped at zero (no cohesion).
-* Tangential: Mindlin spring with history ξ (a scalar along t, so it stays in
-  the tangent plane as the contact rotates), ``k_t = 8 G* √(R* δ)``,
-  damping ``η_t = x_γt η``, slip velocity
-  ``v_t = (u_i − u_j)·t + r_i ω_i + r_j ω_j``. The history is advanced first
-  (ξ ← ξ + v_t Δt), then ``F_t = −k_t ξ − η_t v_t``; if ``|F_t| > μ |F_n|`` the
-  force is capped (Coulomb) and ξ is reset to match the capped force. This is
-  the order and the form of LAMMPS ``tangential mindlin``.
+* Tangential: incremental Mindlin spring. The history is the elastic
+  tangential force S (a scalar along t, so it stays in the tangent plane as
+  the contact rotates) and the contact radius a at its last update. With
+  ``k_t = 8 G* a``, ``a = √(R* δ)`` and slip velocity
+  ``v_t = (u_i − u_j)·t + r_i ω_i + r_j ω_j``: on unloading (a below its last
+  value) S is scaled by a / a_last; then S ← S − k_t v_t Δt and
+  ``F_t = S − η_t v_t`` (η_t = x_γt η); if ``|F_t| > μ |F_n|`` the force is
+  capped (Coulomb) and S reset so that S − η_t v_t equals the capped force.
+  This is LAMMPS ``tangential mindlin/rescale/force`` (except that a contact
+  with no spring force yet, whose viscous force alone passes the cap, gets
+  the capped force where LAMMPS gives none). Unlike the total form
+  F_t = −k_t ξ (LAMMPS ``mindlin``), it stores no energy while a sticking
+  contact loads at fixed tangential displacement, so a contact can never
+  create energy. Tangential damping is off by default: with it, the capped
+  history of the LAMMPS law can point along the slip at the start of a
+  sliding contact and push the floes instead of braking them.
 * Torques: ``τ_i = F_t (r_i − δ/2)``, ``τ_j = F_t (r_j − δ/2)`` (lever arms to the
   contact point).
 """
@@ -112,8 +121,8 @@ def restitution_of_alpha(alpha: float, limit_damping: bool = True) -> float:
     sol = solve_ivp(rhs, (0.0, 50.0), [x0, 1.0], events=events, rtol=1e-11,
                     atol=1e-14, method="DOP853", max_step=0.01)
     if sol.status != 1:
-        raise RuntimeError(f"Hertz impact with alpha={alpha} did not end")
-    return -float(sol.y[1, -1])
+        return 0.0          # over-damped: the floes come to rest in contact
+    return max(-float(sol.y[1, -1]), 0.0)
 
 
 @lru_cache(maxsize=256)
@@ -122,6 +131,10 @@ def _exact_alpha(restitution: float, limit_damping: bool) -> float:
 
     if restitution >= 1.0:
         return 0.0
+    if not limit_damping:
+        # without clipping the closed form is exact (Hertz impact with
+        # η ∝ δ^{1/4} behaves as a linear oscillator in its own time scale)
+        return lammps_damping_alpha(restitution)
     guess = lammps_damping_alpha(restitution)
     lo, hi = 0.0, max(2.0 * guess, 0.1)
     while restitution_of_alpha(hi, limit_damping) > restitution:
@@ -154,7 +167,7 @@ def damping_alpha(restitution: float, model: str = "exact",
 # ---------------------------------------------------------------------------
 
 @njit(cache=True, inline="always", error_model="numpy")
-def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, history, dt_history,
+def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, spring, a_last, dt_history,
                         kn, kt, alpha, gamma_t, mu, limit_damping):
     """Forces of one Hertz–Mindlin contact.
 
@@ -164,9 +177,11 @@ def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, history, dt_histo
     r_eff, m_eff : R* [m], m* [kg]
     v_normal : approach speed (u_i − u_j)·n [m/s]
     v_slip : tangential slip velocity of the contact point of i relative to j [m/s]
-    history : Mindlin displacement ξ before this evaluation [m]
-    dt_history : time step to advance ξ by (0 for an evaluation that must not
-        change the history, e.g. at set-up) [s]
+    spring, a_last : history: elastic tangential force S on i along t [N] and
+        the contact radius √(R* δ) when it was last updated [m] (0, 0 for a new
+        contact)
+    dt_history : time step to advance the history by (0 for an evaluation
+        that must not change it, e.g. at set-up) [s]
     kn : (4/3) E* [Pa];  kt : 8 G* [Pa]
     alpha : normal damping coefficient α;  gamma_t : tangential/normal damping
     mu : Coulomb coefficient;  limit_damping : clip F_n at 0
@@ -175,7 +190,7 @@ def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, history, dt_histo
     -------
     f_normal : repulsive normal force magnitude F_n (acts on i along −n) [N]
     f_tangential : tangential force on i along t [N]
-    history : updated ξ [m]
+    spring, a_last : updated history
     """
     a = math.sqrt(r_eff * delta)                 # contact radius scale √(R* δ)
     stiff = kn * a                               # F_n,c / δ
@@ -184,17 +199,20 @@ def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, history, dt_histo
     f_normal = f_elastic + eta * v_normal
     if limit_damping and f_normal < 0.0:
         f_normal = 0.0
-    # Mindlin tangential spring with history, LAMMPS order
-    k_t = kt * a
+    # incremental Mindlin spring, LAMMPS mindlin/rescale/force order
+    if a < a_last:
+        spring *= a / a_last                     # unloading: shrink with the contact
+    if dt_history > 0.0:
+        spring -= kt * a * v_slip * dt_history
+        a_last = a
     eta_t = gamma_t * eta
-    xi = history + v_slip * dt_history
-    f_t = -k_t * xi - eta_t * v_slip
+    f_t = spring - eta_t * v_slip
     f_crit = mu * abs(f_normal)
     if abs(f_t) > f_crit:
-        if xi != 0.0:
-            f_cap = f_crit if f_t > 0.0 else -f_crit
-            xi = -(f_cap + eta_t * v_slip) / k_t
-            f_t = f_cap
-        else:
-            f_t = 0.0
-    return f_normal, f_t, xi
+        f_cap = f_crit if f_t > 0.0 else -f_crit
+        if spring != 0.0:
+            spring = f_cap + eta_t * v_slip
+        # (with no spring yet, only the viscous force is capped: LAMMPS
+        # returns zero friction there instead)
+        f_t = f_cap
+    return f_normal, f_t, spring, a_last

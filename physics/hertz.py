@@ -65,14 +65,18 @@ class Contacts:
         return int(self.i.size)
 
 
-def minimum_contact_time(radius, thickness, density, contact: ContactParams, speed: float) -> float:
-    """Shortest undamped Hertz contact time among equal-floe pairs at impact
-    speed ``speed`` [s]: t_c = 3.2181 (m*/k)^{2/5} v^{−1/5} with m* = m/2,
-    R* = r/2 for each floe (the smallest floes collide fastest)."""
+def minimum_contact_time(radius, thickness, density, contact: ContactParams, speed: float,
+                         walls: bool = False) -> float:
+    """Shortest undamped Hertz contact time at impact speed ``speed`` [s]:
+    t_c = 3.2181 (m*/k)^{2/5} v^{−1/5}, over each floe hitting its equal
+    (m* = m/2, R* = r/2; the smallest floes collide fastest) and, with
+    ``walls``, each floe hitting a rigid wall (m* = m, R* = r, stiffer E*)."""
     r = np.asarray(radius, dtype=float)
     m = density * np.asarray(thickness, dtype=float) * math.pi * r ** 2
-    k = hertz_stiffness(contact.effective_modulus, 0.5 * r)
-    return float(np.min(contact_time(0.5 * m, k, speed)))
+    t = contact_time(0.5 * m, hertz_stiffness(contact.effective_modulus, 0.5 * r), speed)
+    if walls:
+        t = np.minimum(t, contact_time(m, hertz_stiffness(contact.wall_effective_modulus, r), speed))
+    return float(np.min(t))
 
 
 class HertzSimulation:
@@ -139,7 +143,8 @@ class HertzSimulation:
         n = f.n
 
         # time step against the shortest contact time
-        t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed)
+        t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed,
+                                   walls=not all(box.periodic))
         if self.dt > 0.1 * t_c:
             raise ValueError(
                 f"dt={self.dt:g} s is above a tenth of the shortest contact time "
@@ -193,13 +198,14 @@ class HertzSimulation:
         self._set_drag()
         self.force = np.zeros((n, 2))
         self.torque = np.zeros(n)
-        self._wall_hist = np.zeros((n, 4))
+        self._wall_hist = np.zeros((n, 4, 2))
         self._centre = np.zeros(2)
         self._ref_lengths = np.array([box.lx, box.ly])
         self.time = 0.0
         self.n_steps = 0
         self.n_rebuilds = 0
-        self._build_list(np.zeros(0, dtype=np.int64), np.zeros(n + 1, dtype=np.int64), np.zeros(0))
+        self._build_list(np.zeros(0, dtype=np.int64), np.zeros(n + 1, dtype=np.int64),
+                         np.zeros((0, 2)))
         self._compute_forces(history_step=0.0)
 
     # -- set-up helpers ------------------------------------------------------
@@ -223,7 +229,7 @@ class HertzSimulation:
         (self._start, self._nbr, self._hist, self._rev_start, self._rev_pair,
          self._ref) = K.rebuild(self.positions, self.radius, self.rank, b.lx, b.ly,
                                 b.periodic[0], b.periodic[1], self.skin, self.cell_size,
-                                old_start, old_nbr, old_hist)
+                                old_start, old_nbr, old_hist, self.parallel)
         self._ref_lengths[:] = (b.lx, b.ly)
         self._centre[:] = 0.0
 
@@ -266,8 +272,9 @@ class HertzSimulation:
         if status == K.STATUS_UNSTABLE:
             raise FloatingPointError(
                 f"the integration became unstable at t = {self.time:.6g} s (step {self.n_steps}): "
-                f"a floe moved more than half the Verlet skin in one step. The time step is too "
-                f"large for the impact speeds, or the ice was compressed far beyond jamming")
+                f"a floe moved more than half the Verlet skin ({self.skin:.3g} m) in one step. "
+                f"The time step may be too large for the impact speeds, the ice compressed far "
+                f"beyond jamming, or (for fast floes and long steps) the skin too small")
         if status == K.STATUS_NONFINITE or not (np.all(np.isfinite(self.positions))
                                                  and np.all(np.isfinite(self.velocities))):
             raise FloatingPointError(

@@ -25,7 +25,7 @@ from numba import njit, prange
 
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image, wrap_coordinate
-from .neighbors import build_pair_list, reverse_incidence, transfer_history
+from .neighbors import build_pair_list, build_pair_list_serial, reverse_incidence, transfer_history
 
 # contact parameter vector layout
 CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL = range(8)
@@ -43,40 +43,41 @@ N_CHUNKS = 64   # chunks of the parallel per-floe reductions
 # ---------------------------------------------------------------------------
 
 @njit(cache=True, inline="always", error_model="numpy")
-def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, history, dt_history,
+def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last, dt_history,
                  kn, kt, alpha, gamma_t, mu, limit_damping):
     """Force of floe j on floe i, given their minimum-image separation
     (dx, dy) = x_j − x_i and relative velocity (vrx, vry) = u_i − u_j.
 
-    Returns (touching, fx, fy, torque_i, torque_j, history, f_normal,
+    Returns (touching, fx, fy, torque_i, torque_j, spring, a_last, f_normal,
     f_tangential, nx, ny, delta): (fx, fy) acts on i and −(fx, fy) on j;
-    n = (nx, ny) is the unit vector from i to j. A pair that does not touch,
-    or of two frozen floes, returns zeros (and a reset history).
+    n = (nx, ny) is the unit vector from i to j; (spring, a_last) is the
+    updated Mindlin history. A pair that does not touch, or of two frozen
+    floes, returns zeros (and a reset history).
     """
     rsum = ri + rj
     d2 = dx * dx + dy * dy
     if d2 >= rsum * rsum or inv_mass_sum == 0.0:
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     d = math.sqrt(d2)
     nx = dx / d
     ny = dy / d
     delta = rsum - d
     v_normal = vrx * nx + vry * ny
     v_slip = -vrx * ny + vry * nx + ri * wi + rj * wj
-    fn, ft, xi = hertz_mindlin_force(delta, ri * rj / rsum, 1.0 / inv_mass_sum, v_normal, v_slip,
-                                     history, dt_history, kn, kt, alpha, gamma_t, mu,
-                                     limit_damping)
+    fn, ft, spring, a_last = hertz_mindlin_force(delta, ri * rj / rsum, 1.0 / inv_mass_sum,
+                                                 v_normal, v_slip, spring, a_last, dt_history,
+                                                 kn, kt, alpha, gamma_t, mu, limit_damping)
     fx = -fn * nx - ft * ny
     fy = -fn * ny + ft * nx
-    return (True, fx, fy, ft * (ri - 0.5 * delta), ft * (rj - 0.5 * delta), xi, fn, ft,
-            nx, ny, delta)
+    return (True, fx, fy, ft * (ri - 0.5 * delta), ft * (rj - 0.5 * delta), spring, a_last,
+            fn, ft, nx, ny, delta)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, history, dt_history,
+def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_history,
                  kn, kt, alpha, gamma_t, mu, limit_damping):
     """Force of a rigid wall on a floe; ``side`` 0..3 = wall at x=0, x=lx,
-    y=0, y=ly. Returns (fx, fy, torque, history)."""
+    y=0, y=ly. Returns (fx, fy, torque, spring, a_last)."""
     if side == 0:
         delta, nx, ny = r - x, -1.0, 0.0
     elif side == 1:
@@ -86,12 +87,13 @@ def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, history, dt_history
     else:
         delta, nx, ny = r - (ly - y), 0.0, 1.0
     if delta <= 0.0 or inv_mass == 0.0:
-        return 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0
     v_normal = vx * nx + vy * ny
     v_slip = -vx * ny + vy * nx + r * w
-    fn, ft, xi = hertz_mindlin_force(delta, r, 1.0 / inv_mass, v_normal, v_slip, history,
-                                     dt_history, kn, kt, alpha, gamma_t, mu, limit_damping)
-    return -fn * nx - ft * ny, -fn * ny + ft * nx, ft * (r - delta), xi
+    fn, ft, spring, a_last = hertz_mindlin_force(delta, r, 1.0 / inv_mass, v_normal, v_slip,
+                                                 spring, a_last, dt_history, kn, kt, alpha,
+                                                 gamma_t, mu, limit_damping)
+    return -fn * nx - ft * ny, -fn * ny + ft * nx, ft * (r - delta), spring, a_last
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -158,11 +160,13 @@ def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_his
         for side in range(4):
             if (side < 2 and not walls_x) or (side >= 2 and not walls_y):
                 continue
-            wfx, wfy, wtq, xi = wall_contact(side, pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1],
-                                             omega[i], radius[i], inv_mass[i], lx, ly,
-                                             wall_hist[i, side], dt_history, kn, kt, alpha, gt,
-                                             mu, limit)
-            wall_hist[i, side] = xi
+            wfx, wfy, wtq, sp, al = wall_contact(side, pos[i, 0], pos[i, 1], vel[i, 0],
+                                                 vel[i, 1], omega[i], radius[i], inv_mass[i],
+                                                 lx, ly, wall_hist[i, side, 0],
+                                                 wall_hist[i, side, 1], dt_history, kn, kt,
+                                                 alpha, gt, mu, limit)
+            wall_hist[i, side, 0] = sp
+            wall_hist[i, side, 1] = al
             force[i, 0] += wfx
             force[i, 1] += wfy
             torque[i] += wtq
@@ -202,8 +206,9 @@ def pair_scatter(owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
             res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
                                minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
                                vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p], dt_history, kn, kt, alpha, gt, mu, limit)
-            hist[p] = res[5]
+                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
+            hist[p, 0] = res[5]
+            hist[p, 1] = res[6]
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -247,8 +252,9 @@ def pair_pass(k_lo, k_hi, active, pos, vel, omega, radius, inv_mass, cp, box, st
             res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
                                minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
                                vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p], dt_history, kn, kt, alpha, gt, mu, limit)
-            hist[p] = res[5]
+                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
+            hist[p, 0] = res[5]
+            hist[p, 1] = res[6]
             pair_buf[p, 0] = res[1]
             pair_buf[p, 1] = res[2]
             pair_buf[p, 2] = res[3]
@@ -377,16 +383,20 @@ def half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt):
 
 
 @njit(cache=True, error_model="numpy")
-def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist):
+def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist, parallel):
     """New Verlet list with the contact history carried over.
 
     Returns (start, nbr, hist, rev_start, rev_pair, ref) where ``ref`` is a
     copy of the positions at the build.
     """
-    new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size)
-    new_hist = transfer_history(start, nbr, hist.reshape((-1, 1)), new_start, new_nbr, 1)
+    if parallel:
+        new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size)
+    else:
+        new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin,
+                                                    cell_size)
+    new_hist = transfer_history(start, nbr, hist, new_start, new_nbr, 2)
     rev_start, rev_pair = reverse_incidence(new_start, new_nbr, radius.shape[0])
-    return new_start, new_nbr, new_hist[:, 0].copy(), rev_start, rev_pair, pos.copy()
+    return new_start, new_nbr, new_hist, rev_start, rev_pair, pos.copy()
 
 
 @njit(cache=True, error_model="numpy")
@@ -456,7 +466,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
         if 2.0 * math.sqrt(worst) + shrink * max_cut >= skin:
             start, nbr, hist, rev_start, rev_pair, ref = rebuild(
-                pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist)
+                pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist, parallel)
             ref_lengths[0] = lx
             ref_lengths[1] = ly
             centre[0] = 0.0
@@ -504,16 +514,16 @@ def contact_list(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist):
             res = pair_contact(minimum_image(pos[j, 0] - pos[i, 0], lx, px),
                                minimum_image(pos[j, 1] - pos[i, 1], ly, py), radius[i], radius[j],
                                vel[i, 0] - vel[j, 0], vel[i, 1] - vel[j, 1], omega[i], omega[j],
-                               inv_mass[i] + inv_mass[j], hist[p], 0.0, kn, kt, alpha, gt, mu,
-                               limit)
+                               inv_mass[i] + inv_mass[j], hist[p, 0], hist[p, 1], 0.0, kn, kt,
+                               alpha, gt, mu, limit)
             if res[0]:
                 ii[k] = i
                 jj[k] = j
-                data[k, 0] = res[8]
-                data[k, 1] = res[9]
-                data[k, 2] = res[10]
-                data[k, 3] = res[6]
-                data[k, 4] = res[7]
+                data[k, 0] = res[9]
+                data[k, 1] = res[10]
+                data[k, 2] = res[11]
+                data[k, 3] = res[7]
+                data[k, 4] = res[8]
                 data[k, 5] = res[1]
                 data[k, 6] = res[2]
                 data[k, 7] = res[3]

@@ -194,6 +194,22 @@ def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     return start, nbr
 
 
+@njit(cache=True, error_model="numpy")
+def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size):
+    """:func:`build_pair_list` on the calling thread only (for the serial
+    engine path, which must not wake a thread pool)."""
+    n = pos.shape[0]
+    ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
+    counts = np.zeros(n + 1, dtype=np.int64)
+    _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+                cell_floes, cell_of, counts, counts, counts, False)
+    start = np.cumsum(counts)
+    nbr = np.empty(start[n], dtype=np.int64)
+    _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+                cell_floes, cell_of, counts, start, nbr, True)
+    return start, nbr
+
+
 def brute_force_pairs(pos, radius, box, skin):
     """All pairs (i < j) with centre distance < r_i + r_j + skin, by testing
     every pair (O(N²); for tests and tiny systems)."""

@@ -79,6 +79,9 @@ class ContactParams:
     tangential_damping : float
         Tangential damping coefficient as a multiple of the normal damping
         coefficient [-] (LAMMPS's ``x_gammat`` of ``tangential mindlin``).
+        Default 0: with damping, the Coulomb cap of the Mindlin law can leave
+        the spring pointing along the slip when a sliding contact starts, so
+        that friction briefly pushes instead of brakes (see physics.contact).
     damping_model : str
         How the damping coefficient α is set from ``restitution``:
         ``"exact"`` (default) solves the dimensionless Hertz impact so that the
@@ -95,7 +98,7 @@ class ContactParams:
     poisson_ratio: float = 0.33
     restitution: float = 0.5
     friction: float = 0.7
-    tangential_damping: float = 1.0
+    tangential_damping: float = 0.0
     damping_model: str = "exact"
     limit_damping: bool = True
 
