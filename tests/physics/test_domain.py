@@ -10,7 +10,7 @@ import pytest
 from physics import (HERMAN2013, ChannelBox, ContactParams, DeformingPeriodicBox, FloeField,
                      Forcing, HertzSimulation, PeriodicBox, WalledBox, make_floe_field)
 
-from conftest import disc_mass, hertz_contact_time, hertz_k, hertz_peak_overlap
+from dem_reference import disc_mass, hertz_contact_time, hertz_k, hertz_peak_overlap
 
 
 # ---------------------------------------------------------------------------
@@ -212,7 +212,8 @@ def test_walls_keep_floes_in(box_type):
     """40 floes blown at 10 m/s towards a corner (Herman 2013 forcing and
     contacts), thrown at it at about 1 m/s, stay inside the box: no
     centre leaves it and no floe overlaps a wall by more than 1 % of its
-    radius, at any of 20 checks over 10 s."""
+    radius, at any of 20 checks over 10 s; floes do reach the bottom wall
+    (within 2 cm at a check)."""
     rng = np.random.default_rng(41)
     n = 40
     box = box_type(60.0, 40.0)
@@ -222,14 +223,14 @@ def test_walls_keep_floes_in(box_type):
     vel = rng.normal(0.0, 0.5, (n, 2)) - 0.8
     floes = FloeField(pos, radii, 1.5, vel)
     forcing = Forcing(HERMAN2013.forcing, wind=(-7.0, -7.0))
-    sim = HertzSimulation(floes, box, HERMAN2013.contact, forcing, 8e-4, impact_speed=2.0)
-    wall_contacts = 0
+    sim = HertzSimulation(floes, box, HERMAN2013.contact, forcing, 7e-4, impact_speed=2.0)
+    closest = np.inf
     for _ in range(20):
         sim.advance(0.5)
         x, y = sim.positions.T
-        wall_contacts += np.count_nonzero(y < radii)
+        closest = min(closest, float(np.min(y - radii)))
         assert np.all(box.contains(sim.positions))
         assert np.all(y - radii > -0.01 * radii) and np.all(box.ly - y - radii > -0.01 * radii)
         if box_type is WalledBox:
             assert np.all(x - radii > -0.01 * radii) and np.all(box.lx - x - radii > -0.01 * radii)
-    assert wall_contacts > 0
+    assert closest < 0.02

@@ -18,7 +18,8 @@ def drag_coefficients(params: ForcingParams, radius, thickness):
     r = np.asarray(radius, dtype=float)
     h_f = thickness * (params.water_density - params.ice_density) / params.water_density
     e = params.edge_area_factor
-    a = params.air_density * (math.pi * r ** 2 * params.air_skin_drag + e * r * h_f * params.air_form_drag)
+    a = params.air_density * (math.pi * r ** 2 * params.air_skin_drag
+                              + e * r * h_f * params.air_form_drag)
     b = params.water_density * (math.pi * r ** 2 * params.water_skin_drag
                                 + e * r * (thickness - h_f) * params.water_form_drag)
     return a, b

@@ -12,7 +12,7 @@ from physics.contact import (contact_time, damping_alpha, hertz_stiffness, lammp
                              peak_overlap, restitution_of_alpha)
 from physics.hertz import minimum_contact_time
 
-from conftest import HERTZ_TIME_CONSTANT, disc_mass, hertz_contact_time, hertz_peak_overlap
+from dem_reference import HERTZ_TIME_CONSTANT, disc_mass, hertz_contact_time, hertz_peak_overlap
 
 
 def test_herman2013_table1():
@@ -86,7 +86,8 @@ def test_lammps_damping_alpha(e):
     e_star, r_eff, m_eff, delta = 4.9e9, 0.8, 3000.0, 1e-4
     beta = ln_e / math.sqrt(ln_e ** 2 + math.pi ** 2)
     eta = alpha * math.sqrt(m_eff * 4 / 3 * e_star * math.sqrt(r_eff * delta))
-    eta_lammps = 2 * math.sqrt(5 / 6) * abs(beta) * math.sqrt(2 * e_star * math.sqrt(r_eff * delta) * m_eff)
+    eta_lammps = (2 * math.sqrt(5 / 6) * abs(beta)
+                  * math.sqrt(2 * e_star * math.sqrt(r_eff * delta) * m_eff))
     assert eta == pytest.approx(eta_lammps, rel=1e-13)
 
 

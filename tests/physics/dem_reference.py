@@ -1,4 +1,5 @@
-"""Shared set-ups for the validation of the Hertzian floe engine.
+"""Reference formulas and the binary-impact set-up shared by the tests of
+the Hertzian floe engine.
 
 The analytic quantities here are written out from the contact law
 (Herman 2013; PHYSICS.md section 4) rather than taken from the engine, so
@@ -10,7 +11,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import pytest
 from scipy.special import beta as beta_function
 
 from physics import ContactParams, FloeField, HertzSimulation, PeriodicBox
@@ -170,7 +170,8 @@ def run_impact(radii, speed, contact: ContactParams, *, angle_deg=0.0, thickness
                 e += c.tangential_force[0] ** 2 / (2.0 * kt_coef * math.sqrt(r_eff * delta))
         return e
 
-    overlaps, energies = [overlap()], [energy()] if record else []
+    overlaps = [overlap()]
+    energies = [energy()] if record else []
     touched = False
     max_steps = 20 * steps_per_contact
     chunk = 1 if record else max(1, steps_per_contact // 20)
@@ -195,9 +196,3 @@ def run_impact(radii, speed, contact: ContactParams, *, angle_deg=0.0, thickness
                   velocities_before=vel, velocities_after=sim.velocities.copy(),
                   t_c=t_c, dt=dt, overlaps=np.array(overlaps), energies=np.array(energies),
                   n_steps=sim.n_steps)
-
-
-@pytest.fixture
-def impact():
-    """The binary-impact runner :func:`run_impact`."""
-    return run_impact
