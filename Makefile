@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 # so that the RL extra never pulls the CUDA wheels.
 TORCH_PIN := torch==2.13.0
 
-.PHONY: setup demo test test-slow bench clean
+.PHONY: setup demo test test-slow bench validate clean
 
 setup: $(STAMP)
 
@@ -30,6 +30,9 @@ test-slow: setup
 
 bench: setup
 	$(PY) -m physics.bench hertz
+
+validate: setup
+	$(PY) -m physics.validate
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
