@@ -206,7 +206,7 @@ class HertzSimulation:
         self.n_rebuilds = 0
         self._build_list(np.zeros(0, dtype=np.int64), np.zeros(n + 1, dtype=np.int64),
                          np.zeros((0, 2)))
-        self._compute_forces(history_step=0.0)
+        self._evaluate_forces(self._drag, self._forcing_vector(), self.force, self.torque)
 
     # -- set-up helpers ------------------------------------------------------
     def _set_drag(self):
@@ -233,15 +233,14 @@ class HertzSimulation:
         self._ref_lengths[:] = (b.lx, b.ly)
         self._centre[:] = 0.0
 
-    def _compute_forces(self, history_step: float):
-        """Forces at the current state; ``history_step`` 0 leaves the Mindlin
-        history unchanged (set-up, as LAMMPS does at ``run 0``)."""
+    def _evaluate_forces(self, drag, forcing_vector, force, torque):
+        """Forces at the current positions and velocities into ``force``,
+        ``torque``, leaving the Mindlin history unchanged (as LAMMPS does at
+        ``run 0``)."""
         K.forces_serial(self.positions, self.velocities, self.angular_velocities, self.radius,
-                        self.inv_mass, self._drag, self._forcing_vector(), self._cp,
+                        self.inv_mass, drag, forcing_vector, self._cp,
                         self.box.kernel_array(self.time), self._start, self._nbr,
-                        self._hist if history_step else self._hist.copy(),
-                        self._wall_hist if history_step else self._wall_hist.copy(),
-                        history_step, self.force, self.torque)
+                        self._hist.copy(), self._wall_hist.copy(), 0.0, force, torque)
 
     # -- running -------------------------------------------------------------
     def step(self, n: int = 1) -> None:
@@ -331,10 +330,7 @@ class HertzSimulation:
         velocities, without advancing the contact history."""
         force = np.zeros((self.n_floes, 2))
         torque = np.zeros(self.n_floes)
-        K.forces_serial(self.positions, self.velocities, self.angular_velocities, self.radius,
-                        self.inv_mass, np.zeros((self.n_floes, 4)), np.zeros(4), self._cp,
-                        self.box.kernel_array(self.time), self._start, self._nbr, self._hist.copy(),
-                        self._wall_hist.copy(), 0.0, force, torque)
+        self._evaluate_forces(np.zeros((self.n_floes, 4)), np.zeros(4), force, torque)
         return force, torque
 
     def contacts(self) -> Contacts:

@@ -187,15 +187,20 @@ def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
 
 
 @njit(cache=True, error_model="numpy")
-def pair_scatter(owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                 dt_history, force, torque):
-    """Add all pair forces, one pass over the Verlet list (serial scatter);
-    ``owners`` are the floes whose list slice is not empty."""
+def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
+                dt_history, scatter, force, torque, pair_buf):
+    """Forces of the pairs owned by floes owners[k_lo:k_hi].
+
+    ``scatter`` (serial path): each force is added to both floes at once.
+    Otherwise (parallel path) it is written into the pair's own slot of
+    ``pair_buf`` (fx, fy, torque_i, torque_j) for :func:`gather`.
+    """
     lx, ly = box[BOX_LX], box[BOX_LY]
     px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
     limit = cp[CP_LIMIT] != 0.0
-    for i in owners:
+    for k in range(k_lo, k_hi):
+        i = owners[k]
         xi_, yi_ = pos[i, 0], pos[i, 1]
         vxi, vyi, wi, ri, imi = vel[i, 0], vel[i, 1], omega[i], radius[i], inv_mass[i]
         fxi = 0.0
@@ -209,16 +214,22 @@ def pair_scatter(owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
                                hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
             hist[p, 0] = res[5]
             hist[p, 1] = res[6]
-            if res[0]:
+            if not scatter:
+                pair_buf[p, 0] = res[1]
+                pair_buf[p, 1] = res[2]
+                pair_buf[p, 2] = res[3]
+                pair_buf[p, 3] = res[4]
+            elif res[0]:
                 fxi += res[1]
                 fyi += res[2]
                 tqi += res[3]
                 force[j, 0] -= res[1]
                 force[j, 1] -= res[2]
                 torque[j] += res[4]
-        force[i, 0] += fxi
-        force[i, 1] += fyi
-        torque[i] += tqi
+        if scatter:
+            force[i, 0] += fxi
+            force[i, 1] += fyi
+            torque[i] += tqi
 
 
 @njit(cache=True, error_model="numpy")
@@ -230,35 +241,9 @@ def forces_serial(pos, vel, omega, radius, inv_mass, drag, fv, cp, box, start, n
     if box[BOX_PX] == 0.0 or box[BOX_PY] == 0.0:
         wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
                     force, torque)
-    pair_scatter(np.nonzero(start[1:] > start[:-1])[0], pos, vel, omega, radius, inv_mass, cp,
-                 box, start, nbr, hist, dt_history, force, torque)
-
-
-@njit(cache=True, error_model="numpy")
-def pair_pass(k_lo, k_hi, active, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-              dt_history, pair_buf):
-    """Forces of the pairs owned by floes active[k_lo:k_hi], each written
-    into the pair's own slot of ``pair_buf`` (fx, fy, torque_i, torque_j)."""
-    lx, ly = box[BOX_LX], box[BOX_LY]
-    px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
-    kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
-    limit = cp[CP_LIMIT] != 0.0
-    for k in range(k_lo, k_hi):
-        i = active[k]
-        xi_, yi_ = pos[i, 0], pos[i, 1]
-        vxi, vyi, wi, ri, imi = vel[i, 0], vel[i, 1], omega[i], radius[i], inv_mass[i]
-        for p in range(start[i], start[i + 1]):
-            j = nbr[p]
-            res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
-                               minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
-                               vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
-            hist[p, 0] = res[5]
-            hist[p, 1] = res[6]
-            pair_buf[p, 0] = res[1]
-            pair_buf[p, 1] = res[2]
-            pair_buf[p, 2] = res[3]
-            pair_buf[p, 3] = res[4]
+    owners = np.nonzero(start[1:] > start[:-1])[0]
+    owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
+                hist, dt_history, True, force, torque, force)
 
 
 @njit(cache=True, error_model="numpy")
@@ -296,8 +281,9 @@ def contact_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, start, n
     m = active.shape[0]
     mo = owners.shape[0]
     for c in prange(N_CHUNKS):
-        pair_pass(c * mo // N_CHUNKS, (c + 1) * mo // N_CHUNKS, owners, pos, vel, omega, radius,
-                  inv_mass, cp, box, start, nbr, hist, dt_history, pair_buf)
+        owner_pairs(c * mo // N_CHUNKS, (c + 1) * mo // N_CHUNKS, owners, pos, vel, omega, radius,
+                    inv_mass, cp, box, start, nbr, hist, dt_history, False, force, torque,
+                    pair_buf)
     if box[BOX_PX] == 0.0 or box[BOX_PY] == 0.0:
         for c in prange(N_CHUNKS):
             wall_forces(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, pos, vel, omega, radius,
@@ -483,8 +469,8 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
             if walls:
                 wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
                             force, torque)
-            pair_scatter(owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist, dt,
-                         force, torque)
+            owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
+                        start, nbr, hist, dt, True, force, torque, pair_buf)
         done += 1
     if done > 0:
         half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt)

@@ -262,13 +262,3 @@ def reverse_incidence(start, nbr, n):
         fill[j] += 1
     return rev_start, rev_pair
 
-
-@njit(cache=True, error_model="numpy")
-def owners_of(start):
-    """Owner floe of every pair slot (the i of slot p)."""
-    n = start.shape[0] - 1
-    owner = np.empty(start[n], dtype=np.int64)
-    for i in range(n):
-        for p in range(start[i], start[i + 1]):
-            owner[p] = i
-    return owner
