@@ -226,10 +226,9 @@ class HertzSimulation:
 
     def _build_list(self, old_nbr, old_start, old_hist):
         b = self.box
-        (self._start, self._nbr, self._hist, self._rev_start, self._rev_pair,
-         self._ref) = K.rebuild(self.positions, self.radius, self.rank, b.lx, b.ly,
-                                b.periodic[0], b.periodic[1], self.skin, self.cell_size,
-                                old_start, old_nbr, old_hist, self.parallel)
+        self._start, self._nbr, self._hist, self._ref = K.rebuild(
+            self.positions, self.radius, self.rank, b.lx, b.ly, b.periodic[0], b.periodic[1],
+            self.skin, self.cell_size, old_start, old_nbr, old_hist, self.parallel)
         self._ref_lengths[:] = (b.lx, b.ly)
         self._centre[:] = 0.0
 
@@ -252,14 +251,13 @@ class HertzSimulation:
         if self.forcing is not None:
             self._set_drag_if_changed()
         box_arr = self.box.kernel_array(self.time)
-        (done, status, nreb, self._start, self._nbr, self._hist, self._rev_start,
-         self._rev_pair, self._ref) = K.run_steps(
+        done, status, nreb, self._start, self._nbr, self._hist, self._ref = K.run_steps(
             n, self.dt, self.time, self.positions, self.velocities, self.angular_velocities,
             self.force, self.torque, self.radius, self.rank, self.inv_mass, self.inv_inertia,
             self._drag, self._forcing_vector(), self._cp, box_arr, self.max_concentration,
             self.skin, self.cell_size, self.max_cut, self._start, self._nbr, self._hist,
-            self._rev_start, self._rev_pair, self._ref, self._ref_lengths, self._centre,
-            self._wall_hist, self.parallel)
+            self._ref, self._ref_lengths, self._centre, self._wall_hist, self.parallel,
+            numba.get_num_threads())
         self.time += done * self.dt
         self.n_steps += done
         self.n_rebuilds += nreb

@@ -6,15 +6,16 @@ kernels run them over all pairs or floes, each in a serial and a parallel
 
 * serial pair loop: one pass over the Verlet list, the force of a pair is
   added to i and subtracted from j at once (a scatter);
-* parallel pair loop: two passes, race-free. Pass 1 (prange over owners)
-  writes each pair's force into that pair's own slot of a buffer; pass 2
-  (prange over floes) gathers, for every floe, the slots it owns and the
-  slots where it is the partner (the reverse incidence list). No thread ever
-  writes a slot of another floe.
+* parallel pair loop: the owners of the list are split into as many chunks
+  as there are threads, with equal numbers of pairs; each chunk scatters into
+  its own private force buffer (``fbuf[c]``, ``tbuf[c]``), so no two chunks
+  ever write the same memory. The buffers are summed per floe at the start
+  of the next step, in the same pass as the kick and drift.
 
 Step (LAMMPS ``fix nve/sphere`` order): half kick with F(t) → drift →
-affine remap of a deforming box → Verlet-list check (and rebuild) →
-forces at t + Δt with the half-step velocities → half kick.
+affine remap of a deforming box → drag and wall forces (they need only the
+floe itself) → Verlet-list check (and rebuild) → pair forces at t + Δt with
+the half-step velocities → half kick.
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from numba import njit, prange
 
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image, wrap_coordinate
-from .neighbors import build_pair_list, build_pair_list_serial, reverse_incidence, transfer_history
+from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 
 # contact parameter vector layout
 CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL = range(8)
@@ -188,13 +189,9 @@ def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
 
 @njit(cache=True, error_model="numpy")
 def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                dt_history, scatter, force, torque, pair_buf):
-    """Forces of the pairs owned by floes owners[k_lo:k_hi].
-
-    ``scatter`` (serial path): each force is added to both floes at once.
-    Otherwise (parallel path) it is written into the pair's own slot of
-    ``pair_buf`` (fx, fy, torque_i, torque_j) for :func:`gather`.
-    """
+                dt_history, force, torque):
+    """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
+    both floes of its pair at once (a scatter into ``force``, ``torque``)."""
     lx, ly = box[BOX_LX], box[BOX_LY]
     px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
@@ -214,22 +211,16 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
                                hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
             hist[p, 0] = res[5]
             hist[p, 1] = res[6]
-            if not scatter:
-                pair_buf[p, 0] = res[1]
-                pair_buf[p, 1] = res[2]
-                pair_buf[p, 2] = res[3]
-                pair_buf[p, 3] = res[4]
-            elif res[0]:
+            if res[0]:
                 fxi += res[1]
                 fyi += res[2]
                 tqi += res[3]
                 force[j, 0] -= res[1]
                 force[j, 1] -= res[2]
                 torque[j] += res[4]
-        if scatter:
-            force[i, 0] += fxi
-            force[i, 1] += fyi
-            torque[i] += tqi
+        force[i, 0] += fxi
+        force[i, 1] += fyi
+        torque[i] += tqi
 
 
 @njit(cache=True, error_model="numpy")
@@ -243,91 +234,103 @@ def forces_serial(pos, vel, omega, radius, inv_mass, drag, fv, cp, box, start, n
                     force, torque)
     owners = np.nonzero(start[1:] > start[:-1])[0]
     owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                hist, dt_history, True, force, torque, force)
+                hist, dt_history, force, torque)
 
 
 @njit(cache=True, error_model="numpy")
-def gather(k_lo, k_hi, active, start, rev_start, rev_pair, pair_buf, force, torque):
-    """Add to floes active[k_lo:k_hi] the pair forces of the slots they own
-    (+) and of the slots where they are the partner (−, and their own torque)."""
-    for k in range(k_lo, k_hi):
-        i = active[k]
-        fx = force[i, 0]
-        fy = force[i, 1]
-        tq = torque[i]
-        for p in range(start[i], start[i + 1]):
-            fx += pair_buf[p, 0]
-            fy += pair_buf[p, 1]
-            tq += pair_buf[p, 2]
-        for q in range(rev_start[i], rev_start[i + 1]):
-            p = rev_pair[q]
-            fx -= pair_buf[p, 0]
-            fy -= pair_buf[p, 1]
-            tq += pair_buf[p, 3]
-        force[i, 0] = fx
-        force[i, 1] = fy
-        torque[i] = tq
+def owner_chunks(start, n_chunks):
+    """(owners, bounds): the floes that own pairs of the list, split into
+    ``n_chunks`` runs owners[bounds[c]:bounds[c+1]] with about equal numbers
+    of pairs (a giant floe owning many pairs gets a short run)."""
+    owners = np.nonzero(start[1:] > start[:-1])[0]
+    first = start[owners]
+    total = start[-1]
+    bounds = np.empty(n_chunks + 1, dtype=np.int64)
+    for c in range(n_chunks + 1):
+        bounds[c] = np.searchsorted(first, c * total / n_chunks)
+    bounds[0] = 0
+    bounds[n_chunks] = owners.shape[0]
+    return owners, bounds
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def contact_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                            wall_hist, dt_history, force, torque, pair_buf, rev_start, rev_pair,
-                            owners, active):
-    """Add pair and wall forces, race-free in parallel: per-pair slots, then a
-    per-floe gather (see the module docstring). Only floes with list entries
-    take part (``owners``: own a pair; ``active``: own or partner one); work
-    is split in chunks of them."""
+def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
+                         hist, dt_history, fbuf, tbuf):
+    """:func:`owner_pairs` over the chunks of :func:`owner_chunks` in
+    parallel, chunk c scattering into its private buffers fbuf[c], tbuf[c]:
+    race-free (see the module docstring)."""
+    for c in prange(bounds.shape[0] - 1):
+        owner_pairs(bounds[c], bounds[c + 1], owners, pos, vel, omega, radius, inv_mass, cp, box,
+                    start, nbr, hist, dt_history, fbuf[c], tbuf[c])
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
+                         force, torque):
+    """:func:`wall_forces` over all floes in parallel chunks (each floe only
+    touches its own rows: no race)."""
     n = radius.shape[0]
-    m = active.shape[0]
-    mo = owners.shape[0]
     for c in prange(N_CHUNKS):
-        owner_pairs(c * mo // N_CHUNKS, (c + 1) * mo // N_CHUNKS, owners, pos, vel, omega, radius,
-                    inv_mass, cp, box, start, nbr, hist, dt_history, False, force, torque,
-                    pair_buf)
-    if box[BOX_PX] == 0.0 or box[BOX_PY] == 0.0:
-        for c in prange(N_CHUNKS):
-            wall_forces(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, pos, vel, omega, radius,
-                        inv_mass, cp, box, wall_hist, dt_history, force, torque)
-    for c in prange(N_CHUNKS):
-        gather(c * m // N_CHUNKS, (c + 1) * m // N_CHUNKS, active, start, rev_start, rev_pair,
-               pair_buf, force, torque)
+        wall_forces(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, pos, vel, omega, radius,
+                    inv_mass, cp, box, wall_hist, dt_history, force, torque)
 
 
 @njit(cache=True, error_model="numpy")
-def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, force, torque, inv_mass, inv_inertia,
-               lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv):
+def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, inv_inertia,
+               lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """Kick–drift of floes i_lo..i_hi−1, their displacement since the list
-    build, and their new drag forces (which need only the new half-step
-    velocities; done here to save a pass over memory). ``ref`` (the
-    positions at the build) is remapped with the box. Returns (largest
+    build, and their new drag forces.
+
+    The force of the kick is the sum of the force buffers (fbuf[b, i],
+    tbuf[b, i] over b); afterwards buffer 0 holds the drag force (it needs
+    only the new half-step velocities; done here to save a pass over
+    memory; skipped when ``has_drag`` is false, i.e. without forcing) and
+    the others are zero, ready for the pair scatter. ``ref``
+    (the positions at the build) is remapped with the box. Returns (largest
     squared distance of a displacement from (cx, cy), sum of the
     displacements along x, along y, largest squared speed)."""
     uax, uay, uwx, uwy = fv[FV_UAX], fv[FV_UAY], fv[FV_UWX], fv[FV_UWY]
     wind_speed = math.sqrt(uax * uax + uay * uay)
+    n_buf = fbuf.shape[0]
     vmax2 = 0.0
     worst = 0.0
     sdx = 0.0
     sdy = 0.0
     remap = sx != 1.0 or sy != 1.0
     for i in range(i_lo, i_hi):
+        fx = fbuf[0, i, 0]
+        fy = fbuf[0, i, 1]
+        tq = tbuf[0, i]
+        for b in range(1, n_buf):
+            fx += fbuf[b, i, 0]
+            fy += fbuf[b, i, 1]
+            tq += tbuf[b, i]
+            fbuf[b, i, 0] = 0.0
+            fbuf[b, i, 1] = 0.0
+            tbuf[b, i] = 0.0
         im = inv_mass[i]
         x = pos[i, 0]
         y = pos[i, 1]
+        vx = vel[i, 0]
+        vy = vel[i, 1]
+        w = omega[i]
         if im != 0.0:
-            x, y, vx, vy, w = kick_drift(x, y, vel[i, 0], vel[i, 1], omega[i], force[i, 0],
-                                         force[i, 1], torque[i], im, inv_inertia[i], dt_kick, dt,
-                                         lx, ly, px, py, sx, sy)
+            x, y, vx, vy, w = kick_drift(x, y, vx, vy, w, fx, fy, tq, im, inv_inertia[i], dt_kick,
+                                         dt, lx, ly, px, py, sx, sy)
             pos[i, 0] = x
             pos[i, 1] = y
             vel[i, 0] = vx
             vel[i, 1] = vy
             omega[i] = w
             vmax2 = max(vmax2, vx * vx + vy * vy)
+        # frozen floes have zero drag coefficients: their buffer is cleared
+        fx = fy = tq = 0.0
+        if has_drag:
             fx, fy, tq = floe_drag(vx, vy, w, drag[i, 0], drag[i, 1], drag[i, 2], drag[i, 3],
                                    uax, uay, uwx, uwy, wind_speed)
-            force[i, 0] = fx
-            force[i, 1] = fy
-            torque[i] = tq
+        fbuf[0, i, 0] = fx
+        fbuf[0, i, 1] = fy
+        tbuf[0, i] = tq
         if remap:
             ref[i, 0] *= sx
             ref[i, 1] *= sy
@@ -342,15 +345,15 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, force, torque, inv_mass
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def first_half_parallel(dt_kick, dt, pos, vel, omega, force, torque, inv_mass, inv_inertia, lx, ly,
-                        px, py, sx, sy, ref, cx, cy, drag, fv):
+def first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, inv_inertia, lx, ly,
+                        px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """:func:`first_half` over all floes in parallel chunks (no race)."""
     n = pos.shape[0]
     part = np.zeros((N_CHUNKS, 4))
     for c in prange(N_CHUNKS):
-        w, sx_, sy_, v2 = first_half(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, dt_kick, dt, pos, vel,
-                                 omega, force, torque, inv_mass, inv_inertia, lx, ly, px, py,
-                                 sx, sy, ref, cx, cy, drag, fv)
+        w, sx_, sy_, v2 = first_half(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, dt_kick, dt, pos,
+                                     vel, omega, fbuf, tbuf, inv_mass, inv_inertia, lx, ly, px,
+                                     py, sx, sy, ref, cx, cy, drag, fv, has_drag)
         part[c, 0] = w
         part[c, 1] = sx_
         part[c, 2] = sy_
@@ -372,8 +375,8 @@ def half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt):
 def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist, parallel):
     """New Verlet list with the contact history carried over.
 
-    Returns (start, nbr, hist, rev_start, rev_pair, ref) where ``ref`` is a
-    copy of the positions at the build.
+    Returns (start, nbr, hist, ref) where ``ref`` is a copy of the positions
+    at the build.
     """
     if parallel:
         new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size)
@@ -381,42 +384,42 @@ def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist
         new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin,
                                                     cell_size)
     new_hist = transfer_history(start, nbr, hist, new_start, new_nbr, 2)
-    rev_start, rev_pair = reverse_incidence(new_start, new_nbr, radius.shape[0])
-    return new_start, new_nbr, new_hist, rev_start, rev_pair, pos.copy()
-
-
-@njit(cache=True, error_model="numpy")
-def list_members(start, rev_start):
-    """(owners, active): floes that own a pair of the list, and floes that
-    own or partner one."""
-    own = start[1:] > start[:-1]
-    return np.nonzero(own)[0], np.nonzero(own | (rev_start[1:] > rev_start[:-1]))[0]
+    return new_start, new_nbr, new_hist, pos.copy()
 
 
 @njit(cache=True, error_model="numpy")
 def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, inv_mass,
               inv_inertia, drag, fv, cp, box, max_concentration,
-              skin, cell_size, max_cut, start, nbr, hist, rev_start, rev_pair, ref, ref_lengths,
-              centre, wall_hist, parallel):
+              skin, cell_size, max_cut, start, nbr, hist, ref, ref_lengths, centre, wall_hist,
+              parallel, n_buf):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
     first half kick of the next are done together (leapfrog form); the state
-    returned is synchronised (velocities at full steps). ``box`` is updated
-    in place for a deforming box; the Verlet list is rebuilt whenever the
+    returned is synchronised (velocities at full steps) and ``force``,
+    ``torque`` hold the forces of the last step. ``box`` is updated in place
+    for a deforming box; the Verlet list is rebuilt whenever the
     displacement criterion of :mod:`physics.neighbors` could be violated.
 
-    Returns (steps done, status, n_rebuilds, start, nbr, hist, rev_start,
-    rev_pair, ref). A non-zero status stops the run early: non-finite state,
-    or a deforming box at its concentration limit.
+    ``n_buf`` is the number of private force buffers and of pair chunks of
+    the parallel path (the number of threads; 1 for the serial path).
+
+    Returns (steps done, status, n_rebuilds, start, nbr, hist, ref). A
+    non-zero status stops the run early: non-finite state, a blow-up, or a
+    deforming box at its concentration limit.
     """
     px = box[BOX_PX] != 0.0
     py = box[BOX_PY] != 0.0
     walls = not (px and py)
     n = pos.shape[0]
+    has_drag = np.any(drag != 0.0)
+    n_buf = n_buf if parallel else 1
+    fbuf = np.zeros((n_buf, n, 2))
+    tbuf = np.zeros((n_buf, n))
+    fbuf[0] = force
+    tbuf[0] = torque
     n_rebuilds = 0
-    pair_buf = np.empty((nbr.shape[0], 4))
-    owners, active = list_members(start, rev_start)
+    owners, bounds = owner_chunks(start, n_buf)
     done = 0
     status = STATUS_OK
     for step in range(n_steps):
@@ -430,51 +433,55 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         box[BOX_LY] = ly
         dt_kick = 0.5 * dt if step == 0 else dt
         if parallel:
-            worst, mx, my, vmax2 = first_half_parallel(dt_kick, dt, pos, vel, omega, force, torque,
-                                                inv_mass, inv_inertia, lx, ly, px, py,
-                                                lx / lx_old, ly / ly_old, ref, centre[0],
-                                                centre[1], drag, fv)
+            worst, mx, my, vmax2 = first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf,
+                                                       inv_mass, inv_inertia, lx, ly, px, py,
+                                                       lx / lx_old, ly / ly_old, ref, centre[0],
+                                                       centre[1], drag, fv, has_drag)
         else:
-            worst, mx, my, vmax2 = first_half(0, n, dt_kick, dt, pos, vel, omega, force, torque,
-                                       inv_mass, inv_inertia, lx, ly, px, py, lx / lx_old,
-                                       ly / ly_old, ref, centre[0], centre[1], drag, fv)
+            worst, mx, my, vmax2 = first_half(0, n, dt_kick, dt, pos, vel, omega, fbuf, tbuf,
+                                              inv_mass, inv_inertia, lx, ly, px, py, lx / lx_old,
+                                              ly / ly_old, ref, centre[0], centre[1], drag, fv,
+                                              has_drag)
+        done += 1
         if not math.isfinite(worst + mx + my + vmax2):
             status = STATUS_NONFINITE
-            done += 1
             break
         if vmax2 * dt * dt > 0.25 * skin * skin:
             # a floe crossed half the skin in one step: the dynamics blew up
             status = STATUS_UNSTABLE
-            done += 1
             break
+        if walls:
+            if parallel:
+                wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
+                                     fbuf[0], tbuf[0])
+            else:
+                wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
+                            fbuf[0], tbuf[0])
         centre[0] = mx / n
         centre[1] = my / n
         shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
         if 2.0 * math.sqrt(worst) + shrink * max_cut >= skin:
-            start, nbr, hist, rev_start, rev_pair, ref = rebuild(
-                pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist, parallel)
+            start, nbr, hist, ref = rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size,
+                                            start, nbr, hist, parallel)
             ref_lengths[0] = lx
             ref_lengths[1] = ly
             centre[0] = 0.0
             centre[1] = 0.0
-            pair_buf = np.empty((nbr.shape[0], 4))
-            owners, active = list_members(start, rev_start)
+            owners, bounds = owner_chunks(start, n_buf)
             n_rebuilds += 1
-        # drag forces are already in force/torque (first half); add contacts
+        # drag and wall forces are already in buffer 0; add the pair forces
         if parallel:
-            contact_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                                    wall_hist, dt, force, torque, pair_buf, rev_start, rev_pair,
-                                    owners, active)
+            pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box,
+                                 start, nbr, hist, dt, fbuf, tbuf)
         else:
-            if walls:
-                wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
-                            force, torque)
             owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
-                        start, nbr, hist, dt, True, force, torque, pair_buf)
-        done += 1
+                        start, nbr, hist, dt, fbuf[0], tbuf[0])
+    # total force of the last step, and the closing half kick
+    force[:] = fbuf.sum(axis=0)
+    torque[:] = tbuf.sum(axis=0)
     if done > 0:
         half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt)
-    return done, status, n_rebuilds, start, nbr, hist, rev_start, rev_pair, ref
+    return done, status, n_rebuilds, start, nbr, hist, ref
 
 
 @njit(cache=True, error_model="numpy")

@@ -33,7 +33,7 @@ from numba import njit, prange
 from .domain import minimum_image
 
 __all__ = ["radius_rank", "choose_cell_size", "build_cells", "build_pair_list",
-           "brute_force_pairs", "transfer_history", "reverse_incidence"]
+           "brute_force_pairs", "transfer_history"]
 
 
 def radius_rank(radius: np.ndarray) -> np.ndarray:
@@ -238,27 +238,3 @@ def transfer_history(old_start, old_nbr, old_hist, new_start, new_nbr, ncomp):
                 for k in range(ncomp):
                     new_hist[b, k] = old_hist[a, k]
     return new_hist
-
-
-@njit(cache=True, error_model="numpy")
-def reverse_incidence(start, nbr, n):
-    """For each floe j, the pair slots where j is the (non-owner) partner.
-
-    Returns (rev_start (N+1,), rev_pair (M,)) in CSR form; used by the
-    parallel force gather so that no thread writes another floe's slot.
-    """
-    m = nbr.shape[0]
-    counts = np.zeros(n + 1, dtype=np.int64)
-    for p in range(m):
-        counts[nbr[p] + 1] += 1
-    for j in range(n):
-        counts[j + 1] += counts[j]
-    rev_start = counts.copy()
-    fill = counts[:-1].copy()
-    rev_pair = np.empty(m, dtype=np.int64)
-    for p in range(m):
-        j = nbr[p]
-        rev_pair[fill[j]] = p
-        fill[j] += 1
-    return rev_start, rev_pair
-
