@@ -56,21 +56,26 @@ class CollisionLog:
         return self.time.shape[0]
 
 
-def choose_cells(radii: np.ndarray, length: float, max_big: int = K.MAX_BIG):
-    """Cell list sizing for a power-law FSD in a periodic square of side
-    ``length``: (number of cells per side, cell side, indices of big floes).
+def choose_cells(radii: np.ndarray, length: float, floes_per_cell: float = 1.5,
+                 max_big_fraction: float = 0.1):
+    """Cell list sizing for a periodic square of side ``length``: (number of
+    cells per side, cell side, indices of the big floes).
 
-    The cell side is at least the largest diameter of the "small" floes; at
-    most ``max_big`` of the largest floes (and at most 2 % of all floes) are
-    "big" and handled by their bounding boxes (see
-    :mod:`physics.harddisk_kernels`). For equal floes there are no big ones.
+    The target cell side s₀ holds ``floes_per_cell`` floe centres on
+    average. Floes with a diameter above s₀ (at most ``max_big_fraction`` of
+    them, the largest) are "big" and handled by their bounding boxes (see
+    :mod:`physics.harddisk_kernels`); the cell side is the largest diameter
+    of the others, so for equal floes there are no big ones and the cell is
+    one diameter.
     """
     r = np.asarray(radii, dtype=float)
     n = r.size
-    n_big = min(max_big, n // 50)
+    s0 = np.sqrt(floes_per_cell * length * length / n)
     order = np.argsort(-r, kind="stable")
-    r_small = r[order[n_big]] if n_big < n else r.max()
-    bigs = order[:n_big][r[order[:n_big]] > r_small]
+    n_big = min(int(np.sum(2.0 * r > s0)), int(max_big_fraction * n))
+    bigs = order[:n_big]
+    r_small = r[order[n_big]]
+    bigs = bigs[r[bigs] > r_small]
     side = 2.0 * r_small * (1.0 + 1e-9)          # margin against round-off at cell walls
     nc = int(length // side)
     return nc, length / max(nc, 1), np.sort(bigs).astype(np.int64)
@@ -171,6 +176,8 @@ class HardDiskSimulation:
         self._cell_of = np.full(n, -1, dtype=np.int64)
         self._cix = np.zeros(n, dtype=np.int64)
         self._ciy = np.zeros(n, dtype=np.int64)
+        self._cover = np.zeros((nc * nc, 8), dtype=np.int64)
+        self._cover_n = np.zeros(nc * nc, dtype=np.int64)
 
         # state
         self._pos = pos.copy()
@@ -194,6 +201,7 @@ class HardDiskSimulation:
 
         K.build_cells(self._pos, self._big_rank, self.cell, nc, self._head, self._nxt, self._prv,
                       self._cell_of, self._cix, self._ciy, self._bbox, self.radius)
+        self._build_cover()
         K.kinetic_tensor(self._vel, self._inv_mass, self._acc)
         self._reschedule()
 
@@ -212,11 +220,23 @@ class HardDiskSimulation:
             new[:old.shape[0]] = old
             setattr(self, name, new)
 
+    def _build_cover(self):
+        """Cover lists of the big floes, growing them until none is full."""
+        while True:
+            self._counters[K.C_COVER_FULL] = 0
+            K.build_cover(self._bbox, self._bigs.size, self.n_cells, self._cover, self._cover_n,
+                          self._counters)
+            if self._counters[K.C_COVER_FULL] == 0:
+                return
+            self._cover = np.zeros((self._cover.shape[0], 2 * self._cover.shape[1]),
+                                   dtype=np.int64)
+
     def _reschedule(self):
         self._count += 1        # every stored prediction is now stale
         K.schedule_all(self.time, self._pos, self._vel, self.radius, self._t_loc, self._inv_mass,
                        self._big_rank, self._bigs, self._bbox, self.cell, self.n_cells, self.L,
-                       self._head, self._nxt, self._cix, self._ciy, self._count,
+                       self._head, self._nxt, self._cix, self._ciy, self._cover, self._cover_n,
+                       self._count,
                        self._ev_partner, self._ev_count, self._heap, self._where, self._key,
                        self._counters)
 
@@ -250,7 +270,7 @@ class HardDiskSimulation:
                     self._pos, self._vel, self.radius, self._t_loc, self._inv_mass,
                     self._big_rank, self._bigs, self._bbox, self.cell, self.n_cells, self.L,
                     self._head, self._nxt, self._prv, self._cell_of, self._cix, self._ciy,
-                    self._count, self._ev_partner, self._ev_count, self._heap, self._where,
+                    self._cover, self._cover_n, self._count, self._ev_partner, self._ev_count, self._heap, self._where,
                     self._key, self._last_coll, self._rapid, self.restitution,
                     self.collision_duration, inv_tau, u_eq, has_drag, self._t_drag, self._acc,
                     self._counters, self._log_t, self._log_ij, self._log_j, self._log_n,
@@ -264,6 +284,9 @@ class HardDiskSimulation:
                     break
                 if status == K.STATUS_LOG_FULL:
                     self._grow_log()
+                elif status == K.STATUS_COVER_FULL:
+                    self._build_cover()
+                    self._reschedule()
                 elif status == K.STATUS_COLLAPSE:
                     raise RuntimeError(
                         f"inelastic collapse at t = {t:.9g} s: a floe collided "

@@ -10,15 +10,18 @@ the partner has changed course since, the event is stale and is simply
 predicted again (no search over all pairs).
 
 Cell list for power-law sizes. The cell side is at least the diameter of
-every "small" floe; a few "big" floes (at most ``MAX_BIG``, the largest of
-the field) are not stored in cells but as the rectangle of cells their
-bounding box covers. A small floe looks for partners in its 3 × 3 block of
-cells and among the big floes whose rectangle, grown by one cell, holds
-its cell; a big floe looks for small floes in the ring of cells around its
-rim (cells entirely inside its disc cannot hold a floe centre) and at every
-other big floe. The relation is symmetric, so every pair that can touch
-before either floe crosses a cell boundary is seen by both. A big floe's
-"virtual wall" is an edge of its bounding box crossing a cell boundary.
+every "small" floe; the "big" floes (the largest of the field, see
+:func:`physics.harddisk.choose_cells`) are not stored in cells but as the
+rectangle of cells their bounding box covers, and every cell keeps a short
+"cover list" of the big floes whose rectangle, grown by one cell, holds
+it. A small floe looks for partners in its 3 × 3 block of cells and in the
+cover list of its own cell; a big floe looks for small floes in the ring of
+cells around its rim (cells entirely inside its disc cannot hold a floe
+centre) and at every other big floe whose grown rectangle meets its own.
+The relation is symmetric, so every pair that can touch before either floe
+crosses a cell boundary is seen by both. A big floe's "virtual wall" is an
+edge of its bounding box crossing a cell boundary; it updates one row or
+column of cover lists.
 
 Collisions (eqs 10–11) with restitution ε and the TC model of Luding and
 McNamara: a floe that collided less than ``collision_duration`` ago
@@ -45,13 +48,12 @@ from .event_calendar import heap_build, heap_update
 EV_CELL = -1        # virtual wall: cell crossing (small) or bounding-box change (big)
 EV_NONE = -2        # nothing can happen (floe at rest, alone)
 # status codes of run_events
-STATUS_DONE, STATUS_EVENTS, STATUS_LOG_FULL, STATUS_COLLAPSE, STATUS_NONFINITE = range(5)
+STATUS_DONE, STATUS_EVENTS, STATUS_LOG_FULL, STATUS_COLLAPSE, STATUS_NONFINITE, STATUS_COVER_FULL = range(6)
 COLLAPSE_INTERVAL = 1e-9   # [s] collisions of one floe closer than this count as rapid
-COLLAPSE_EVENTS = 10000    # rapid collisions in a row that mean inelastic collapse
-MAX_BIG = 64
+COLLAPSE_EVENTS = 20       # rapid collisions of one floe in a row that mean inelastic collapse
 # counters (int64 array) layout
-C_COLLISIONS, C_CROSSINGS, C_STALE, C_REPAIR_OVERLAP, C_REPAIR_TIME, C_SYNCS, C_TC = range(7)
-N_COUNTERS = 7
+C_COLLISIONS, C_CROSSINGS, C_STALE, C_REPAIR_OVERLAP, C_REPAIR_TIME, C_SYNCS, C_TC, C_COVER_FULL = range(8)
+N_COUNTERS = 8
 # accumulators (float array): kinetic tensor Σ m v⊗v (xx, xy, yy), its time
 # integral, collision virial Σ r_ij ⊗ J_ij, time of the last accumulation,
 # start of the window, energy lost in collisions
@@ -142,6 +144,51 @@ def cell_remove(i, head, nxt, prv, cell_of):
     prv[i] = -1
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def wrap_cell(c, nc):
+    """Cell index c (at most one box length off) into 0..nc−1."""
+    if c >= nc:
+        return c - nc
+    if c < 0:
+        return c + nc
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def cover_line(b, kx0, kx1, ky0, ky1, add, nc, cover, cover_n, counters):
+    """Add big floe b to (or remove it from) the cover lists of the cells
+    kx0..kx1 × ky0..ky1 (unwrapped indices). A full list sets the
+    C_COVER_FULL counter (the caller grows the lists and rebuilds them)."""
+    cap = cover.shape[1]
+    for ky in range(ky0, ky1 + 1):
+        row = (ky % nc) * nc
+        for kx in range(kx0, kx1 + 1):
+            c = row + kx % nc
+            m = cover_n[c]
+            if add:
+                if m < cap:
+                    cover[c, m] = b
+                    cover_n[c] = m + 1
+                else:
+                    counters[C_COVER_FULL] = 1
+            else:
+                for q in range(m):
+                    if cover[c, q] == b:
+                        cover[c, q] = cover[c, m - 1]
+                        cover_n[c] = m - 1
+                        break
+
+
+@njit(cache=True, error_model="numpy")
+def build_cover(bbox, n_big, nc, cover, cover_n, counters):
+    """Cover lists from scratch: every big floe in the cells of its bounding
+    box grown by one cell."""
+    cover_n[:] = 0
+    for b in range(n_big):
+        cover_line(b, bbox[b, 0] - 1, bbox[b, 1] + 1, bbox[b, 2] - 1, bbox[b, 3] + 1, True, nc,
+                   cover, cover_n, counters)
+
+
 @njit(cache=True, error_model="numpy")
 def build_cells(pos, big_rank, cell, nc, head, nxt, prv, cell_of, cix, ciy, bbox, radius):
     """Put small floes into cells by their centres and set the bounding-box
@@ -187,7 +234,7 @@ def _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel, radius, t_loc, inv_mass, 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-            nxt, cix, ciy):
+            nxt, cix, ciy, cover, cover_n):
     """Earliest event of floe i from time t: (time offset, partner or EV_CELL /
     EV_NONE, repair flag). ``t`` must not precede t_loc[i]."""
     dti = t - t_loc[i]
@@ -211,22 +258,20 @@ def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
             best = min(tx, ty)
             best_j = EV_CELL
         for oy in range(-1, 2):
-            yy = (cy + oy) % nc
+            yy = wrap_cell(cy + oy, nc) * nc
             for ox in range(-1, 2):
-                c = yy * nc + (cx + ox) % nc
-                j = head[c]
+                j = head[yy + wrap_cell(cx + ox, nc)]
                 while j >= 0:
                     if j != i:
                         best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel,
                                                       radius, t_loc, inv_mass, L, best, best_j)
                         repair |= rep
                     j = nxt[j]
-        for b in range(nb):
-            if (in_range(cx, bbox[b, 0] - 1, bbox[b, 1] + 1, nc)
-                    and in_range(cy, bbox[b, 2] - 1, bbox[b, 3] + 1, nc)):
-                best, best_j, rep = _try_pair(i, bigs[b], t, xi, yi, vxi, vyi, ri, pos, vel,
-                                              radius, t_loc, inv_mass, L, best, best_j)
-                repair |= rep
+        c = cy * nc + cx
+        for q in range(cover_n[c]):
+            best, best_j, rep = _try_pair(i, bigs[cover[c, q]], t, xi, yi, vxi, vyi, ri, pos, vel,
+                                          radius, t_loc, inv_mass, L, best, best_j)
+            repair |= rep
     else:
         x0, x1, y0, y1 = bbox[b_i, 0], bbox[b_i, 1], bbox[b_i, 2], bbox[b_i, 3]
         # virtual walls: an edge of the bounding box reaching a cell boundary
@@ -259,20 +304,22 @@ def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
                     repair |= rep
                     j = nxt[j]
         for b in range(nb):
-            j = bigs[b]
-            if j != i:
-                best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel, radius,
-                                              t_loc, inv_mass, L, best, best_j)
+            # other big floes whose grown rectangle meets this one's
+            if b != b_i and (in_range(x0 % nc, bbox[b, 0] - x1 + x0 - 2, bbox[b, 1] + 2, nc)
+                             and in_range(y0 % nc, bbox[b, 2] - y1 + y0 - 2, bbox[b, 3] + 2, nc)):
+                best, best_j, rep = _try_pair(i, bigs[b], t, xi, yi, vxi, vyi, ri, pos, vel,
+                                              radius, t_loc, inv_mass, L, best, best_j)
                 repair |= rep
     return best, best_j, repair
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def schedule(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-             nxt, cix, ciy, count, ev_partner, ev_count, heap, where, key, counters):
+             nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
+             counters):
     """Predict the next event of floe i from time t and put it in the calendar."""
     dt, j, rep = predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc,
-                         L, head, nxt, cix, ciy)
+                         L, head, nxt, cix, ciy, cover, cover_n)
     if rep:
         counters[C_REPAIR_OVERLAP] += 1
     ev_partner[i] = j
@@ -282,12 +329,13 @@ def schedule(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell
 
 @njit(cache=True, error_model="numpy")
 def schedule_all(t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-                 nxt, cix, ciy, count, ev_partner, ev_count, heap, where, key, counters):
+                 nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
+                 counters):
     """Predict every floe's next event from time t and rebuild the calendar."""
     n = pos.shape[0]
     for i in range(n):
         dt, j, rep = predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
-                             nc, L, head, nxt, cix, ciy)
+                             nc, L, head, nxt, cix, ciy, cover, cover_n)
         if rep:
             counters[C_REPAIR_OVERLAP] += 1
         ev_partner[i] = j
@@ -393,7 +441,7 @@ def collide(i, j, t, pos, vel, inv_mass, L, restitution, last_coll, tc_duration,
 
 @njit(cache=True, inline="always", error_model="numpy")
 def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt, prv, cell_of,
-          cix, ciy):
+          cix, ciy, cover, cover_n, counters):
     """Virtual-wall event of floe i at time t: move it into the next cell (a
     small floe) or shift its bounding-box range (a big floe), wrapping at
     the periodic boundary."""
@@ -434,14 +482,24 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
         t3, s3 = line_crossing(y - r, vel[i, 1], y0 * cell, (y0 + 1) * cell)
         t4, s4 = line_crossing(y + r, vel[i, 1], y1 * cell, (y1 + 1) * cell)
         tm = min(min(t1, t2), min(t3, t4))
+        # one edge moves by one cell: one column (or row) of cells enters or
+        # leaves the grown rectangle x0−1..x1+1 × y0−1..y1+1
         if t1 == tm:
             bbox[b, 0] += s1
+            kx = x0 - 1 if s1 > 0 else x0 - 2
+            cover_line(b, kx, kx, y0 - 1, y1 + 1, s1 < 0, nc, cover, cover_n, counters)
         elif t2 == tm:
             bbox[b, 1] += s2
+            kx = x1 + 2 if s2 > 0 else x1 + 1
+            cover_line(b, kx, kx, y0 - 1, y1 + 1, s2 > 0, nc, cover, cover_n, counters)
         elif t3 == tm:
             bbox[b, 2] += s3
+            ky = y0 - 1 if s3 > 0 else y0 - 2
+            cover_line(b, x0 - 1, x1 + 1, ky, ky, s3 < 0, nc, cover, cover_n, counters)
         else:
             bbox[b, 3] += s4
+            ky = y1 + 2 if s4 > 0 else y1 + 1
+            cover_line(b, x0 - 1, x1 + 1, ky, ky, s4 > 0, nc, cover, cover_n, counters)
         # keep the centre in [0, L) and the ranges consistent with it
         if x >= L:
             pos[i, 0] -= L
@@ -487,8 +545,8 @@ def drag_update(dt, vel, inv_tau, u_eq):
 
 @njit(cache=True, error_model="numpy")
 def run_events(t_now, t_end, next_sync, dt_max, max_events, pos, vel, radius, t_loc, inv_mass,
-               big_rank, bigs, bbox, cell, nc, L, head, nxt, prv, cell_of, cix, ciy, count,
-               ev_partner, ev_count, heap, where, key, last_coll, rapid, restitution,
+               big_rank, bigs, bbox, cell, nc, L, head, nxt, prv, cell_of, cix, ciy, cover,
+               cover_n, count, ev_partner, ev_count, heap, where, key, last_coll, rapid, restitution,
                tc_duration, inv_tau, u_eq, has_drag, t_drag, acc, counters, log_t, log_ij,
                log_j, log_n, log_on):
     """Process events from t_now until t_end (then every floe is moved to
@@ -520,8 +578,8 @@ def run_events(t_now, t_end, next_sync, dt_max, max_events, pos, vel, radius, t_
                 next_sync += dt_max
                 counters[C_SYNCS] += 1
                 schedule_all(t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
-                             nc, L, head, nxt, cix, ciy, count, ev_partner, ev_count, heap, where,
-                             key, counters)
+                             nc, L, head, nxt, cix, ciy, cover, cover_n, count, ev_partner,
+                             ev_count, heap, where, key, counters)
                 continue
             t = t_end
             accumulate(t, acc)
@@ -572,11 +630,14 @@ def run_events(t_now, t_end, next_sync, dt_max, max_events, pos, vel, radius, t_
                     log_n += 1
         elif j == EV_CELL:
             cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt, prv,
-                  cell_of, cix, ciy)
+                  cell_of, cix, ciy, cover, cover_n, counters)
             counters[C_CROSSINGS] += 1
+            if counters[C_COVER_FULL] != 0:
+                status = STATUS_COVER_FULL
         for k in range(n_sched):
             q = i if k == 0 else j
             schedule(q, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L,
-                     head, nxt, cix, ciy, count, ev_partner, ev_count, heap, where, key, counters)
+                     head, nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where,
+                     key, counters)
         if status != STATUS_DONE:
             return status, t, next_sync, t_drag, log_n
