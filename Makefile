@@ -30,6 +30,7 @@ test-slow: setup
 
 bench: setup
 	$(PY) -m physics.bench hertz
+	$(PY) -m physics.bench harddisk
 
 validate: setup
 	$(PY) -m physics.validate

@@ -1,4 +1,5 @@
-"""Benchmarks of the physics engines: ``python -m physics.bench hertz``.
+"""Benchmarks of the physics engines: ``python -m physics.bench hertz`` and
+``python -m physics.bench harddisk``.
 
 Hertz engine (Herman 2013 material table, α = 1.8 floe sizes with mean
 radius 4 m, no external forcing):
@@ -15,6 +16,15 @@ second (floes × steps / wall time), the best of three timed segments. A
 scalar control loop, timed the same way, shows how much two threads can
 give on the machine at all. The peak memory of a run with
 N = 100000 floes is measured in a fresh process.
+
+Hard-disc engine (collisions per second, one core, compile time excluded):
+
+* elastic equal discs, N = 10000, packing fraction 0.5, no drag, Gaussian
+  velocities of 1 m/s per component, after 5 collisions per disc to lose
+  the placement's structure;
+* the Herman (2011) set-up: N = 3000, α_r = 1.5, mean diameter 2 m,
+  Ā = 0.75, wind 10 m/s, ε = 0.85, Δt_max = 1 s, Δt_c = 0.1 s, timed in
+  the quasi-steady state after 4000 s of model time.
 """
 from __future__ import annotations
 
@@ -252,6 +262,99 @@ def format_table(rows: list[dict], n: int) -> str:
     return "\n".join(lines)
 
 
+# ---------------------------------------------------------------------------
+# hard-disc engine
+# ---------------------------------------------------------------------------
+
+def _harddisk_gas(n: int, eta: float, seed: int):
+    from .floes import place_floes
+    r = 0.5
+    length = float(np.sqrt(n * np.pi * r * r / eta))
+    box = PeriodicBox(length)
+    rng = np.random.default_rng(seed)
+    pos = place_floes(np.full(n, r), box, rng)
+    vel = rng.normal(0.0, 1.0, (n, 2))
+    vel -= vel.mean(axis=0)
+    return FloeField(pos, np.full(n, r), 1.0, vel), box
+
+
+def _time_collisions(sim, min_collisions: int, chunk: float) -> tuple[float, float, int]:
+    """Advance in chunks of model time until ``min_collisions`` collisions;
+    returns (collisions per wall second, model seconds, collisions)."""
+    c0 = sim.collision_count
+    t0 = sim.time
+    w0 = time.perf_counter()
+    while sim.collision_count - c0 < min_collisions:
+        sim.advance(chunk)
+    wall = time.perf_counter() - w0
+    done = sim.collision_count - c0
+    return done / wall, sim.time - t0, done
+
+
+def bench_harddisk(seed: int = 1, quiet: bool = False) -> list[dict]:
+    """Collisions per second of the hard-disc engine (see the module docstring)."""
+    from .forcing import Forcing
+    from .harddisk import HardDiskSimulation
+    from .params import HERMAN2011
+
+    def log(msg):
+        if not quiet:
+            print(msg, flush=True)
+
+    rows = []
+    # warm-up: compile (or load) every kernel on a tiny system
+    f, b = _harddisk_gas(200, 0.3, seed)
+    HardDiskSimulation(f, b, restitution=1.0, collision_duration=0.0).advance(1.0)
+    field, box = _harddisk_gas(10000, 0.5, seed)
+    sim = HardDiskSimulation(field, box, restitution=1.0, collision_duration=0.0)
+    sim.advance(1.0)                          # about 5 collisions per disc
+    best = 0.0
+    for _ in range(REPEATS):
+        rate, span, done = _time_collisions(sim, 1_000_000, 1.0)
+        best = max(best, rate)
+    d = sim.diagnostics
+    rows.append(dict(case="elastic, N = 10000, η = 0.5", rate=best, collisions=done,
+                     model_time=span, repairs=sim.repairs,
+                     crossings_per_collision=d["crossings"] / d["collisions"]))
+    log(f"  {rows[-1]['case']}: {best:.3g} collisions/s")
+
+    P = HERMAN2011
+    field, box = make_floe_field(3000, concentration=0.75, alpha=P.fsd_exponent,
+                                 mean_diameter=P.mean_diameter, thickness=P.thickness, seed=seed,
+                                 velocity_std=0.01)
+    forcing = Forcing(P.forcing)
+    sim = HardDiskSimulation(field, box, restitution=P.contact.restitution, forcing=forcing,
+                             max_velocity_step=1.0, collision_duration=0.1)
+    sim.advance(4000.0, progress=not quiet)
+    rate, span, done = _time_collisions(sim, 200_000, 100.0)
+    m = sim.mass
+    u = float((m * sim.velocities[:, 0]).sum() / m.sum())
+    d = sim.diagnostics
+    rows.append(dict(case="Herman 2011, N = 3000, Ā = 0.75", rate=rate, collisions=done,
+                     model_time=span, repairs=sim.repairs,
+                     crossings_per_collision=d["crossings"] / d["collisions"],
+                     mean_drift=u))
+    log(f"  {rows[-1]['case']}: {rate:.3g} collisions/s, mass-weighted drift {u:.3f} m/s")
+    return rows
+
+
+def format_harddisk_table(rows: list[dict]) -> str:
+    lines = [f"Hard-disc engine, one core, {platform.processor() or platform.machine()}, "
+             f"numba {numba.__version__}",
+             "",
+             "| case | collisions/s | collisions timed | model time [s] | cell crossings per collision | repairs |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['rate']:.3g} | {r['collisions']} | {r['model_time']:.4g} | "
+                     f"{r['crossings_per_collision']:.2f} | {r['repairs']} |")
+    for r in rows:
+        if "mean_drift" in r:
+            lines.append("")
+            lines.append(f"Herman (2011) set-up after {4000 + r['model_time']:.0f} s: mass-weighted "
+                         f"mean along-wind velocity {r['mean_drift']:.3f} m/s (paper: about 0.23)")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m physics.bench", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -265,6 +368,9 @@ def main(argv=None) -> int:
     h.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
                    help="where the prepared floe fields are kept (default ./.bench_cache)")
     h.add_argument("--quiet", action="store_true")
+    hd = sub.add_parser("harddisk", help="collisions per second of the hard-disc engine")
+    hd.add_argument("--seed", type=int, default=1)
+    hd.add_argument("--quiet", action="store_true")
     sub.add_parser("_control")
     m = sub.add_parser("_memory")
     m.add_argument("n", type=int)
@@ -274,6 +380,11 @@ def main(argv=None) -> int:
     t.add_argument("steps", type=int)
     t.add_argument("dt", type=float)
     args = p.parse_args(argv)
+    if args.engine == "harddisk":
+        hd_rows = bench_harddisk(args.seed, args.quiet)
+        print()
+        print(format_harddisk_table(hd_rows))
+        return 0
     if args.engine == "_control":
         _control_child()
         return 0
