@@ -261,7 +261,8 @@ class HardDiskSimulation:
         bar = None
         if progress:
             from tqdm.auto import tqdm
-            bar = tqdm(total=float(duration), unit="s", desc="hard discs")
+            bar = tqdm(total=float(duration), desc="hard discs",
+                       bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} model s [{elapsed}<{remaining}]")
         t_start = self.time
         try:
             while True:
