@@ -501,22 +501,12 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
             ky = y1 + 2 if s4 > 0 else y1 + 1
             cover_line(b, x0 - 1, x1 + 1, ky, ky, s4 > 0, nc, cover, cover_n, counters)
         # keep the centre in [0, L) and the ranges consistent with it
-        if x >= L:
-            pos[i, 0] -= L
-            bbox[b, 0] -= nc
-            bbox[b, 1] -= nc
-        elif x < 0.0:
-            pos[i, 0] += L
-            bbox[b, 0] += nc
-            bbox[b, 1] += nc
-        if y >= L:
-            pos[i, 1] -= L
-            bbox[b, 2] -= nc
-            bbox[b, 3] -= nc
-        elif y < 0.0:
-            pos[i, 1] += L
-            bbox[b, 2] += nc
-            bbox[b, 3] += nc
+        for ax in range(2):
+            shift = -1 if pos[i, ax] >= L else (1 if pos[i, ax] < 0.0 else 0)
+            if shift != 0:
+                pos[i, ax] += shift * L
+                bbox[b, 2 * ax] += shift * nc
+                bbox[b, 2 * ax + 1] += shift * nc
 
 
 @njit(cache=True, error_model="numpy")
