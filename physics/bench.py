@@ -86,14 +86,23 @@ def _time_child(path: str, parallel: bool, steps: int, dt: float) -> None:
                           rebuilds=round((sim.n_rebuilds - rebuilds0) / REPEATS))))
 
 
+def _child(*args: str, threads: int | None = None):
+    """Run ``python -m physics.bench <args>`` in a fresh process (with a
+    thread pool of ``threads`` threads if given) and return the JSON of the
+    last line it prints."""
+    env = dict(os.environ)
+    if threads is not None:
+        env["NUMBA_NUM_THREADS"] = str(threads)
+    out = subprocess.run([sys.executable, "-m", "physics.bench", *args], check=True,
+                         capture_output=True, text=True, env=env)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
 def _timed_steps(path: Path, dt: float, steps: int, parallel: bool, threads: int) -> dict:
     """Time ``steps`` steps of the saved state in a fresh process, so that the
     thread pool has exactly ``threads`` threads and nothing else is running."""
-    env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
-    out = subprocess.run([sys.executable, "-m", "physics.bench", "_time", str(path),
-                          "1" if parallel else "0", str(steps), repr(dt)],
-                         check=True, capture_output=True, text=True, env=env)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    return _child("_time", str(path), "1" if parallel else "0", str(steps), repr(dt),
+                  threads=threads)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -126,13 +135,7 @@ def _control_child() -> None:
 def machine_scaling(threads: int) -> float:
     """Speed-up of the control loop on ``threads`` threads over one thread,
     each in a fresh process: the ceiling the hardware puts on any kernel."""
-    rates = []
-    for t in (1, threads):
-        env = dict(os.environ, NUMBA_NUM_THREADS=str(t))
-        out = subprocess.run([sys.executable, "-m", "physics.bench", "_control"], check=True,
-                             capture_output=True, text=True, env=env)
-        rates.append(json.loads(out.stdout.strip().splitlines()[-1])["rate"])
-    return rates[1] / rates[0]
+    return _child("_control", threads=threads)["rate"] / _child("_control", threads=1)["rate"]
 
 
 def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float = 0.90):
@@ -181,9 +184,7 @@ def _memory_child(n: int) -> None:
 def peak_memory(n: int) -> int:
     """Peak resident memory [bytes] of a fresh process that builds and runs
     an N-floe Hertz simulation at Ā = 0.7 (Numba and NumPy included)."""
-    out = subprocess.run([sys.executable, "-m", "physics.bench", "_memory", str(n)],
-                         check=True, capture_output=True, text=True)
-    return int(out.stdout.strip().splitlines()[-1])
+    return int(_child("_memory", str(n)))
 
 
 def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Path | None = None,

@@ -128,12 +128,8 @@ class HardDiskSimulation:
         check_range("restitution", restitution, 0.0, 1.0, low_open=True)
         check_range("max_velocity_step", max_velocity_step, 0.0, None, low_open=True)
         check_range("collision_duration", collision_duration, 0.0, None)
-        if forcing is not None:
-            if not isinstance(forcing, Forcing):
-                raise ValueError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
-            if forcing.coriolis != 0.0:
-                raise ValueError(f"the hard-disc engine has no Coriolis force (Herman 2011); "
-                                 f"got forcing.coriolis = {forcing.coriolis:g}, set it to 0")
+        if forcing is not None and not isinstance(forcing, Forcing):
+            raise ValueError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
         f = field
         n = f.n
         if n < 2:
@@ -145,10 +141,9 @@ class HardDiskSimulation:
         self.max_velocity_step = float(max_velocity_step)
         self.collision_duration = float(collision_duration)
         self.forcing = forcing
+        self._check_coriolis()
         self.radius = f.radii.copy()
         self.mass = f.masses.copy()
-        if np.any(f.frozen & (np.hypot(*f.velocities.T) > 0)):
-            raise ValueError("frozen floes must have zero velocity")
 
         pos = box.wrap(f.positions)
         worst = max_overlap(pos, f.radii, box)
@@ -206,6 +201,12 @@ class HardDiskSimulation:
         self._reschedule()
 
     # -- internals -------------------------------------------------------------
+    def _check_coriolis(self):
+        # the coriolis parameter of a Forcing may be changed between calls
+        if self.forcing is not None and self.forcing.coriolis != 0.0:
+            raise ValueError(f"the hard-disc engine has no Coriolis force (Herman 2011); "
+                             f"got forcing.coriolis = {self.forcing.coriolis:g}, set it to 0")
+
     def _log_alloc(self, size):
         self._log_t = np.zeros(size)
         self._log_ij = np.zeros((size, 2), dtype=np.int64)
@@ -254,8 +255,7 @@ class HardDiskSimulation:
         """Advance by ``duration`` model seconds; afterwards every floe's
         position is at :attr:`time`. ``progress=True`` shows a progress bar."""
         check_range("duration", duration, 0.0, None)
-        if self.forcing is not None and self.forcing.coriolis != 0.0:
-            raise ValueError("the hard-disc engine has no Coriolis force; set forcing.coriolis = 0")
+        self._check_coriolis()
         inv_tau, u_eq, has_drag = self._drag_arrays()
         t_end = self.time + float(duration)
         bar = None

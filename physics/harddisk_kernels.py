@@ -314,17 +314,28 @@ def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def schedule(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-             nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
-             counters):
-    """Predict the next event of floe i from time t and put it in the calendar."""
+def predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L,
+                  head, nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, counters):
+    """Predict the next event of floe i from time t, store its partner and
+    the partner's collision counter, and return its time."""
     dt, j, rep = predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc,
                          L, head, nxt, cix, ciy, cover, cover_n)
     if rep:
         counters[C_REPAIR_OVERLAP] += 1
     ev_partner[i] = j
     ev_count[i] = count[j] if j >= 0 else 0
-    heap_update(heap, where, key, i, t + dt)
+    return t + dt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def schedule(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
+             nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
+             counters):
+    """Predict the next event of floe i from time t and put it in the calendar."""
+    heap_update(heap, where, key, i,
+                predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox,
+                              cell, nc, L, head, nxt, cix, ciy, cover, cover_n, count,
+                              ev_partner, ev_count, counters))
 
 
 @njit(cache=True, error_model="numpy")
@@ -332,15 +343,10 @@ def schedule_all(t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cel
                  nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
                  counters):
     """Predict every floe's next event from time t and rebuild the calendar."""
-    n = pos.shape[0]
-    for i in range(n):
-        dt, j, rep = predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
-                             nc, L, head, nxt, cix, ciy, cover, cover_n)
-        if rep:
-            counters[C_REPAIR_OVERLAP] += 1
-        ev_partner[i] = j
-        ev_count[i] = count[j] if j >= 0 else 0
-        key[i] = t + dt
+    for i in range(pos.shape[0]):
+        key[i] = predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox,
+                               cell, nc, L, head, nxt, cix, ciy, cover, cover_n, count,
+                               ev_partner, ev_count, counters)
     heap_build(heap, where, key)
 
 
@@ -440,6 +446,18 @@ def collide(i, j, t, pos, vel, inv_mass, L, restitution, last_coll, tc_duration,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def step_cell(c, s, nc, L):
+    """Cell index after a step s = ±1 along one axis, and the shift of the
+    coordinate that wraps with it at the periodic boundary."""
+    c += s
+    if c == nc:
+        return 0, -L
+    if c < 0:
+        return nc - 1, L
+    return c, 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt, prv, cell_of,
           cix, ciy, cover, cover_n, counters):
     """Virtual-wall event of floe i at time t: move it into the next cell (a
@@ -455,21 +473,11 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
         tx, sx = line_crossing(x, vel[i, 0], cx * cell, (cx + 1) * cell)
         ty, sy = line_crossing(y, vel[i, 1], cy * cell, (cy + 1) * cell)
         if tx <= ty:
-            cx += sx
-            if cx == nc:
-                cx = 0
-                pos[i, 0] -= L
-            elif cx < 0:
-                cx = nc - 1
-                pos[i, 0] += L
+            cx, shift = step_cell(cx, sx, nc, L)
+            pos[i, 0] += shift
         else:
-            cy += sy
-            if cy == nc:
-                cy = 0
-                pos[i, 1] -= L
-            elif cy < 0:
-                cy = nc - 1
-                pos[i, 1] += L
+            cy, shift = step_cell(cy, sy, nc, L)
+            pos[i, 1] += shift
         cell_remove(i, head, nxt, prv, cell_of)
         cix[i] = cx
         ciy[i] = cy
