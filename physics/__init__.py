@@ -6,6 +6,9 @@ Engines
 State and set-up
     :class:`FloeField`, :func:`make_floe_field`, boxes of :mod:`physics.domain`,
     :class:`Forcing`, parameter tables :data:`HERMAN2011`, :data:`HERMAN2013`.
+Observables
+    :mod:`physics.observables` — contact fabric and stress (both engines).
+    :mod:`physics.clusters` — clusters, power-law exponents, g_rdf, g_ffd.
 
 This package never imports gymnasium or torch.
 """
@@ -15,8 +18,12 @@ from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBo
 from .floes import (FloeField, PlacementError, domain_size, make_floe_field, place_floes,
                     power_law_diameters, rank_order_diameters, sample_power_law_diameters)
 from .forcing import Forcing, steady_drift
+from .clusters import (ClusterStats, cluster_statistics, find_clusters, fsd_exponent, g_ffd,
+                       g_rdf, power_law_exponent, rank_order)
 from .harddisk import CollisionLog, HardDiskSimulation
-from .hertz import Contacts, HertzSimulation
+from .hertz import HertzSimulation
+from .observables import (Contacts, Fabric, Stress, collision_stress, contacts_within, fabric,
+                          stress)
 from .params import HERMAN2011, HERMAN2013, ContactParams, ForcingParams, PaperPreset
 
 __version__ = "0.1.0"
@@ -27,6 +34,9 @@ __all__ = [
     "power_law_diameters", "rank_order_diameters", "sample_power_law_diameters",
     "Forcing", "steady_drift", "Contacts", "HertzSimulation", "CollisionLog",
     "HardDiskSimulation",
+    "Fabric", "Stress", "fabric", "stress", "collision_stress", "contacts_within",
+    "ClusterStats", "find_clusters", "cluster_statistics", "power_law_exponent", "rank_order",
+    "fsd_exponent", "g_rdf", "g_ffd",
     "HERMAN2011", "HERMAN2013", "ContactParams", "ForcingParams", "PaperPreset",
     "damping_alpha",
 ]

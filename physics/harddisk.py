@@ -33,6 +33,7 @@ from .domain import Box, PeriodicBox
 from .event_calendar import new_heap
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
+from .observables import Contacts, Fabric, Stress, collision_stress, contacts_within, fabric
 from .params import check_range
 
 __all__ = ["HardDiskSimulation", "CollisionLog", "choose_cells"]
@@ -192,6 +193,7 @@ class HardDiskSimulation:
         self._next_sync = self.max_velocity_step
         self._t_drag = 0.0
         self._log_on = bool(log_collisions)
+        self._log_t0 = 0.0
         self._log_alloc(1024 if self._log_on else 1)
 
         K.build_cells(self._pos, self._big_rank, self.cell, nc, self._head, self._nxt, self._prv,
@@ -373,7 +375,30 @@ class HardDiskSimulation:
                             self._log_ij[:k, 1].copy(), self._log_j[:k].copy())
 
     def clear_collision_log(self) -> None:
+        """Empty the collision log; it starts a new window for :meth:`contact_stress`."""
         self._log_n = 0
+        self._log_t0 = self.time
+
+    def contacts(self, gap: float = 0.01) -> Contacts:
+        """Floe pairs whose edges are closer than ``gap`` [m] now (hard discs
+        touch only at the instants of collision, so a contact is a near
+        neighbour), without forces; see :func:`physics.observables.contacts_within`."""
+        return contacts_within(self.positions, self.radius, self.box, gap)
+
+    def fabric(self, gap: float = 0.01) -> Fabric:
+        """Contact fabric of the pairs closer than ``gap`` [m] (see :meth:`contacts`)."""
+        return fabric(self.contacts(gap), self.n)
+
+    def contact_stress(self, *, per_floe: bool = True) -> Stress:
+        """Collision-virial stress over the collision log's window (since the
+        start or :meth:`clear_collision_log`), compression positive [N/m]; the
+        contact part of :meth:`stress` (see :func:`physics.observables.collision_stress`).
+        Needs ``log_collisions=True``."""
+        log = self.collision_log
+        span = self.time - self._log_t0
+        if span <= 0:
+            raise ValueError("the collision window is empty: advance the simulation first")
+        return collision_stress(log, self.radius, self.L * self.L, span, per_floe=per_floe)
 
     def reset_stress(self) -> None:
         """Start a new averaging window for :meth:`stress`."""

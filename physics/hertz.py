@@ -16,7 +16,6 @@ Example
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -27,42 +26,10 @@ from .domain import Box
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
 from .neighbors import choose_cell_size, radius_rank
+from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, check_range
 
 __all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
-
-
-@dataclass
-class Contacts:
-    """Contacts at one instant, one row per touching pair (i < j not implied).
-
-    Attributes
-    ----------
-    i, j : (K,) int — the two floes
-    normal : (K, 2) — unit vector from the centre of i to the centre of j
-    overlap : (K,) — δ [m]
-    normal_force : (K,) — magnitude of the repulsive normal force [N]
-    tangential_force : (K,) — tangential force on i along t = k × n [N]
-    force : (K, 2) — total contact force on i (−force acts on j) [N]
-    contact_point : (K, 2) — midpoint of the overlap, r_i − δ/2 from i along n [m]
-        (in the box's coordinates, possibly outside [0, L) near a periodic edge)
-    branch_i, branch_j : (K, 2) — vectors from the centres of i and j to the
-        contact point [m]
-    """
-
-    i: np.ndarray
-    j: np.ndarray
-    normal: np.ndarray
-    overlap: np.ndarray
-    normal_force: np.ndarray
-    tangential_force: np.ndarray
-    force: np.ndarray
-    contact_point: np.ndarray
-    branch_i: np.ndarray
-    branch_j: np.ndarray
-
-    def __len__(self):
-        return int(self.i.size)
 
 
 def minimum_contact_time(radius, thickness, density, contact: ContactParams, speed: float,
@@ -344,6 +311,16 @@ class HertzSimulation:
         return Contacts(i=i, j=j, normal=normal, overlap=delta.copy(), normal_force=d[:, 3].copy(),
                         tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
                         contact_point=self.positions[i] + arm_i, branch_i=arm_i, branch_j=arm_j)
+
+    def fabric(self) -> Fabric:
+        """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts
+        (see :func:`physics.observables.fabric`)."""
+        return fabric(self.contacts(), self.n_floes)
+
+    def contact_stress(self, *, per_floe: bool = True) -> Stress:
+        """Love–Weber stress of the current floe–floe contacts over the box
+        area, compression positive [N/m] (see :func:`physics.observables.stress`)."""
+        return stress(self.contacts(), self.box.area, n_floes=self.n_floes, per_floe=per_floe)
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of mobile floes [J]."""
