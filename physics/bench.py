@@ -1,5 +1,6 @@
-"""Benchmarks of the physics engines: ``python -m physics.bench hertz`` and
-``python -m physics.bench harddisk``.
+"""Benchmarks of the physics engines and observables: ``python -m physics.bench
+hertz``, ``python -m physics.bench harddisk`` and ``python -m physics.bench
+observables``.
 
 Hertz engine (Herman 2013 material table, α = 1.8 floe sizes with mean
 radius 4 m, no external forcing):
@@ -25,11 +26,19 @@ Hard-disc engine (collisions per second, one core, compile time excluded):
 * the Herman (2011) set-up: N = 3000, α_r = 1.5, mean diameter 2 m,
   Ā = 0.75, wind 10 m/s, ε = 0.85, Δt_max = 1 s, Δt_c = 0.1 s, timed in
   the quasi-steady state after 4000 s of model time.
+
+Observables (wall time, best of five calls after a warm-up call, all
+threads): a Herman (2011) field (α_r = 1.5, mean diameter 2 m, Ā = 0.75) of
+N = 100 008 floes, a placed field of 2778 floes tiled 6 × 6; clusters with
+d_m = 0.5 m, cluster statistics, g_ffd and g_rdf; fabric and stress
+(per-floe parts included) from the first 10⁵ contacts of the pairs closer
+than 1 m, with repulsive normal forces of random size.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import resource
@@ -339,12 +348,16 @@ def bench_harddisk(seed: int = 1, quiet: bool = False) -> list[dict]:
     return rows
 
 
+def _table_head(title: str, columns: list[str]) -> list[str]:
+    """Title line (with the machine and numba version) and Markdown table head."""
+    return [f"{title}, {platform.processor() or platform.machine()}, numba {numba.__version__}",
+            "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+
+
 def format_harddisk_table(rows: list[dict]) -> str:
-    lines = [f"Hard-disc engine, one core, {platform.processor() or platform.machine()}, "
-             f"numba {numba.__version__}",
-             "",
-             "| case | collisions/s | collisions timed | model time [s] | cell crossings per collision | repairs |",
-             "|---|---|---|---|---|---|"]
+    lines = _table_head("Hard-disc engine, one core",
+                        ["case", "collisions/s", "collisions timed", "model time [s]",
+                         "cell crossings per collision", "repairs"])
     for r in rows:
         lines.append(f"| {r['case']} | {r['rate']:.3g} | {r['collisions']} | {r['model_time']:.4g} | "
                      f"{r['crossings_per_collision']:.2f} | {r['repairs']} |")
@@ -353,6 +366,80 @@ def format_harddisk_table(rows: list[dict]) -> str:
             lines.append("")
             lines.append(f"Herman (2011) set-up after {4000 + r['model_time']:.0f} s: mass-weighted "
                          f"mean along-wind velocity {r['mean_drift']:.3f} m/s (paper: about 0.23)")
+    return "\n".join(lines)
+
+
+def _best_time(fn, repeats: int = 5) -> float:
+    """Best wall time of ``repeats`` calls of ``fn`` after one warm-up call [s]."""
+    fn()
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench_observables(seed: int = 1, tiles: int = 6, quiet: bool = False) -> list[dict]:
+    """Wall times of the observables on N ≈ 10⁵ floes (see the module docstring)."""
+    from .clusters import cluster_statistics, find_clusters, g_ffd, g_rdf
+    from .observables import Contacts, contacts_within, fabric, stress
+    from .params import HERMAN2011
+
+    P = HERMAN2011
+    tile, tile_box = make_floe_field(100008 // tiles ** 2, concentration=0.75,
+                                     alpha=P.fsd_exponent, mean_diameter=P.mean_diameter,
+                                     thickness=P.thickness, seed=seed)
+    shift = np.array([(a * tile_box.lx, b * tile_box.ly) for a in range(tiles)
+                      for b in range(tiles)])
+    pos = (tile.positions[None, :, :] + shift[:, None, :]).reshape(-1, 2)
+    radii = np.tile(tile.radii, tiles * tiles)
+    box = PeriodicBox(tiles * tile_box.lx, tiles * tile_box.ly)
+    n = radii.size
+    rows = []
+
+    def record(case, seconds, **extra):
+        rows.append(dict(case=case, seconds=seconds, **extra))
+        if not quiet:
+            print(f"  {case}: {seconds * 1e3:.3g} ms", flush=True)
+
+    labels = find_clusters(pos, radii, box, 0.5)
+    cs = cluster_statistics(labels, radii)
+    record(f"find_clusters, N = {n}, d_m = 0.5 m",
+           _best_time(lambda: find_clusters(pos, radii, box, 0.5)),
+           clusters=cs.n_clusters, largest_fraction=cs.largest_fraction)
+    record(f"cluster_statistics, {cs.n_clusters} clusters",
+           _best_time(lambda: cluster_statistics(labels, radii)))
+    record(f"g_ffd, N = {n}, x < 2 m, 100 bins",
+           _best_time(lambda: g_ffd(pos, radii, box, 2.0, 100)))
+    record(f"g_rdf, N = {n}, x < 10 m, 100 bins",
+           _best_time(lambda: g_rdf(pos, box, 10.0, 100)))
+
+    geo = contacts_within(pos, radii, box, 1.0)
+    k = min(len(geo), 100000)
+    rng = np.random.default_rng(seed)
+    push = rng.uniform(1e3, 1e5, k)                  # repulsive normal forces [N]
+    force = -push[:, None] * geo.normal[:k]
+    c = Contacts(geo.i[:k], geo.j[:k], geo.normal[:k], geo.overlap[:k], push,
+                 np.zeros(k), force, geo.contact_point[:k], geo.branch_i[:k], geo.branch_j[:k])
+    record(f"fabric, {k} contacts", _best_time(lambda: fabric(c, n)))
+    record(f"stress with per-floe parts, {k} contacts",
+           _best_time(lambda: stress(c, box.area, n_floes=n)))
+    record(f"stress, tensor only, {k} contacts",
+           _best_time(lambda: stress(c, box.area, per_floe=False)))
+    return rows
+
+
+def format_observables_table(rows: list[dict]) -> str:
+    lines = _table_head(f"Observables, {numba.get_num_threads()} threads",
+                        ["case", "wall time [ms]"])
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['seconds'] * 1e3:.3g} |")
+    for r in rows:
+        if "clusters" in r:
+            lines.append("")
+            lines.append(f"{r['clusters']} clusters; the largest holds "
+                         f"{100 * r['largest_fraction']:.1f} % of the floe area")
     return "\n".join(lines)
 
 
@@ -372,6 +459,9 @@ def main(argv=None) -> int:
     hd = sub.add_parser("harddisk", help="collisions per second of the hard-disc engine")
     hd.add_argument("--seed", type=int, default=1)
     hd.add_argument("--quiet", action="store_true")
+    ob = sub.add_parser("observables", help="wall time of clusters, fabric and stress")
+    ob.add_argument("--seed", type=int, default=1)
+    ob.add_argument("--quiet", action="store_true")
     sub.add_parser("_control")
     m = sub.add_parser("_memory")
     m.add_argument("n", type=int)
@@ -385,6 +475,11 @@ def main(argv=None) -> int:
         hd_rows = bench_harddisk(args.seed, args.quiet)
         print()
         print(format_harddisk_table(hd_rows))
+        return 0
+    if args.engine == "observables":
+        ob_rows = bench_observables(args.seed, quiet=args.quiet)
+        print()
+        print(format_observables_table(ob_rows))
         return 0
     if args.engine == "_control":
         _control_child()
