@@ -9,6 +9,9 @@ State and set-up
 Observables
     :mod:`physics.observables` — contact fabric and stress (both engines).
     :mod:`physics.clusters` — clusters, power-law exponents, g_rdf, g_ffd.
+Ice thickness distribution
+    :mod:`physics.itd` — Smoluchowski coagulation, the generalised Thorndike
+    model (:class:`ThorndikeModel`), Lensu's fragmentation.
 
 This package never imports gymnasium or torch.
 """
@@ -22,6 +25,7 @@ from .clusters import (ClusterStats, cluster_statistics, find_clusters, fsd_expo
                        g_rdf, power_law_exponent, rank_order)
 from .harddisk import CollisionLog, HardDiskSimulation
 from .hertz import HertzSimulation
+from .itd import ThorndikeModel, make_kernel, solve_fragmentation, solve_smoluchowski
 from .observables import (Contacts, Fabric, Stress, collision_stress, contacts_within, fabric,
                           stress)
 from .params import HERMAN2011, HERMAN2013, ContactParams, ForcingParams, PaperPreset
@@ -37,6 +41,7 @@ __all__ = [
     "Fabric", "Stress", "fabric", "stress", "collision_stress", "contacts_within",
     "ClusterStats", "find_clusters", "cluster_statistics", "power_law_exponent", "rank_order",
     "fsd_exponent", "g_rdf", "g_ffd",
+    "ThorndikeModel", "make_kernel", "solve_smoluchowski", "solve_fragmentation",
     "HERMAN2011", "HERMAN2013", "ContactParams", "ForcingParams", "PaperPreset",
     "damping_alpha",
 ]
