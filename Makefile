@@ -32,6 +32,7 @@ bench: setup
 	$(PY) -m physics.bench hertz
 	$(PY) -m physics.bench harddisk
 	$(PY) -m physics.bench observables
+	$(PY) -m physics.bench itd
 
 validate: setup
 	$(PY) -m physics.validate

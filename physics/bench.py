@@ -33,6 +33,11 @@ N = 100 008 floes, a placed field of 2778 floes tiled 6 × 6; clusters with
 d_m = 0.5 m, cluster statistics, g_ffd and g_rdf; fabric and stress
 (per-floe parts included) from the first 10⁵ contacts of the pairs closer
 than 1 m, with repulsive normal forces of random size.
+
+Ice thickness distribution (one core, best of three after a warm-up):
+a 2000-day generalised-Thorndike run with 200 classes of 0.1 m and daily
+steps for each kernel of Table 1 and rafting, and ``solve_smoluchowski``
+with n = 1000 masses to t = 10 (constant kernel, monodisperse start).
 """
 from __future__ import annotations
 
@@ -443,6 +448,52 @@ def format_observables_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def _itd_cases():
+    """The Table 1 kernels with the rates of ``python -m physics.itd_figures``
+    (Fig. 4) and its rafting run with the 1 m cut-off (Fig. 5)."""
+    from .itd_figures import KERNELS, R0, RAFT_FACTOR
+    return list(KERNELS.items()) + [("rafting", dict(r=R0, h_raft=1.0, factor=RAFT_FACTOR))]
+
+
+def bench_itd(quiet: bool = False) -> list[dict]:
+    """Wall times of the ITD models (see the module docstring)."""
+    from .itd import ThorndikeModel, constant_kernel, solve_smoluchowski
+
+    rows = []
+    for kind, params in _itd_cases():
+        def run(kind=kind, params=params):
+            m = ThorndikeModel(kind, **params)
+            m.run(2000)
+            return m
+        seconds = _best_time(run, repeats=3)
+        m = run()
+        rows.append(dict(case=f"Thorndike, {kind} kernel {params}, 2000 days", seconds=seconds,
+                         substeps=m.substeps, open_water=m.open_water,
+                         mean_thickness=m.mean_thickness))
+        if not quiet:
+            print(f"  {rows[-1]['case']}: {seconds:.3g} s", flush=True)
+    n = 1000
+    u0 = np.zeros(n)
+    u0[0] = 1.0
+    k = constant_kernel(n)
+    seconds = _best_time(lambda: solve_smoluchowski(k, u0, [10.0]), repeats=3)
+    rows.append(dict(case="solve_smoluchowski, n = 1000, t = 10, constant kernel",
+                     seconds=seconds))
+    if not quiet:
+        print(f"  {rows[-1]['case']}: {seconds:.3g} s", flush=True)
+    return rows
+
+
+def format_itd_table(rows: list[dict]) -> str:
+    lines = _table_head("Ice thickness distribution, one core",
+                        ["case", "wall time [s]", "Euler steps", "open water", "mean h [m]"])
+    for r in rows:
+        extra = (f"{r['substeps']} | {r['open_water']:.3f} | {r['mean_thickness']:.3f}"
+                 if "substeps" in r else "– | – | –")
+        lines.append(f"| {r['case']} | {r['seconds']:.3g} | {extra} |")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m physics.bench", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -462,6 +513,7 @@ def main(argv=None) -> int:
     ob = sub.add_parser("observables", help="wall time of clusters, fabric and stress")
     ob.add_argument("--seed", type=int, default=1)
     ob.add_argument("--quiet", action="store_true")
+    sub.add_parser("itd", help="wall time of the ice-thickness-distribution models")
     sub.add_parser("_control")
     m = sub.add_parser("_memory")
     m.add_argument("n", type=int)
@@ -480,6 +532,9 @@ def main(argv=None) -> int:
         ob_rows = bench_observables(args.seed, quiet=args.quiet)
         print()
         print(format_observables_table(ob_rows))
+        return 0
+    if args.engine == "itd":
+        print(format_itd_table(bench_itd()))
         return 0
     if args.engine == "_control":
         _control_child()
