@@ -43,6 +43,8 @@ Generalised Thorndike model
     * **Strength**: the kernel matrix is multiplied by ``kernel_scale``
       (settable between steps, e.g. by an environment); for the constant
       kernel K = 1/R_T this sets Godlovitch's relative strength R_T.
+      :meth:`ThorndikeModel.set_rafting` changes the rafting factor and
+      cut-off between steps, for any kernel.
 
 Fragmentation
     :func:`solve_fragmentation` — Lensu's pure-fragmentation model: every
@@ -401,6 +403,13 @@ class ThorndikeModel:
         self.dh = float(dh)
         self.h = np.concatenate([[0.0], self.h])
         self.K = make_kernel(kernel, self.n, self.dh, **kernel_params)
+        self._K_base = self.K
+        self.rafting_factor, self.h_raft = 1.0, 0.0
+        if isinstance(kernel, str) and kernel == "rafting":
+            # the stacking and rafting parts kept apart, so that either can change
+            self._K_base = constant_kernel(self.n, kernel_params.get("r", 1.0))
+            self.rafting_factor = _check_rate("factor", kernel_params.get("factor", 2.0))
+            self.h_raft = float(kernel_params.get("h_raft", 0.5))
         self.kernel_scale = scale
         self.thermodynamics = bool(thermodynamics)
         self.thermo_strength = _check_rate("thermo_strength", thermo_strength)
@@ -424,6 +433,20 @@ class ThorndikeModel:
         self.g = g
         self._work = np.zeros(self.n + 1)
         self.substeps = 0
+
+    def set_rafting(self, factor: float, h_raft: float | None = None) -> None:
+        """Multiply the kernel by ``factor`` where both floes are thinner than
+        ``h_raft`` [m] (eq 18 applied to any kernel), from the next step on;
+        factor 1 switches rafting off. ``h_raft`` defaults to the current cut-off."""
+        factor = _check_rate("factor", factor)
+        h = self.h_raft if h_raft is None else float(h_raft)
+        if not (math.isfinite(h) and h >= 0):
+            raise ValueError(f"h_raft must be a finite thickness >= 0 [m], got {h_raft!r}")
+        thin = self.h[1:] < h
+        k = self._K_base.copy()
+        k[np.ix_(thin, thin)] *= factor
+        self.K = k
+        self.rafting_factor, self.h_raft = factor, h
 
     @property
     def kernel_scale(self) -> float:

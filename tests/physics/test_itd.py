@@ -707,3 +707,36 @@ def test_bad_model_and_kernel_parameters_raise():
         ThorndikeModel("constant", n_classes=4, dh=-0.1)
     with pytest.raises(ValueError):
         solve_fragmentation(GOOD_U, [0.0, 1.0], rate=-1.0)
+
+
+def test_rafting_can_be_changed_between_steps():
+    """set_rafting multiplies the kernel by the factor exactly where both
+    classes are thinner than h_raft, for any kernel, and factor 1 restores
+    the base kernel; kernel="rafting" starts from that split (K = factor·r
+    on thin-thin pairs). One step after doubling the thin-thin rate, open
+    water production from purely thin ice doubles (no thermodynamics, 1e-12)."""
+    m = ThorndikeModel("exponential", n_classes=10, r=0.3, beta=0.2, thermodynamics=False)
+    base = m.K.copy()
+    m.set_rafting(3.0, h_raft=0.35)
+    thin = m.h[1:] < 0.35
+    expect = base.copy()
+    expect[np.ix_(thin, thin)] *= 3.0
+    np.testing.assert_array_equal(m.K, expect)
+    m.set_rafting(1.0)
+    np.testing.assert_array_equal(m.K, base)
+    r = ThorndikeModel("rafting", n_classes=10, r=0.2, h_raft=0.45, factor=4.0)
+    np.testing.assert_array_equal(r.K, rafting_kernel(10, r=0.2, h_raft=0.45, dx=0.1, factor=4.0))
+    assert (r.rafting_factor, r.h_raft) == (4.0, 0.45)
+    g0 = np.zeros(11)
+    g0[0], g0[1] = 0.5, 0.5                       # open water and 0.1 m ice
+    gains = []
+    for factor in (1.0, 2.0):
+        t = ThorndikeModel("constant", n_classes=10, r=0.1, g0=g0, thermodynamics=False)
+        t.set_rafting(factor, h_raft=0.15)
+        t.step(0.01)
+        gains.append(t.open_water - 0.5)
+    assert gains[1] == pytest.approx(2 * gains[0], rel=1e-12)
+    with pytest.raises(ValueError, match="factor"):
+        m.set_rafting(-1.0)
+    with pytest.raises(ValueError, match="h_raft"):
+        m.set_rafting(2.0, h_raft=float("nan"))
