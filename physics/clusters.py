@@ -32,6 +32,7 @@ from numba import njit
 
 from .domain import Box
 from .observables import check_positions, near_pairs
+from .params import check_range
 
 __all__ = ["find_clusters", "ClusterStats", "cluster_statistics", "PowerLawFit",
            "power_law_exponent", "exponent_series", "rank_order", "fsd_exponent",
@@ -97,8 +98,8 @@ def find_clusters(positions, radii, box: Box, max_gap: float = 0.5) -> np.ndarra
     largest cluster). Near-linear in N: cell lists sized for the typical floe
     and union–find, never all pairs.
     """
-    pos, r = check_positions(positions, radii)
-    i, j, _, _, _ = near_pairs(pos, r, box, max_gap)
+    i, j, _, _, _ = near_pairs(positions, radii, box, max_gap)     # validates the input
+    r = np.asarray(radii, dtype=float)
     root = union_find_roots(r.size, i, j)
     return _labels_by_area(root, np.pi * r * r)
 
@@ -243,9 +244,8 @@ def fsd_exponent(diameters, k: int = 1) -> PowerLawFit:
 # -- pair distributions ----------------------------------------------------------
 
 def _check_histogram(name, x_max, bins, box):
+    check_range(f"{name} [m]", x_max, 0.0, None, low_open=True)
     xm = float(x_max)
-    if not (math.isfinite(xm) and xm > 0):
-        raise ValueError(f"{name} must be a positive distance [m], got {x_max!r}")
     if isinstance(bins, bool) or int(bins) != bins or bins < 1:
         raise ValueError(f"bins must be a positive integer, got {bins!r}")
     if not isinstance(box, Box) or not all(box.periodic):

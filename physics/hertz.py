@@ -305,12 +305,11 @@ class HertzSimulation:
                                  self.box.kernel_array(self.time), self._start, self._nbr,
                                  self._hist)
         normal = d[:, 0:2].copy()
-        delta = d[:, 2]
-        arm_i = (self.radius[i] - 0.5 * delta)[:, None] * normal
-        arm_j = -(self.radius[j] - 0.5 * delta)[:, None] * normal
-        return Contacts(i=i, j=j, normal=normal, overlap=delta.copy(), normal_force=d[:, 3].copy(),
+        delta = d[:, 2].copy()
+        point, arm_i, arm_j = Contacts.branches(self.positions, self.radius, i, j, normal, delta)
+        return Contacts(i=i, j=j, normal=normal, overlap=delta, normal_force=d[:, 3].copy(),
                         tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
-                        contact_point=self.positions[i] + arm_i, branch_i=arm_i, branch_j=arm_j)
+                        contact_point=point, branch_i=arm_i, branch_j=arm_j)
 
     def fabric(self) -> Fabric:
         """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts

@@ -67,6 +67,8 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
+from .params import check_range
+
 __all__ = ["constant_kernel", "exponential_kernel", "multiplicative_kernel", "additive_kernel",
            "rafting_kernel", "kernel_from_function", "make_kernel", "check_kernel",
            "solve_smoluchowski", "smoluchowski_rhs", "ThorndikeModel", "growth_rates",
@@ -80,17 +82,22 @@ YEAR_DAYS = 360.0
 def _class_values(n, dx):
     if isinstance(n, bool) or int(n) != n or n < 2:
         raise ValueError(f"the number of classes n must be an integer >= 2, got {n!r}")
-    dx = float(dx)
-    if not (math.isfinite(dx) and dx > 0):
-        raise ValueError(f"the class width must be positive, got {dx!r}")
-    return dx * np.arange(1, int(n) + 1)
+    check_range("class width dx", dx, 0.0, None, low_open=True)
+    return float(dx) * np.arange(1, int(n) + 1)
 
 
-def _check_rate(name, value):
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0):
-        raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
-    return v
+def _check_rate(name, value) -> float:
+    """A rate or factor: finite and >= 0, as a float."""
+    check_range(name, value, 0.0, None)
+    return float(value)
+
+
+def _check_times(t_eval) -> np.ndarray:
+    t = np.asarray(t_eval, dtype=float)
+    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or t[0] < 0 \
+            or np.any(np.diff(t) < 0):
+        raise ValueError("t_eval must be a non-empty, non-decreasing array of finite times >= 0")
+    return t
 
 
 def check_kernel(K, n: int | None = None) -> np.ndarray:
@@ -240,10 +247,7 @@ def solve_smoluchowski(K, u0, t_eval, *, method: str = "DOP853", rtol: float = 1
 
     u0 = _check_numbers(u0)
     k = check_kernel(K, u0.size)
-    t = np.asarray(t_eval, dtype=float)
-    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or t[0] < 0 \
-            or np.any(np.diff(t) < 0):
-        raise ValueError("t_eval must be a non-empty, non-decreasing array of finite times >= 0")
+    t = _check_times(t_eval)
     out = np.empty_like(u0)
     if t[-1] == 0:
         return np.repeat(u0[None, :], t.size, axis=0)
@@ -402,20 +406,22 @@ class ThorndikeModel:
         self.n = self.h.size
         self.dh = float(dh)
         self.h = np.concatenate([[0.0], self.h])
-        self.K = make_kernel(kernel, self.n, self.dh, **kernel_params)
-        self._K_base = self.K
         self.rafting_factor, self.h_raft = 1.0, 0.0
         if isinstance(kernel, str) and kernel == "rafting":
             # the stacking and rafting parts kept apart, so that either can change
-            self._K_base = constant_kernel(self.n, kernel_params.get("r", 1.0))
-            self.rafting_factor = _check_rate("factor", kernel_params.get("factor", 2.0))
-            self.h_raft = float(kernel_params.get("h_raft", 0.5))
+            self._K_base = make_kernel("constant", self.n, self.dh, r=kernel_params.pop("r", 1.0))
+            self.K = self._K_base
+            self.set_rafting(kernel_params.pop("factor", 2.0), kernel_params.pop("h_raft", 0.5))
+            if kernel_params:
+                raise TypeError(f"unexpected rafting kernel parameters {sorted(kernel_params)}")
+        else:
+            self.K = make_kernel(kernel, self.n, self.dh, **kernel_params)
+            self._K_base = self.K
         self.kernel_scale = scale
         self.thermodynamics = bool(thermodynamics)
         self.thermo_strength = _check_rate("thermo_strength", thermo_strength)
+        check_range("start_day", start_day)
         self.time = float(start_day)
-        if not math.isfinite(self.time):
-            raise ValueError(f"start_day must be finite, got {start_day!r}")
         if g0 is None:
             g = np.zeros(self.n + 1)
             g[0] = 1.0
@@ -440,8 +446,7 @@ class ThorndikeModel:
         factor 1 switches rafting off. ``h_raft`` defaults to the current cut-off."""
         factor = _check_rate("factor", factor)
         h = self.h_raft if h_raft is None else float(h_raft)
-        if not (math.isfinite(h) and h >= 0):
-            raise ValueError(f"h_raft must be a finite thickness >= 0 [m], got {h_raft!r}")
+        check_range("h_raft", h, 0.0, None)
         thin = self.h[1:] < h
         k = self._K_base.copy()
         k[np.ix_(thin, thin)] *= factor
@@ -465,9 +470,8 @@ class ThorndikeModel:
         """Advance by ``dt`` days in forward-Euler substeps, each short enough
         that no class loses more than 90 % of itself (the limit is taken
         again before every substep); ``substeps`` counts them."""
+        check_range("dt", dt, 0.0, None, low_open=True)
         dt = float(dt)
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be a positive number of days, got {dt!r}")
         end = self.time + dt
         left = dt
         while left > 0.0:
@@ -487,23 +491,28 @@ class ThorndikeModel:
         """Step for ``days`` days with steps of ``dt``; with ``every`` (days),
         return (times, g snapshots) taken every that many days (and at the
         end)."""
+        check_range("dt", dt, 0.0, None, low_open=True)
+        if every is not None:
+            check_range("every", every, 0.0, None, low_open=True)
         dt = float(dt)
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be a positive number of days, got {dt!r}")
-        if every is not None and not (math.isfinite(float(every)) and float(every) > 0):
-            raise ValueError(f"every must be a positive number of days, got {every!r}")
         steps = int(round(float(days) / dt))
         if steps < 0 or not math.isclose(steps * dt, days, rel_tol=1e-9, abs_tol=1e-12):
             raise ValueError(f"days ({days!r}) must be a non-negative multiple of dt ({dt!r})")
         per = None if every is None else max(1, int(round(float(every) / float(dt))))
         times, snaps = [self.time], [self.g.copy()]
-        bar = _progress(steps, progress)
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
+            bar = tqdm(total=steps, unit="step", desc="ITD", dynamic_ncols=True)
         for s in range(1, steps + 1):
             self.step(dt)
             if per is not None and (s % per == 0 or s == steps):
                 times.append(self.time)
                 snaps.append(self.g.copy())
-            bar(s)
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
         if per is not None:
             return np.array(times), np.array(snaps)
         return None
@@ -541,23 +550,6 @@ class ThorndikeModel:
                 f"open_water={self.open_water:.4f}, mean_thickness={self.mean_thickness:.3f} m)")
 
 
-def _progress(total, enabled):
-    if not enabled:
-        return lambda _s: None
-    import sys
-    state = {"last": -1}
-
-    def show(s):
-        pct = int(100 * s / max(total, 1))
-        if pct != state["last"]:
-            state["last"] = pct
-            sys.stderr.write(f"\r  {pct:3d} % ({s}/{total} steps)")
-            if s >= total:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
-    return show
-
-
 # -- fragmentation (Lensu) -----------------------------------------------------------
 
 def solve_fragmentation(u0, t_eval, rate: float = 1.0) -> np.ndarray:
@@ -574,10 +566,7 @@ def solve_fragmentation(u0, t_eval, rate: float = 1.0) -> np.ndarray:
 
     u0 = _check_numbers(u0)
     a = _check_rate("rate", rate)
-    t = np.asarray(t_eval, dtype=float)
-    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or t[0] < 0 \
-            or np.any(np.diff(t) < 0):
-        raise ValueError("t_eval must be a non-empty, non-decreasing array of finite times >= 0")
+    t = _check_times(t_eval)
     n = u0.size
     A = np.zeros((n, n))
     for k in range(2, n + 1):                 # a floe of mass k feeds every j < k

@@ -44,6 +44,7 @@ import numpy as np
 
 from .domain import Box
 from .neighbors import build_pair_list, choose_cell_size, radius_rank
+from .params import check_range
 
 __all__ = ["Contacts", "Fabric", "Stress", "fabric", "stress", "collision_stress",
            "near_pairs", "contacts_within", "check_positions"]
@@ -82,6 +83,14 @@ class Contacts:
     def __len__(self):
         return int(self.i.size)
 
+    @staticmethod
+    def branches(positions, radii, i, j, normal, overlap):
+        """Contact points (the middle of the overlap δ, or of the gap if δ < 0)
+        and the branch vectors from the centres of i and j to them."""
+        arm_i = (radii[i] - 0.5 * overlap)[:, None] * normal
+        arm_j = -(radii[j] - 0.5 * overlap)[:, None] * normal
+        return positions[i] + arm_i, arm_i, arm_j
+
     @classmethod
     def from_geometry(cls, positions, radii, i, j, normal, distance, force=None):
         """Build a table from pair geometry: the contact point is the middle
@@ -92,14 +101,13 @@ class Contacts:
         normal = np.asarray(normal, dtype=float).reshape(-1, 2)
         radii = np.asarray(radii, dtype=float)
         delta = radii[i] + radii[j] - np.asarray(distance, dtype=float)
-        arm_i = (radii[i] - 0.5 * delta)[:, None] * normal
-        arm_j = -(radii[j] - 0.5 * delta)[:, None] * normal
+        point, arm_i, arm_j = cls.branches(np.asarray(positions, dtype=float), radii, i, j,
+                                           normal, delta)
         f = np.zeros((i.size, 2)) if force is None else np.asarray(force, dtype=float).reshape(-1, 2)
         tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
         return cls(i=i, j=j, normal=normal, overlap=delta, normal_force=-np.sum(f * normal, axis=1),
                    tangential_force=np.sum(f * tangent, axis=1), force=f,
-                   contact_point=np.asarray(positions, dtype=float)[i] + arm_i,
-                   branch_i=arm_i, branch_j=arm_j)
+                   contact_point=point, branch_i=arm_i, branch_j=arm_j)
 
 
 @dataclass
@@ -158,10 +166,8 @@ class Stress:
 # -- input checks ---------------------------------------------------------------
 
 def _check_area(area) -> float:
-    a = float(area)
-    if not (math.isfinite(a) and a > 0):
-        raise ValueError(f"area must be a positive finite number [m^2], got {area!r}")
-    return a
+    check_range("area [m^2]", area, 0.0, None, low_open=True)
+    return float(area)
 
 
 def _check_count(name, n) -> int:
@@ -316,9 +322,8 @@ def collision_stress(log, radii, area: float, duration: float, *,
     arrays i, j and impulse (K, 2)).
     """
     s = _check_area(area)
+    check_range("duration", duration, 0.0, None, low_open=True)
     t = float(duration)
-    if not (math.isfinite(t) and t > 0):
-        raise ValueError(f"duration must be positive, got {duration!r}")
     r = np.asarray(radii, dtype=float)
     if r.ndim != 1 or not np.all(np.isfinite(r)) or np.any(r < 0):
         raise ValueError("radii must be a 1-D array of finite non-negative values")
@@ -345,9 +350,8 @@ def near_pairs(positions, radii, box: Box, max_gap: float):
     side (``ValueError`` otherwise).
     """
     pos, r = check_positions(positions, radii)
+    check_range("max_gap [m]", max_gap, 0.0, None)
     gap = float(max_gap)
-    if not (math.isfinite(gap) and gap >= 0):
-        raise ValueError(f"max_gap must be a finite non-negative distance [m], got {max_gap!r}")
     if not isinstance(box, Box):
         raise ValueError(f"box must be a physics.domain Box, got {type(box).__name__}")
     n = r.size
