@@ -1,0 +1,285 @@
+"""Shared plumbing of the floe environments: :class:`FloeEnv`.
+
+A floe environment owns one engine (``self.sim``), turns an action into
+forcing, advances the engine by the control interval, measures the
+observables of :mod:`iceenvs.observations` and scores them with a reward
+function of :mod:`iceenvs.rewards`. Subclasses say only what differs:
+
+* ``_make_sim(rng, options)`` — a new engine for an episode;
+* ``_apply_action(action)`` — the (clipped) action into forcing;
+* ``_measure()`` — the raw physical observables (dict of SI values);
+* ``_terminated(now)`` — task failure;
+* class attributes ``extra_features`` (entries after the common ones),
+  ``action_names`` and the default ``reward_fn``.
+
+Data flow of one step::
+
+    action → NaN/inf → 0, clip → forcing → engine.advance(control interval)
+      → observables (SI dict) → reward(prev, action, now) and float32 vector
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable
+
+import gymnasium as gym
+import numpy as np
+
+from physics import PaperPreset
+from physics.params import check_range
+
+from .observations import FLOE_FEATURES, Feature, normalise
+
+__all__ = ["FloeEnv", "sanitise_action", "scaled_contact", "hertz_time_step"]
+
+
+def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
+    """The action as float64 of the space's shape with NaN and ±inf set to
+    0 and every entry clipped into the space's bounds."""
+    a = np.array(action, dtype=np.float64).reshape(space.shape)
+    a[~np.isfinite(a)] = 0.0
+    return np.clip(a, space.low, space.high)
+
+
+def scaled_contact(contact, stiffness_scale: float):
+    """The contact law with Young's modulus multiplied by ``stiffness_scale``
+    (a softer contact allows a longer time step: Δt ∝ E^(−2/5))."""
+    check_range("stiffness_scale", stiffness_scale, 0.0, 1.0, low_open=True)
+    return dataclasses.replace(contact, elastic_modulus=contact.elastic_modulus * stiffness_scale)
+
+
+def hertz_time_step(field, box, contact, impact_speed: float, preset_dt: float,
+                    stiffness_scale: float) -> float:
+    """Time step of a Hertz env: the preset's Δt scaled with the stiffness
+    (Δt ∝ E^(−2/5)), and never above a tenth of the shortest contact time
+    at ``impact_speed`` [m/s]."""
+    from physics.hertz import minimum_contact_time
+
+    t_c = minimum_contact_time(field.radii, field.thickness, field.density, contact, impact_speed,
+                               walls=not all(box.periodic))
+    return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
+
+
+class FloeEnv(gym.Env):
+    """Base of the floe environments (not registered itself).
+
+    Parameters common to every floe environment
+    -------------------------------------------
+    n_floes : int — number of floes
+    concentration : float — ice concentration Ā of the start state
+    preset : PaperPreset — parameter table (FSD, material, forcing)
+    control_interval : float — model seconds per env step
+    episode_steps : int — env steps before the episode is truncated
+    reward_fn : callable, optional — ``reward(prev, action, now, **reward_params)``
+    reward_params : dict, optional — overrides of the task's reward parameters
+    stiffness_scale : float — multiplies Young's modulus (Hertz envs); < 1
+        trades contact stiffness for a longer time step (faster training)
+    cluster_gap : float — largest gap [m] between two floes of a cluster
+    render_mode : None, "rgb_array" or "human"
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    extra_features: tuple[Feature, ...] = ()
+    action_names: tuple[str, ...] = ()
+    reward_fn: Callable = None
+    failure_reward = -10.0
+
+    def __init__(self, *, n_floes: int, concentration: float, preset: PaperPreset,
+                 control_interval: float, episode_steps: int, reward_fn=None,
+                 reward_params: dict | None = None, stiffness_scale: float = 1.0,
+                 cluster_gap: float = 0.1, render_mode: str | None = None):
+        check_range("n_floes", n_floes, 2, None)
+        check_range("concentration", concentration, 0.0, 1.0, low_open=True, high_open=True)
+        check_range("control_interval", control_interval, 0.0, None, low_open=True)
+        check_range("episode_steps", episode_steps, 1, None)
+        check_range("cluster_gap", cluster_gap, 0.0, None)
+        if not isinstance(preset, PaperPreset):
+            raise TypeError(f"preset must be a PaperPreset (e.g. physics.HERMAN2013), "
+                            f"got {type(preset).__name__}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
+                             f"None, got {render_mode!r}")
+        self.n_floes = int(n_floes)
+        self.concentration = float(concentration)
+        self.preset = preset
+        self.control_interval = float(control_interval)
+        self.episode_steps = int(episode_steps)
+        self.stiffness_scale = float(stiffness_scale)
+        self.contact = scaled_contact(preset.contact, stiffness_scale)
+        self.cluster_gap = float(cluster_gap)
+        self.render_mode = render_mode
+        if reward_fn is not None:
+            if not callable(reward_fn):
+                raise TypeError("reward_fn must be callable as reward(prev, action, now, **params)")
+            self.reward_fn = reward_fn
+        else:
+            self.reward_fn = type(self).reward_fn
+        self.reward_params = self.default_reward_params()
+        unknown = set(reward_params or ()) - set(self.reward_params)
+        if unknown and reward_fn is None:
+            raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
+                             f"{sorted(self.reward_params)}")
+        self.reward_params.update(reward_params or {})
+
+        self.features = FLOE_FEATURES + self.extra_features
+        n_act = self.action_space.shape[0]
+        low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
+        high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self.sim = None
+        self._steps = 0
+        self._last_action = np.zeros(n_act)
+        self._prev = None
+        self._obs = None
+        self._renderer = None
+
+    # -- to be provided by subclasses ------------------------------------------------
+    def default_reward_params(self) -> dict:
+        return {}
+
+    def _make_sim(self, rng: np.random.Generator, options: dict):
+        raise NotImplementedError
+
+    def _apply_action(self, action: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _measure(self) -> dict:
+        raise NotImplementedError
+
+    def _terminated(self, now: dict) -> bool:
+        return False
+
+    def _advance(self) -> None:
+        self.sim.advance(self.control_interval)
+
+    # -- gymnasium API ----------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        self._reset_options(options)
+        self.sim = self._make_sim(self.np_random, options)
+        self._steps = 0
+        self._last_action = np.zeros(self.action_space.shape[0])
+        self._apply_action(self._last_action)
+        now = self._measure()
+        self._prev = now
+        self._obs = self._vector(now)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), self._info(now)
+
+    def _reset_options(self, options: dict) -> None:
+        """Task options of ``reset(options=...)`` (subclasses read theirs)."""
+        if options:
+            raise ValueError(f"unknown reset options {sorted(options)}")
+
+    def step(self, action):
+        if self.sim is None:
+            raise RuntimeError("call reset() before step()")
+        a = sanitise_action(action, self.action_space)
+        self._last_action = a
+        self._steps += 1
+        try:
+            self._apply_action(a)
+            self._advance()
+            now = self._measure()
+        except (FloatingPointError, RuntimeError, ValueError) as err:
+            # a physics failure ends the episode instead of crashing the caller
+            info = self._info(self._prev)
+            info["error"] = f"{type(err).__name__}: {err}"
+            return self._obs.copy(), float(self.failure_reward), True, False, info
+        reward = float(self.reward_fn(self._prev, a, now, **self.reward_params))
+        info = self._info(now)
+        terminated = bool(self._terminated(now))
+        if not math.isfinite(reward):
+            info["error"] = f"non-finite reward {reward}"
+            reward, terminated = float(self.failure_reward), True
+        self._prev = now
+        self._obs = self._vector(now)
+        truncated = self._steps >= self.episode_steps and not terminated
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), reward, terminated, truncated, info
+
+    def _vector(self, now: dict) -> np.ndarray:
+        vec = normalise(now, self.features)
+        return np.concatenate([vec, self._last_action.astype(np.float32)])
+
+    def _info(self, now: dict) -> dict:
+        return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps}
+
+    # -- rendering --------------------------------------------------------------------
+    def _frame(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode="
+                            "'rgb_array' or 'human' to gymnasium.make")
+            return None
+        if self.sim is None:
+            raise RuntimeError("call reset() before render()")
+        frame = self._frame()
+        if self.render_mode == "rgb_array":
+            return frame
+        from .rendering import Window
+
+        if self._renderer is None:
+            self._renderer = Window(type(self).__name__, frame.shape[1], frame.shape[0],
+                                    self.metadata["render_fps"])
+        self._renderer.show(frame)
+        return None
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+class HertzEnv(FloeEnv):
+    """Base of the environments over the Hertz engine
+    (:class:`physics.HertzSimulation`): measurement from the engine's
+    contacts and Love–Weber stress, frames with force chains.
+
+    ``impact_speed`` [m/s] is the largest relative speed at impact the time
+    step must resolve (wind of 20 m/s drives floes at about 0.5 m/s).
+    """
+
+    impact_speed = 1.0
+
+    def _hertz_sim(self, field, box, forcing):
+        from physics import HertzSimulation
+
+        dt = hertz_time_step(field, box, self.contact, self.impact_speed,
+                             self.preset.time_step,
+                             self.stiffness_scale)
+        return HertzSimulation(field, box, self.contact, forcing, dt=dt,
+                               impact_speed=self.impact_speed, parallel=False)
+
+    def _contact_physics(self) -> dict:
+        from physics.observables import stress
+
+        from .observations import floe_physics
+
+        sim = self.sim
+        self._contacts = sim.contacts()
+        area = sim.box.area
+        st = stress(self._contacts, area, n_floes=sim.n_floes, per_floe=False)
+        mobile = sim.inv_mass > 0
+        return floe_physics(sim.positions, sim.velocities, sim.mass, sim.radius, sim.box,
+                            self._contacts, st.tensor, area, mobile,
+                            cluster_gap=self.cluster_gap)
+
+    def _measure(self) -> dict:
+        return self._contact_physics()
+
+    def _frame(self) -> np.ndarray:
+        from .rendering import draw_floes
+
+        sim = self.sim
+        c = self._contacts
+        return draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
+                          np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
+                          frozen=sim.inv_mass == 0, contact_i=c.i, contact_j=c.j,
+                          contact_force=c.normal_force)

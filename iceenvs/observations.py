@@ -1,0 +1,175 @@
+"""Observations of the floe environments: physical values in SI units and
+their normalised float32 vector.
+
+:func:`floe_physics` measures one snapshot of an engine (a
+:class:`physics.HertzSimulation` or :class:`physics.HardDiskSimulation`)
+with :mod:`physics.observables` and :mod:`physics.clusters` and returns a
+dict of SI values; :func:`normalise` maps such a dict to the vector the
+agent sees, feature by feature, as listed in :data:`FLOE_FEATURES`. The raw
+dict is what reward functions receive and what ``info["physics"]`` holds.
+
+Scaling of the vector (every entry is clipped into the observation space):
+
+* fractions and direction cosines are passed as they are;
+* a stress s [N/m] is ``sign(s) log10(1 + |s| / 1 N/m)`` (so 1 ↔ 9 N/m,
+  4 ↔ 10 kN/m), bounded to [−8, 8];
+* velocities are divided by 1 m/s and bounded to [−5, 5];
+* the granular temperature T [m²/s²] is ``log10(1 + T / 1e-6 m²/s²)``,
+  bounded to [0, 10];
+* a rate x [1/s] is ``log10(1 + x / 0.01 1/s)``, bounded to [0, 10];
+* the cluster exponent α is passed as it is (0 when undefined), bounded to
+  [0, 10].
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from physics import cluster_statistics, find_clusters
+
+__all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "log_stress",
+           "feature_table"]
+
+STRESS_REF = 1.0          # N/m
+TEMPERATURE_REF = 1e-6    # m²/s²
+RATE_REF = 0.01           # 1/s
+
+
+@dataclass(frozen=True)
+class Feature:
+    """One observation entry: name, meaning, unit of the raw value, scaling,
+    bounds of the scaled value."""
+    name: str
+    meaning: str
+    unit: str
+    scaling: str
+    low: float
+    high: float
+
+
+def log_stress(s):
+    """sign(s) log10(1 + |s| / 1 N/m)."""
+    return math.copysign(math.log10(1.0 + abs(s) / STRESS_REF), s)
+
+
+def _identity(x):
+    return x
+
+
+def _velocity(x):
+    return x / 1.0
+
+
+def _temperature(x):
+    return math.log10(1.0 + max(x, 0.0) / TEMPERATURE_REF)
+
+
+def _rate(x):
+    return math.log10(1.0 + max(x, 0.0) / RATE_REF)
+
+
+def _exponent(x):
+    return 0.0 if not math.isfinite(x) else x
+
+
+_SCALERS = {"none": _identity, "log stress": log_stress, "/ 1 m/s": _velocity,
+            "log temperature": _temperature, "log rate": _rate,
+            "exponent": _exponent}
+
+FLOE_FEATURES: tuple[Feature, ...] = (
+    Feature("concentration", "ice concentration A = floe area / box area", "-", "none", 0.0, 1.0),
+    Feature("z_c", "mean contact number of non-rattlers Z_c (Herman 2013 eq 10)", "-", "none",
+            0.0, 20.0),
+    Feature("z_a", "contact anisotropy Z_a", "-", "none", 0.0, 20.0),
+    Feature("f_nr", "fraction of non-rattlers (floes with ≥ 2 contacts)", "-", "none", 0.0, 1.0),
+    Feature("fabric_cos2", "cos 2θ_f of the fabric's principal direction θ_f", "-", "none",
+            -1.0, 1.0),
+    Feature("fabric_sin2", "sin 2θ_f", "-", "none", -1.0, 1.0),
+    Feature("pressure", "p = (σ₁ + σ₂)/2 of the contact stress, compression > 0", "N/m",
+            "log stress", -8.0, 8.0),
+    Feature("shear", "τ = (σ₁ − σ₂)/2", "N/m", "log stress", -8.0, 8.0),
+    Feature("stress_cos2", "cos 2θ_σ of the major principal stress direction θ_σ", "-", "none",
+            -1.0, 1.0),
+    Feature("stress_sin2", "sin 2θ_σ", "-", "none", -1.0, 1.0),
+    Feature("u_x", "mean ice velocity, x (mass-weighted, mobile floes)", "m/s", "/ 1 m/s",
+            -5.0, 5.0),
+    Feature("u_y", "mean ice velocity, y", "m/s", "/ 1 m/s", -5.0, 5.0),
+    Feature("temperature", "granular temperature ⟨|u − ū|²⟩/2 (mass-weighted)", "m²/s²",
+            "log temperature", 0.0, 10.0),
+    Feature("largest_cluster", "area of the largest cluster / total floe area", "-", "none",
+            0.0, 1.0),
+    Feature("clusters_per_floe", "number of clusters / number of floes", "-", "none", 0.0, 1.0),
+    Feature("cluster_alpha", "ML exponent α of the cluster-size distribution (0: undefined)",
+            "-", "exponent", 0.0, 10.0),
+)
+
+
+def _direction(tensor):
+    """(cos 2θ, sin 2θ) of the major principal axis of a symmetric 2×2 tensor
+    (0, 0 when isotropic)."""
+    a, b, c = tensor[0, 0], tensor[0, 1], tensor[1, 1]
+    x, y = a - c, 2.0 * b
+    norm = math.hypot(x, y)
+    if norm <= 1e-12 * (abs(a) + abs(c) + 1e-300):
+        return 0.0, 0.0
+    return x / norm, y / norm
+
+
+def floe_physics(positions, velocities, masses, radii, box, contacts, stress_tensor, area,
+                 mobile, *, cluster_gap: float) -> dict:
+    """Physical observables of one snapshot, SI units (see :data:`FLOE_FEATURES`).
+
+    ``contacts`` is a :class:`physics.Contacts` table, ``stress_tensor`` the
+    (2, 2) contact stress [N/m] (compression positive), ``mobile`` the mask
+    of floes that can move, ``cluster_gap`` [m] the largest edge-to-edge
+    gap of two floes of one cluster.
+    """
+    from physics import fabric
+
+    n = radii.size
+    fab = fabric(contacts, n)
+    s1, s2 = np.linalg.eigvalsh(0.5 * (stress_tensor + stress_tensor.T))[::-1]
+    fc, fs = _direction(fab.tensor)
+    sc, ss = _direction(stress_tensor)
+    m = masses[mobile]
+    v = velocities[mobile]
+    if m.size:
+        mean_v = (m[:, None] * v).sum(axis=0) / m.sum()
+        temp = 0.5 * float((m * ((v - mean_v) ** 2).sum(axis=1)).sum() / m.sum())
+    else:
+        mean_v, temp = np.zeros(2), 0.0
+    stats = cluster_statistics(find_clusters(positions, radii, box, cluster_gap), radii)
+    return dict(
+        concentration=float(np.pi * np.sum(radii ** 2) / area),
+        z_c=float(fab.z_c), z_a=float(fab.z_a), f_nr=float(fab.f_nr),
+        fabric_cos2=fc, fabric_sin2=fs,
+        pressure=float(0.5 * (s1 + s2)), shear=float(0.5 * (s1 - s2)),
+        stress_cos2=sc, stress_sin2=ss,
+        u_x=float(mean_v[0]), u_y=float(mean_v[1]), temperature=temp,
+        largest_cluster=float(stats.largest_fraction),
+        clusters_per_floe=stats.n_clusters / n,
+        cluster_alpha=float(stats.alpha),
+    )
+
+
+def normalise(raw: dict, features) -> np.ndarray:
+    """The float32 vector of ``features`` from a raw dict, scaled and clipped
+    into each feature's bounds; a non-finite value becomes 0."""
+    out = np.empty(len(features), dtype=np.float32)
+    for k, f in enumerate(features):
+        x = _SCALERS[f.scaling](float(raw[f.name]))
+        if not math.isfinite(x):
+            x = 0.0
+        out[k] = min(max(x, f.low), f.high)
+    return out
+
+
+def feature_table(features) -> str:
+    """Markdown table of the observation entries (for docstrings and the README)."""
+    lines = ["| index | name | meaning | unit | scaling | bounds |", "|---|---|---|---|---|---|"]
+    for k, f in enumerate(features):
+        lines.append(f"| {k} | `{f.name}` | {f.meaning} | {f.unit} | {f.scaling} | "
+                     f"[{f.low:g}, {f.high:g}] |")
+    return "\n".join(lines)

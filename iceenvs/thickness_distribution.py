@@ -1,0 +1,400 @@
+"""``iceenvs/ThicknessDistribution-v0``: hold the ice thickness distribution
+at a target through the seasonal cycle."""
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
+from physics.itd_figures import KERNELS, R0, RAFT_FACTOR
+from physics.params import check_range
+
+from .base import sanitise_action
+from .rewards import thickness_distribution_reward, wasserstein1
+
+__all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
+           "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
+
+RAFT_MAX = 2.0 * RAFT_FACTOR     # rafting factor at action[1] = +1 (1 at action[1] = −1)
+RAFT_CUTOFF = 0.5                # m: rafting acts where both floes are thinner than this
+COARSE_WIDTH = 0.5               # m: width of the coarse observation classes
+N_COARSE = 20                    # coarse ice classes; the last gathers h >= 9.5 m
+MEAN_SCALE = 10.0                # m: the mean thickness is observed in these units
+TARGET_OPEN_WATER = 0.05         # open-water fraction of the default target
+TARGET_EFOLDING = 1.0            # m: λ of the default target g ∝ h exp(−h/λ)
+START_NOISE = 0.1                # log-normal perturbation of the default start
+# default kernel parameters: the calibrated rates, r0 for the constant kernel
+DEFAULT_KERNEL_PARAMS = {**KERNELS, "constant": dict(r=R0)}
+
+_OPTIONS = ("target", "g0")
+
+
+def default_target(h, open_water: float = TARGET_OPEN_WATER,
+                   efolding: float = TARGET_EFOLDING) -> np.ndarray:
+    """The default target on the class thicknesses ``h`` (open water first):
+    ``open_water`` of open water and the rest ice with g ∝ h exp(−h/λ),
+    λ = ``efolding`` [m] (mean ice thickness 2λ), normalised to sum 1."""
+    h = np.asarray(h, dtype=float)
+    ice = h[1:] * np.exp(-h[1:] / efolding)
+    g = np.empty(h.size)
+    g[0] = open_water
+    g[1:] = (1.0 - open_water) * ice / ice.sum()
+    return g
+
+
+def _coarse_index(h) -> np.ndarray:
+    """Coarse class of every fine class: 0 for open water, 1 + j for ice with
+    j·0.5 m <= h < (j + 1)·0.5 m, j < 19, and 20 for h >= 9.5 m."""
+    h = np.asarray(h, dtype=float)
+    j = np.floor(h[1:] / COARSE_WIDTH + 1e-9).astype(np.intp)
+    idx = np.empty(h.size, dtype=np.intp)
+    idx[0] = 0
+    idx[1:] = 1 + np.minimum(j, N_COARSE - 1)
+    return idx
+
+
+def _distribution(name: str, value, size: int) -> np.ndarray:
+    """A fine-class distribution from ``reset`` options: 1-D of ``size``
+    entries, finite, >= 0 and not all 0; returned normalised to sum 1."""
+    try:
+        g = np.array(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be an array of {size} fractions: {err}") from None
+    if g.shape != (size,):
+        raise ValueError(f"{name} must have shape ({size},) (open water first, then the "
+                         f"n_classes ice classes), got {g.shape}")
+    if not np.all(np.isfinite(g)) or np.any(g < 0):
+        raise ValueError(f"{name} must be finite and >= 0")
+    total = g.sum()
+    if not total > 0:
+        raise ValueError(f"{name} must have a positive sum")
+    return g / total
+
+
+_TABLE_ROWS = "\n".join(
+    f"    | {1 + j} | `g_{1 + j}` | ice of {j * COARSE_WIDTH:g} m <= h < "
+    f"{(j + 1) * COARSE_WIDTH:g} m | area fraction | [0, 1] |"
+    for j in range(N_COARSE - 1))
+
+
+class ThicknessDistributionEnv(gym.Env):
+    __doc__ = f"""Keep the sea-ice thickness distribution g(h) close to a target
+    through the seasonal cycle by controlling mechanical redistribution.
+
+    ## Description
+    The generalised Thorndike model of Godlovitch et al. (the ice thickness
+    distribution as a coagulation process, after Thorndike 2000), in
+    :class:`physics.itd.ThorndikeModel`: area fractions g_0 (open water) and
+    g_1 … g_n of ice of thickness kΔh (200 classes of 0.1 m by default).
+    Mechanical redistribution stacks two floes of thicknesses h1 and h2 into
+    one of h1 + h2 and frees one cell of open water (a Smoluchowski
+    coagulation kernel K(h1, h2)); thermodynamics grows thin ice in winter
+    and melts ice in summer over a 360-day year that starts in mid-winter
+    (day 0). The agent sets the strength of the redistribution and of rafting
+    (thin ice over-riding thin ice) every `days_per_step` model days. Stronger
+    stacking builds thick ice and opens water, weaker stacking lets
+    thermodynamics thin the pack; the seasonal cycle keeps pushing g(h)
+    away from any fixed target.
+
+    The default kernel is the constant kernel K = r0 with the rate
+    r0 = {R0:g}/day of Godlovitch's Fig. 4 as calibrated in
+    :mod:`physics.itd_figures` (`R0`); the other named kernels
+    ("exponential", "multiplicative", "additive") default to their
+    calibrated rates there (`KERNELS`). One step costs about the time of
+    `days_per_step` model days of the Thorndike model (a few forward-Euler
+    substeps of O(n²) each).
+
+    ## Action Space
+    `Box(-1, 1, (2,), float32)`; NaN/inf entries are set to 0 and entries
+    clipped into [-1, 1]:
+
+    | Index | Action | Mapping |
+    |---|---|---|
+    | 0 | redistribution intensity | kernel scale = 10**action[0]: 0.1× … 10× the kernel's rate (1× at 0) |
+    | 1 | rafting strength | rafting factor = 1 + (RAFT_MAX − 1)(action[1] + 1)/2, RAFT_MAX = 2 × {RAFT_FACTOR:g} = {RAFT_MAX:g}: 1 (no rafting) … {RAFT_MAX:g}, the kernel multiplied by it where both floes are thinner than {RAFT_CUTOFF:g} m |
+
+    ## Observation Space
+    `Box(float32)` of {N_COARSE + 6} entries, every entry clipped into its
+    bounds. The fine classes are summed into open water and {N_COARSE} coarse
+    classes of {COARSE_WIDTH:g} m (a fine class of thickness h = kΔh goes to
+    the coarse class whose interval holds h; the last gathers everything
+    thicker):
+
+    | Index | Name | Meaning | Unit | Bounds |
+    |---|---|---|---|---|
+    | 0 | `g_0` | open water | area fraction | [0, 1] |
+{_TABLE_ROWS}
+    | {N_COARSE} | `g_{N_COARSE}` | ice of h >= {(N_COARSE - 1) * COARSE_WIDTH:g} m | area fraction | [0, 1] |
+    | {N_COARSE + 1} | `season_cos` | cos(2π t / 360 d) of the model day t (1 mid-winter) | - | [-1, 1] |
+    | {N_COARSE + 2} | `season_sin` | sin(2π t / 360 d) | - | [-1, 1] |
+    | {N_COARSE + 3} | `mean_thickness` | mean thickness over the whole area (open water 0) / {MEAN_SCALE:g} m | - | [0, 2] |
+    | {N_COARSE + 4}, {N_COARSE + 5} | `action` | the last action | - | [-1, 1] |
+
+    `info["physics"]` holds the raw values: `g` (fine fractions, a copy),
+    `h` (fine class thicknesses [m], open water 0 first), `open_water`,
+    `mean_thickness` [m], `day` (model time [days]), `kernel_scale`,
+    `rafting_factor` and `w1` (the Wasserstein-1 distance to the target
+    [m]); `info["target"]` is the target on the fine classes.
+
+    ## Rewards
+    :func:`iceenvs.rewards.thickness_distribution_reward`: minus the
+    Wasserstein-1 distance [m] between the fine g(h) and the target,
+    ∫ |G(h) − G*(h)| dh with G the cumulative fractions (0 when g equals the
+    target). `reward_fn=` replaces it; it is called as
+    `reward_fn(prev, action, now, target=..., h=...)` with the physics dicts.
+    A physics failure gives `failure_reward` (−10).
+
+    ## Starting State
+    Day 0 (mid-winter). The default target is an exponential-tailed
+    distribution like the Beaufort Sea mean: open water
+    {TARGET_OPEN_WATER:g} and ice with g ∝ h exp(−h/λ), λ = {TARGET_EFOLDING:g} m (mean
+    ice thickness about 2 m), normalised. Option `target`: a target on the
+    fine classes (n_classes + 1 entries, open water first, finite, >= 0;
+    normalised here) for this episode. The start is the target with every
+    ice class multiplied by exp({START_NOISE:g} ξ), ξ standard normal from the
+    env's seeded generator, and renormalised; option `g0` (same form as
+    `target`, normalised here) sets the start instead. Options apply to the
+    episode they are given for; unknown options raise `ValueError`.
+
+    ## Episode End
+    Truncated after ceil(`episode_days` / `days_per_step`) steps (72 with the
+    defaults: one year of 360 days in steps of 5 days). Terminated only when
+    the physics fails (`info["error"]`).
+
+    ## Arguments
+    `kernel="constant"` (a kernel name of :func:`physics.itd.make_kernel`
+    other than "rafting", which the action controls; a callable K(x, y) of
+    thicknesses [m]; or an n × n matrix), `kernel_params=None` (e.g.
+    `dict(r=...)`, replacing the defaults; default: the calibrated rates of
+    the named kernels),
+    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=5.0`, `episode_days=360.0`,
+    `reward_fn=None`, `render_mode=None` ("rgb_array" or "human").
+
+    ## Version History
+    * v0: initial version.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+    action_names = ("redistribution", "rafting")
+    reward_fn = staticmethod(thickness_distribution_reward)
+    failure_reward = -10.0
+
+    def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
+                 n_classes: int = 200, dh: float = 0.1, days_per_step: float = 5.0,
+                 episode_days: float = YEAR_DAYS, reward_fn=None,
+                 render_mode: str | None = None):
+        if isinstance(n_classes, bool) or not isinstance(n_classes, (int, np.integer)) \
+                or n_classes < 2:
+            raise ValueError(f"n_classes must be an integer >= 2, got {n_classes!r}")
+        check_range("dh", dh, 0.0, None, low_open=True)
+        check_range("days_per_step", days_per_step, 0.0, None, low_open=True)
+        check_range("episode_days", episode_days, 0.0, None, low_open=True)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
+                             f"None, got {render_mode!r}")
+        if kernel_params is not None and not isinstance(kernel_params, dict):
+            raise ValueError(f"kernel_params must be a dict, got {type(kernel_params).__name__}")
+        if isinstance(kernel, str) and kernel == "rafting":
+            raise ValueError('kernel="rafting" is not available: the action sets the rafting '
+                             'of any kernel')
+        if kernel_params is None:
+            kernel_params = (dict(DEFAULT_KERNEL_PARAMS.get(kernel, {}))
+                             if isinstance(kernel, str) else {})
+        elif kernel_params and not isinstance(kernel, str):
+            raise ValueError("kernel_params apply to named kernels only, not to a callable "
+                             "or a matrix")
+        if reward_fn is not None and not callable(reward_fn):
+            raise ValueError("reward_fn must be callable as reward(prev, action, now, **params)")
+
+        self.n_classes = int(n_classes)
+        self.dh = float(dh)
+        self.days_per_step = float(days_per_step)
+        self.episode_days = float(episode_days)
+        self.episode_steps = max(1, int(math.ceil(self.episode_days / self.days_per_step - 1e-9)))
+        self.kernel = kernel
+        self.kernel_params = dict(kernel_params)
+        try:
+            # a private copy: a matrix passed in is not shared with the caller
+            self._K = np.array(make_kernel(kernel, self.n_classes, self.dh,
+                                           **self.kernel_params))
+        except TypeError as err:
+            raise ValueError(f"bad kernel or kernel_params: {err}") from None
+        self.reward_fn = reward_fn if reward_fn is not None else type(self).reward_fn
+        self._default_reward = reward_fn is None
+        self.render_mode = render_mode
+
+        h = np.concatenate([[0.0], self.dh * np.arange(1, self.n_classes + 1)])
+        h.setflags(write=False)
+        self._h = h
+        self._coarse_idx = _coarse_index(h)
+        self._h_coarse = np.concatenate(
+            [[0.0], COARSE_WIDTH * (np.arange(N_COARSE) + 0.5)])      # class centres [m]
+        self._default_target = default_target(h)
+        self._default_target.setflags(write=False)
+        self._target = self._default_target
+        self.reward_params = {"target": self._target, "h": self._h}
+
+        n_obs = N_COARSE + 6
+        low = np.zeros(n_obs, dtype=np.float32)
+        high = np.ones(n_obs, dtype=np.float32)
+        low[N_COARSE + 1:N_COARSE + 3] = -1.0
+        high[N_COARSE + 3] = 2.0
+        low[N_COARSE + 4:] = -1.0
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self._low64 = low.astype(np.float64)
+        self._high64 = high.astype(np.float64)
+        self._vec = np.zeros(n_obs)                     # work buffer of the observation
+
+        self.model: ThorndikeModel | None = None
+        self._steps = 0
+        self._last_action = np.zeros(2)
+        self._prev = None
+        self._obs = None
+        self._renderer = None
+
+    # -- helpers ----------------------------------------------------------------------
+    @property
+    def target(self) -> np.ndarray:
+        """The target distribution on the fine classes (open water first)."""
+        return self._target
+
+    @property
+    def h(self) -> np.ndarray:
+        """Fine class thicknesses [m], open water (0) first."""
+        return self._h
+
+    def coarse(self, g) -> np.ndarray:
+        """Fine fractions summed into open water and the coarse classes."""
+        return np.bincount(self._coarse_idx, weights=g, minlength=N_COARSE + 1)
+
+    def _apply_action(self, a: np.ndarray) -> None:
+        m = self.model
+        m.kernel_scale = 10.0 ** float(a[0])
+        factor = 1.0 + (RAFT_MAX - 1.0) * (float(a[1]) + 1.0) * 0.5
+        if factor != m.rafting_factor:                  # rebuilding K costs O(n²)
+            m.set_rafting(factor, RAFT_CUTOFF)
+
+    def _measure(self) -> dict:
+        m = self.model
+        g = m.g
+        if not np.all(np.isfinite(g)):
+            raise FloatingPointError("the thickness distribution is no longer finite")
+        return {"g": g.copy(), "h": self._h, "open_water": float(g[0]),
+                "mean_thickness": float(np.dot(g, self._h)), "day": float(m.time),
+                "kernel_scale": float(m.kernel_scale), "rafting_factor": float(m.rafting_factor),
+                "w1": wasserstein1(g, self._target, self._h)}
+
+    def _vector(self, now: dict) -> np.ndarray:
+        v = self._vec
+        v[:N_COARSE + 1] = np.bincount(self._coarse_idx, weights=now["g"],
+                                       minlength=N_COARSE + 1)
+        phase = 2.0 * math.pi * now["day"] / YEAR_DAYS
+        v[N_COARSE + 1] = math.cos(phase)
+        v[N_COARSE + 2] = math.sin(phase)
+        v[N_COARSE + 3] = now["mean_thickness"] / MEAN_SCALE
+        v[N_COARSE + 4:] = self._last_action
+        return np.clip(v, self._low64, self._high64).astype(np.float32)
+
+    def _info(self, now: dict) -> dict:
+        # fresh arrays: what an info holds is never shared with another call's
+        physics = dict(now)
+        physics["g"] = now["g"].copy()
+        physics["h"] = now["h"].copy()
+        return {"physics": physics, "target": self._target.copy(), "steps": self._steps}
+
+    # -- gymnasium API ----------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - set(_OPTIONS)
+        if unknown:
+            raise ValueError(f"unknown reset options {sorted(unknown)}; this env takes "
+                             f"{list(_OPTIONS)}")
+        size = self.n_classes + 1
+        if options.get("target") is not None:
+            target = _distribution("target", options["target"], size)
+            target.setflags(write=False)
+        else:
+            target = self._default_target
+        if options.get("g0") is not None:
+            g0 = _distribution("g0", options["g0"], size)
+        else:
+            g0 = target.copy()
+            g0[1:] *= np.exp(START_NOISE * self.np_random.standard_normal(size - 1))
+            g0 /= g0.sum()
+        self._target = target
+        self.reward_params = {"target": target, "h": self._h}
+        self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh, g0=g0)
+        self._steps = 0
+        self._last_action = np.zeros(2)
+        self._apply_action(self._last_action)
+        now = self._measure()
+        self._prev = now
+        self._obs = self._vector(now)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), self._info(now)
+
+    def step(self, action):
+        if self.model is None:
+            raise RuntimeError("call reset() before step()")
+        a = sanitise_action(action, self.action_space)
+        self._last_action = a
+        self._steps += 1
+        try:
+            self._apply_action(a)
+            self.model.step(self.days_per_step)
+            now = self._measure()
+        except (FloatingPointError, RuntimeError, ValueError) as err:
+            # a physics failure ends the episode instead of crashing the caller
+            info = self._info(self._prev)
+            info["error"] = f"{type(err).__name__}: {err}"
+            return self._obs.copy(), float(self.failure_reward), True, False, info
+        if self._default_reward:
+            reward = -now["w1"]            # thickness_distribution_reward, already computed
+        else:
+            reward = float(self.reward_fn(self._prev, a, now, **self.reward_params))
+        info = self._info(now)
+        terminated = False
+        if not math.isfinite(reward):
+            info["error"] = f"non-finite reward {reward}"
+            reward, terminated = float(self.failure_reward), True
+        self._prev = now
+        self._obs = self._vector(now)
+        truncated = self._steps >= self.episode_steps and not terminated
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), reward, terminated, truncated, info
+
+    # -- rendering --------------------------------------------------------------------
+    def _frame(self) -> np.ndarray:
+        from .rendering import draw_itd
+
+        return draw_itd(self._h_coarse, self.coarse(self.model.g),
+                        target=self.coarse(self._target))
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode="
+                            "'rgb_array' or 'human' to gymnasium.make")
+            return None
+        if self.model is None:
+            raise RuntimeError("call reset() before render()")
+        frame = self._frame()
+        if self.render_mode == "rgb_array":
+            return frame
+        from .rendering import Window
+
+        if self._renderer is None:
+            self._renderer = Window(type(self).__name__, frame.shape[1], frame.shape[0],
+                                    self.metadata["render_fps"])
+        self._renderer.show(frame)
+        return None
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
