@@ -271,7 +271,6 @@ class Window:
         pygame = _pygame()
         self._pygame = pygame
         self.fps = int(fps)
-        pygame.init()
         pygame.display.init()
         pygame.display.set_caption(title)
         self.screen = pygame.display.set_mode((int(width), int(height)))

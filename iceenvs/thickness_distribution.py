@@ -159,8 +159,8 @@ class ThicknessDistributionEnv(gym.Env):
     episode they are given for; unknown options raise `ValueError`.
 
     ## Episode End
-    Truncated after ceil(`episode_days` / `days_per_step`) steps (72 with the
-    defaults: one year of 360 days in steps of 5 days). Terminated only when
+    Truncated after ceil(`episode_days` / `days_per_step`) steps (360 with the
+    defaults: one year of 360 days in daily steps). Terminated only when
     the physics fails (`info["error"]`).
 
     ## Arguments
@@ -169,7 +169,7 @@ class ThicknessDistributionEnv(gym.Env):
     thicknesses [m]; or an n × n matrix), `kernel_params=None` (e.g.
     `dict(r=...)`, replacing the defaults; default: the calibrated rates of
     the named kernels),
-    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=5.0`, `episode_days=360.0`,
+    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=1.0`, `episode_days=360.0`,
     `reward_fn=None`, `render_mode=None` ("rgb_array" or "human").
 
     ## Version History
@@ -183,7 +183,7 @@ class ThicknessDistributionEnv(gym.Env):
     failure_reward = -10.0
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
-                 n_classes: int = 200, dh: float = 0.1, days_per_step: float = 5.0,
+                 n_classes: int = 200, dh: float = 0.1, days_per_step: float = 1.0,
                  episode_days: float = YEAR_DAYS, reward_fn=None,
                  render_mode: str | None = None):
         if isinstance(n_classes, bool) or not isinstance(n_classes, (int, np.integer)) \

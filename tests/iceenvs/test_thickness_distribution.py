@@ -62,7 +62,7 @@ def test_spaces_and_defaults(env):
     # constant kernel with the calibrated rate r0 of the Godlovitch figures
     assert env.kernel == "constant" and env.kernel_params == {"r": R0}
     assert np.all(env._K == R0)
-    assert env.episode_steps == 72
+    assert env.episode_steps == 360
     assert RAFT_MAX == 2 * RAFT_FACTOR
 
 
@@ -154,9 +154,9 @@ def test_observation_layout(env):
     assert obs[1] == pytest.approx(g[1:5].sum(), rel=1e-6)      # 0.1 … 0.4 m
     assert obs[2] == pytest.approx(g[5:10].sum(), rel=1e-6)     # 0.5 … 0.9 m
     # season phase of the model day
-    assert p["day"] == pytest.approx(5.0)
-    assert obs[21] == pytest.approx(math.cos(2 * math.pi * 5 / 360), rel=1e-6)
-    assert obs[22] == pytest.approx(math.sin(2 * math.pi * 5 / 360), rel=1e-6)
+    assert p["day"] == pytest.approx(1.0)
+    assert obs[21] == pytest.approx(math.cos(2 * math.pi * 1 / 360), rel=1e-6)
+    assert obs[22] == pytest.approx(math.sin(2 * math.pi * 1 / 360), rel=1e-6)
     assert obs[23] == pytest.approx(p["mean_thickness"] / 10.0, rel=1e-6)
     assert p["mean_thickness"] == pytest.approx(float(np.dot(g, h)))
     assert p["open_water"] == g[0]
@@ -177,14 +177,14 @@ def test_info_physics_is_a_copy(env):
 
 def test_responds_to_the_kernel_scale_in_the_expected_direction(env):
     """Mechanical redistribution stacks two floes into one of their summed
-    thickness and frees a cell of open water: from the same start, 20 steps
-    (100 winter days) at 10× the redistribution rate (action[0] = +1) must
+    thickness and frees a cell of open water: from the same start, 100 daily
+    steps (100 winter days) at 10× the redistribution rate (action[0] = +1) must
     end with a larger mean thickness, more ice thicker than 3 m and more
     open water than at 0.1× (action[0] = −1)."""
     results = {}
     for a0 in (1.0, -1.0):
         env.reset(seed=5)
-        for _ in range(20):
+        for _ in range(100):
             _, _, terminated, _, info = env.step([a0, 0.0])
             assert not terminated
         p = info["physics"]
@@ -292,10 +292,10 @@ def test_bad_options_raise(env, options):
 
 def test_truncated_after_one_year_with_defaults(env):
     env.reset(seed=0)
-    for k in range(1, 73):
+    for k in range(1, 361):
         _, _, terminated, truncated, info = env.step([0, 0])
         assert not terminated
-        assert truncated == (k == 72)
+        assert truncated == (k == 360)
     assert info["physics"]["day"] == pytest.approx(360.0)
 
 
@@ -349,7 +349,7 @@ def test_custom_reward_fn_receives_target_and_h():
     assert r == 1.5
     prev, action, now, target, h = calls[0]
     assert np.array_equal(action, [1.0, 0.0])
-    assert prev["day"] == 0.0 and now["day"] == 5.0
+    assert prev["day"] == 0.0 and now["day"] == 1.0
     assert np.array_equal(target, e.target) and np.array_equal(h, e.h)
 
 
