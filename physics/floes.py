@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from .domain import Box, PeriodicBox, minimum_image, wrap_coordinate
-from .neighbors import build_pair_list, choose_cell_size, radius_rank
+from .neighbors import choose_cell_size, pair_list, radius_rank
 from .params import check_range
 
 __all__ = [
@@ -360,7 +360,7 @@ def max_overlap(positions, radii, box: Box) -> float:
     r = np.asarray(radii, dtype=float)
     rank = radius_rank(r)
     cell = choose_cell_size(r, box.lx, box.ly, 0.0)
-    start, nbr = build_pair_list(pos, r, rank, box.lx, box.ly, box.periodic[0], box.periodic[1], 0.0, cell)
+    start, nbr = pair_list(pos, r, rank, box.lx, box.ly, box.periodic[0], box.periodic[1], 0.0, cell)
     if nbr.size == 0:
         return 0.0
     owner = np.repeat(np.arange(len(r)), np.diff(start))
@@ -447,7 +447,7 @@ def _grow(pos, r, scale, box: Box, growth_steps: int) -> None:
         rs = r * f
         tol = inflate
         for _ in range(400):
-            start, nbr = build_pair_list(pos, rs, rank, box.lx, box.ly, px, py, skin, cell)
+            start, nbr = pair_list(pos, rs, rank, box.lx, box.ly, px, py, skin, cell)
             worst, moved = _relax_overlaps(pos, rs, weight, start, nbr, box.lx, box.ly,
                                            px, py, 20, 1e-3)
             if worst <= tol and moved < 0.25 * skin:

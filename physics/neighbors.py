@@ -32,7 +32,7 @@ from numba import njit, prange
 
 from .domain import minimum_image
 
-__all__ = ["radius_rank", "choose_cell_size", "build_cells", "build_pair_list",
+__all__ = ["radius_rank", "choose_cell_size", "build_cells", "build_pair_list", "pair_list",
            "brute_force_pairs", "transfer_history"]
 
 
@@ -208,6 +208,19 @@ def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
                 cell_floes, cell_of, counts, start, nbr, True)
     return start, nbr
+
+
+PARALLEL_MIN_FLOES = 5000   # smaller fields are scanned on the calling thread
+
+
+def pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
+    """:func:`build_pair_list` for large fields, :func:`build_pair_list_serial`
+    below ``PARALLEL_MIN_FLOES`` floes: waking the thread pool costs more
+    than the scan of a small field, and a process that never starts the
+    OpenMP pool can still be forked safely (``gymnasium.make_vec`` with
+    ``vectorization_mode="async"``)."""
+    build = build_pair_list if pos.shape[0] >= PARALLEL_MIN_FLOES else build_pair_list_serial
+    return build(pos, radius, rank, lx, ly, px, py, skin, cell_size)
 
 
 def brute_force_pairs(pos, radius, box, skin):

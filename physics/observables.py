@@ -43,10 +43,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .domain import Box
-from .neighbors import build_pair_list, build_pair_list_serial, choose_cell_size, radius_rank
+from .neighbors import choose_cell_size, pair_list, radius_rank
 from .params import check_range
-
-PARALLEL_MIN_FLOES = 5000   # fields at least this large are scanned on all threads
 
 __all__ = ["Contacts", "Fabric", "Stress", "fabric", "stress", "collision_stress",
            "near_pairs", "contacts_within", "check_positions"]
@@ -369,9 +367,7 @@ def near_pairs(positions, radii, box: Box, max_gap: float):
     lx, ly = float(box.lx), float(box.ly)
     px, py = box.periodic
     cell = choose_cell_size(r, lx, ly, gap)
-    # small fields on the calling thread: waking a thread pool costs more than the scan
-    build = build_pair_list if n >= PARALLEL_MIN_FLOES else build_pair_list_serial
-    start, nbr = build(wrapped, r, radius_rank(r), lx, ly, px, py, gap, cell)
+    start, nbr = pair_list(wrapped, r, radius_rank(r), lx, ly, px, py, gap, cell)
     i = np.repeat(np.arange(n, dtype=np.int64), np.diff(start))
     j = nbr
     d = box.minimum_image(wrapped[j] - wrapped[i])
