@@ -150,7 +150,7 @@ def floe_physics(positions, velocities, masses, radii, box, contacts, stress_ten
         u_x=float(mean_v[0]), u_y=float(mean_v[1]), temperature=temp,
         largest_cluster=float(stats.largest_fraction),
         clusters_per_floe=stats.n_clusters / n,
-        cluster_alpha=float(stats.alpha),
+        cluster_alpha=float(stats.alpha) if math.isfinite(stats.alpha) else 0.0,
     )
 
 
