@@ -33,6 +33,7 @@ bench: setup
 	$(PY) -m physics.bench harddisk
 	$(PY) -m physics.bench observables
 	$(PY) -m physics.bench itd
+	$(PY) -m iceenvs.bench
 
 validate: setup
 	$(PY) -m physics.validate
