@@ -58,8 +58,8 @@ def _child(env_id: str, steps: int) -> dict:
 
 
 def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) -> list[dict]:
-    """Run WindDrift-v0 (wind 10 m/s along x) and Convergence-v0 (constant
-    convergence from A = 0.80) with the same seed and actions at several
+    """Run WindDrift-v0 (wind 10 m/s along x, 60 steps of 5 s) and
+    Convergence-v0 (1 per hour from A = 0.80, 150 steps of 2 s) with the same seed and actions at several
     ``stiffness_scale`` values; report steps/s and the observables averaged
     over the last third of the run."""
     import gymnasium as gym
@@ -68,7 +68,7 @@ def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) ->
     import iceenvs  # noqa: F401
 
     cases = [("iceenvs/WindDrift-v0", np.array([0.5, 0.0]), {}),
-             ("iceenvs/Convergence-v0", np.array([0.5]), {"concentration": 0.8})]
+             ("iceenvs/Convergence-v0", np.array([1.0]), {"concentration": 0.8})]
     keys = ("concentration", "u_x", "z_c", "f_nr", "pressure", "largest_cluster")
     rows = []
     for env_id, action, options in cases:
@@ -78,7 +78,7 @@ def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) ->
             env.step(action)
             t0 = time.perf_counter()
             record = []
-            for _ in range(steps):
+            for _ in range(steps if "WindDrift" in env_id else 150):
                 _, _, term, trunc, info = env.step(action)
                 record.append([info["physics"][k] for k in keys])
                 if term or trunc:
