@@ -31,7 +31,7 @@ from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
 
-__all__ = ["FloeEnv", "sanitise_action", "scaled_contact", "hertz_time_step"]
+__all__ = ["ControlEnv", "FloeEnv", "sanitise_action", "scaled_contact", "hertz_time_step"]
 
 
 def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
@@ -61,7 +61,125 @@ def hertz_time_step(field, box, contact, impact_speed: float, preset_dt: float,
     return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
 
 
-class FloeEnv(gym.Env):
+class ControlEnv(gym.Env):
+    """The control loop every environment of the suite shares.
+
+    One step: sanitise the action → ``_apply_action`` → ``_advance`` →
+    ``_measure`` (raw SI dict) → ``_reward`` → observation ``_vector`` and
+    ``_info``. A physics failure (FloatingPointError, RuntimeError,
+    ValueError) or a non-finite reward ends the episode with
+    ``info["error"]`` and ``failure_reward``; the episode is truncated after
+    ``episode_steps`` steps. Subclasses build their model in ``reset`` and
+    then call ``_begin_episode``; they provide the hooks named above,
+    ``_ready`` (a model exists) and ``_frame`` (an RGB array).
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    failure_reward = -10.0
+    _renderer = None
+
+    def _set_render_mode(self, render_mode: str | None) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
+                             f"None, got {render_mode!r}")
+        self.render_mode = render_mode
+
+    # -- hooks --------------------------------------------------------------------------
+    def _ready(self) -> bool:
+        raise NotImplementedError
+
+    def _apply_action(self, action: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _advance(self) -> None:
+        raise NotImplementedError
+
+    def _measure(self) -> dict:
+        raise NotImplementedError
+
+    def _vector(self, now: dict) -> np.ndarray:
+        raise NotImplementedError
+
+    def _info(self, now: dict) -> dict:
+        raise NotImplementedError
+
+    def _terminated(self, now: dict) -> bool:
+        return False
+
+    def _reward(self, action: np.ndarray, now: dict) -> float:
+        return float(self.reward_fn(self._prev, action, now, **self.reward_params))
+
+    def _frame(self) -> np.ndarray:
+        raise NotImplementedError
+
+    # -- the loop -----------------------------------------------------------------------
+    def _begin_episode(self):
+        """Zero action, first measurement and observation of a new episode;
+        returns what ``reset`` returns."""
+        self._steps = 0
+        self._last_action = np.zeros(self.action_space.shape[0])
+        self._apply_action(self._last_action)
+        now = self._measure()
+        self._prev = now
+        self._obs = self._vector(now)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), self._info(now)
+
+    def step(self, action):
+        if not self._ready():
+            raise RuntimeError("call reset() before step()")
+        a = sanitise_action(action, self.action_space)
+        self._last_action = a
+        self._steps += 1
+        try:
+            self._apply_action(a)
+            self._advance()
+            now = self._measure()
+        except (FloatingPointError, RuntimeError, ValueError) as err:
+            # a physics failure ends the episode instead of crashing the caller
+            info = self._info(self._prev)
+            info["error"] = f"{type(err).__name__}: {err}"
+            return self._obs.copy(), float(self.failure_reward), True, False, info
+        reward = self._reward(a, now)
+        info = self._info(now)
+        terminated = bool(self._terminated(now))
+        if not math.isfinite(reward):
+            info["error"] = f"non-finite reward {reward}"
+            reward, terminated = float(self.failure_reward), True
+        self._prev = now
+        self._obs = self._vector(now)
+        truncated = self._steps >= self.episode_steps and not terminated
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), reward, terminated, truncated, info
+
+    # -- rendering ----------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode="
+                            "'rgb_array' or 'human' to gymnasium.make")
+            return None
+        if not self._ready():
+            raise RuntimeError("call reset() before render()")
+        frame = self._frame()
+        if self.render_mode == "rgb_array":
+            return frame
+        from .rendering import Window
+
+        if self._renderer is None:
+            self._renderer = Window(type(self).__name__, frame.shape[1], frame.shape[0],
+                                    self.metadata["render_fps"])
+        self._renderer.show(frame)
+        return None
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+class FloeEnv(ControlEnv):
     """Base of the floe environments (not registered itself).
 
     Parameters common to every floe environment
@@ -79,11 +197,9 @@ class FloeEnv(gym.Env):
     render_mode : None, "rgb_array" or "human"
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
     extra_features: tuple[Feature, ...] = ()
     action_names: tuple[str, ...] = ()
     reward_fn: Callable = None
-    failure_reward = -10.0
 
     def __init__(self, *, n_floes: int, concentration: float, preset: PaperPreset,
                  control_interval: float, episode_steps: int, reward_fn=None,
@@ -97,9 +213,7 @@ class FloeEnv(gym.Env):
         if not isinstance(preset, PaperPreset):
             raise TypeError(f"preset must be a PaperPreset (e.g. physics.HERMAN2013), "
                             f"got {type(preset).__name__}")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
-                             f"None, got {render_mode!r}")
+        self._set_render_mode(render_mode)
         self.n_floes = int(n_floes)
         self.concentration = float(concentration)
         self.preset = preset
@@ -108,7 +222,6 @@ class FloeEnv(gym.Env):
         self.stiffness_scale = float(stiffness_scale)
         self.contact = scaled_contact(preset.contact, stiffness_scale)
         self.cluster_gap = float(cluster_gap)
-        self.render_mode = render_mode
         if reward_fn is not None:
             if not callable(reward_fn):
                 raise TypeError("reward_fn must be callable as reward(prev, action, now, **params)")
@@ -132,7 +245,6 @@ class FloeEnv(gym.Env):
         self._last_action = np.zeros(n_act)
         self._prev = None
         self._obs = None
-        self._renderer = None
 
     # -- to be provided by subclasses ------------------------------------------------
     def default_reward_params(self) -> dict:
@@ -141,14 +253,8 @@ class FloeEnv(gym.Env):
     def _make_sim(self, rng: np.random.Generator, options: dict):
         raise NotImplementedError
 
-    def _apply_action(self, action: np.ndarray) -> None:
-        raise NotImplementedError
-
-    def _measure(self) -> dict:
-        raise NotImplementedError
-
-    def _terminated(self, now: dict) -> bool:
-        return False
+    def _ready(self) -> bool:
+        return self.sim is not None
 
     def _advance(self) -> None:
         self.sim.advance(self.control_interval)
@@ -159,48 +265,12 @@ class FloeEnv(gym.Env):
         options = dict(options or {})
         self._reset_options(options)
         self.sim = self._make_sim(self.np_random, options)
-        self._steps = 0
-        self._last_action = np.zeros(self.action_space.shape[0])
-        self._apply_action(self._last_action)
-        now = self._measure()
-        self._prev = now
-        self._obs = self._vector(now)
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), self._info(now)
+        return self._begin_episode()
 
     def _reset_options(self, options: dict) -> None:
         """Task options of ``reset(options=...)`` (subclasses read theirs)."""
         if options:
             raise ValueError(f"unknown reset options {sorted(options)}")
-
-    def step(self, action):
-        if self.sim is None:
-            raise RuntimeError("call reset() before step()")
-        a = sanitise_action(action, self.action_space)
-        self._last_action = a
-        self._steps += 1
-        try:
-            self._apply_action(a)
-            self._advance()
-            now = self._measure()
-        except (FloatingPointError, RuntimeError, ValueError) as err:
-            # a physics failure ends the episode instead of crashing the caller
-            info = self._info(self._prev)
-            info["error"] = f"{type(err).__name__}: {err}"
-            return self._obs.copy(), float(self.failure_reward), True, False, info
-        reward = float(self.reward_fn(self._prev, a, now, **self.reward_params))
-        info = self._info(now)
-        terminated = bool(self._terminated(now))
-        if not math.isfinite(reward):
-            info["error"] = f"non-finite reward {reward}"
-            reward, terminated = float(self.failure_reward), True
-        self._prev = now
-        self._obs = self._vector(now)
-        truncated = self._steps >= self.episode_steps and not terminated
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), reward, terminated, truncated, info
 
     def _vector(self, now: dict) -> np.ndarray:
         vec = normalise(now, self.features)
@@ -208,33 +278,6 @@ class FloeEnv(gym.Env):
 
     def _info(self, now: dict) -> dict:
         return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps}
-
-    # -- rendering --------------------------------------------------------------------
-    def _frame(self) -> np.ndarray:
-        raise NotImplementedError
-
-    def render(self):
-        if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode="
-                            "'rgb_array' or 'human' to gymnasium.make")
-            return None
-        if self.sim is None:
-            raise RuntimeError("call reset() before render()")
-        frame = self._frame()
-        if self.render_mode == "rgb_array":
-            return frame
-        from .rendering import Window
-
-        if self._renderer is None:
-            self._renderer = Window(type(self).__name__, frame.shape[1], frame.shape[0],
-                                    self.metadata["render_fps"])
-        self._renderer.show(frame)
-        return None
-
-    def close(self):
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
 
 
 class HertzEnv(FloeEnv):

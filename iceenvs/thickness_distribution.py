@@ -11,7 +11,7 @@ from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
 from physics.itd_figures import KERNELS, R0, RAFT_FACTOR
 from physics.params import check_range
 
-from .base import sanitise_action
+from .base import ControlEnv
 from .rewards import thickness_distribution_reward, wasserstein1
 
 __all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
@@ -79,7 +79,7 @@ _TABLE_ROWS = "\n".join(
     for j in range(N_COARSE - 1))
 
 
-class ThicknessDistributionEnv(gym.Env):
+class ThicknessDistributionEnv(ControlEnv):
     __doc__ = f"""Keep the sea-ice thickness distribution g(h) close to a target
     through the seasonal cycle by controlling mechanical redistribution.
 
@@ -176,11 +176,9 @@ class ThicknessDistributionEnv(gym.Env):
     * v0: initial version.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("redistribution", "rafting")
     reward_fn = staticmethod(thickness_distribution_reward)
-    failure_reward = -10.0
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
                  n_classes: int = 200, dh: float = 0.1, days_per_step: float = 1.0,
@@ -192,9 +190,7 @@ class ThicknessDistributionEnv(gym.Env):
         check_range("dh", dh, 0.0, None, low_open=True)
         check_range("days_per_step", days_per_step, 0.0, None, low_open=True)
         check_range("episode_days", episode_days, 0.0, None, low_open=True)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
-                             f"None, got {render_mode!r}")
+        self._set_render_mode(render_mode)
         if kernel_params is not None and not isinstance(kernel_params, dict):
             raise ValueError(f"kernel_params must be a dict, got {type(kernel_params).__name__}")
         if isinstance(kernel, str) and kernel == "rafting":
@@ -224,7 +220,6 @@ class ThicknessDistributionEnv(gym.Env):
             raise ValueError(f"bad kernel or kernel_params: {err}") from None
         self.reward_fn = reward_fn if reward_fn is not None else type(self).reward_fn
         self._default_reward = reward_fn is None
-        self.render_mode = render_mode
 
         h = np.concatenate([[0.0], self.dh * np.arange(1, self.n_classes + 1)])
         h.setflags(write=False)
@@ -253,7 +248,6 @@ class ThicknessDistributionEnv(gym.Env):
         self._last_action = np.zeros(2)
         self._prev = None
         self._obs = None
-        self._renderer = None
 
     # -- helpers ----------------------------------------------------------------------
     @property
@@ -289,8 +283,7 @@ class ThicknessDistributionEnv(gym.Env):
 
     def _vector(self, now: dict) -> np.ndarray:
         v = self._vec
-        v[:N_COARSE + 1] = np.bincount(self._coarse_idx, weights=now["g"],
-                                       minlength=N_COARSE + 1)
+        v[:N_COARSE + 1] = self.coarse(now["g"])
         phase = 2.0 * math.pi * now["day"] / YEAR_DAYS
         v[N_COARSE + 1] = math.cos(phase)
         v[N_COARSE + 2] = math.sin(phase)
@@ -328,46 +321,18 @@ class ThicknessDistributionEnv(gym.Env):
         self._target = target
         self.reward_params = {"target": target, "h": self._h}
         self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh, g0=g0)
-        self._steps = 0
-        self._last_action = np.zeros(2)
-        self._apply_action(self._last_action)
-        now = self._measure()
-        self._prev = now
-        self._obs = self._vector(now)
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), self._info(now)
+        return self._begin_episode()
 
-    def step(self, action):
-        if self.model is None:
-            raise RuntimeError("call reset() before step()")
-        a = sanitise_action(action, self.action_space)
-        self._last_action = a
-        self._steps += 1
-        try:
-            self._apply_action(a)
-            self.model.step(self.days_per_step)
-            now = self._measure()
-        except (FloatingPointError, RuntimeError, ValueError) as err:
-            # a physics failure ends the episode instead of crashing the caller
-            info = self._info(self._prev)
-            info["error"] = f"{type(err).__name__}: {err}"
-            return self._obs.copy(), float(self.failure_reward), True, False, info
+    def _ready(self) -> bool:
+        return self.model is not None
+
+    def _advance(self) -> None:
+        self.model.step(self.days_per_step)
+
+    def _reward(self, action: np.ndarray, now: dict) -> float:
         if self._default_reward:
-            reward = -now["w1"]            # thickness_distribution_reward, already computed
-        else:
-            reward = float(self.reward_fn(self._prev, a, now, **self.reward_params))
-        info = self._info(now)
-        terminated = False
-        if not math.isfinite(reward):
-            info["error"] = f"non-finite reward {reward}"
-            reward, terminated = float(self.failure_reward), True
-        self._prev = now
-        self._obs = self._vector(now)
-        truncated = self._steps >= self.episode_steps and not terminated
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), reward, terminated, truncated, info
+            return -now["w1"]              # thickness_distribution_reward, already computed
+        return super()._reward(action, now)
 
     # -- rendering --------------------------------------------------------------------
     def _frame(self) -> np.ndarray:
@@ -375,26 +340,3 @@ class ThicknessDistributionEnv(gym.Env):
 
         return draw_itd(self._h_coarse, self.coarse(self.model.g),
                         target=self.coarse(self._target))
-
-    def render(self):
-        if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode="
-                            "'rgb_array' or 'human' to gymnasium.make")
-            return None
-        if self.model is None:
-            raise RuntimeError("call reset() before render()")
-        frame = self._frame()
-        if self.render_mode == "rgb_array":
-            return frame
-        from .rendering import Window
-
-        if self._renderer is None:
-            self._renderer = Window(type(self).__name__, frame.shape[1], frame.shape[0],
-                                    self.metadata["render_fps"])
-        self._renderer.show(frame)
-        return None
-
-    def close(self):
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
