@@ -41,7 +41,7 @@ from numba import njit
 
 from .domain import PeriodicBox, minimum_image, wrap_coordinate
 from .floes import FloeField, max_overlap
-from .neighbors import build_pair_list_serial, choose_cell_size
+from .neighbors import build_pair_list_serial, choose_cell_size, radius_rank
 from .params import check_range
 
 __all__ = ["RelaxResult", "relax_floes", "compress_floes", "jamming_concentration",
@@ -112,17 +112,13 @@ def overlap_forces(pos, radius, lx, ly, start, nbr, force, stiffness):
 
 
 @njit(cache=True, error_model="numpy")
-def fire_relax(pos, radius, lx, ly, cell_size, max_iter, energy_tol, force_tol, dt_cap):
+def fire_relax(pos, radius, rank, lx, ly, cell_size, max_iter, energy_tol, force_tol, dt_cap):
     """FIRE minimisation of the overlap energy, positions updated in place.
 
     Returns (status, iterations, energy per floe, contacts, largest net
     force over mean contact force, number of list rebuilds).
     """
     n = radius.shape[0]
-    rank = np.empty(n, dtype=np.int64)
-    order = np.argsort(radius, kind="mergesort")
-    for k in range(n):
-        rank[order[k]] = k
     vel = np.zeros((n, 2))
     force = np.zeros((n, 2))
     stiffness = np.zeros(n)
@@ -238,10 +234,20 @@ class RelaxResult:
         return self.status != "unjammed"
 
 
-def _check_input(positions, radii, box):
+def _check_periodic(box) -> None:
     if not isinstance(box, PeriodicBox):
         raise ValueError(f"jammed packings are made in a doubly periodic box (PeriodicBox), "
                          f"got {type(box).__name__}")
+
+
+def _at_rest(field: FloeField, positions) -> FloeField:
+    """The floes of ``field`` at ``positions``, at rest."""
+    return FloeField(positions, field.radii, field.thickness, np.zeros_like(positions),
+                     np.zeros(field.n), field.density)
+
+
+def _check_input(positions, radii, box):
+    _check_periodic(box)
     pos = np.array(positions, dtype=float)
     r = np.asarray(radii, dtype=float)
     if r.ndim != 1 or r.size < 2:
@@ -285,7 +291,7 @@ def relax_floes(positions, radii, box: PeriodicBox, *, max_iter: int = 200000,
     rs = r / scale
     lx, ly = box.lx / scale, box.ly / scale
     cell = choose_cell_size(rs, lx, ly, _SKIN)
-    status, it, e, nc, res, _ = fire_relax(p, rs, lx, ly, cell, int(max_iter), float(energy_tol),
+    status, it, e, nc, res, _ = fire_relax(p, rs, radius_rank(rs), lx, ly, cell, int(max_iter), float(energy_tol),
                                            float(force_tol), 1.0)
     out = p * scale
     return RelaxResult(positions=out, status=_STATUS_NAMES[int(status)], iterations=int(it),
@@ -305,9 +311,7 @@ def _check_field(field: FloeField, box):
     if np.any(field.frozen):
         raise ValueError("jammed packings are made of mobile floes; this field has "
                          f"{int(field.frozen.sum())} frozen floes")
-    if not isinstance(box, PeriodicBox):
-        raise ValueError(f"jammed packings are made in a doubly periodic box (PeriodicBox), "
-                         f"got {type(box).__name__}")
+    _check_periodic(box)
 
 
 def compress_floes(field: FloeField, box: PeriodicBox, concentration: float, *,
@@ -339,9 +343,7 @@ def compress_floes(field: FloeField, box: PeriodicBox, concentration: float, *,
         pos = result.positions
         if progress:
             targets.set_postfix(Z=f"{result.contacts_per_floe:.2f}", status=result.status)
-    out = FloeField(pos, field.radii, field.thickness, np.zeros_like(pos),
-                    np.zeros(field.n), field.density)
-    return out, box, result
+    return _at_rest(field, pos), box, result
 
 
 @dataclass(frozen=True)
@@ -425,11 +427,7 @@ def jamming_concentration(field: FloeField, box: PeriodicBox, *, increment: floa
         raise ValueError(f"no jamming below max_concentration={max_concentration}")
     jam_a = field.total_area / jam_box.area
 
-    def at_rest(p):
-        return FloeField(p, field.radii, field.thickness, np.zeros_like(p), np.zeros(field.n),
-                         field.density)
-
     return JammingResult(concentration=0.5 * (a + jam_a), uncertainty=0.5 * (jam_a - a),
-                         unjammed_field=at_rest(pos), unjammed_box=cur_box,
-                         jammed_field=at_rest(jam_pos), jammed_box=jam_box,
+                         unjammed_field=_at_rest(field, pos), unjammed_box=cur_box,
+                         jammed_field=_at_rest(field, jam_pos), jammed_box=jam_box,
                          jammed_result=jam_res, relaxations=count)
