@@ -1,0 +1,113 @@
+"""``ice-scenarios`` (also ``python -m physics.scenarios``): list, show, run and
+plot the papers' experiments.
+
+::
+
+    ice-scenarios list
+    ice-scenarios show herman2013-convergence
+    ice-scenarios run herman2013-convergence --quick
+    ice-scenarios run herman2011-clustering --floes 2000 --ensemble 2 --set concentrations=[0.6,0.8]
+    ice-scenarios run my-copy.yaml --out runs/mine
+    ice-scenarios run --resume runs/herman2013-convergence
+    ice-scenarios plot runs/herman2013-convergence
+"""
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import textwrap
+
+from .config import bundled_configs, load_config, parse_set
+from .runner import find_config, plot_run, resume_run, run_scenario
+
+
+def _list() -> int:
+    rows = [(name, load_config(path)) for name, path in bundled_configs().items()]
+    width = max(len(n) for n, _ in rows)
+    for name, cfg in rows:
+        print(f"{name:{width}s}  {cfg.title} ({cfg.reproduces})")
+    print("\nice-scenarios show NAME for its parameters; ice-scenarios run NAME --quick to try it")
+    return 0
+
+
+def _show(name: str) -> int:
+    cfg = find_config(name)
+    print(f"{cfg.name}: {cfg.title}")
+    print(f"reproduces: {cfg.reproduces}")
+    print(f"file: {cfg.path} (copy it, edit it, run the copy)\n")
+    print(textwrap.fill(cfg.description, 88) + "\n")
+    width = max(len(k) for k in cfg.params)
+    print(f"{'parameter':{width}s}  {'default':>14s}  {'--quick':>10s}  allowed / meaning")
+    for key, p in cfg.params.items():
+        quick = cfg.quick.get(key, "")
+        units = f" [{p.units}]" if p.units else ""
+        print(f"{key:{width}s}  {str(p.default):>14s}  {str(quick):>10s}  {p.allowed()}")
+        print(f"{'':{width}s}  {'':14s}  {'':10s}  {p.help}{units}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="ice-scenarios", description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=textwrap.dedent(__doc__.split("::", 1)[1]))
+    sub = ap.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="the scenarios")
+    s = sub.add_parser("show", help="a scenario's parameters and the figure it reproduces")
+    s.add_argument("name")
+    r = sub.add_parser("run", help="run a scenario (or --resume an interrupted run)")
+    r.add_argument("name", nargs="?", help="scenario name or path of a scenario YAML file")
+    r.add_argument("--floes", type=int, help="number of floes (the 'floes' parameter)")
+    r.add_argument("--seed", type=int, default=0, help="seed of the run (default 0)")
+    r.add_argument("--ensemble", type=int, default=1, help="ensemble members (default 1)")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="set a parameter (YAML value: 0.5, true, [0.6,0.8]); repeatable")
+    r.add_argument("--out", help="run directory (default runs/NAME, runs/NAME-quick)")
+    r.add_argument("--quick", action="store_true", help="the reduced form (minutes)")
+    r.add_argument("--force", action="store_true", help="overwrite an existing run directory")
+    r.add_argument("--resume", metavar="RUN_DIR", help="continue an interrupted run")
+    r.add_argument("--workers", type=int, help="parallel processes (default: one per core)")
+    r.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+                   help="wall seconds between checkpoints (default 60)")
+    r.add_argument("--no-plots", action="store_true", help="skip the figures")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p = sub.add_parser("plot", help="(re)make the figures of a run directory")
+    p.add_argument("run_dir")
+    return ap
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "list":
+            return _list()
+        if args.command == "show":
+            return _show(args.name)
+        if args.command == "plot":
+            for path in plot_run(args.run_dir):
+                print(path)
+            return 0
+        common = dict(workers=args.workers, checkpoint_every=args.checkpoint_every,
+                      progress=not args.no_progress, plots=not args.no_plots)
+        if args.resume:
+            if args.name or args.set or args.floes is not None or args.quick:
+                raise ValueError("--resume continues a run as it was started; give only the "
+                                 "run directory (and --workers, --checkpoint-every)")
+            resume_run(args.resume, **common)
+            return 0
+        if not args.name:
+            raise ValueError("run needs a scenario name (ice-scenarios list) or --resume RUN_DIR")
+        run_scenario(args.name, overrides=parse_set(args.set), floes=args.floes, seed=args.seed,
+                     ensemble=args.ensemble, quick=args.quick, out=args.out, force=args.force,
+                     command="ice-scenarios " + shlex.join(argv), **common)
+        return 0
+    except (ValueError, FileExistsError, FileNotFoundError) as exc:
+        print(f"ice-scenarios: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

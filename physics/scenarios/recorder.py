@@ -1,0 +1,237 @@
+"""What one simulation of a scenario writes: time series, snapshots, results,
+and the checkpoints that let it resume.
+
+An experiment's ``simulate`` gets a :class:`Recorder` and calls
+
+* ``rec.record(time, p=..., z_c=..., profile=("y", array))`` once per
+  output time (scalars, or (dimension, 1-D array) pairs over a dimension
+  declared with ``rec.coord``);
+* ``rec.snapshot(time, positions, radii, velocities, contacts=(i, j, f))``
+  at the chosen snapshot times;
+* ``rec.result(a_j=...)`` for per-run results;
+* ``rec.progress(fraction)`` for the progress bar;
+* ``rec.checkpoint(state)`` after each output: every ``checkpoint_every``
+  wall seconds the state (anything picklable: the simulation object, loop
+  counters, generators) and everything recorded so far are written together,
+  atomically, so an interrupted run resumes exactly where its last
+  checkpoint left it (``rec.restore()`` returns that state, or ``None`` on a
+  fresh start).
+
+:meth:`Recorder.dataset` turns it all into an ``xarray.Dataset`` with
+dimensions ``sample`` (output times), ``snapshot``, ``floe`` and
+``contact`` plus the declared ones. Snapshot variables: ``snapshot_time``,
+``snapshot_lx``, ``snapshot_ly``, ``floe_x``, ``floe_y``, ``floe_u``,
+``floe_v``, ``floe_radius``, ``floe_frozen``, ``contact_i``, ``contact_j``,
+``contact_force``.
+"""
+from __future__ import annotations
+
+import os
+import pickle
+import time as _time
+from pathlib import Path
+
+import numpy as np
+
+CHECKPOINT_VERSION = 1
+
+
+def atomic_write(path: Path, write) -> None:
+    """Call ``write(tmp_path)`` and move the result onto ``path`` in one
+    step: an interruption leaves either the old file or the new one."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+class Recorder:
+    """Collects one simulation's output; see the module docstring.
+
+    Parameters
+    ----------
+    checkpoint_path : Path or None
+        Where checkpoints go (none are written if ``None``).
+    checkpoint_every : float
+        Wall seconds between checkpoints (0: at every call).
+    on_progress : callable(fraction) or None
+        Receives the progress in [0, 1].
+    variables : dict
+        name → (units, description) of the recorded variables, written as
+        attributes.
+    """
+
+    def __init__(self, checkpoint_path: Path | None = None, checkpoint_every: float = 60.0,
+                 on_progress=None, variables: dict | None = None):
+        self.checkpoint_path = Path(checkpoint_path) if checkpoint_path else None
+        self.checkpoint_every = float(checkpoint_every)
+        self.on_progress = on_progress
+        self.variables = dict(variables or {})
+        self.rows: list[tuple[float, dict]] = []
+        self.coords: dict[str, tuple[np.ndarray, dict]] = {}
+        self.snapshots: list[dict] = []
+        self.results: dict[str, float] = {}
+        self.n_checkpoints = 0
+        self._state = None
+        self._last = _time.monotonic()
+        self._fraction = 0.0
+        if self.checkpoint_path is not None and self.checkpoint_path.exists():
+            self._load()
+
+    # -- writing -----------------------------------------------------------
+    def coord(self, name: str, values, units: str = "", description: str = "") -> None:
+        """Declare an extra dimension (e.g. the y bins of a profile)."""
+        self.coords[name] = (np.asarray(values, dtype=float),
+                             {"units": units, "long_name": description})
+
+    def record(self, time: float, **values) -> None:
+        row = {}
+        for key, v in values.items():
+            if isinstance(v, tuple):
+                dim, arr = v
+                if dim not in self.coords:
+                    raise KeyError(f"record({key}=...) uses dimension {dim!r}; declare it with "
+                                   f"coord() first")
+                row[key] = (dim, np.asarray(arr, dtype=float).copy())
+            else:
+                row[key] = float(v)
+        self.rows.append((float(time), row))
+
+    def snapshot(self, time: float, positions, radii, velocities, *, box=(np.nan, np.nan),
+                 contacts=None, frozen=None) -> None:
+        """Floe positions, radii, velocities (and ``frozen`` mask) at
+        ``time`` in a box of lengths ``box`` = (lx, ly); ``contacts`` = (i,
+        j, normal force) of the touching pairs for force-network plots."""
+        snap = dict(time=float(time), box=(float(box[0]), float(box[1])),
+                    positions=np.array(positions, dtype=float),
+                    radii=np.array(radii, dtype=float),
+                    velocities=np.array(velocities, dtype=float))
+        snap["frozen"] = (np.zeros(len(snap["radii"]), bool) if frozen is None
+                          else np.array(frozen, bool))
+        if contacts is not None:
+            i, j, f = contacts
+            snap["contacts"] = (np.asarray(i, np.int64).copy(), np.asarray(j, np.int64).copy(),
+                                np.asarray(f, float).copy())
+        self.snapshots.append(snap)
+
+    def result(self, **values) -> None:
+        self.results.update({k: float(v) for k, v in values.items()})
+
+    def progress(self, fraction: float) -> None:
+        self._fraction = min(max(float(fraction), 0.0), 1.0)
+        if self.on_progress is not None:
+            self.on_progress(self._fraction)
+
+    # -- checkpoints -----------------------------------------------------------
+    def restore(self):
+        """The state saved by the last checkpoint, or ``None``."""
+        return self._state
+
+    def checkpoint(self, state, *, force: bool = False) -> bool:
+        """Save ``state`` and the output so far if ``checkpoint_every`` wall
+        seconds have passed (or ``force``). Returns whether it wrote."""
+        if self.checkpoint_path is None:
+            return False
+        now = _time.monotonic()
+        if not force and now - self._last < self.checkpoint_every:
+            return False
+        payload = dict(version=CHECKPOINT_VERSION, state=state, rows=self.rows,
+                       coords=self.coords, snapshots=self.snapshots, results=self.results,
+                       fraction=self._fraction)
+
+        def write(tmp):
+            with open(tmp, "wb") as fh:
+                pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        atomic_write(self.checkpoint_path, write)
+        self._last = now
+        self.n_checkpoints += 1
+        return True
+
+    def _load(self) -> None:
+        with open(self.checkpoint_path, "rb") as fh:
+            payload = pickle.load(fh)
+        if payload.get("version") != CHECKPOINT_VERSION:
+            raise ValueError(f"checkpoint {self.checkpoint_path} was written by another version "
+                             f"of the runner; start the run again with --force")
+        self._state = payload["state"]
+        self.rows = payload["rows"]
+        self.coords = payload["coords"]
+        self.snapshots = payload["snapshots"]
+        self.results = payload["results"]
+        self._fraction = payload["fraction"]
+
+    # -- output ------------------------------------------------------------
+    def dataset(self):
+        """Everything recorded, as an ``xarray.Dataset``."""
+        import xarray as xr
+
+        ds = xr.Dataset()
+        for name, (values, attrs) in self.coords.items():
+            ds.coords[name] = (name, values, attrs)
+        n = len(self.rows)
+        ds.coords["sample"] = ("sample", np.arange(n))
+        ds["time"] = ("sample", np.array([t for t, _ in self.rows], dtype=float),
+                      {"units": "s", "long_name": "model time of the output"})
+        names = list(dict.fromkeys(k for _, row in self.rows for k in row))
+        for key in names:
+            first = next(row[key] for _, row in self.rows if key in row)
+            if isinstance(first, tuple):
+                dim = first[0]
+                arr = np.full((n, len(self.coords[dim][0])), np.nan)
+                for s, (_, row) in enumerate(self.rows):
+                    if key in row:
+                        arr[s] = row[key][1]
+                ds[key] = (("sample", dim), arr)
+            else:
+                ds[key] = ("sample", np.array([row.get(key, np.nan) for _, row in self.rows]))
+        if self.snapshots:
+            nf = max(len(s["radii"]) for s in self.snapshots)
+            nc = max((len(s["contacts"][0]) for s in self.snapshots if "contacts" in s),
+                     default=0)
+            k = len(self.snapshots)
+            ds.coords["snapshot"] = ("snapshot", np.arange(k))
+            ds.coords["floe"] = ("floe", np.arange(nf))
+            ds["snapshot_time"] = ("snapshot", np.array([s["time"] for s in self.snapshots]),
+                                   {"units": "s"})
+            ds["snapshot_lx"] = ("snapshot", np.array([s["box"][0] for s in self.snapshots]),
+                                 {"units": "m", "long_name": "box length along x"})
+            ds["snapshot_ly"] = ("snapshot", np.array([s["box"][1] for s in self.snapshots]),
+                                 {"units": "m", "long_name": "box length along y"})
+            fields = {"floe_x": ("positions", 0, "m"), "floe_y": ("positions", 1, "m"),
+                      "floe_u": ("velocities", 0, "m/s"), "floe_v": ("velocities", 1, "m/s"),
+                      "floe_radius": ("radii", None, "m")}
+            for name, (src, col, units) in fields.items():
+                arr = np.full((k, nf), np.nan)
+                for s, snap in enumerate(self.snapshots):
+                    a = snap[src] if col is None else snap[src][:, col]
+                    arr[s, :len(a)] = a
+                ds[name] = (("snapshot", "floe"), arr, {"units": units})
+            fz = np.zeros((k, nf), np.int8)
+            for s, snap in enumerate(self.snapshots):
+                fz[s, :len(snap["frozen"])] = snap["frozen"]
+            ds["floe_frozen"] = (("snapshot", "floe"), fz, {"long_name": "1 for frozen floes"})
+            if nc:
+                ds.coords["contact"] = ("contact", np.arange(nc))
+                ci = np.full((k, nc), -1, np.int64)
+                cj = np.full((k, nc), -1, np.int64)
+                cf = np.full((k, nc), np.nan)
+                for s, snap in enumerate(self.snapshots):
+                    if "contacts" in snap:
+                        i, j, f = snap["contacts"]
+                        ci[s, :len(i)], cj[s, :len(j)], cf[s, :len(f)] = i, j, f
+                ds["contact_i"] = (("snapshot", "contact"), ci,
+                                   {"long_name": "first floe of a touching pair (-1: none)"})
+                ds["contact_j"] = (("snapshot", "contact"), cj,
+                                   {"long_name": "second floe of a touching pair (-1: none)"})
+                ds["contact_force"] = (("snapshot", "contact"), cf,
+                                       {"units": "N", "long_name": "normal contact force"})
+        for key, value in self.results.items():
+            ds[key] = ((), value)
+        for key, (units, description) in self.variables.items():
+            if key in ds:
+                ds[key].attrs.update(units=units, long_name=description)
+        return ds

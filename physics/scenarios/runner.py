@@ -1,0 +1,405 @@
+"""Run a scenario: its cases × ensemble members in parallel processes, with a
+progress bar, checkpoints, a resumable run directory, NetCDF output, figures
+and a summary table.
+
+A run directory holds::
+
+    run.yaml        what was run: scenario file, parameters, seeds, command, versions
+    jobs/           one NetCDF per finished (case, member); checkpoints of unfinished ones
+    results.nc      all runs together (dimensions case, member, sample, ...)
+    figures/*.png   the scenario's figures
+    summary.md      the summary table printed at the end
+
+Ensemble member m of every case gets the seed ``SeedSequence(seed).spawn(K)[m]``
+(the same random floe field across the cases of a sweep), so a run is
+reproduced exactly by its seed; a run resumed from checkpoints continues the
+very trajectories it was interrupted in.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import platform
+import shlex
+import shutil
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .config import ScenarioConfig, bundled_configs, dump_yaml, load_config, parse_config
+from .experiment import get_experiment
+from .recorder import Recorder, atomic_write
+
+RUN_FILE = "run.yaml"
+RESULTS_FILE = "results.nc"
+
+
+def find_config(scenario) -> ScenarioConfig:
+    """A scenario by name (a shipped file) or by the path of a YAML file."""
+    if isinstance(scenario, ScenarioConfig):
+        return scenario
+    text = str(scenario)
+    if text.endswith((".yaml", ".yml")) or os.sep in text:
+        cfg = load_config(text)
+    else:
+        files = bundled_configs()
+        if text not in files:
+            raise ValueError(f"unknown scenario {text!r}; valid scenarios: "
+                             f"{', '.join(files)} (or the path of a scenario file)")
+        cfg = load_config(files[text])
+    get_experiment(cfg.name)           # the file must name a known experiment
+    return cfg
+
+
+def member_seeds(seed: int, ensemble: int) -> list[int]:
+    """Seeds of the ensemble members, derived reproducibly from ``seed``."""
+    children = np.random.SeedSequence(int(seed)).spawn(int(ensemble))
+    return [int(c.generate_state(1, dtype=np.uint64)[0] >> np.uint64(1)) for c in children]
+
+
+def versions() -> dict[str, str]:
+    import numba
+    import xarray
+
+    from .. import __version__
+    return {"seaice-gym": __version__, "python": platform.python_version(),
+            "numpy": np.__version__, "numba": numba.__version__, "xarray": xarray.__version__,
+            "platform": platform.platform()}
+
+
+@dataclass
+class RunResult:
+    """What :func:`run_scenario` made."""
+
+    directory: Path
+    dataset: Path
+    figures: list[Path]
+    summary: list[tuple[str, str, str]]
+    wall_time: float
+
+
+# ---------------------------------------------------------------------------
+# jobs (run in worker processes or in-process)
+# ---------------------------------------------------------------------------
+
+_QUEUE = None
+
+
+def _init_worker(queue, threads):
+    """Worker start-up: progress queue, one Numba thread, and Ctrl-C left to
+    the parent (which stops the workers; their checkpoints are intact)."""
+    global _QUEUE
+    _QUEUE = queue
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if threads:
+        import numba
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+
+
+def _job_paths(directory: Path, c: int, m: int) -> tuple[Path, Path]:
+    base = directory / "jobs" / f"case{c:02d}_member{m:02d}"
+    return base.with_suffix(".nc"), base.with_suffix(".ckpt")
+
+
+def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: str, c: int,
+             m: int, checkpoint_every: float, job_id: int, on_progress=None) -> str:
+    """One simulation: (case c, member m). Returns the path of its NetCDF."""
+    cfg = parse_config(config_data)
+    exp = get_experiment(cfg.name)
+    out, ckpt = _job_paths(Path(directory), c, m)
+    if on_progress is None and _QUEUE is not None:
+        last = [0.0, -1.0]
+
+        def on_progress(f):
+            now = time.monotonic()
+            if f >= 1.0 or now - last[0] > 0.5:
+                last[0] = now
+                _QUEUE.put((job_id, f))
+    rec = Recorder(ckpt, checkpoint_every, on_progress, exp.variables)
+    exp.simulate(params, case, seed, rec)
+    rec.progress(1.0)
+    ds = rec.dataset()
+    ds.attrs.update(case=c, member=m, seed=str(seed))
+    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    if ckpt.exists():
+        ckpt.unlink()
+    return str(out)
+
+
+# ---------------------------------------------------------------------------
+# the run
+# ---------------------------------------------------------------------------
+
+def _prepare_directory(out: Path, force: bool, resume: bool) -> None:
+    if resume:
+        if not (out / RUN_FILE).exists():
+            raise FileNotFoundError(f"{out} is not a run directory (no {RUN_FILE}); nothing to "
+                                    f"resume")
+        return
+    if out.exists() and any(out.iterdir()):
+        if not force:
+            raise FileExistsError(f"output directory {out} exists; pass --force to overwrite it "
+                                  f"or --resume to continue the run in it")
+        shutil.rmtree(out)
+    (out / "jobs").mkdir(parents=True, exist_ok=True)
+
+
+def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None = None,
+                 seed: int = 0, ensemble: int = 1, quick: bool = False, out=None,
+                 force: bool = False, workers: int | None = None,
+                 checkpoint_every: float = 60.0, progress: bool = True, plots: bool = True,
+                 command: str | None = None, log=print) -> RunResult:
+    """Run ``scenario`` (a name or a YAML path) and write its run directory.
+
+    ``overrides`` are parameter values (checked against the file's ranges);
+    ``floes`` is a shortcut for the ``floes`` parameter. ``out`` defaults to
+    ``runs/NAME`` (``runs/NAME-quick`` with ``quick``); an existing directory
+    is only replaced with ``force``. See :func:`resume_run` to continue an
+    interrupted run.
+    """
+    cfg = find_config(scenario)
+    overrides = dict(overrides or {})
+    if floes is not None:
+        if "floes" not in cfg.params:
+            raise ValueError(f"scenario {cfg.name!r} has no floes parameter (--floes); valid "
+                             f"parameters: {', '.join(cfg.params)}")
+        overrides["floes"] = floes
+    if int(ensemble) < 1:
+        raise ValueError(f"ensemble must be a positive number of members, got {ensemble}")
+    if int(seed) < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    params = cfg.resolve(overrides, quick=quick)
+    out = Path(out) if out is not None else Path("runs") / (cfg.name + ("-quick" if quick else ""))
+    _prepare_directory(out, force, resume=False)
+    data = yaml_config(cfg)
+    run_info = dict(scenario=cfg.name, title=cfg.title, reproduces=cfg.reproduces,
+                    quick=bool(quick), seed=int(seed), ensemble=int(ensemble),
+                    member_seeds=member_seeds(seed, ensemble), parameters=params,
+                    overrides=overrides, command=command or "", config=data,
+                    created=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+                    versions=versions())
+    atomic_write(out / RUN_FILE, lambda tmp: Path(tmp).write_text(dump_yaml(run_info)))
+    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log)
+
+
+def resume_run(out, *, workers: int | None = None, checkpoint_every: float = 60.0,
+               progress: bool = True, plots: bool = True, log=print) -> RunResult:
+    """Continue the run in directory ``out``: finished simulations are kept,
+    interrupted ones restart from their last checkpoint, the rest start."""
+    import yaml
+
+    out = Path(out)
+    _prepare_directory(out, False, resume=True)
+    run_info = yaml.safe_load((out / RUN_FILE).read_text())
+    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log)
+
+
+def yaml_config(cfg: ScenarioConfig) -> dict:
+    """The scenario file as a mapping (stored in run.yaml, so that a run made
+    from a user's file resumes even if that file changes)."""
+    import yaml
+    if cfg.path is not None:
+        return yaml.safe_load(Path(cfg.path).read_text())
+    raise ValueError("scenario config has no file")
+
+
+def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, log) -> RunResult:
+    t0 = time.perf_counter()
+    cfg = parse_config(info["config"])
+    exp = get_experiment(cfg.name)
+    params = info["parameters"]
+    cases = exp.cases(params)
+    seeds = info["member_seeds"]
+    jobs = []
+    for c, case in enumerate(cases):
+        for m, s in enumerate(seeds):
+            nc_path, _ = _job_paths(out, c, m)
+            jobs.append(dict(c=c, m=m, case=case, seed=s, done=nc_path.exists(),
+                             cost=exp.workload(params, case)))
+    todo = sorted((j for j in jobs if not j["done"]), key=lambda j: -j["cost"])
+    n_cpu = os.cpu_count() or 1
+    workers = min(len(todo), n_cpu) if workers is None else max(1, min(int(workers), len(todo) or 1))
+    log(f"{cfg.name}: {len(cases)} case(s) x {len(seeds)} member(s) = {len(jobs)} run(s)"
+        + (f", {len(jobs) - len(todo)} already finished" if len(todo) < len(jobs) else "")
+        + (f", {workers} in parallel" if workers > 1 else "") + f" -> {out}")
+    if todo:
+        _run_jobs(out, info, todo, workers, checkpoint_every, progress)
+    ds = combine(out, info, cases, exp)
+    atomic_write(out / RESULTS_FILE, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    figures = []
+    if plots:
+        figures = make_figures(out, ds, exp, params)
+    rows = exp.summarise(ds, params)
+    wall = time.perf_counter() - t0
+    table = format_summary(cfg, rows, wall, out)
+    (out / "summary.md").write_text(table + "\n")
+    log(table)
+    return RunResult(out, out / RESULTS_FILE, figures, rows, wall)
+
+
+def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every, progress):
+    """Run the unfinished jobs, ``workers`` at a time, with one progress bar."""
+    from tqdm.auto import tqdm
+
+    fractions = {k: 0.0 for k in range(len(todo))}
+    for k, job in enumerate(todo):
+        _, ckpt = _job_paths(out, job["c"], job["m"])
+        if ckpt.exists():
+            fractions[k] = Recorder(ckpt)._fraction
+    bar = tqdm(total=len(todo), unit="run", desc=info["scenario"], disable=not progress,
+               dynamic_ncols=True, bar_format="{l_bar}{bar}| {n:.2f}/{total} runs "
+                                               "[{elapsed}<{remaining}]")
+    lock = threading.Lock()
+
+    def update(k, f):
+        with lock:
+            fractions[k] = max(fractions[k], f)
+            bar.n = sum(fractions.values())
+            bar.refresh()
+    update(0, fractions[0])
+    args = [(info["config"], info["parameters"], j["case"], j["seed"], str(out), j["c"],
+             j["m"], checkpoint_every, k) for k, j in enumerate(todo)]
+    previous = signal.getsignal(signal.SIGTERM)
+    in_main = threading.current_thread() is threading.main_thread()
+
+    def on_term(signum, frame):
+        raise KeyboardInterrupt
+    if in_main:
+        signal.signal(signal.SIGTERM, on_term)
+    try:
+        if workers == 1:
+            for k, a in enumerate(args):
+                _run_job(*a, on_progress=lambda f, k=k: update(k, f))
+                update(k, 1.0)
+        else:
+            _run_pool(args, workers, update)
+    except KeyboardInterrupt:
+        bar.close()
+        print(f"\ninterrupted: finished runs and checkpoints are kept in {out}; continue with\n"
+              f"  ice-scenarios run --resume {shlex.quote(str(out))}", file=sys.stderr)
+        raise
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+        bar.close()
+
+
+def _run_pool(args, workers, update):
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    ctx = mp.get_context("spawn")     # fresh interpreters: no Numba thread pool is forked
+    queue = ctx.Queue()
+    stop = threading.Event()
+
+    def pump():
+        while not stop.is_set():
+            try:
+                k, f = queue.get(timeout=0.2)
+            except Exception:
+                continue
+            update(k, f)
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                               initargs=(queue, 1))
+    try:
+        futures = {pool.submit(_run_job, *a): a[-1] for a in args}
+        for fut in as_completed(futures):
+            fut.result()
+            update(futures[fut], 1.0)
+    except BaseException:
+        for p in list(getattr(pool, "_processes", {}).values()):
+            p.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    finally:
+        stop.set()
+        reader.join(timeout=1.0)
+    pool.shutdown()
+
+
+# ---------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------
+
+def combine(out: Path, info: dict, cases: list[dict], exp):
+    """All job datasets of the run directory as one dataset with dimensions
+    ``case`` and ``member`` in front."""
+    import xarray as xr
+
+    fill = {"contact_i": -1, "contact_j": -1, "floe_frozen": 0}
+    per_case = []
+    for c in range(len(cases)):
+        members = []
+        for m in range(len(info["member_seeds"])):
+            path, _ = _job_paths(out, c, m)
+            with xr.open_dataset(path, engine="h5netcdf") as d:
+                members.append(d.load())
+        per_case.append(xr.concat(members, "member", join="outer", fill_value=fill,
+                                  combine_attrs="drop"))
+    ds = xr.concat(per_case, "case", join="outer", fill_value=fill, combine_attrs="drop")
+    ds.coords["member"] = ("member", np.arange(len(info["member_seeds"])))
+    ds["member_seed"] = ("member", np.array([str(s) for s in info["member_seeds"]], dtype=object))
+    ds.coords["case"] = ("case", np.arange(len(cases)))
+    for key in dict.fromkeys(k for case in cases for k in case):
+        ds.coords[key] = ("case", np.array([case.get(key, np.nan) for case in cases]))
+    for key, (units, description) in exp.variables.items():
+        if key in ds:
+            ds[key].attrs.update(units=units, long_name=description)
+    params = info["parameters"]
+    ds.attrs.update(
+        scenario=info["scenario"], title=info["title"], reproduces=info["reproduces"],
+        quick=int(info["quick"]), seed=int(info["seed"]), ensemble=int(info["ensemble"]),
+        command=info.get("command", ""), created=info["created"],
+        parameters=dump_yaml(params), versions=dump_yaml(info["versions"]),
+        Conventions="CF-1.8")
+    for key, value in params.items():
+        ds.attrs[f"param_{key}"] = (int(value) if isinstance(value, bool)
+                                    else np.asarray(value) if isinstance(value, list) else value)
+    return ds
+
+
+def make_figures(out: Path, ds, exp, params) -> list[Path]:
+    import matplotlib
+    matplotlib.use("Agg")
+    fig_dir = out / "figures"
+    fig_dir.mkdir(exist_ok=True)
+    return [Path(p) for p in exp.plot(ds, params, fig_dir)]
+
+
+def format_summary(cfg: ScenarioConfig, rows, wall: float, out: Path) -> str:
+    lines = [f"## {cfg.name}: {cfg.title}", "",
+             f"Reproduces {cfg.reproduces}. Output: {out}. Wall time {_hms(wall)}.", ""]
+    if rows:
+        lines += ["| quantity | this run | paper |", "|---|---|---|"]
+        lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+    return "\n".join(lines)
+
+
+def _hms(seconds: float) -> str:
+    s = int(round(seconds))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}" if s >= 3600 else \
+        f"{s // 60}:{s % 60:02d}" if s >= 60 else f"{seconds:.1f} s"
+
+
+def plot_run(directory) -> list[Path]:
+    """(Re)make the figures of a finished run directory."""
+    import xarray as xr
+    import yaml
+
+    out = Path(directory)
+    if not (out / RESULTS_FILE).exists():
+        raise FileNotFoundError(f"{out} holds no {RESULTS_FILE}: not a finished run directory"
+                                + (" (resume it with ice-scenarios run --resume)"
+                                   if (out / RUN_FILE).exists() else ""))
+    info = yaml.safe_load((out / RUN_FILE).read_text())
+    exp = get_experiment(info["scenario"])
+    with xr.open_dataset(out / RESULTS_FILE, engine="h5netcdf") as ds:
+        ds = ds.load()
+    return make_figures(out, ds, exp, info["parameters"])
