@@ -19,7 +19,6 @@ Data flow of one step::
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Callable
 
@@ -27,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 from physics import PaperPreset
+from physics.hertz import hertz_time_step, scaled_contact  # noqa: F401  (used by the envs)
 from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
@@ -40,25 +40,6 @@ def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
     a = np.array(action, dtype=np.float64).reshape(space.shape)
     a[~np.isfinite(a)] = 0.0
     return np.clip(a, space.low, space.high)
-
-
-def scaled_contact(contact, stiffness_scale: float):
-    """The contact law with Young's modulus multiplied by ``stiffness_scale``
-    (a softer contact allows a longer time step: Δt ∝ E^(−2/5))."""
-    check_range("stiffness_scale", stiffness_scale, 0.0, 1.0, low_open=True)
-    return dataclasses.replace(contact, elastic_modulus=contact.elastic_modulus * stiffness_scale)
-
-
-def hertz_time_step(field, box, contact, impact_speed: float, preset_dt: float,
-                    stiffness_scale: float) -> float:
-    """Time step of a Hertz env: the preset's Δt scaled with the stiffness
-    (Δt ∝ E^(−2/5)), and never above a tenth of the shortest contact time
-    at ``impact_speed`` [m/s]."""
-    from physics.hertz import minimum_contact_time
-
-    t_c = minimum_contact_time(field.radii, field.thickness, field.density, contact, impact_speed,
-                               walls=not all(box.periodic))
-    return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
 
 
 class ControlEnv(gym.Env):

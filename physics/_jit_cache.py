@@ -5,7 +5,9 @@ a function itself changes, not when a function it inlines from another
 module does; after an update that touched only ``physics/contact.py`` the
 kernels of ``physics/hertz_kernels.py`` would silently run the old contact
 law. So the cache lives in a directory named after a hash of every source
-file of the package, and other such directories are removed.
+file of the package's top-level modules (where every kernel lives;
+subpackages such as ``physics.scenarios`` hold no kernels and do not enter
+the hash), and other such directories are removed.
 
 The base directory is ``$NUMBA_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/seaice-gym/numba`` (``~/.cache/seaice-gym/numba``).
@@ -24,7 +26,7 @@ import numba
 def _source_hash() -> str:
     h = hashlib.sha1()
     root = Path(__file__).resolve().parent
-    for path in sorted(root.rglob("*.py")):
+    for path in sorted(root.glob("*.py")):
         h.update(str(path.relative_to(root)).encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]

@@ -15,6 +15,7 @@ Example
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numba
@@ -44,6 +45,24 @@ def minimum_contact_time(radius, thickness, density, contact: ContactParams, spe
     if walls:
         t = np.minimum(t, contact_time(m, hertz_stiffness(contact.wall_effective_modulus, r), speed))
     return float(np.min(t))
+
+
+def scaled_contact(contact: ContactParams, stiffness_scale: float) -> ContactParams:
+    """The contact law with Young's modulus multiplied by ``stiffness_scale``
+    in (0, 1] (a softer contact allows a longer time step: Δt ∝ E^(−2/5))."""
+    check_range("stiffness_scale", stiffness_scale, 0.0, 1.0, low_open=True)
+    return dataclasses.replace(contact, elastic_modulus=contact.elastic_modulus * stiffness_scale)
+
+
+def hertz_time_step(field: FloeField, box: Box, contact: ContactParams, impact_speed: float,
+                    preset_dt: float, stiffness_scale: float) -> float:
+    """Time step for a contact law softened by ``stiffness_scale``: the
+    preset's Δt × stiffness_scale^(−2/5) (the contact time scales as
+    E^(−2/5)), and never above a tenth of the shortest contact time at
+    ``impact_speed`` [m/s]."""
+    t_c = minimum_contact_time(field.radii, field.thickness, field.density, contact, impact_speed,
+                               walls=not all(box.periodic))
+    return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
 
 
 class HertzSimulation:
