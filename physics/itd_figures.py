@@ -51,6 +51,12 @@ and ice thicker than about 1.35 m thins by about 0.01 m/day all year.
 The tail is not yet stationary after 2000 days for the constant kernel (λ
 still creeps up by about 1 % per 200 days), so λ at the last day depends on
 ``--days``; the rates above were tuned for 2000 days.
+
+The constants and helpers here (daily diagnostics :func:`advance_day`,
+:func:`tail_formation`, :func:`seasonal_cycle`, the panels :func:`plot_g` and
+:func:`plot_scm`) are shared with the configurable, resumable scenarios of
+:mod:`physics.scenarios.godlovitch` (``ice-scenarios run godlovitch-kernels``
+and the others).
 """
 from __future__ import annotations
 
@@ -78,10 +84,11 @@ KERNELS = {
 # brackets for the bisection in tune_rate (the tail e-folding grows with r)
 _BRACKETS = {"constant": (0.001, 0.008), "exponential": (0.003, 0.05),
              "multiplicative": (1e-4, 1e-3), "additive": (1e-4, 1e-3)}
-_KERNEL_TEXT = {"constant": "K = r", "exponential": "K = r exp(−β(x+y))",
-                "multiplicative": "K = r x y", "additive": "K = r (x+y)"}
-_R_UNITS = {"constant": "1/day", "exponential": "1/day", "multiplicative": "1/(m² day)",
-            "additive": "1/(m day)"}
+# the kernels as formulas, and the units of their rates r
+KERNEL_TEXT = {"constant": "K = r", "exponential": "K = r exp(−β(x+y))",
+               "multiplicative": "K = r x y", "additive": "K = r (x+y)"}
+R_UNITS = {"constant": "1/day", "exponential": "1/day", "multiplicative": "1/(m² day)",
+           "additive": "1/(m day)"}
 
 R0 = KERNELS["constant"]["r"]            # base rate of Figs 5 and 6 [1/day]
 RAFT_FACTOR = 4.0
@@ -102,7 +109,7 @@ def _plt():
     return plt
 
 
-def _colours(n, start, end):
+def colours(n, start, end):
     """n colours interpolated linearly from ``start`` to ``end`` (RGB)."""
     a, b = np.asarray(start, float), np.asarray(end, float)
     return [tuple(a + (b - a) * (i / max(n - 1, 1))) for i in range(n)]
@@ -111,7 +118,8 @@ def _colours(n, start, end):
 GREEN, RED, BLUE = (0.0, 0.65, 0.0), (0.85, 0.0, 0.0), (0.0, 0.2, 0.9)
 
 
-def _time_colourbar(fig, axes, plt, start, end, t_max, label="model time [days]"):
+def time_colourbar(fig, axes, plt, start, end, t_max, label="model time [days]"):
+    """A colour bar from ``start`` (t = 0) to ``end`` (t = ``t_max``) beside ``axes``."""
     from matplotlib.colors import LinearSegmentedColormap, Normalize
 
     cmap = LinearSegmentedColormap.from_list("time", [start, end])
@@ -119,13 +127,42 @@ def _time_colourbar(fig, axes, plt, start, end, t_max, label="model time [days]"
     fig.colorbar(sm, ax=axes, label=label, shrink=0.8, pad=0.02)
 
 
-def _every(days):
+def snapshot_every(days):
+    """Days between the g(h) snapshots of a run of ``days`` days (ten per run)."""
     return max(1, int(round(days / 10)))
 
 
-def _ice_volume_above(model, h_min):
+def ice_volume_above(model, h_min):
+    """Ice volume per unit area in the classes thicker than ``h_min`` [m]."""
     use = model.h > h_min
     return float(np.dot(model.h[use], model.g[use]))
+
+
+#: daily series kept by :func:`advance_day`: model time [days], mean thickness
+#: [m], open water, ice volume above 2 m and above 5 m [m], tail e-folding λ [m]
+SERIES = ("t", "mean", "open", "v2", "v5", "lam")
+
+
+def new_series(days) -> dict:
+    """Empty (NaN) daily series of :data:`SERIES` for a run of ``days`` days."""
+    return {k: np.full(int(days), np.nan) for k in SERIES}
+
+
+def advance_day(model, series: dict, d: int, fit_every: int = 5) -> None:
+    """Step ``model`` by one day and store the diagnostics of day ``d``
+    (0-based) in ``series`` (from :func:`new_series`); the tail e-folding
+    thickness is fitted every ``fit_every`` days and on the last day (NaN
+    between, and while the tail is too short to fit)."""
+    n = len(series["t"])
+    model.step(1.0)
+    series["t"][d] = model.time
+    series["mean"][d] = model.mean_thickness
+    series["open"][d] = model.open_water
+    series["v2"][d] = ice_volume_above(model, 2.0)
+    series["v5"][d] = ice_volume_above(model, 5.0)
+    if (d + 1) % fit_every == 0 or d == n - 1:
+        lam = model.tail_fit(TAIL_MIN).efolding
+        series["lam"][d] = lam if math.isfinite(lam) else np.nan
 
 
 def _run(model, days, *, fit_every=5):
@@ -133,55 +170,121 @@ def _run(model, days, *, fit_every=5):
     and daily series of mean thickness, open water, ice volume above 2 m and
     5 m, and the tail e-folding thickness (every ``fit_every`` days, NaN
     between and while the tail is too short to fit)."""
-    every = _every(days)
+    every = snapshot_every(days)
     snap_t, snaps = [], []
     n = int(days)
-    s = {k: np.full(n, np.nan) for k in ("t", "mean", "open", "v2", "v5", "lam")}
+    s = new_series(n)
     for d in range(n):
-        model.step(1.0)
-        s["t"][d] = model.time
-        s["mean"][d] = model.mean_thickness
-        s["open"][d] = model.open_water
-        s["v2"][d] = _ice_volume_above(model, 2.0)
-        s["v5"][d] = _ice_volume_above(model, 5.0)
-        if (d + 1) % fit_every == 0 or d == n - 1:
-            lam = model.tail_fit(TAIL_MIN).efolding
-            s["lam"][d] = lam if math.isfinite(lam) else np.nan
+        advance_day(model, s, d, fit_every)
         if (d + 1) % every == 0 or d == n - 1:
             snap_t.append(model.time)
             snaps.append(model.g.copy())
     return np.array(snap_t), np.array(snaps), s
 
 
-def _first_day(t, series, level):
+def first_day(t, series, level):
     """First time at which ``series`` >= ``level`` (NaN entries skipped)."""
     ok = np.isfinite(series) & (series >= level)
     return float(t[np.argmax(ok)]) if ok.any() else math.nan
 
 
-def _last_year(x):
+def last_year(x):
+    """The last 360 entries (one model year of daily values) of ``x``."""
     return x[-min(len(x), int(360)):]
 
 
-def _plot_g(ax, model, snap_t, snaps, colours, fit=None, title=None):
-    h = model.h[1:]
-    for t, g, c in zip(snap_t, snaps, colours):
-        ax.semilogy(h, np.where(g[1:] > 0, g[1:], np.nan), color=c, lw=1.1)
+def tail_formation(s: dict) -> dict:
+    """How fast the thick ice forms, from daily series ``s``: the day the ice
+    volume above 2 m (and 5 m) first reaches 90 % of its mean over the last
+    year, and those means [m]."""
+    v2, v5 = last_year(s["v2"]).mean(), last_year(s["v5"]).mean()
+    return dict(t90_volume_above_2m=first_day(s["t"], s["v2"], 0.9 * v2),
+                t90_volume_above_5m=first_day(s["t"], s["v5"], 0.9 * v5),
+                volume_above_2m=float(v2), volume_above_5m=float(v5))
+
+
+def seasonal_cycle(s: dict) -> dict:
+    """The seasonal cycle over the last year of daily series ``s``: mean
+    thickness, its amplitude (half the range) absolute and relative, the
+    range of the tail e-folding thickness λ and its range relative to its
+    mean, and the range of the open-water fraction."""
+    mean_y, lam_y = last_year(s["mean"]), last_year(s["lam"])
+    lam_y = lam_y[np.isfinite(lam_y)]
+    if lam_y.size == 0:
+        lam_y = np.array([math.nan])
+    open_y = last_year(s["open"])
+    return dict(mean_thickness=float(mean_y.mean()),
+                mean_thickness_amplitude=float((mean_y.max() - mean_y.min()) / 2),
+                relative_amplitude=float((mean_y.max() - mean_y.min()) / 2 / mean_y.mean()),
+                efolding_range=(float(lam_y.min()), float(lam_y.max())),
+                efolding_relative_range=float((lam_y.max() - lam_y.min()) / lam_y.mean()),
+                open_water_range=(float(open_y.min()), float(open_y.max())))
+
+
+def plot_g(ax, h, snaps, line_colours, fit=None, title=None):
+    """g(h) of the ice classes on a log axis, one line per snapshot.
+
+    Parameters
+    ----------
+    ax : matplotlib axes
+    h : (n,) array — thicknesses of the ice classes [m] (open water left out)
+    snaps : (k, n) array — area fractions of the ice classes, oldest first
+    line_colours : k colours
+    fit : TailFit, optional — drawn as a dashed line through the last snapshot
+    title : str, optional
+    """
+    h = np.asarray(h, dtype=float)
+    snaps = np.atleast_2d(np.asarray(snaps, dtype=float))
+    for g, c in zip(snaps, line_colours):
+        ax.semilogy(h, np.where(g > 0, g, np.nan), color=c, lw=1.1)
     if fit is not None and math.isfinite(fit.efolding):
         hh = np.linspace(TAIL_MIN, h[-2], 50)
-        use = (h > TAIL_MIN) & (snaps[-1][1:] > 1e-12)
+        use = (h > TAIL_MIN) & (snaps[-1] > 1e-12)
         use[-1] = False
-        icpt = np.mean(np.log(snaps[-1][1:][use]) - fit.slope * h[use])
+        icpt = np.mean(np.log(snaps[-1][use]) - fit.slope * h[use])
         ax.semilogy(hh, np.exp(icpt + fit.slope * hh), "k--", lw=1.0,
                     label=f"fit > {TAIL_MIN:g} m: λ = {fit.efolding:.2f} m, R² = {fit.r2:.3f}")
         ax.legend(loc="upper right", fontsize=7.5, frameon=False)
     ax.set_xlim(0, h[-1])
     ax.set_ylim(1e-12, 1.5)
     ax.set_xlabel("h [m]")
-    ax.set_ylabel("g(h) per 0.1 m class")
+    ax.set_ylabel(f"g(h) per {h[1] - h[0]:.3g} m class")
     ax.grid(True, which="major", alpha=0.3)
     if title:
         ax.set_title(title, fontsize=9.5)
+
+
+def scm_exact(k, t):
+    """Exact solution of the coagulation equation with K = 1 from u_1(0) = 1:
+    u_k(t) = (1 + t/2)^(−2) (t/(2 + t))^(k−1), broadcast over ``k`` and ``t``."""
+    k = np.asarray(k, dtype=float)
+    t = np.asarray(t, dtype=float)
+    return (1.0 + t / 2.0) ** -2 * (t / (2.0 + t)) ** (k - 1)
+
+
+def plot_scm(ax, ax2, k, times, u, exact, n_classes, rtol):
+    """Fig. 7 panels: numerical u_k (dots) against the exact solution (lines)
+    on ``ax`` and their relative error on ``ax2``, one colour per time
+    (blue → red); ``u`` and ``exact`` have shape (len(times), len(k))."""
+    u, exact = np.asarray(u, float), np.asarray(exact, float)
+    shown = exact > 1e-12
+    rel = np.abs(u - exact) / np.where(shown, exact, 1.0)
+    for q, (tq, c) in enumerate(zip(times, colours(len(times), BLUE, RED))):
+        ax.semilogy(k, exact[q], color=c, lw=1.0)
+        ax.semilogy(k, u[q], "o", color=c, ms=3, label=f"t = {tq:g}")
+        ok = shown[q]
+        ax2.semilogy(k[ok], np.maximum(rel[q][ok], 1e-16), color=c, lw=1.0)
+    ax.set_ylim(1e-12, 1.5)
+    ax.set_xlabel("mass k")
+    ax.set_ylabel("number density u_k")
+    ax.set_title(r"$u_k(t)$: numerical (dots), exact $(1 + t/2)^{-2}\,(t/(2 + t))^{k-1}$ "
+                 "(lines)", fontsize=9.5)
+    ax.legend(fontsize=7.5, frameon=False, ncol=2)
+    ax.grid(True, alpha=0.3)
+    ax2.set_xlabel("mass k")
+    ax2.set_ylabel("|u_k − exact| / exact (where exact u_k > 1e-12)")
+    ax2.set_title(f"relative error ({n_classes} classes, DOP853, rtol {rtol:g})", fontsize=9.5)
+    ax2.grid(True, alpha=0.3)
 
 
 # -- tuning --------------------------------------------------------------------------------
@@ -221,15 +324,15 @@ def figure4(out_dir: Path, days: int = 2000, kernels=None) -> dict:
         res[kind] = dict(params, efolding=fit.efolding, r2=fit.r2, open_water=m.open_water,
                          mean_thickness=m.mean_thickness, top_class=float(m.g[-1]))
         extra = f", β = {params['beta']:g}/m" if "beta" in params else ""
-        _plot_g(ax, m, t, snaps, _colours(len(t), GREEN, RED), fit,
-                f"{kind}: {_KERNEL_TEXT[kind]}, r = {params['r']:.3g} {_R_UNITS[kind]}{extra}")
+        plot_g(ax, m.h[1:], snaps[:, 1:], colours(len(t), GREEN, RED), fit,
+               f"{kind}: {KERNEL_TEXT[kind]}, r = {params['r']:.3g} {R_UNITS[kind]}{extra}")
     for ax in axes[0]:
         ax.set_xlabel("")
     for ax in axes[:, 1]:
         ax.set_ylabel("")
-    fig.suptitle(f"Godlovitch et al. Fig. 4: Table 1 kernels, g(h) every {_every(days)} days "
-                 f"for {days} days (green → red)", fontsize=11)
-    _time_colourbar(fig, axes, plt, GREEN, RED, days)
+    fig.suptitle(f"Godlovitch et al. Fig. 4: Table 1 kernels, g(h) every "
+                 f"{snapshot_every(days)} days for {days} days (green → red)", fontsize=11)
+    time_colourbar(fig, axes, plt, GREEN, RED, days)
     _save(fig, out_dir / "itd_fig4_kernels.png", plt)
     return res
 
@@ -250,12 +353,9 @@ def figure5(out_dir: Path, days: int = 2000) -> dict:
     for hr, (m, t, snaps, s) in runs.items():
         fit = m.tail_fit(TAIL_MIN)
         res["none" if hr is None else hr] = dict(
-            t90_volume_above_2m=_first_day(s["t"], s["v2"], 0.9 * _last_year(s["v2"]).mean()),
-            t90_volume_above_5m=_first_day(s["t"], s["v5"], 0.9 * _last_year(s["v5"]).mean()),
-            t_efolding_90pc_of_no_rafting=_first_day(s["t"], s["lam"], 0.9 * lam_ref),
-            efolding=fit.efolding, r2=fit.r2,
-            volume_above_2m=float(_last_year(s["v2"]).mean()),
-            volume_above_5m=float(_last_year(s["v5"]).mean()))
+            tail_formation(s),
+            t_efolding_90pc_of_no_rafting=first_day(s["t"], s["lam"], 0.9 * lam_ref),
+            efolding=fit.efolding, r2=fit.r2)
 
     fig, axes = plt.subplots(2, 3, figsize=(13.5, 7.6))
     shown = [None, 0.5, 1.0, 2.0]
@@ -265,8 +365,8 @@ def figure5(out_dir: Path, days: int = 2000) -> dict:
             f"rafting below h_R = {hr:g} m (K = 4 r0), K = r0 above"
         if hr is None:
             name += "; h_R = 0.2 m is the same"
-        _plot_g(ax, m, t, snaps, _colours(len(t), GREEN, RED),
-                m.tail_fit(TAIL_MIN), name)
+        plot_g(ax, m.h[1:], snaps[:, 1:], colours(len(t), GREEN, RED),
+               m.tail_fit(TAIL_MIN), name)
     styles = dict(zip(RAFT_CUTOFFS, ["k", "tab:cyan", "tab:blue", "tab:orange", "tab:red"]))
     order = list(RAFT_CUTOFFS[1:]) + [None]         # no rafting on top
     ax = axes.flat[4]
@@ -292,8 +392,8 @@ def figure5(out_dir: Path, days: int = 2000) -> dict:
     ax.set_ylim(1e-5, 1.5)
     ax.grid(True, alpha=0.3)
     fig.suptitle(f"Godlovitch et al. Fig. 5: constant kernel r0 = {R0:g}/day with rafting "
-                 f"(K = {RAFT_FACTOR:g} r0 below the cut-off h_R), g(h) every {_every(days)} days "
-                 f"(green → red)", fontsize=11)
+                 f"(K = {RAFT_FACTOR:g} r0 below the cut-off h_R), g(h) every "
+                 f"{snapshot_every(days)} days (green → red)", fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     _save(fig, out_dir / "itd_fig5_rafting.png", plt)
     return res
@@ -308,34 +408,23 @@ def figure6(out_dir: Path, days: int = 2000) -> dict:
         m = ThorndikeModel("constant", r=R0, scale=1.0 / rt)
         t, snaps, s = _run(m, days)
         fit = m.tail_fit(TAIL_MIN)
-        mean_y, lam_y = _last_year(s["mean"]), _last_year(s["lam"])
-        lam_y = lam_y[np.isfinite(lam_y)]
-        if lam_y.size == 0:
-            lam_y = np.array([math.nan])
-        res[rt] = dict(efolding=fit.efolding, r2=fit.r2,
-                       mean_thickness=float(mean_y.mean()),
-                       mean_thickness_amplitude=float((mean_y.max() - mean_y.min()) / 2),
-                       relative_amplitude=float((mean_y.max() - mean_y.min()) / 2 / mean_y.mean()),
-                       efolding_range=(float(lam_y.min()), float(lam_y.max())),
-                       efolding_relative_range=float((lam_y.max() - lam_y.min()) / lam_y.mean()),
-                       open_water_range=(float(_last_year(s["open"]).min()),
-                                         float(_last_year(s["open"]).max())))
+        res[rt] = dict(efolding=fit.efolding, r2=fit.r2, **seasonal_cycle(s))
         series[rt] = s
-        _plot_g(ax, m, t, snaps, _colours(len(t), BLUE, RED), fit,
-                f"R_T = {rt:g}: K = r0/R_T = {R0 / rt:.3g}/day")
-    colours = _colours(len(RELATIVE_STRENGTHS), BLUE, RED)
+        plot_g(ax, m.h[1:], snaps[:, 1:], colours(len(t), BLUE, RED), fit,
+               f"R_T = {rt:g}: K = r0/R_T = {R0 / rt:.3g}/day")
+    strength_colours = colours(len(RELATIVE_STRENGTHS), BLUE, RED)
     panels = [("mean", "mean thickness (open water as 0) [m]", "mean thickness"),
               ("lam", "λ / its mean over the last year",
                f"tail e-folding thickness λ (h > {TAIL_MIN:g} m), relative"),
               ("open", "open-water fraction g_0", "open water")]
     for ax, (key, ylabel, title) in zip(axes.flat[5:], panels):
-        for rt, c in zip(RELATIVE_STRENGTHS, colours):
+        for rt, c in zip(RELATIVE_STRENGTHS, strength_colours):
             s = series[rt]
             last = slice(-min(len(s["t"]), 1080), None)
             y, tt = s[key][last], s["t"][last]
             ok = np.isfinite(y)
             if key == "lam":
-                y = y / np.nanmean(_last_year(s["lam"]))
+                y = y / np.nanmean(last_year(s["lam"]))
             ax.plot(tt[ok], y[ok], color=c, lw=1.2, label=f"R_T = {rt:g}")
         ax.set_xlabel("t [days] (mid-winter at multiples of 360)")
         ax.set_ylabel(ylabel)
@@ -345,8 +434,8 @@ def figure6(out_dir: Path, days: int = 2000) -> dict:
     lo, hi = axes.flat[5].get_ylim()
     axes.flat[5].set_ylim(lo, hi + 0.3 * (hi - lo))
     fig.suptitle(f"Godlovitch et al. Fig. 6: relative strength R_T of thermodynamics and "
-                 f"stacking, K = r0/R_T with r0 = {R0:g}/day, g(h) every {_every(days)} days "
-                 f"(blue → red)", fontsize=11)
+                 f"stacking, K = r0/R_T with r0 = {R0:g}/day, g(h) every "
+                 f"{snapshot_every(days)} days (blue → red)", fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     _save(fig, out_dir / "itd_fig6_relative_strength.png", plt)
     return res
@@ -361,8 +450,7 @@ def figure7(out_dir: Path) -> dict:
     u0[0] = 1.0
     u = solve_smoluchowski(constant_kernel(n, 1.0), u0, t)[1:]
     k = np.arange(1, n + 1)
-    tt = np.asarray(SCM_TIMES)[:, None]
-    exact = (1.0 + tt / 2.0) ** -2 * (tt / (2.0 + tt)) ** (k[None, :] - 1)
+    exact = scm_exact(k[None, :], np.asarray(SCM_TIMES)[:, None])
     rel = np.abs(u - exact) / exact
     shown = exact[:, :SCM_KMAX] > 1e-12
     res = dict(max_rel_error_k_le_10=float(rel[:, :10].max()),
@@ -370,24 +458,7 @@ def figure7(out_dir: Path) -> dict:
                mass_error=float(np.abs((u * k).sum(1) - 1.0).max()))
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 4.8))
-    colours = _colours(len(SCM_TIMES), BLUE, RED)
-    kk = k[:SCM_KMAX]
-    for q, (tq, c) in enumerate(zip(SCM_TIMES, colours)):
-        ax.semilogy(kk, exact[q, :SCM_KMAX], color=c, lw=1.0)
-        ax.semilogy(kk, u[q, :SCM_KMAX], "o", color=c, ms=3, label=f"t = {tq:g}")
-        ok = shown[q]
-        ax2.semilogy(kk[ok], np.maximum(rel[q, :SCM_KMAX][ok], 1e-16), color=c, lw=1.0)
-    ax.set_ylim(1e-12, 1.5)
-    ax.set_xlabel("mass k")
-    ax.set_ylabel("number density u_k")
-    ax.set_title(r"$u_k(t)$: numerical (dots), exact $(1 + t/2)^{-2}\,(t/(2 + t))^{k-1}$ "
-                 "(lines)", fontsize=9.5)
-    ax.legend(fontsize=7.5, frameon=False, ncol=2)
-    ax.grid(True, alpha=0.3)
-    ax2.set_xlabel("mass k")
-    ax2.set_ylabel("|u_k − exact| / exact (where exact u_k > 1e-12)")
-    ax2.set_title(f"relative error ({n} classes, DOP853, rtol 1e-10)", fontsize=9.5)
-    ax2.grid(True, alpha=0.3)
+    plot_scm(ax, ax2, k[:SCM_KMAX], SCM_TIMES, u[:, :SCM_KMAX], exact[:, :SCM_KMAX], n, 1e-10)
     fig.suptitle("Godlovitch et al. Fig. 7: Smoluchowski coagulation with K(j, k) = 1, "
                  "u_1(0) = 1", fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.94))
@@ -465,7 +536,7 @@ def main(argv=None) -> int:
             extra = {k: v for k, v in params.items() if k != "r"}
             r, lam = tune_rate(kind, TAIL_TARGET, args.days, **extra)
             kernels[kind] = dict(params, r=float(f"{r:.3g}"))
-            print(f"tuned {kind}: r = {r:.3g} {_R_UNITS[kind]} (λ = {lam:.3f} m)")
+            print(f"tuned {kind}: r = {r:.3g} {R_UNITS[kind]} (λ = {lam:.3f} m)")
     res = make_figures(args.out, args.days, kernels)
     for line in summary(res):
         print(line)

@@ -37,13 +37,12 @@ def _show(name: str) -> int:
     print(f"reproduces: {cfg.reproduces}")
     print(f"file: {cfg.path} (copy it, edit it, run the copy)\n")
     print(textwrap.fill(cfg.description, 88) + "\n")
-    width = max(len(k) for k in cfg.params)
-    print(f"{'parameter':{width}s}  {'default':>14s}  {'--quick':>10s}  allowed / meaning")
+    print("parameters (--set NAME=VALUE):")
     for key, p in cfg.params.items():
-        quick = cfg.quick.get(key, "")
+        quick = f"   (--quick: {cfg.quick[key]})" if key in cfg.quick else ""
         units = f" [{p.units}]" if p.units else ""
-        print(f"{key:{width}s}  {str(p.default):>14s}  {str(quick):>10s}  {p.allowed()}")
-        print(f"{'':{width}s}  {'':14s}  {'':10s}  {p.help}{units}")
+        print(f"  {key} = {p.default}{quick}")
+        print(f"      {p.help}{units}; {p.allowed()}")
     return 0
 
 

@@ -206,8 +206,12 @@ def load_config(path) -> ScenarioConfig:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no scenario file {path}")
+    yaml = _yaml()
     with open(path) as fh:
-        data = _yaml().safe_load(fh)
+        try:
+            data = yaml.safe_load(fh)
+        except yaml.YAMLError as exc:
+            raise ValueError(f"scenario file {path} is not valid YAML: {exc}") from None
     return parse_config(data, path)
 
 

@@ -67,6 +67,8 @@ class Experiment:
     required: tuple[str, ...] = ()
     #: the coordinate that labels the cases (for tables and plots)
     case_label: str | None = None
+    #: whether runs store floe snapshots (their variables then always exist)
+    takes_snapshots: bool = True
 
     def cases(self, p: dict) -> list[dict]:
         """One dict of coordinate values per independent run (default: one)."""

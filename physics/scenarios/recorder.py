@@ -63,18 +63,22 @@ class Recorder:
     variables : dict
         name → (units, description) of the recorded variables, written as
         attributes.
+    keep_snapshots : bool
+        Write the snapshot variables even when there are no snapshots.
     """
 
     def __init__(self, checkpoint_path: Path | None = None, checkpoint_every: float = 60.0,
-                 on_progress=None, variables: dict | None = None):
+                 on_progress=None, variables: dict | None = None, keep_snapshots: bool = True):
         self.checkpoint_path = Path(checkpoint_path) if checkpoint_path else None
         self.checkpoint_every = float(checkpoint_every)
         self.on_progress = on_progress
         self.variables = dict(variables or {})
+        self.keep_snapshots = keep_snapshots
         self.rows: list[tuple[float, dict]] = []
         self.coords: dict[str, tuple[np.ndarray, dict]] = {}
         self.snapshots: list[dict] = []
         self.results: dict[str, float] = {}
+        self.notes: list[str] = []
         self.n_checkpoints = 0
         self._state = None
         self._last = _time.monotonic()
@@ -121,6 +125,10 @@ class Recorder:
     def result(self, **values) -> None:
         self.results.update({k: float(v) for k, v in values.items()})
 
+    def note(self, text: str) -> None:
+        """A remark on the run (e.g. why it ended early), shown in the summary."""
+        self.notes.append(str(text))
+
     def progress(self, fraction: float) -> None:
         self._fraction = min(max(float(fraction), 0.0), 1.0)
         if self.on_progress is not None:
@@ -141,7 +149,7 @@ class Recorder:
             return False
         payload = dict(version=CHECKPOINT_VERSION, state=state, rows=self.rows,
                        coords=self.coords, snapshots=self.snapshots, results=self.results,
-                       fraction=self._fraction)
+                       notes=self.notes, fraction=self._fraction)
 
         def write(tmp):
             with open(tmp, "wb") as fh:
@@ -162,9 +170,53 @@ class Recorder:
         self.coords = payload["coords"]
         self.snapshots = payload["snapshots"]
         self.results = payload["results"]
+        self.notes = payload["notes"]
         self._fraction = payload["fraction"]
 
     # -- output ------------------------------------------------------------
+    def _snapshot_variables(self, ds) -> None:
+        """Snapshot variables (zero-length when there are none, so that runs
+        that ended before their first snapshot still combine)."""
+        nf = max((len(s["radii"]) for s in self.snapshots), default=0)
+        nc = max((len(s["contacts"][0]) for s in self.snapshots if "contacts" in s),
+                 default=0)
+        k = len(self.snapshots)
+        ds.coords["snapshot"] = ("snapshot", np.arange(k))
+        ds.coords["floe"] = ("floe", np.arange(nf))
+        ds["snapshot_time"] = ("snapshot", np.array([s["time"] for s in self.snapshots]),
+                               {"units": "s"})
+        ds["snapshot_lx"] = ("snapshot", np.array([s["box"][0] for s in self.snapshots]),
+                             {"units": "m", "long_name": "box length along x"})
+        ds["snapshot_ly"] = ("snapshot", np.array([s["box"][1] for s in self.snapshots]),
+                             {"units": "m", "long_name": "box length along y"})
+        fields = {"floe_x": ("positions", 0, "m"), "floe_y": ("positions", 1, "m"),
+                  "floe_u": ("velocities", 0, "m/s"), "floe_v": ("velocities", 1, "m/s"),
+                  "floe_radius": ("radii", None, "m")}
+        for name, (src, col, units) in fields.items():
+            arr = np.full((k, nf), np.nan)
+            for s, snap in enumerate(self.snapshots):
+                a = snap[src] if col is None else snap[src][:, col]
+                arr[s, :len(a)] = a
+            ds[name] = (("snapshot", "floe"), arr, {"units": units})
+        fz = np.zeros((k, nf), np.int8)
+        for s, snap in enumerate(self.snapshots):
+            fz[s, :len(snap["frozen"])] = snap["frozen"]
+        ds["floe_frozen"] = (("snapshot", "floe"), fz, {"long_name": "1 for frozen floes"})
+        ds.coords["contact"] = ("contact", np.arange(nc))
+        ci = np.full((k, nc), -1, np.int64)
+        cj = np.full((k, nc), -1, np.int64)
+        cf = np.full((k, nc), np.nan)
+        for s, snap in enumerate(self.snapshots):
+            if "contacts" in snap:
+                i, j, f = snap["contacts"]
+                ci[s, :len(i)], cj[s, :len(j)], cf[s, :len(f)] = i, j, f
+        ds["contact_i"] = (("snapshot", "contact"), ci,
+                           {"long_name": "first floe of a touching pair (-1: none)"})
+        ds["contact_j"] = (("snapshot", "contact"), cj,
+                           {"long_name": "second floe of a touching pair (-1: none)"})
+        ds["contact_force"] = (("snapshot", "contact"), cf,
+                               {"units": "N", "long_name": "normal contact force"})
+
     def dataset(self):
         """Everything recorded, as an ``xarray.Dataset``."""
         import xarray as xr
@@ -188,49 +240,11 @@ class Recorder:
                 ds[key] = (("sample", dim), arr)
             else:
                 ds[key] = ("sample", np.array([row.get(key, np.nan) for _, row in self.rows]))
-        if self.snapshots:
-            nf = max(len(s["radii"]) for s in self.snapshots)
-            nc = max((len(s["contacts"][0]) for s in self.snapshots if "contacts" in s),
-                     default=0)
-            k = len(self.snapshots)
-            ds.coords["snapshot"] = ("snapshot", np.arange(k))
-            ds.coords["floe"] = ("floe", np.arange(nf))
-            ds["snapshot_time"] = ("snapshot", np.array([s["time"] for s in self.snapshots]),
-                                   {"units": "s"})
-            ds["snapshot_lx"] = ("snapshot", np.array([s["box"][0] for s in self.snapshots]),
-                                 {"units": "m", "long_name": "box length along x"})
-            ds["snapshot_ly"] = ("snapshot", np.array([s["box"][1] for s in self.snapshots]),
-                                 {"units": "m", "long_name": "box length along y"})
-            fields = {"floe_x": ("positions", 0, "m"), "floe_y": ("positions", 1, "m"),
-                      "floe_u": ("velocities", 0, "m/s"), "floe_v": ("velocities", 1, "m/s"),
-                      "floe_radius": ("radii", None, "m")}
-            for name, (src, col, units) in fields.items():
-                arr = np.full((k, nf), np.nan)
-                for s, snap in enumerate(self.snapshots):
-                    a = snap[src] if col is None else snap[src][:, col]
-                    arr[s, :len(a)] = a
-                ds[name] = (("snapshot", "floe"), arr, {"units": units})
-            fz = np.zeros((k, nf), np.int8)
-            for s, snap in enumerate(self.snapshots):
-                fz[s, :len(snap["frozen"])] = snap["frozen"]
-            ds["floe_frozen"] = (("snapshot", "floe"), fz, {"long_name": "1 for frozen floes"})
-            if nc:
-                ds.coords["contact"] = ("contact", np.arange(nc))
-                ci = np.full((k, nc), -1, np.int64)
-                cj = np.full((k, nc), -1, np.int64)
-                cf = np.full((k, nc), np.nan)
-                for s, snap in enumerate(self.snapshots):
-                    if "contacts" in snap:
-                        i, j, f = snap["contacts"]
-                        ci[s, :len(i)], cj[s, :len(j)], cf[s, :len(f)] = i, j, f
-                ds["contact_i"] = (("snapshot", "contact"), ci,
-                                   {"long_name": "first floe of a touching pair (-1: none)"})
-                ds["contact_j"] = (("snapshot", "contact"), cj,
-                                   {"long_name": "second floe of a touching pair (-1: none)"})
-                ds["contact_force"] = (("snapshot", "contact"), cf,
-                                       {"units": "N", "long_name": "normal contact force"})
+        if self.snapshots or self.keep_snapshots:
+            self._snapshot_variables(ds)
         for key, value in self.results.items():
             ds[key] = ((), value)
+        ds.attrs["notes"] = "\n".join(self.notes)
         for key, (units, description) in self.variables.items():
             if key in ds:
                 ds[key].attrs.update(units=units, long_name=description)

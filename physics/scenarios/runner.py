@@ -120,7 +120,8 @@ def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: 
             if f >= 1.0 or now - last[0] > 0.5:
                 last[0] = now
                 _QUEUE.put((job_id, f))
-    rec = Recorder(ckpt, checkpoint_every, on_progress, exp.variables)
+    rec = Recorder(ckpt, checkpoint_every, on_progress, exp.variables,
+                   keep_snapshots=exp.takes_snapshots)
     exp.simulate(params, case, seed, rec)
     rec.progress(1.0)
     ds = rec.dataset()
@@ -236,7 +237,7 @@ def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, 
         figures = make_figures(out, ds, exp, params)
     rows = exp.summarise(ds, params)
     wall = time.perf_counter() - t0
-    table = format_summary(cfg, rows, wall, out)
+    table = format_summary(cfg, rows, wall, out, ds.attrs.get("notes", ""))
     (out / "summary.md").write_text(table + "\n")
     log(table)
     return RunResult(out, out / RESULTS_FILE, figures, rows, wall)
@@ -335,12 +336,15 @@ def combine(out: Path, info: dict, cases: list[dict], exp):
 
     fill = {"contact_i": -1, "contact_j": -1, "floe_frozen": 0}
     per_case = []
+    notes = []
     for c in range(len(cases)):
         members = []
         for m in range(len(info["member_seeds"])):
             path, _ = _job_paths(out, c, m)
             with xr.open_dataset(path, engine="h5netcdf") as d:
                 members.append(d.load())
+            if members[-1].attrs.get("notes"):
+                notes.append(f"case {c} {cases[c]}, member {m}: {members[-1].attrs['notes']}")
         per_case.append(xr.concat(members, "member", join="outer", fill_value=fill,
                                   combine_attrs="drop"))
     ds = xr.concat(per_case, "case", join="outer", fill_value=fill, combine_attrs="drop")
@@ -348,7 +352,8 @@ def combine(out: Path, info: dict, cases: list[dict], exp):
     ds["member_seed"] = ("member", np.array([str(s) for s in info["member_seeds"]], dtype=object))
     ds.coords["case"] = ("case", np.arange(len(cases)))
     for key in dict.fromkeys(k for case in cases for k in case):
-        ds.coords[key] = ("case", np.array([case.get(key, np.nan) for case in cases]))
+        name = key if key not in ds.data_vars else f"{key}_case"   # a recorded variable keeps its name
+        ds.coords[name] = ("case", np.array([case.get(key, np.nan) for case in cases]))
     for key, (units, description) in exp.variables.items():
         if key in ds:
             ds[key].attrs.update(units=units, long_name=description)
@@ -358,7 +363,7 @@ def combine(out: Path, info: dict, cases: list[dict], exp):
         quick=int(info["quick"]), seed=int(info["seed"]), ensemble=int(info["ensemble"]),
         command=info.get("command", ""), created=info["created"],
         parameters=dump_yaml(params), versions=dump_yaml(info["versions"]),
-        Conventions="CF-1.8")
+        notes="\n".join(notes), Conventions="CF-1.8")
     for key, value in params.items():
         ds.attrs[f"param_{key}"] = (int(value) if isinstance(value, bool)
                                     else np.asarray(value) if isinstance(value, list) else value)
@@ -373,12 +378,14 @@ def make_figures(out: Path, ds, exp, params) -> list[Path]:
     return [Path(p) for p in exp.plot(ds, params, fig_dir)]
 
 
-def format_summary(cfg: ScenarioConfig, rows, wall: float, out: Path) -> str:
+def format_summary(cfg: ScenarioConfig, rows, wall: float, out: Path, notes: str = "") -> str:
     lines = [f"## {cfg.name}: {cfg.title}", "",
              f"Reproduces {cfg.reproduces}. Output: {out}. Wall time {_hms(wall)}.", ""]
     if rows:
         lines += ["| quantity | this run | paper |", "|---|---|---|"]
         lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+    if notes:
+        lines += ["", "Notes:"] + [f"- {n}" for n in notes.splitlines()]
     return "\n".join(lines)
 
 
