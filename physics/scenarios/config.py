@@ -85,7 +85,7 @@ class Param:
                 return value.lower() in ("true", "yes")
             raise bad
         if kind is list:
-            if not isinstance(value, (list, tuple)) or not value:
+            if not isinstance(value, (list, tuple)):
                 raise bad
             try:
                 items = [float(v) for v in value]

@@ -119,7 +119,7 @@ def _advance(sim: HertzSimulation, duration: float) -> str | None:
     """Advance; a physics failure is returned as a message (the run ends
     there, with everything recorded so far)."""
     try:
-        sim.advance(duration)
+        sim.advance(max(duration, sim.dt))     # at least one step: the loops always progress
     except (FloatingPointError, RuntimeError) as exc:
         return str(exc)
     return None
@@ -241,7 +241,7 @@ class Convergence(Experiment):
         sim = st["sim"]
         a0, a1 = p["start_concentration"], p["end_concentration"]
         dt_out = p["output_step"] / rate
-        while st["error"] is None and sim.concentration < a1 - 1e-9:
+        while st["error"] is None and sim.concentration < a1 - 0.5 * rate * sim.dt:
             step = min(dt_out, (a1 - sim.concentration) / rate)
             st["error"] = _advance(sim, step)
             net, c = network(sim)
@@ -376,7 +376,7 @@ class Wind(Experiment):
             st = dict(sim=sim, error=None, next_snap=0)
         sim = st["sim"]
         snaps = sorted(p["snapshot_times"]) + [p["duration"]]
-        while st["error"] is None and sim.time < p["duration"] - 1e-9:
+        while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
             st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
             net, c = network(sim)
             net.pop("concentration")          # fixed: it is the case coordinate
@@ -503,7 +503,7 @@ class MarginalIceZone(Experiment):
         rec.coord("y", 0.5 * (edges[1:] + edges[:-1]), "m", "distance from the fast-ice side")
         mobile = sim.inv_mass > 0
         snaps = sorted(p["snapshot_times"]) + [p["duration"]]
-        while st["error"] is None and sim.time < p["duration"] - 1e-9:
+        while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
             st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
             net, c = network(sim)
             y = sim.positions[mobile, 1]

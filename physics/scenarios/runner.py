@@ -175,6 +175,9 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
     if int(seed) < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed}")
     params = cfg.resolve(overrides, quick=quick)
+    if not get_experiment(cfg.name).cases(params):
+        raise ValueError(f"these parameters give scenario {cfg.name!r} nothing to run (an empty "
+                         f"list of cases)")
     out = Path(out) if out is not None else Path("runs") / (cfg.name + ("-quick" if quick else ""))
     _prepare_directory(out, force, resume=False)
     data = yaml_config(cfg)
@@ -260,8 +263,7 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
     def update(k, f):
         with lock:
             fractions[k] = max(fractions[k], f)
-            bar.n = sum(fractions.values())
-            bar.refresh()
+            bar.update(sum(fractions.values()) - bar.n)    # tqdm throttles the redraws
     update(0, fractions[0])
     args = [(info["config"], info["parameters"], j["case"], j["seed"], str(out), j["c"],
              j["m"], checkpoint_every, k) for k, j in enumerate(todo)]

@@ -1,0 +1,106 @@
+"""Herman (2013) scenarios: the analysis functions on known curves, and small
+runs that show the paper's qualitative results."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+xr = pytest.importorskip("xarray")
+pytest.importorskip("yaml")
+
+from physics.scenarios import run_scenario  # noqa: E402
+from physics.scenarios.herman2013 import first_crossing, jamming_from_pressure, shear_zone  # noqa: E402
+
+
+def _run(name, out, **overrides):
+    res = run_scenario(name, overrides=overrides, out=out, workers=1, progress=False,
+                       plots=False, log=lambda *a: None)
+    return xr.open_dataset(res.dataset).load()
+
+
+def test_knee_of_a_two_slope_pressure_curve():
+    """ln p with slope 100 below A = 0.9 and 1000 above: the knee within one
+    output step (0.002), the slopes within 1 %."""
+    rng = np.random.default_rng(0)
+    a = np.arange(0.80, 0.95, 0.002)
+    lnp = 2.0 + 100 * (a - 0.8) + 900 * np.maximum(0.0, a - 0.9) + rng.normal(0, 0.01, a.size)
+    knee, lo, hi = jamming_from_pressure(a, np.exp(lnp))
+    assert abs(knee - 0.9) <= 0.002
+    assert lo == pytest.approx(100, rel=0.01) and hi == pytest.approx(1000, rel=0.01)
+    # zero pressures (no contact at that instant) are skipped; too few points → NaN
+    p = np.exp(lnp)
+    p[::5] = 0.0
+    assert abs(jamming_from_pressure(a, p)[0] - 0.9) <= 0.004
+    assert math.isnan(jamming_from_pressure(a[:5], p[:5])[0])
+
+
+def test_first_crossing_is_where_the_curve_stays_above():
+    a = np.linspace(0.8, 0.9, 11)
+    z = np.array([0, 2, 3.5, 2, 2, 3.2, 3.4, 3.6, 2.9, 3.1, 3.3])
+    assert first_crossing(a, z, 3.0) == pytest.approx(0.89)
+    assert math.isnan(first_crossing(a, np.zeros(11), 3.0))
+
+
+def test_shear_zone_width_of_a_ramp_profile():
+    """u_x rising linearly from 0 at y = 20 m to 1 m/s at y = 60 m, flat
+    beyond: 10–90 % of the outer speed is 0.8 × 40 m = 32 m (± one bin)."""
+    y = np.arange(0.5, 200, 1.0)
+    u = np.clip((y - 20) / 40, 0, 1)
+    width, outer = shear_zone(y, u, edge_width=10.0)
+    assert outer == pytest.approx(1.0)
+    assert abs(width - 32.0) <= 1.0
+
+
+def test_convergence_jams_with_the_papers_signatures(tmp_path):
+    """300 floes from A = 0.82 at 1 per hour: binary collisions well below
+    the knee (≤ 1.6 contacts per touching floe, f_nr < 0.1), Z_c > 3 and
+    f_nr > 0.3 beyond it, and a pressure rise of more than 4 decades."""
+    ds = _run("herman2013-convergence", tmp_path / "c", floes=300, start_concentration=0.82,
+              end_concentration=0.92, rate=1.0, output_step=0.002)
+    a = ds["concentration"].values[0, 0]
+    aj = float(ds["a_j"].values[0, 0])
+    assert 0.84 < aj < 0.92
+    early = (a > 0.825) & (a < aj - 0.015)
+    late = a > aj + 0.01
+    assert early.sum() >= 3 and late.sum() >= 2
+    assert np.mean(ds["z_touch"].values[0, 0][early]) <= 1.6
+    assert np.mean(ds["f_nr"].values[0, 0][early]) < 0.1
+    assert np.mean(ds["z_c"].values[0, 0][late]) > 3.0
+    assert np.mean(ds["f_nr"].values[0, 0][late]) > 0.3
+    p = ds["p"].values[0, 0]
+    assert np.nanmax(p[late]) > 1e4 * np.nanmedian(p[early][p[early] > 0])
+    # the Z_c > 3 estimate of A_J agrees with the knee within 0.02
+    assert abs(float(ds["a_j_network"].values[0, 0]) - aj) < 0.02
+
+
+def test_wind_anisotropy_falls_with_concentration(tmp_path):
+    """Under wind, loose ice (A = 0.80) has an anisotropic contact network
+    (Z_a > 0.15) and small stresses; jammed ice (A = 0.90, 200 floes) is
+    nearly isotropic (Z_a < 0.1) and carries orders of magnitude more
+    pressure (Fig 5: τ and Z_a grow as A decreases)."""
+    ds = _run("herman2013-wind", tmp_path / "w", floes=200, concentrations=[0.8, 0.9],
+              duration=150.0, output_interval=5.0, snapshot_times=[])
+    late = ds["time"].values >= 75.0
+    za = [np.nanmean(ds["z_a"].values[c][late[c]]) for c in range(2)]
+    p = [np.nanmean(ds["p"].values[c][late[c]]) for c in range(2)]
+    assert za[0] > 0.15 and za[1] < 0.1
+    assert p[1] > 100 * p[0]
+    assert list(ds.coords["concentration"].values) == [0.8, 0.9]
+
+
+def test_miz_fast_ice_holds_and_ice_moves_along_the_edge(tmp_path):
+    """Frozen floes never move; with onshore wind the floes next to the fast
+    ice move slower along it than the outer ice."""
+    ds = _run("herman2013-miz", tmp_path / "m", floes=200, wind_y=[-5.0], duration=200.0,
+              output_interval=10.0, snapshot_times=[50.0], profile_bins=6)
+    frozen = ds["floe_frozen"].values[0, 0, 0].astype(bool)
+    assert frozen.any() and not frozen.all()
+    for k in range(1, ds.sizes["snapshot"]):
+        np.testing.assert_array_equal(ds["floe_x"].values[0, 0, k][frozen],
+                                      ds["floe_x"].values[0, 0, 0][frozen])
+        np.testing.assert_array_equal(ds["floe_u"].values[0, 0, k][frozen], 0.0)
+    prof = np.nanmean(ds["u_x_profile"].values[0, 0][-5:], axis=0)
+    assert np.nanmean(prof[-3:]) > 0.01
+    assert prof[0] < 0.5 * np.nanmean(prof[-3:])

@@ -1,0 +1,166 @@
+"""The scenario runner: parameter checks, run directories, the command line
+end to end, checkpoints and resume, reproducible ensembles."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+xr = pytest.importorskip("xarray")
+pytest.importorskip("yaml")
+
+from physics.scenarios import get_experiment, load_config, resume_run, run_scenario  # noqa: E402
+from physics.scenarios import recorder as recorder_module  # noqa: E402
+from physics.scenarios.config import bundled_configs, parse_set  # noqa: E402
+from physics.scenarios.runner import find_config, member_seeds  # noqa: E402
+
+ALL = ["godlovitch-kernels", "godlovitch-rafting", "godlovitch-thermo", "herman2013-convergence",
+       "herman2013-miz", "herman2013-wind", "scm-analytic"]
+# a convergence run of a few seconds
+TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.0,
+            output_step=0.004)
+
+
+def _run(out, **kw):
+    kw.setdefault("overrides", TINY)
+    return run_scenario("herman2013-convergence", out=out, workers=1, progress=False,
+                        plots=False, log=lambda *a: None, **kw)
+
+
+def test_every_shipped_file_parses_and_names_an_experiment():
+    files = bundled_configs()
+    for name in ALL:
+        cfg = load_config(files[name])
+        assert cfg.name == name
+        get_experiment(name)
+        cfg.resolve(quick=True)
+
+
+def test_unknown_scenario_and_parameter_list_the_valid_ones():
+    with pytest.raises(ValueError, match="valid scenarios: .*herman2013-convergence"):
+        find_config("herman2099")
+    cfg = find_config("herman2013-convergence")
+    with pytest.raises(ValueError, match="valid parameters: floes, start_concentration"):
+        cfg.resolve({"flows": 10})
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("floes", 5, r"'floes' must be an integer in \[100, 200000\], got 5"),
+    ("floes", 2.5, "must be an integer"),
+    ("rate", -1.0, r"'rate' must be a number in \(0, 10\]"),
+    ("rate", "fast", "must be a number"),
+    ("snapshot_concentrations", [0.9, 1.2], r"a list of numbers in \[0.3, 0.99\]"),
+    ("friction", float("nan"), "friction"),
+])
+def test_bad_values_name_the_allowed_range(key, value, message):
+    with pytest.raises(ValueError, match=message):
+        find_config("herman2013-convergence").resolve({key: value})
+
+
+def test_set_values_are_yaml():
+    assert parse_set(["a=0.5", "b=[0.6, 0.7]", "c=true", "d=text"]) == \
+        dict(a=0.5, b=[0.6, 0.7], c=True, d="text")
+    with pytest.raises(ValueError, match="key=value"):
+        parse_set(["novalue"])
+
+
+def test_broken_scenario_file_is_reported(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nparameters: {a: {default: [1, }\n")
+    with pytest.raises(ValueError, match="not valid YAML"):
+        load_config(bad)
+    bad.write_text("name: herman2013-convergence\ntitle: t\nparameters:\n"
+                   "  floes: {default: 10, min: 100, help: n}\n")
+    with pytest.raises(ValueError, match="'floes' must be"):
+        load_config(bad)
+
+
+def test_existing_output_is_not_overwritten_without_force(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "precious.txt").write_text("keep me")
+    with pytest.raises(FileExistsError, match="--force"):
+        _run(out)
+    assert (out / "precious.txt").read_text() == "keep me"
+    _run(out, force=True)
+    assert not (out / "precious.txt").exists() and (out / "results.nc").exists()
+
+
+def test_member_seeds_are_reproducible_and_distinct():
+    assert member_seeds(3, 4) == member_seeds(3, 4)
+    assert len(set(member_seeds(3, 4))) == 4
+    assert member_seeds(3, 2) == member_seeds(3, 4)[:2]     # more members keep the first ones
+
+
+def test_same_seed_same_trajectory_other_seed_another(tmp_path):
+    a = xr.open_dataset(_run(tmp_path / "a", seed=5).dataset)
+    b = xr.open_dataset(_run(tmp_path / "b", seed=5).dataset)
+    c = xr.open_dataset(_run(tmp_path / "c", seed=6).dataset)
+    np.testing.assert_array_equal(a["p"].values, b["p"].values)
+    np.testing.assert_array_equal(a["floe_x"].values, b["floe_x"].values)
+    assert not np.array_equal(a["floe_x"].values, c["floe_x"].values)
+
+
+def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch):
+    whole = xr.open_dataset(_run(tmp_path / "whole", seed=2).dataset).load()
+    real = recorder_module.Recorder.checkpoint
+    calls = {"n": 0}
+
+    def checkpoint_then_crash(self, state, *, force=False):
+        wrote = real(self, state, force=True)
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt          # as Ctrl-C right after the 4th checkpoint
+        return wrote
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", checkpoint_then_crash)
+    out = tmp_path / "cut"
+    with pytest.raises(KeyboardInterrupt):
+        _run(out, seed=2, checkpoint_every=0)
+    assert list((out / "jobs").glob("*.ckpt")) and not (out / "results.nc").exists()
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", real)
+    res = resume_run(out, workers=1, progress=False, plots=False, log=lambda *a: None)
+    resumed = xr.open_dataset(res.dataset).load()
+    for name in ("time", "p", "z_c", "f_nr", "floe_x", "contact_force", "a_j"):
+        np.testing.assert_array_equal(resumed[name].values, whole[name].values, err_msg=name)
+    assert not list((out / "jobs").glob("*.ckpt"))
+
+
+def test_ensemble_in_worker_processes(tmp_path):
+    res = run_scenario("herman2013-convergence", overrides=TINY, ensemble=2, workers=2,
+                       out=tmp_path / "ens", progress=False, plots=False, log=lambda *a: None)
+    ds = xr.open_dataset(res.dataset)
+    assert ds.sizes["member"] == 2
+    assert not np.array_equal(ds["floe_x"].values[0, 0], ds["floe_x"].values[0, 1])
+    solo = xr.open_dataset(_run(tmp_path / "solo", seed=0).dataset)
+    # member 0 of the ensemble (seed 0) is the run of seed 0's first member
+    np.testing.assert_array_equal(ds["p"].values[0, 0], solo["p"].values[0, 0])
+
+
+def test_command_line_quick_run_end_to_end(tmp_path):
+    """What CI checks: a quick scenario from the command line writes the
+    NetCDF with the expected variables, the figures and the summary."""
+    out = tmp_path / "quick"
+    cmd = [sys.executable, "-m", "physics.scenarios", "run", "herman2013-convergence", "--quick",
+           "--out", str(out), "--no-progress"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "| A_J, knee of ln p(A) |" in done.stdout
+    ds = xr.open_dataset(out / "results.nc")
+    for name in get_experiment("herman2013-convergence").required:
+        assert name in ds, name
+    assert ds.attrs["scenario"] == "herman2013-convergence" and ds.attrs["quick"] == 1
+    assert "numba" in ds.attrs["versions"]
+    pngs = sorted(p.name for p in (out / "figures").glob("*.png"))
+    assert pngs == ["convergence_force_networks.png", "convergence_pressure_contacts.png"]
+    assert all((out / "figures" / p).stat().st_size > 10000 for p in pngs)
+    # the same command again refuses to overwrite; a bad value names its range
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 2 and "--force" in again.stderr
+    bad = subprocess.run(cmd[:-3] + ["--set", "rate=-2", "--out", str(tmp_path / "x")],
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and "'rate' must be a number in (0, 10]" in bad.stderr
+    replot = subprocess.run([sys.executable, "-m", "physics.scenarios", "plot", str(out)],
+                            capture_output=True, text=True, timeout=600)
+    assert replot.returncode == 0 and "convergence_pressure_contacts.png" in replot.stdout
