@@ -234,7 +234,8 @@ class Convergence(Experiment):
             # no wind and no current, but water drag and Coriolis act on moving floes
             forcing = Forcing(HERMAN2013.forcing, wind=(0.0, 0.0), current=(0.0, 0.0))
             sim = _simulation(field, box, p, forcing)
-            st = dict(sim=sim, snaps=sorted(p["snapshot_concentrations"]), error=None)
+            st = dict(sim=sim, next_snap=p["start_concentration"] + p["snapshot_step"],
+                      error=None)
             net, c = network(sim)
             rec.record(sim.time, **net)
             _snapshot(rec, sim, c)
@@ -246,8 +247,9 @@ class Convergence(Experiment):
             st["error"] = _advance(sim, step)
             net, c = network(sim)
             rec.record(sim.time, **net)
-            while st["snaps"] and net["concentration"] >= st["snaps"][0] - 1e-9:
-                st["snaps"].pop(0)
+            if net["concentration"] >= st["next_snap"] - 1e-9:
+                while st["next_snap"] <= net["concentration"] + 1e-9:
+                    st["next_snap"] += p["snapshot_step"]
                 _snapshot(rec, sim, c)
             rec.progress((sim.concentration - a0) / (a1 - a0))
             if net["p"] > p["max_pressure"]:
@@ -328,14 +330,16 @@ class Convergence(Experiment):
         ax.legend(fontsize=8, loc="upper left")
         ax.set_title("contact numbers (Fig 3)", fontsize=9)
         out.append(plots.savefig(fig, Path(out_dir) / "convergence_pressure_contacts.png"))
-        k = int(np.isfinite(ds["snapshot_time"].values[0, 0]).sum())
-        picks = list(range(1, k)) if k > 1 else [0]
-        picks = picks[-3:]
-        conc_at = []
-        for s in picks:
-            t_s = ds["snapshot_time"].values[0, 0, s]
-            i = int(np.nanargmin(np.abs(ds["time"].values[0, 0] - t_s)))
-            conc_at.append(ds["concentration"].values[0, 0, i])
+        # three snapshots of member 0 around its A_J: below, near and at/after it (Fig 2)
+        times = ds["snapshot_time"].values[0, 0]
+        times = times[np.isfinite(times)]
+        conc_snap = np.interp(times, ds["time"].values[0, 0][np.isfinite(a[0])],
+                              a[0][np.isfinite(a[0])])
+        aj = float(ds["a_j"].values[0, 0])
+        ref = aj if np.isfinite(aj) else float(conc_snap[-1])
+        picks = sorted({int(np.argmin(np.abs(conc_snap - t)))
+                        for t in (ref - 0.01, ref - 0.004, ref + 0.004)})
+        conc_at = [conc_snap[s] for s in picks]
         out.append(plots.snapshot_panels(
             ds, Path(out_dir) / "convergence_force_networks.png",
             title="force networks under convergence (Fig 2); line width ∝ √F_n",

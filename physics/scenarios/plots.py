@@ -104,7 +104,7 @@ def snapshot_panels(ds, path: Path, *, title: str, labels, forces: bool = True,
         coll = draw_snapshot(ax, s, forces=forces, vmax=vmax or None, title=lab)
     if coll is not None:
         fig.colorbar(coll, ax=axes[0].tolist(), shrink=0.8, label="speed [m/s]")
-    fig.suptitle(title, fontsize=10)
-    fig.savefig(path, dpi=120)
+    fig.suptitle(title, fontsize=9)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return Path(path)
