@@ -51,12 +51,17 @@ def test_unknown_scenario_and_parameter_list_the_valid_ones():
     ("floes", 2.5, "must be an integer"),
     ("rate", -1.0, r"'rate' must be a number in \(0, 10\]"),
     ("rate", "fast", "must be a number"),
-    ("snapshot_concentrations", [0.9, 1.2], r"a list of numbers in \[0.3, 0.99\]"),
     ("friction", float("nan"), "friction"),
 ])
 def test_bad_values_name_the_allowed_range(key, value, message):
     with pytest.raises(ValueError, match=message):
         find_config("herman2013-convergence").resolve({key: value})
+
+
+def test_bad_list_item_names_the_allowed_range():
+    with pytest.raises(ValueError, match=r"'concentrations' must be a list of numbers in "
+                                         r"\[0.3, 0.93\], got \[0.9, 1.2\]"):
+        find_config("herman2013-wind").resolve({"concentrations": [0.9, 1.2]})
 
 
 def test_set_values_are_yaml():
