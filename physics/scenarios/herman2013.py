@@ -134,6 +134,26 @@ def _finish(rec, sim: HertzSimulation, st: dict) -> None:
         rec.note(f"ended at t = {sim.time:.1f} s: {st['error']}")
 
 
+def _run_for_duration(p: dict, st: dict, rec, measure) -> None:
+    """The time loop of the fixed-forcing runs: advance ``st["sim"]`` to
+    ``p["duration"]`` in steps of ``p["output_interval"]``, record
+    ``measure(sim)`` → (values, contacts) after each, take snapshots at
+    ``p["snapshot_times"]`` and at the end, report progress and checkpoint
+    ``st`` (which carries ``sim``, ``error`` and ``next_snap``)."""
+    sim = st["sim"]
+    snaps = sorted(p["snapshot_times"]) + [p["duration"]]
+    while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
+        st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
+        values, c = measure(sim)
+        rec.record(sim.time, **values)
+        while st["next_snap"] < len(snaps) and sim.time >= snaps[st["next_snap"]] - 1e-9:
+            st["next_snap"] += 1
+            _snapshot(rec, sim, c)
+        rec.progress(sim.time / p["duration"])
+        rec.checkpoint(st)
+    _finish(rec, sim, st)
+
+
 def _fmt(values, fmt=".3g") -> str:
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -378,19 +398,12 @@ class Wind(Experiment):
                               density=field.density)
             sim = _simulation(field, box, p, forcing)
             st = dict(sim=sim, error=None, next_snap=0)
-        sim = st["sim"]
-        snaps = sorted(p["snapshot_times"]) + [p["duration"]]
-        while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
-            st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
+
+        def measure(sim):
             net, c = network(sim)
             net.pop("concentration")          # fixed: it is the case coordinate
-            rec.record(sim.time, **net)
-            while st["next_snap"] < len(snaps) and sim.time >= snaps[st["next_snap"]] - 1e-9:
-                st["next_snap"] += 1
-                _snapshot(rec, sim, c)
-            rec.progress(sim.time / p["duration"])
-            rec.checkpoint(st)
-        _finish(rec, sim, st)
+            return net, c
+        _run_for_duration(p, st, rec, measure)
 
     def summarise(self, ds, p):
         conc = ds.coords["concentration"].values
@@ -506,9 +519,8 @@ class MarginalIceZone(Experiment):
         edges = np.linspace(0.0, sim.box.ly, p["profile_bins"] + 1)
         rec.coord("y", 0.5 * (edges[1:] + edges[:-1]), "m", "distance from the fast-ice side")
         mobile = sim.inv_mass > 0
-        snaps = sorted(p["snapshot_times"]) + [p["duration"]]
-        while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
-            st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
+
+        def measure(sim):
             net, c = network(sim)
             y = sim.positions[mobile, 1]
             k = np.clip(np.searchsorted(edges, y) - 1, 0, p["profile_bins"] - 1)
@@ -516,13 +528,8 @@ class MarginalIceZone(Experiment):
             sums = np.bincount(k, sim.velocities[mobile, 0], minlength=p["profile_bins"])
             with np.errstate(invalid="ignore", divide="ignore"):
                 prof = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
-            rec.record(sim.time, u_x_profile=("y", prof), **net)
-            while st["next_snap"] < len(snaps) and sim.time >= snaps[st["next_snap"]] - 1e-9:
-                st["next_snap"] += 1
-                _snapshot(rec, sim, c)
-            rec.progress(sim.time / p["duration"])
-            rec.checkpoint(st)
-        _finish(rec, sim, st)
+            return dict(u_x_profile=("y", prof), **net), c
+        _run_for_duration(p, st, rec, measure)
 
     def summarise(self, ds, p):
         rows = []
