@@ -237,7 +237,7 @@ class Convergence(Experiment):
                  "a_j_network": ("1", "first A from which Z_c stays above 3"),
                  "slope_below": ("1", "d ln p / dA below A_J"),
                  "slope_above": ("1", "d ln p / dA above A_J"),
-                 "completed": ("1", "1 if the run reached end_concentration")}
+                 "completed": ("1", "1 if the run reached end_concentration or max_pressure")}
     required = ("time", "concentration", "p", "tau", "z_c", "z_a", "f_nr", "z_touch", "a_j",
                 "floe_x", "contact_force")
 
@@ -274,6 +274,7 @@ class Convergence(Experiment):
             rec.progress((sim.concentration - a0) / (a1 - a0))
             if net["p"] > p["max_pressure"]:
                 st["error"] = f"pressure {net['p']:.3g} N/m above max_pressure"
+                st["pressure_limit"] = True
             rec.checkpoint(st)
         _finish(rec, sim, st)
         a = np.array([row["concentration"] for _, row in rec.rows])
@@ -282,8 +283,8 @@ class Convergence(Experiment):
         a_j, lo, hi = jamming_from_pressure(a, pr)
         rec.result(a_j=a_j, a_j_network=first_crossing(a, zc, 3.0), slope_below=lo,
                    slope_above=hi,
-                   completed=float(sim.concentration >= a1 - 1e-6 or st["error"] is not None
-                                   and "max_pressure" in st["error"]))
+                   completed=float(sim.concentration >= a1 - 1e-6
+                                   or st.get("pressure_limit", False)))
 
     def summarise(self, ds, p):
         a = ds["concentration"].values[0]            # (member, sample)
