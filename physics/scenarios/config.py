@@ -151,6 +151,8 @@ class ScenarioConfig:
     params: dict[str, Param]
     quick: dict[str, Any] = field(default_factory=dict)
     path: Path | None = None
+    #: the file's mapping as read (stored with a run, so it resumes even if the file changes)
+    data: dict = field(default_factory=dict)
 
     def defaults(self, quick: bool = False) -> dict[str, Any]:
         values = {k: p.default for k, p in self.params.items()}
@@ -196,7 +198,7 @@ def parse_config(data: dict, path: Path | None = None) -> ScenarioConfig:
     cfg = ScenarioConfig(name=data["name"], title=data["title"],
                          reproduces=data.get("reproduces", ""),
                          description=data.get("description", "").strip(), params=params,
-                         quick=dict(data.get("quick") or {}), path=path)
+                         quick=dict(data.get("quick") or {}), path=path, data=data)
     cfg.resolve(quick=True)             # quick overrides must be valid too
     return cfg
 

@@ -180,11 +180,10 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
                          f"list of cases)")
     out = Path(out) if out is not None else Path("runs") / (cfg.name + ("-quick" if quick else ""))
     _prepare_directory(out, force, resume=False)
-    data = yaml_config(cfg)
     run_info = dict(scenario=cfg.name, title=cfg.title, reproduces=cfg.reproduces,
                     quick=bool(quick), seed=int(seed), ensemble=int(ensemble),
                     member_seeds=member_seeds(seed, ensemble), parameters=params,
-                    overrides=overrides, command=command or "", config=data,
+                    overrides=overrides, command=command or "", config=cfg.data,
                     created=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                     versions=versions())
     atomic_write(out / RUN_FILE, lambda tmp: Path(tmp).write_text(dump_yaml(run_info)))
@@ -201,15 +200,6 @@ def resume_run(out, *, workers: int | None = None, checkpoint_every: float = 60.
     _prepare_directory(out, False, resume=True)
     run_info = yaml.safe_load((out / RUN_FILE).read_text())
     return _execute(out, run_info, workers, checkpoint_every, progress, plots, log)
-
-
-def yaml_config(cfg: ScenarioConfig) -> dict:
-    """The scenario file as a mapping (stored in run.yaml, so that a run made
-    from a user's file resumes even if that file changes)."""
-    import yaml
-    if cfg.path is not None:
-        return yaml.safe_load(Path(cfg.path).read_text())
-    raise ValueError("scenario config has no file")
 
 
 def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, log) -> RunResult:
