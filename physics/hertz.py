@@ -29,6 +29,7 @@ from .forcing import Forcing
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, check_range
+from .progress import steps_with_bar
 
 __all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
 
@@ -283,16 +284,7 @@ class HertzSimulation:
         if not progress:
             self.step(n)
             return
-        from tqdm.auto import tqdm
-
-        per = max(1, int(round((chunk or duration / 100.0) / self.dt)))
-        with tqdm(total=n, unit="step", desc="Hertz", dynamic_ncols=True) as bar:
-            left = n
-            while left > 0:
-                k = min(per, left)
-                self.step(k)
-                left -= k
-                bar.update(k)
+        steps_with_bar(self.step, n, round((chunk or duration / 100.0) / self.dt), "Hertz")
 
     # -- observation ---------------------------------------------------------
     @property
