@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 # so that the RL extra never pulls the CUDA wheels.
 TORCH_PIN := torch==2.13.0
 
-.PHONY: setup demo test test-slow bench validate clean
+.PHONY: setup demo test test-slow bench validate crosscheck clean
 
 setup: $(STAMP)
 
@@ -37,6 +37,9 @@ bench: setup
 
 validate: setup
 	$(PY) -m physics.validate
+
+crosscheck: setup
+	$(PY) -m physics.crosscheck all --out docs/crosscheck --force
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
