@@ -1,0 +1,307 @@
+"""Baseline policies with the ``predict`` interface of SB3 models.
+
+``predict(obs, deterministic=True) -> (action, None)`` accepts one
+observation or a batch. Every baseline reads the *raw* observation of the
+environment (not a normalised one) and may keep state within an episode;
+``reset(seed)`` starts a new episode.
+
+================  ==========================================================
+name              policy
+================  ==========================================================
+``random``        uniform samples of the action space, seeded
+``zero``          the all-zero action, clipped into the space
+``heuristic``     the hand-written controller of the environment (below)
+================  ==========================================================
+
+>>> env = gymnasium.make("iceenvs/Convergence-v0")
+>>> policy = make_baseline("heuristic", env)
+>>> obs, _ = env.reset(seed=0)
+>>> action, _ = policy.predict(obs)
+"""
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from iceenvs.observations import log_stress
+
+__all__ = ["Baseline", "RandomPolicy", "ZeroPolicy", "WindDriftController",
+           "ConvergenceController", "MarginalIceZoneController", "FloeClusteringController",
+           "ThicknessDistributionController", "HEURISTICS", "BASELINES", "make_baseline"]
+
+
+class Baseline:
+    """Base of the baselines: batching, clipping and episode resets.
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        The environment the policy acts in (spaces, feature layout and
+        task parameters are read from it).
+    seed : int
+        Seed of any random choice of the policy.
+    """
+
+    def __init__(self, env: gym.Env, seed: int = 0):
+        self.env = env
+        self.action_space = env.action_space
+        self.observation_space = env.observation_space
+        self.seed = int(seed)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Start a new episode (``seed``: the episode's seed)."""
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        """The action for one raw observation."""
+        raise NotImplementedError
+
+    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
+        """``(action, None)`` for one observation or a batch (first axis)."""
+        obs = np.asarray(obs, dtype=np.float32)
+        low, high = self.action_space.low, self.action_space.high
+        if obs.ndim == len(self.observation_space.shape) + 1:
+            actions = np.stack([np.clip(self.act(o), low, high) for o in obs])
+            return actions.astype(self.action_space.dtype), None
+        return np.clip(self.act(obs), low, high).astype(self.action_space.dtype), None
+
+
+class RandomPolicy(Baseline):
+    """Uniform random actions from a copy of the action space seeded with
+    ``seed`` (re-seeded with each episode's seed by ``reset``)."""
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        s = self.action_space
+        self._space = gym.spaces.Box(s.low, s.high, s.shape, s.dtype, seed=self.seed)
+
+    def reset(self, seed: int | None = None) -> None:
+        if seed is not None:
+            self._space.seed(int(seed))
+
+    def act(self, obs):
+        return self._space.sample()
+
+
+class ZeroPolicy(Baseline):
+    """The all-zero action clipped into the action space: no wind, no
+    convergence, the kernel's own redistribution rate."""
+
+    def act(self, obs):
+        return np.zeros(self.action_space.shape)
+
+
+class _FloeController(Baseline):
+    """A controller of a floe environment: observation entries by feature
+    name."""
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        names = [f.name for f in env.unwrapped.features]
+        self._index = {n: k for k, n in enumerate(names)}
+        self.reward_params = env.unwrapped.reward_params
+
+    def _get(self, obs, name: str) -> float:
+        return float(obs[self._index[name]])
+
+
+class WindDriftController(_FloeController):
+    """Blow along the target heading, corrected for the turning of the drift.
+
+    The wind points along the heading (read from the observation), turned
+    to the left by an angle ``turn`` and scaled so that its largest
+    component is 1 (the strongest wind the action box allows in that
+    direction; the drift speed grows with the wind, the action cost of
+    0.01 |a|² is small against it). Coriolis turns the drift to the right
+    of the wind, so ``turn`` is adapted from the measured drift: each step
+    it changes by ``-gain`` × the angle of the mean ice velocity from the
+    heading (once the ice moves faster than 1 cm/s), within ±45°. When the
+    pressure passes the task's ``pressure_max`` the wind is halved, because
+    the reward penalises the excess.
+    """
+
+    gain = 0.3
+    max_turn = math.pi / 4
+
+    def reset(self, seed=None):
+        self.turn = 0.0
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        self.reset()
+
+    def act(self, obs):
+        hx, hy = self._get(obs, "heading_cos"), self._get(obs, "heading_sin")
+        ux, uy = self._get(obs, "u_x"), self._get(obs, "u_y")
+        if math.hypot(ux, uy) > 0.01:
+            error = math.atan2(hx * uy - hy * ux, hx * ux + hy * uy)   # drift left of heading > 0
+            self.turn = float(np.clip(self.turn - self.gain * error, -self.max_turn,
+                                      self.max_turn))
+        heading = math.atan2(hy, hx) + self.turn
+        wind = np.array([math.cos(heading), math.sin(heading)])
+        wind /= np.max(np.abs(wind))
+        if self._get(obs, "pressure") > log_stress(self.reward_params["pressure_max"]):
+            wind *= 0.5
+        return wind
+
+
+class ConvergenceController(_FloeController):
+    """Proportional control of the concentration with a pressure limit.
+
+    The convergence rate is ``-gain`` × the observed error (A − A*)/0.1,
+    clipped to the action bounds: full convergence far below the target,
+    slowing down within 0.1/gain of it, divergence above it. As the ice
+    approaches jamming the pressure rises steeply; between half of the
+    task's ``pressure_max`` and ``pressure_max`` the convergence rate is
+    scaled down linearly in log pressure to 0, and above ``pressure_max``
+    the box diverges slowly (−0.2) to relieve the pressure.
+    """
+
+    gain = 20.0
+
+    def act(self, obs):
+        rate = float(np.clip(-self.gain * self._get(obs, "error"), -1.0, 1.0))
+        p = self._get(obs, "pressure")
+        p_max = log_stress(self.reward_params["pressure_max"])
+        p_soft = log_stress(0.5 * self.reward_params["pressure_max"])
+        if p > p_max:
+            rate = -0.2
+        elif p > p_soft and rate > 0:
+            rate *= (p_max - p) / (p_max - p_soft)
+        return np.array([rate])
+
+
+class MarginalIceZoneController(_FloeController):
+    """Full wind along the edge, turned away from the fast ice as the edge
+    stress rises.
+
+    Transport grows with the wind speed, so the speed is full
+    (action[0] = 1). With Coriolis the drift turns to the right of the
+    wind, i.e. towards the fast-ice edge for wind along +x; the wind is
+    therefore turned left (away from the edge) by a base angle of 0.1 π
+    (18°), plus up to a further 0.2 π in proportion to the log edge stress
+    between a quarter of the task's ``edge_stress_max`` and
+    ``edge_stress_max``, so that the ice is not pressed onto the edge.
+    """
+
+    base = 0.1
+    extra = 0.2
+
+    def act(self, obs):
+        s = self._get(obs, "edge_stress")
+        s_max = log_stress(self.reward_params["edge_stress_max"])
+        s_low = log_stress(0.25 * self.reward_params["edge_stress_max"])
+        load = float(np.clip((s - s_low) / (s_max - s_low), 0.0, 1.0))
+        return np.array([1.0, self.base + self.extra * load])
+
+
+class FloeClusteringController(_FloeController):
+    """Steady wind to build clusters, alternating wind to break them.
+
+    Below the target largest-cluster fraction the wind blows steadily
+    along +x with a strength proportional to the deficit (full at a
+    deficit of 0.2, at least 0.2): under Stokes drag floes of different
+    sizes drift at different speeds, collide and gather. Above the target
+    the wind reverses direction every step with a strength proportional to
+    the excess, which shears the clusters apart; within ±0.02 of the
+    target the wind is off.
+    """
+
+    def reset(self, seed=None):
+        self._sign = 1.0
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        self.reset()
+
+    def act(self, obs):
+        error = self._get(obs, "target") - self._get(obs, "largest_cluster")
+        if error > 0.02:
+            return np.array([float(np.clip(error / 0.2, 0.2, 1.0)), 0.0])
+        if error < -0.02:
+            self._sign = -self._sign
+            return np.array([self._sign * float(np.clip(-error / 0.2, 0.2, 1.0)), 0.0])
+        return np.zeros(2)
+
+
+class ThicknessDistributionController(Baseline):
+    """Greedy kernel scale: the redistribution strength that brings g(h)
+    closest to the target over a short look-ahead.
+
+    Each step, every redistribution action in ``levels`` (kernel scale
+    10**a: 0.1× … 10×) is tried on a copy of the environment's thickness
+    model, held for ``horizon`` steps of the environment's
+    ``days_per_step``, and the one with the smallest Wasserstein-1
+    distance to the target at the end is taken (ties: the first, i.e. the
+    weakest). This is a model-based controller: it reads the model state
+    and the target from the environment (``env.unwrapped``), not only the
+    observation, which is why it is a yardstick a learned policy must
+    approach from observations alone. Rafting consumes ice thinner than
+    0.5 m, so it is full (+1) when the observed fraction of ice below
+    0.5 m exceeds the target's and off (−1) otherwise.
+    """
+
+    levels = (-1.0, -0.5, 0.0, 0.5, 1.0)
+    horizon = 30
+
+    def _distance(self, model, target, h, redistribution: float, rafting: float) -> float:
+        import copy
+
+        from iceenvs.rewards import wasserstein1
+        from iceenvs.thickness_distribution import RAFT_CUTOFF, RAFT_MAX
+
+        env = self.env.unwrapped
+        trial = copy.deepcopy(model)
+        trial.kernel_scale = 10.0 ** redistribution
+        factor = 1.0 + (RAFT_MAX - 1.0) * (rafting + 1.0) * 0.5
+        if factor != trial.rafting_factor:
+            trial.set_rafting(factor, RAFT_CUTOFF)
+        for _ in range(self.horizon):
+            trial.step(env.days_per_step)
+        return wasserstein1(trial.g, target, h)
+
+    def act(self, obs):
+        env = self.env.unwrapped
+        target = env.target
+        rafting = 1.0 if float(obs[1]) > float(env.coarse(target)[1]) else -1.0
+        if env.model is None:
+            return np.array([0.0, rafting])
+        dist = [self._distance(env.model, target, env.h, a, rafting) for a in self.levels]
+        return np.array([self.levels[int(np.argmin(dist))], rafting])
+
+
+#: env name → its hand-written controller
+HEURISTICS = {
+    "WindDrift-v0": WindDriftController,
+    "Convergence-v0": ConvergenceController,
+    "MarginalIceZone-v0": MarginalIceZoneController,
+    "FloeClustering-v0": FloeClusteringController,
+    "ThicknessDistribution-v0": ThicknessDistributionController,
+}
+
+
+def _heuristic(env, seed: int = 0) -> Baseline:
+    name = env.spec.id.split("/")[-1] if env.spec is not None else ""
+    if name not in HEURISTICS:
+        raise ValueError(f"no heuristic controller for {name or type(env).__name__}; "
+                         f"controllers exist for {', '.join(HEURISTICS)}")
+    return HEURISTICS[name](env, seed)
+
+
+#: baseline name → constructor ``(env, seed)``
+BASELINES = {"random": RandomPolicy, "zero": ZeroPolicy, "heuristic": _heuristic}
+
+
+def make_baseline(name: str, env: gym.Env, seed: int = 0) -> Baseline:
+    """The baseline ``name`` (a key of :data:`BASELINES`) for ``env``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (the message lists the valid ones).
+    """
+    if name not in BASELINES:
+        raise ValueError(f"unknown baseline {name!r}; valid baselines: "
+                         f"{', '.join(BASELINES)}")
+    return BASELINES[name](env, seed)

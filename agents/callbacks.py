@@ -1,0 +1,144 @@
+"""Training callbacks: the physics metrics of ``info["physics"]`` logged
+next to the returns (and written to ``metrics.csv``), and a tqdm progress
+bar."""
+from __future__ import annotations
+
+import csv
+import math
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+from .metrics import physics_metrics
+
+__all__ = ["PhysicsMetricsCallback", "TqdmCallback"]
+
+
+class PhysicsMetricsCallback(BaseCallback):
+    """Log the task's physics metrics per finished episode.
+
+    For every finished episode of every sub-environment, the final value
+    and the episode mean of each metric of :func:`agents.metrics.physics_metrics`
+    are kept; at the end of each rollout the means over the last
+    ``window`` episodes are recorded as ``physics/final_<name>`` and
+    ``physics/mean_<name>`` (next to SB3's ``rollout/ep_rew_mean``). Each
+    episode is also a row of the CSV file ``csv_path``: timesteps, env
+    index, return and length (from :class:`VecMonitor`), then the final and
+    mean values.
+
+    Parameters
+    ----------
+    env_id : str
+        Environment id (chooses the metrics).
+    csv_path : path
+        The CSV file to write (created, header first).
+    window : int
+        Number of recent episodes averaged in the logs.
+    """
+
+    def __init__(self, env_id: str, csv_path: str | Path, window: int = 20, verbose: int = 0):
+        super().__init__(verbose)
+        self.env_id = env_id
+        self.csv_path = Path(csv_path)
+        self.window = window
+        self._file = None
+        self._writer = None
+        self._fields = None
+        self._sums = None
+        self._counts = None
+        self.recent: deque = deque(maxlen=window)
+        self.episodes = 0
+
+    def _on_training_start(self) -> None:
+        n = self.training_env.num_envs
+        self._sums = [dict() for _ in range(n)]
+        self._counts = np.zeros(n, dtype=int)
+        self._file = open(self.csv_path, "w", newline="")
+
+    def _on_step(self) -> bool:
+        infos = self.locals.get("infos", ())
+        dones = self.locals.get("dones", np.zeros(len(infos), dtype=bool))
+        for i, info in enumerate(infos):
+            values = physics_metrics(self.env_id, info)
+            sums = self._sums[i]
+            for name, v in values.items():
+                sums[name] = sums.get(name, 0.0) + v
+            self._counts[i] += 1
+            if dones[i]:
+                self._episode_end(i, info, values)
+        return True
+
+    def _episode_end(self, i: int, info: dict, final: dict) -> None:
+        count = max(int(self._counts[i]), 1)
+        row = {"timesteps": self.num_timesteps, "env": i}
+        ep = info.get("episode", {})
+        row["return"] = float(ep.get("r", math.nan))
+        row["length"] = int(ep.get("l", count))
+        row.update({f"final_{k}": v for k, v in final.items()})
+        row.update({f"mean_{k}": s / count for k, s in self._sums[i].items()})
+        if self._writer is None:
+            self._fields = list(row)
+            self._writer = csv.DictWriter(self._file, fieldnames=self._fields,
+                                          extrasaction="ignore", restval="")
+            self._writer.writeheader()
+        self._writer.writerow(row)
+        self._file.flush()
+        self.recent.append(row)
+        self.episodes += 1
+        self._sums[i] = {}
+        self._counts[i] = 0
+
+    def _on_rollout_end(self) -> None:
+        if not self.recent:
+            return
+        keys = [k for k in self.recent[-1] if k.startswith(("final_", "mean_"))]
+        for k in keys:
+            values = [r[k] for r in self.recent if k in r and math.isfinite(r[k])]
+            if values:
+                self.logger.record(f"physics/{k}", float(np.mean(values)))
+        self.logger.record("physics/episodes", self.episodes)
+
+    def _on_training_end(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+
+class TqdmCallback(BaseCallback):
+    """A tqdm progress bar over the training timesteps, with the mean
+    return of the recent episodes in its postfix.
+
+    Parameters
+    ----------
+    total : int
+        Timesteps of the run.
+    disable : bool
+        Hide the bar.
+    """
+
+    def __init__(self, total: int, disable: bool = False):
+        super().__init__(0)
+        self.total = total
+        self.disable = disable
+        self.bar = None
+
+    def _on_training_start(self) -> None:
+        from tqdm.auto import tqdm
+
+        self.bar = tqdm(total=self.total, unit="step", desc="training",
+                        disable=self.disable, dynamic_ncols=True)
+
+    def _on_step(self) -> bool:
+        n = self.training_env.num_envs
+        self.bar.update(min(n, self.total - self.bar.n))
+        buf = self.model.ep_info_buffer
+        if buf and self.n_calls % 50 == 0:
+            self.bar.set_postfix(ep_return=f"{np.mean([e['r'] for e in buf]):.3g}",
+                                 refresh=False)
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

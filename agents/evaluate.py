@@ -1,0 +1,296 @@
+"""Evaluate a trained policy against baselines on the same seeded episodes.
+
+    python -m agents.evaluate RUN_DIR [--episodes 20] [--seed S]
+        [--baselines random,zero,heuristic] [--out DIR]
+    python -m agents.evaluate --baseline NAME --env ID [--episodes N]
+        [--env-kwargs key=value ...]
+
+Episode k of every policy starts from ``reset(seed=S + k)``. The trained
+policy sees observations normalised with the run's saved statistics
+(``vecnormalize.pkl``, frozen); the baselines see raw observations. The
+environment is built with the run's ``env_kwargs``.
+
+Output (in ``--out``, default the run directory): ``evaluation.md`` (a
+Markdown table of mean ± std and standard error of the return and of the
+final physics metrics, printed as well), ``evaluation.json`` (every
+episode's return and final metrics) and ``evaluation.png`` (reward and the
+task's main physics metric against step, per policy). The policy beats a
+baseline when the mean of the paired differences of return exceeds two
+standard errors of that mean.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .metrics import MAIN_METRIC, env_name, physics_metrics
+
+__all__ = ["TrainedPolicy", "run_episode", "evaluate", "summarise", "compare",
+           "markdown_table", "plot_trajectories", "main"]
+
+
+class TrainedPolicy:
+    """A saved SB3 model with the ``predict`` interface of the baselines,
+    normalising raw observations with the run's frozen statistics.
+
+    Parameters
+    ----------
+    run_dir : path
+        A run directory of :mod:`agents.train`.
+    """
+
+    def __init__(self, run_dir: str | Path):
+        from .envs import load_normalization
+        from .train import algo_class
+
+        run_dir = Path(run_dir)
+        with open(run_dir / "args.yaml") as fh:
+            self.args = yaml.safe_load(fh)
+        with open(run_dir / "hyperparams.yaml") as fh:
+            self.hyperparams = yaml.safe_load(fh)
+        self.env_id = self.args["env"]
+        self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
+        self.model = algo_class(self.args["algo"]).load(run_dir / "model.zip", device="cpu")
+        self.normalization = load_normalization(run_dir / "vecnormalize.pkl", self.env_id,
+                                                self.env_kwargs)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Nothing to reset: the policy is memoryless."""
+
+    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
+        obs = np.asarray(obs, dtype=np.float32)
+        if self.normalization is not None:
+            obs = self.normalization.normalize_obs(obs).astype(np.float32)
+        return self.model.predict(obs, deterministic=deterministic)
+
+
+def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
+    """One episode from ``reset(seed=seed)``: return, length, final physics
+    metrics and the per-step rewards and main metric."""
+    obs, info = env.reset(seed=seed)
+    policy.reset(seed)
+    rewards, trace = [], []
+    final = physics_metrics(env.spec.id, info)
+    while True:
+        action, _ = policy.predict(obs, deterministic=True)
+        obs, reward, terminated, truncated, info = env.step(action)
+        rewards.append(float(reward))
+        metrics = physics_metrics(env.spec.id, info)
+        final = metrics or final
+        trace.append(metrics.get(main_metric, math.nan) if main_metric else math.nan)
+        if terminated or truncated:
+            break
+    return dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
+                terminated=bool(terminated), final=final, rewards=rewards, trace=trace)
+
+
+def evaluate(env_id: str, policies: dict, *, episodes: int, seed: int,
+             env_kwargs: dict | None = None, progress: bool = True) -> dict:
+    """Run every policy of ``{name: policy}`` on episodes seeded
+    ``seed, seed + 1, …``; returns ``{name: [episode dicts]}``."""
+    import gymnasium as gym
+    from tqdm.auto import tqdm
+
+    import iceenvs  # noqa: F401
+
+    main_metric = MAIN_METRIC.get(env_name(env_id))
+    env = gym.make(env_id, **(env_kwargs or {}))
+    results = {}
+    try:
+        with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
+                  disable=not progress) as bar:
+            for name, policy in policies.items():
+                results[name] = []
+                for k in range(episodes):
+                    results[name].append(run_episode(env, policy, seed + k, main_metric))
+                    bar.update()
+    finally:
+        env.close()
+    return results
+
+
+def _stats(values) -> dict:
+    x = np.asarray(values, dtype=float)
+    n = x.size
+    std = float(np.std(x, ddof=1)) if n > 1 else 0.0
+    return dict(mean=float(np.mean(x)), std=std, sem=std / math.sqrt(n), n=int(n))
+
+
+def summarise(episodes: list[dict]) -> dict:
+    """Mean, std (ddof 1) and standard error of the return, the length and
+    every final physics metric over episodes."""
+    out = {"return": _stats([e["ret"] for e in episodes]),
+           "length": _stats([e["length"] for e in episodes])}
+    for key in episodes[0]["final"]:
+        out[key] = _stats([e["final"].get(key, math.nan) for e in episodes])
+    return out
+
+
+def compare(policy: list[dict], baseline: list[dict]) -> dict:
+    """Paired comparison of returns on the same seeds: mean difference
+    (policy − baseline), its standard error and whether it exceeds two
+    standard errors."""
+    d = np.array([p["ret"] - b["ret"] for p, b in zip(policy, baseline)])
+    s = _stats(d)
+    return dict(diff=s["mean"], sem=s["sem"],
+                beats=bool(s["mean"] > 2.0 * s["sem"] and s["mean"] > 0))
+
+
+def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
+                   seed: int) -> str:
+    """The comparison as Markdown: one row per policy, one column per
+    quantity (mean ± std, standard error in brackets)."""
+    keys = list(next(iter(summaries.values())))
+    lines = [f"## Evaluation on `{env_id}`", "",
+             f"{episodes} episodes per policy, episode k seeded {seed} + k; mean ± std "
+             f"[standard error] of the return and of the final physics metrics.", "",
+             "| policy | " + " | ".join(keys) + " |",
+             "|---|" + "---|" * len(keys)]
+    for name, summary in summaries.items():
+        cells = [f"{summary[k]['mean']:.4g} ± {summary[k]['std']:.3g} [{summary[k]['sem']:.2g}]"
+                 for k in keys]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    if comparisons:
+        lines += ["", "Return of the policy minus the baseline's, paired by seed "
+                  "(mean [standard error of the difference]):", "",
+                  "| baseline | difference | beaten by > 2 standard errors |", "|---|---|---|"]
+        for name, c in comparisons.items():
+            lines.append(f"| {name} | {c['diff']:.4g} [{c['sem']:.2g}] | "
+                         f"{'yes' if c['beats'] else 'no'} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
+    """Reward and the main physics metric against step, one colour per
+    policy (thin lines: episodes, thick: the mean over episodes)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    metric = MAIN_METRIC.get(env_name(env_id), "")
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for k, (name, episodes) in enumerate(results.items()):
+        colour = f"C{k}"
+        for j, key in enumerate(("rewards", "trace")):
+            ax = axes[j]
+            n = max(len(e[key]) for e in episodes)
+            grid = np.full((len(episodes), n), np.nan)
+            for i, e in enumerate(episodes):
+                ax.plot(e[key], color=colour, alpha=0.2, lw=0.7)
+                grid[i, :len(e[key])] = e[key]
+            with np.errstate(all="ignore"):
+                mean = np.nanmean(grid, axis=0) if np.isfinite(grid).any() else grid[0]
+            ax.plot(mean, color=colour, lw=2, label=name if j == 0 else None)
+    axes[0].set_ylabel("reward")
+    axes[0].legend(loc="best", fontsize="small")
+    axes[1].set_ylabel(metric or "physics metric")
+    axes[1].set_xlabel("step")
+    fig.suptitle(env_id)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .baselines import BASELINES
+
+    p = argparse.ArgumentParser(prog="python -m agents.evaluate",
+                                description="Compare a trained policy with baselines.")
+    p.add_argument("run_dir", nargs="?", type=Path, help="run directory of agents.train")
+    p.add_argument("--episodes", type=int, default=20, help="episodes per policy (default 20)")
+    p.add_argument("--seed", type=int, default=10_000,
+                   help="episode k is seeded SEED + k (default 10000, away from training)")
+    p.add_argument("--baselines", default="random,zero,heuristic",
+                   help="comma-separated baselines to compare with ('' for none); valid: "
+                        + ", ".join(BASELINES))
+    p.add_argument("--baseline", help="evaluate this baseline alone (with --env)")
+    p.add_argument("--env", help="environment id for --baseline")
+    p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
+                   help="gymnasium.make arguments for --baseline (VALUE is YAML)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output directory (default: the run directory, or "
+                        "runs/agents/baseline_<env-name>_<name>)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    return p
+
+
+def main(argv: list[str] | None = None) -> dict:
+    """Command-line entry point; returns the summaries per policy."""
+    from iceenvs import ENV_IDS
+
+    from .baselines import BASELINES, make_baseline
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.episodes < 1:
+        parser.error("--episodes must be >= 1")
+    names = [n.strip() for n in args.baselines.split(",") if n.strip()]
+    if args.baseline is not None:
+        names = [args.baseline]
+    unknown = [n for n in names if n not in BASELINES]
+    if unknown:
+        parser.error(f"unknown baselines {unknown}; valid baselines: {', '.join(BASELINES)}")
+
+    policies = {}
+    if args.baseline is not None:
+        if args.run_dir is not None:
+            parser.error("give either RUN_DIR or --baseline, not both")
+        if args.env not in ENV_IDS:
+            parser.error(f"--baseline needs --env, one of: {', '.join(ENV_IDS)}")
+        env_id = args.env
+        env_kwargs = {}
+        for item in args.env_kwargs:
+            key, sep, text = item.partition("=")
+            if not sep:
+                parser.error(f"--env-kwargs entries are key=value, got {item!r}")
+            env_kwargs[key] = yaml.safe_load(text)
+        out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{args.baseline}"
+    else:
+        if args.run_dir is None:
+            parser.error("give a RUN_DIR, or --baseline NAME --env ID")
+        if not (args.run_dir / "model.zip").exists():
+            parser.error(f"{args.run_dir} holds no model.zip")
+        trained = TrainedPolicy(args.run_dir)
+        env_id, env_kwargs = trained.env_id, trained.env_kwargs
+        policies[f"{trained.args['algo']} policy"] = trained
+        out = args.out or args.run_dir
+
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+
+    probe = gym.make(env_id, **env_kwargs)
+    for name in names:
+        policies[name] = make_baseline(name, probe, seed=args.seed)
+    results = evaluate(env_id, policies, episodes=args.episodes, seed=args.seed,
+                       env_kwargs=env_kwargs, progress=not args.no_progress)
+    summaries = {name: summarise(eps) for name, eps in results.items()}
+    comparisons = {}
+    if args.baseline is None:
+        first = next(iter(results))
+        comparisons = {n: compare(results[first], results[n]) for n in names}
+    table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed)
+    print(table)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "evaluation.md").write_text(table)
+    report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
+                  summaries=summaries, comparisons=comparisons,
+                  episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
+                                            terminated=e["terminated"], final=e["final"])
+                                       for e in eps] for n, eps in results.items()})
+    with open(out / "evaluation.json", "w") as fh:
+        json.dump(report, fh, indent=2)
+    plot_trajectories(env_id, results, out / "evaluation.png")
+    probe.close()
+    return summaries
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,375 @@
+"""Train an agent on an environment of the suite.
+
+    python -m agents.train --env iceenvs/Convergence-v0 --algo ppo [--timesteps N]
+        [--seed S] [--n-envs K] [--out DIR] [--force] [--eval-freq F]
+        [--eval-episodes E] [--hyperparams key=value ...]
+
+``main`` runs named steps: parse and check the arguments → prepare the run
+directory → read the hyperparameters (``agents/hyperparams/<algo>.yaml``,
+the env's entry over ``default``, then ``--hyperparams`` overrides) → save
+the configuration → make the environments → make the model → make the
+callbacks → learn → save the model and the normalisation statistics.
+
+The run directory (default ``runs/agents/<env-name>_<algo>_<seed>``)
+holds ``model.zip``, ``vecnormalize.pkl`` (when the observations or
+rewards are normalised), ``hyperparams.yaml`` (resolved),
+``args.yaml``, ``command.txt``, ``checkpoints/``, ``eval/``,
+``metrics.csv`` (physics metrics per training episode) and ``logs/``
+(SB3's ``progress.csv``; TensorBoard events when tensorboard is
+installed).
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import importlib.util
+import inspect
+import shlex
+import shutil
+import sys
+from pathlib import Path
+
+import yaml
+
+__all__ = ["ALGOS", "HYPERPARAMS_DIR", "SPECIAL_KEYS", "build_parser", "main",
+           "read_hyperparams", "valid_keys", "default_run_dir"]
+
+#: algorithm names of the command line → stable-baselines3 class names
+ALGOS = {"ppo": "PPO", "sac": "SAC"}
+HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
+#: hyperparameters that are not arguments of the algorithm's constructor
+SPECIAL_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs")
+#: constructor arguments the trainer sets itself
+_RESERVED = {"self", "policy", "env", "seed", "verbose", "device", "tensorboard_log",
+             "_init_setup_model"}
+#: model artefacts that --force removes from an existing run directory
+RUN_FILES = ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml", "command.txt",
+             "metrics.csv", "checkpoints", "eval", "logs", "evaluation.md", "evaluation.json",
+             "evaluation.png")
+#: the evaluation environment is seeded this far from the training seed
+EVAL_SEED_OFFSET = 1000
+
+
+def algo_class(algo: str):
+    """The stable-baselines3 class of an algorithm name (``"ppo"``, ``"sac"``)."""
+    import stable_baselines3
+
+    return getattr(stable_baselines3, ALGOS[algo])
+
+
+def valid_keys(algo: str) -> list[str]:
+    """Hyperparameter names accepted for ``algo``: :data:`SPECIAL_KEYS` and the
+    constructor arguments of the SB3 class (except those the trainer sets)."""
+    params = inspect.signature(algo_class(algo).__init__).parameters
+    return sorted(set(SPECIAL_KEYS) | (set(params) - _RESERVED))
+
+
+def default_run_dir(env_id: str, algo: str, seed: int) -> Path:
+    """``runs/agents/<env-name>_<algo>_<seed>`` (relative to the working directory)."""
+    return Path("runs") / "agents" / f"{env_id.split('/')[-1]}_{algo}_{seed}"
+
+
+# -- step 1: arguments -------------------------------------------------------------------
+def build_parser() -> argparse.ArgumentParser:
+    """The command-line parser (env ids and algorithms as choices)."""
+    from iceenvs import ENV_IDS
+
+    p = argparse.ArgumentParser(prog="python -m agents.train",
+                                description="Train a stable-baselines3 agent on an iceenvs "
+                                            "environment.")
+    p.add_argument("--env", required=True, choices=ENV_IDS, metavar="ID",
+                   help="environment id, one of: " + ", ".join(ENV_IDS))
+    p.add_argument("--algo", required=True, choices=sorted(ALGOS),
+                   help="algorithm: " + ", ".join(sorted(ALGOS)))
+    p.add_argument("--timesteps", type=int, default=None,
+                   help="total environment steps (default: n_timesteps of the YAML)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--n-envs", type=int, default=None,
+                   help="parallel environments (default: n_envs of the YAML)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="run directory (default runs/agents/<env-name>_<algo>_<seed>)")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite the artefacts of an existing run directory")
+    p.add_argument("--eval-freq", type=int, default=25_000,
+                   help="evaluate every this many steps, all envs together (0: never)")
+    p.add_argument("--eval-episodes", type=int, default=5,
+                   help="episodes per evaluation (default 5)")
+    p.add_argument("--save-freq", type=int, default=50_000,
+                   help="checkpoint every this many steps, all envs together (0: never)")
+    p.add_argument("--hyperparams", nargs="+", default=[], metavar="KEY=VALUE",
+                   help="override hyperparameters; VALUE is YAML, KEY may be dotted "
+                        "(env_kwargs.episode_steps=50)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
+    return p
+
+
+def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
+    """Parse and check the arguments (errors exit with status 2)."""
+    args = parser.parse_args(argv)
+    for name in ("timesteps", "n_envs"):
+        value = getattr(args, name)
+        if value is not None and value < 1:
+            parser.error(f"--{name.replace('_', '-')} must be >= 1, got {value}")
+    for name in ("eval_freq", "save_freq"):
+        if getattr(args, name) < 0:
+            parser.error(f"--{name.replace('_', '-')} must be >= 0")
+    if args.eval_episodes < 1:
+        parser.error("--eval-episodes must be >= 1")
+    if args.out is None:
+        args.out = default_run_dir(args.env, args.algo, args.seed)
+    return args
+
+
+# -- step 2: the run directory -------------------------------------------------------------
+def prepare_run_dir(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Path:
+    """Create the run directory; an existing non-empty one is refused
+    unless ``--force``, which removes the artefacts of the previous run."""
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        parser.error(f"--out {out} exists and is not a directory")
+    if out.is_dir() and any(out.iterdir()):
+        if not args.force:
+            parser.error(f"run directory {out} exists and is not empty; pass --force to "
+                         f"overwrite it or choose another --out")
+        for name in RUN_FILES:
+            path = out / name
+            if path.is_dir():
+                shutil.rmtree(path)
+            elif path.exists():
+                path.unlink()
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+# -- step 3: hyperparameters -------------------------------------------------------------
+def _set_dotted(hp: dict, key: str, value) -> None:
+    head, _, rest = key.partition(".")
+    if not rest:
+        hp[head] = value
+        return
+    sub = hp.get(head)
+    if not isinstance(sub, dict):
+        sub = {}
+    hp[head] = sub
+    _set_dotted(sub, rest, value)
+
+
+def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | None = None,
+                     n_envs: int | None = None) -> dict:
+    """The resolved hyperparameters of a run.
+
+    Parameters
+    ----------
+    algo : str
+        ``"ppo"`` or ``"sac"``.
+    env_id : str
+        Environment id; its YAML entry replaces the ``default`` entry key
+        by key.
+    overrides : iterable of str
+        ``key=value`` strings (value parsed as YAML; dotted keys set one
+        entry of a mapping such as ``env_kwargs``).
+    timesteps, n_envs : int, optional
+        Override ``n_timesteps`` and ``n_envs``.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ValueError
+        For a malformed override or an unknown key (the message lists the
+        valid ones).
+    """
+    with open(HYPERPARAMS_DIR / f"{algo}.yaml") as fh:
+        table = yaml.safe_load(fh)
+    hp = copy.deepcopy(table.get("default", {}))
+    hp.update(copy.deepcopy(table.get(env_id, {})))
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        if not sep or not key:
+            raise ValueError(f"--hyperparams entries are key=value, got {item!r}")
+        _set_dotted(hp, key.strip(), yaml.safe_load(text))
+    if timesteps is not None:
+        hp["n_timesteps"] = int(timesteps)
+    if n_envs is not None:
+        hp["n_envs"] = int(n_envs)
+    valid = valid_keys(algo)
+    unknown = sorted(set(hp) - set(valid))
+    if unknown:
+        raise ValueError(f"unknown hyperparameters {unknown} for {algo}; valid keys: "
+                         f"{', '.join(valid)}")
+    for key in ("n_envs", "n_timesteps"):
+        if not isinstance(hp.get(key), int) or hp[key] < 1:
+            raise ValueError(f"hyperparameter {key} must be an integer >= 1, got "
+                             f"{hp.get(key)!r}")
+    hp.setdefault("policy", "MlpPolicy")
+    hp.setdefault("env_kwargs", {})
+    return hp
+
+
+def _schedule(value):
+    """A learning rate: a float, or ``"lin_<x>"`` for a linear decay from x to 0."""
+    if isinstance(value, str) and value.startswith("lin_"):
+        start = float(value[4:])
+
+        def linear(progress_remaining: float) -> float:
+            return progress_remaining * start
+
+        return linear
+    return float(value)
+
+
+def algo_kwargs(hp: dict) -> dict:
+    """Constructor arguments of the algorithm from resolved hyperparameters
+    (learning-rate schedules, activation names, ``train_freq`` lists)."""
+    import torch
+
+    kw = {k: v for k, v in hp.items() if k not in SPECIAL_KEYS}
+    if "learning_rate" in kw:
+        kw["learning_rate"] = _schedule(kw["learning_rate"])
+    pk = dict(kw.get("policy_kwargs") or {})
+    if isinstance(pk.get("activation_fn"), str):
+        pk["activation_fn"] = getattr(torch.nn, {"tanh": "Tanh", "relu": "ReLU",
+                                                 "elu": "ELU"}.get(pk["activation_fn"].lower(),
+                                                                    pk["activation_fn"]))
+    if pk:
+        kw["policy_kwargs"] = pk
+    if isinstance(kw.get("train_freq"), list):
+        kw["train_freq"] = tuple(kw["train_freq"])
+    return kw
+
+
+def normalize_kwargs(hp: dict) -> dict | None:
+    """Keyword arguments of :class:`VecNormalize` (``None``: no normalisation);
+    its discount defaults to the algorithm's ``gamma``."""
+    norm = hp.get("normalize", False)
+    if not norm:
+        return None
+    kw = {} if norm is True else dict(norm)
+    if "gamma" in hp:
+        kw.setdefault("gamma", hp["gamma"])
+    return kw
+
+
+# -- step 4: configuration ---------------------------------------------------------------
+def save_config(run_dir: Path, args: argparse.Namespace, hp: dict, argv: list[str]) -> None:
+    """Write ``hyperparams.yaml``, ``args.yaml`` and ``command.txt``."""
+    with open(run_dir / "hyperparams.yaml", "w") as fh:
+        yaml.safe_dump(hp, fh, sort_keys=True)
+    plain = {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()}
+    with open(run_dir / "args.yaml", "w") as fh:
+        yaml.safe_dump(plain, fh, sort_keys=True)
+    (run_dir / "command.txt").write_text(
+        shlex.join([sys.executable, "-m", "agents.train", *argv]) + "\n")
+
+
+# -- step 5: environments -------------------------------------------------------------------
+def make_envs(args: argparse.Namespace, hp: dict):
+    """The training stack and a one-env evaluation stack (seeded
+    ``seed + EVAL_SEED_OFFSET``; normalisation frozen, synced from training
+    by :class:`EvalCallback`)."""
+    from .envs import make_vec_env
+
+    norm = normalize_kwargs(hp)
+    env = make_vec_env(args.env, n_envs=hp["n_envs"], seed=args.seed,
+                       env_kwargs=hp["env_kwargs"], normalize=norm)
+    eval_env = None
+    if args.eval_freq > 0:
+        eval_env = make_vec_env(args.env, n_envs=1, seed=args.seed + EVAL_SEED_OFFSET,
+                                env_kwargs=hp["env_kwargs"], normalize=norm, training=False)
+    return env, eval_env
+
+
+# -- step 6: model ---------------------------------------------------------------------------
+def make_model(args: argparse.Namespace, hp: dict, env, run_dir: Path):
+    """The SB3 model, seeded, on the CPU, logging to ``run_dir/logs``
+    (CSV; TensorBoard when importable; stdout when ``--verbose``)."""
+    from stable_baselines3.common.logger import configure
+
+    model = algo_class(args.algo)(hp["policy"], env, seed=args.seed, device="cpu",
+                                  verbose=args.verbose, **algo_kwargs(hp))
+    formats = ["csv"]
+    if importlib.util.find_spec("tensorboard") is not None:
+        formats.append("tensorboard")
+    if args.verbose:
+        formats.append("stdout")
+    model.set_logger(configure(str(run_dir / "logs"), formats))
+    return model
+
+
+# -- step 7: callbacks -----------------------------------------------------------------------
+def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path) -> list:
+    """Checkpoints, evaluation, physics metrics and the progress bar."""
+    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
+
+    from .callbacks import PhysicsMetricsCallback, TqdmCallback
+
+    n_envs = hp["n_envs"]
+    callbacks = []
+    if args.save_freq > 0:
+        callbacks.append(CheckpointCallback(max(args.save_freq // n_envs, 1),
+                                            str(run_dir / "checkpoints"), name_prefix="model",
+                                            save_vecnormalize=True))
+    if eval_env is not None:
+        callbacks.append(EvalCallback(eval_env, n_eval_episodes=args.eval_episodes,
+                                      eval_freq=max(args.eval_freq // n_envs, 1),
+                                      log_path=str(run_dir / "eval"),
+                                      best_model_save_path=str(run_dir / "eval"),
+                                      deterministic=True, verbose=args.verbose))
+    callbacks.append(PhysicsMetricsCallback(args.env, run_dir / "metrics.csv"))
+    callbacks.append(TqdmCallback(hp["n_timesteps"], disable=args.no_progress))
+    return callbacks
+
+
+# -- step 8: learn and save --------------------------------------------------------------------
+def learn(model, hp: dict, callbacks: list) -> None:
+    """Run ``model.learn`` for ``n_timesteps``."""
+    from stable_baselines3.common.callbacks import CallbackList
+
+    model.learn(total_timesteps=hp["n_timesteps"], callback=CallbackList(callbacks),
+                progress_bar=False)
+
+
+def save(model, env, run_dir: Path) -> None:
+    """Write ``model.zip`` and, when normalising, ``vecnormalize.pkl``."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    model.save(run_dir / "model.zip")
+    if isinstance(env, VecNormalize):
+        env.save(str(run_dir / "vecnormalize.pkl"))
+
+
+def main(argv: list[str] | None = None) -> Path:
+    """Command-line entry point; returns the run directory."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args = parse_args(parser, argv)
+    try:
+        hp = read_hyperparams(args.algo, args.env, args.hyperparams, timesteps=args.timesteps,
+                              n_envs=args.n_envs)
+    except ValueError as err:
+        parser.error(str(err))
+    run_dir = prepare_run_dir(parser, args)
+    save_config(run_dir, args, hp, argv)
+
+    import torch
+
+    torch.set_num_threads(1)
+    env, eval_env = make_envs(args, hp)
+    try:
+        model = make_model(args, hp, env, run_dir)
+        callbacks = make_callbacks(args, hp, eval_env, run_dir)
+        learn(model, hp, callbacks)
+        save(model, env, run_dir)
+    finally:
+        env.close()
+        if eval_env is not None:
+            eval_env.close()
+    print(f"saved {run_dir / 'model.zip'}")
+    return run_dir
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,282 @@
+"""Training, saving, reloading and evaluating agents, the baselines and the
+command-line errors, on tiny budgets and short episodes."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import iceenvs
+from iceenvs import ENV_IDS
+
+pytest.importorskip("stable_baselines3")
+
+from agents import train  # noqa: E402
+from agents.baselines import BASELINES, make_baseline  # noqa: E402
+from agents.metrics import PHYSICS_METRICS  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+CONVERGENCE = "iceenvs/Convergence-v0"
+ITD = "iceenvs/ThicknessDistribution-v0"
+
+# small instances with episodes of a few steps
+SMALL = {
+    "iceenvs/WindDrift-v0": dict(n_floes=60, episode_steps=16),
+    CONVERGENCE: dict(n_floes=60, episode_steps=16),
+    "iceenvs/MarginalIceZone-v0": dict(n_floes=60, episode_steps=16),
+    "iceenvs/FloeClustering-v0": dict(n_floes=150, episode_steps=16),
+    ITD: dict(n_classes=60, days_per_step=5.0, episode_days=80.0),
+}
+TINY_PPO = ["n_steps=64", "batch_size=64", "n_epochs=2",
+            "policy_kwargs={net_arch: [16, 16]}"]
+
+
+def env_kwargs_args(env_id):
+    return [f"env_kwargs={json.dumps(SMALL[env_id])}"]
+
+
+def run_train(args, **kwargs):
+    return subprocess.run([sys.executable, "-m", "agents.train", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300, **kwargs)
+
+
+def observations(env_id, n_seeds=3, steps=4):
+    """A batch of raw observations from a few seeded episodes."""
+    env = gym.make(env_id, **SMALL[env_id])
+    space = gym.spaces.Box(env.action_space.low, env.action_space.high, seed=0)
+    out = []
+    for seed in range(n_seeds):
+        obs, _ = env.reset(seed=seed)
+        out.append(obs)
+        for _ in range(steps):
+            obs, *_ = env.step(space.sample())
+            out.append(obs)
+    env.close()
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def ppo_runs(tmp_path_factory):
+    """One tiny PPO run per env id, each in its own process."""
+    base = tmp_path_factory.mktemp("runs")
+    runs = {}
+    for env_id in ENV_IDS:
+        out = base / env_id.split("/")[1]
+        proc = run_train(["--env", env_id, "--algo", "ppo", "--timesteps", "256",
+                          "--n-envs", "1", "--seed", "3", "--out", str(out),
+                          "--eval-freq", "128", "--eval-episodes", "1", "--save-freq", "128",
+                          "--no-progress", "--hyperparams", *TINY_PPO,
+                          *env_kwargs_args(env_id)])
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        runs[env_id] = out
+    return runs
+
+
+def test_package_import_is_light():
+    code = "import sys, agents; assert 'torch' not in sys.modules and " \
+           "'stable_baselines3' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True)
+
+
+def test_hyperparams_cover_every_env():
+    for algo in train.ALGOS:
+        table = yaml.safe_load((train.HYPERPARAMS_DIR / f"{algo}.yaml").read_text())
+        assert set(table) == set(ENV_IDS) | {"default"}
+        for env_id in ENV_IDS:
+            hp = train.read_hyperparams(algo, env_id)
+            assert set(hp) <= set(train.valid_keys(algo))
+            assert hp["n_timesteps"] >= 10_000 and hp["n_envs"] >= 1
+    assert set(PHYSICS_METRICS) == {i.split("/")[1] for i in ENV_IDS}
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_ppo_run_saves_reloads_and_evaluates(ppo_runs, env_id, tmp_path):
+    from agents.evaluate import TrainedPolicy, main as evaluate_main
+
+    run = ppo_runs[env_id]
+    for name in ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml",
+                 "command.txt", "metrics.csv"):
+        assert (run / name).is_file(), name
+    assert list((run / "checkpoints").glob("model_*_steps.zip"))
+    assert (run / "eval" / "evaluations.npz").is_file()
+    hp = yaml.safe_load((run / "hyperparams.yaml").read_text())
+    assert hp["n_timesteps"] == 256 and hp["n_envs"] == 1 and hp["n_steps"] == 64
+    assert hp["env_kwargs"] == SMALL[env_id]
+    args = yaml.safe_load((run / "args.yaml").read_text())
+    assert args["env"] == env_id and args["algo"] == "ppo" and args["seed"] == 3
+    command = (run / "command.txt").read_text()
+    assert command.startswith(f"{sys.executable} -m agents.train") and env_id in command
+
+    # one row per finished training episode, with the task's physics metrics
+    lines = (run / "metrics.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert len(lines) - 1 >= 256 // 16 - 1
+    for name in PHYSICS_METRICS[env_id.split("/")[1]].values():
+        assert f"final_{name}" in header and f"mean_{name}" in header
+    progress = (run / "logs" / "progress.csv").read_text().splitlines()[0].split(",")
+    assert "rollout/ep_rew_mean" in progress
+    assert any(col.startswith("physics/final_") for col in progress)
+
+    # reloading gives the same deterministic actions on a batch of observations
+    obs = observations(env_id)
+    first = TrainedPolicy(run)
+    a1, _ = first.predict(obs)
+    a2, _ = TrainedPolicy(run).predict(obs)
+    space = gym.make(env_id, **SMALL[env_id]).action_space
+    assert a1.shape == (len(obs),) + space.shape
+    np.testing.assert_array_equal(a1, a2)
+    # the frozen statistics are applied: raw and normalised inputs differ
+    assert not np.allclose(first.normalization.normalize_obs(obs), obs)
+
+    summaries = evaluate_main([str(run), "--episodes", "2", "--no-progress",
+                               "--out", str(tmp_path), "--seed", "7"])
+    assert set(summaries) == {"ppo policy", "random", "zero", "heuristic"}
+    report = json.loads((tmp_path / "evaluation.json").read_text())
+    for episodes in report["episodes_detail"].values():
+        assert [e["seed"] for e in episodes] == [7, 8]
+    # the two seeds are two different episodes
+    zero = report["episodes_detail"]["zero"]
+    assert zero[0]["final"] != zero[1]["final"]
+    table = (tmp_path / "evaluation.md").read_text()
+    assert "beaten by > 2 standard errors" in table and "| heuristic |" in table
+    assert (tmp_path / "evaluation.png").stat().st_size > 1000
+
+
+def test_sac_smoke(tmp_path):
+    out = tmp_path / "sac"
+    proc = run_train(["--env", ITD, "--algo", "sac", "--timesteps", "256", "--n-envs", "1",
+                      "--out", str(out), "--eval-freq", "0", "--no-progress", "--hyperparams",
+                      "learning_starts=64", "batch_size=32",
+                      "policy_kwargs={net_arch: [16, 16]}", *env_kwargs_args(ITD)])
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    from stable_baselines3 import SAC
+
+    model = SAC.load(out / "model.zip", device="cpu")
+    assert model.num_timesteps == 256
+    assert (out / "vecnormalize.pkl").is_file()
+
+
+def _train_in_process(tmp_path, name, seed):
+    out = tmp_path / name
+    train.main(["--env", ITD, "--algo", "ppo", "--timesteps", "128", "--n-envs", "2",
+                "--seed", str(seed), "--out", str(out), "--eval-freq", "0", "--save-freq", "0",
+                "--no-progress", "--hyperparams", *TINY_PPO, *env_kwargs_args(ITD)])
+    from stable_baselines3 import PPO
+
+    params = PPO.load(out / "model.zip", device="cpu").policy.state_dict()
+    return np.concatenate([v.numpy().ravel() for v in params.values()])
+
+
+def test_same_seed_same_training(tmp_path):
+    a = _train_in_process(tmp_path, "a", seed=5)
+    b = _train_in_process(tmp_path, "b", seed=5)
+    c = _train_in_process(tmp_path, "c", seed=6)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("name", sorted(BASELINES))
+def test_baselines_stay_in_action_space(env_id, name):
+    env = gym.make(env_id, **SMALL[env_id])
+    policy = make_baseline(name, env, seed=1)
+    obs, _ = env.reset(seed=1)
+    policy.reset(1)
+    actions = []
+    for _ in range(6):
+        action, state = policy.predict(obs)
+        assert state is None and env.action_space.contains(action)
+        actions.append(action)
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            break
+    batch, _ = policy.predict(np.stack([obs, obs]))
+    assert batch.shape == (2,) + env.action_space.shape
+    if name == "zero":
+        assert not np.any(actions)
+    elif name == "heuristic":
+        assert np.any(actions)      # a controller that acts
+    env.close()
+
+
+def test_random_baseline_is_seeded():
+    env = gym.make(ITD, **SMALL[ITD])
+    obs, _ = env.reset(seed=0)
+    draws = []
+    for seed in (4, 4, 5):
+        policy = make_baseline("random", env, seed=0)
+        policy.reset(seed)
+        draws.append(np.array([policy.predict(obs)[0] for _ in range(3)]))
+    np.testing.assert_array_equal(draws[0], draws[1])
+    assert not np.array_equal(draws[0], draws[2])
+
+
+def test_unknown_baseline_lists_valid_ones():
+    env = gym.make(ITD, **SMALL[ITD])
+    with pytest.raises(ValueError, match="random, zero, heuristic"):
+        make_baseline("greedy", env)
+
+
+def _episode(env, policy, seed):
+    obs, _ = env.reset(seed=seed)
+    policy.reset(seed)
+    total = 0.0
+    while True:
+        obs, reward, terminated, truncated, info = env.step(policy.predict(obs)[0])
+        total += reward
+        if terminated or truncated:
+            return total, info["physics"]
+
+
+def test_convergence_heuristic_beats_zero_action():
+    # zero action leaves A at its start in [0.70, 0.80]; the controller
+    # converges towards A* = 0.9 and so earns less negative reward
+    env = gym.make(CONVERGENCE, episode_steps=60)
+    heuristic = make_baseline("heuristic", env)
+    zero = make_baseline("zero", env)
+    for seed in (0, 1, 2):
+        r_h, p_h = _episode(env, heuristic, seed)
+        r_z, p_z = _episode(env, zero, seed)
+        assert r_h > r_z + 50.0
+        assert abs(p_h["concentration"] - 0.9) < abs(p_z["concentration"] - 0.9) - 0.02
+
+
+def test_baseline_alone_from_the_command_line(tmp_path):
+    from agents.evaluate import main as evaluate_main
+
+    summaries = evaluate_main(["--baseline", "heuristic", "--env", ITD, "--episodes", "2",
+                               "--no-progress", "--out", str(tmp_path), "--env-kwargs",
+                               *[f"{k}={v}" for k, v in SMALL[ITD].items()]])
+    assert set(summaries) == {"heuristic"}
+    assert summaries["heuristic"]["length"]["mean"] == 16
+    assert (tmp_path / "evaluation.md").is_file()
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--env", "iceenvs/Nope-v0", "--algo", "ppo"], ENV_IDS),
+    (["--env", CONVERGENCE, "--algo", "dqn"], ("ppo", "sac")),
+    (["--env", CONVERGENCE, "--algo", "ppo", "--hyperparams", "n_stepz=3"],
+     ("n_steps", "batch_size", "env_kwargs")),
+])
+def test_bad_input_lists_valid_choices(argv, expected, capsys, tmp_path):
+    with pytest.raises(SystemExit) as exc:
+        train.main([*argv, "--out", str(tmp_path / "run")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    for word in expected:
+        assert word in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_existing_run_directory_needs_force(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "model.zip").write_text("earlier run")
+    proc = run_train(["--env", CONVERGENCE, "--algo", "ppo", "--out", str(out)])
+    assert proc.returncode == 2
+    assert "--force" in proc.stderr
+    assert (out / "model.zip").read_text() == "earlier run"
