@@ -40,7 +40,7 @@ from ..forcing import Forcing
 from ..hertz import HertzSimulation
 from ..params import HERMAN2013, ContactParams
 from .lammps_runner import LammpsSimulation
-from .results import Check
+from .results import Check, save_figure
 
 __all__ = ["zero_step_forces", "trajectories", "convergence", "speed", "run",
            "compressed_field", "jammed_field"]
@@ -159,10 +159,9 @@ def trajectories(n: int = 2000, steps: int = 500, seed: int = 0,
 
 
 def _plot_trajectories(h, out_dir: Path) -> str:
-    import matplotlib
+    from ..scenarios.plots import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     floor = 1e-18
@@ -174,12 +173,7 @@ def _plot_trajectories(h, out_dir: Path) -> str:
     ax.set_ylabel("largest difference, ours − LAMMPS")
     ax.set_title("Hertz engine vs LAMMPS: same discs, same steps")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    name = "lammps_trajectories.png"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_dir / name, dpi=120)
-    plt.close(fig)
-    return name
+    return save_figure(fig, out_dir, "lammps_trajectories.png")
 
 
 def jammed_field(n: int, seed: int, concentration: float, rate_per_hour: float = 10.0):
@@ -264,8 +258,8 @@ def convergence(n: int = 1000, seed: int = 3, out_dir: Path | None = None,
         rel2 = np.abs(through[hi, 3] / through[hi, 2] - 1.0)
         rows.append(Check(
             "lammps/convergence/through-jamming",
-            f"the same floes compressed from Ā = 0.85 through jamming: largest |Δp|/p where "
-            f"p > 10 % of its final value (two realisations, not one trajectory)",
+            "the same floes compressed from Ā = 0.85 through jamming: largest |Δp|/p where "
+            "p > 10 % of its final value (two realisations, not one trajectory)",
             float(rel2.max()), None,
             detail=f"A at which p first exceeds 1e6 N/m: ours "
                    f"{_first_above(through[:, 0], through[:, 2], 1e6):.4f}, LAMMPS "
@@ -283,10 +277,9 @@ def _first_above(a, p, level):
 
 
 def _plot_convergence(jam, through, out_dir: Path) -> str:
-    import matplotlib
+    from ..scenarios.plots import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     ax = axes[0]
@@ -311,12 +304,7 @@ def _plot_convergence(jam, through, out_dir: Path) -> str:
     ax.set_xlabel("concentration A")
     ax.set_ylabel("p_LAMMPS / p_ours − 1 [%]")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    name = "lammps_convergence.png"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out_dir / name, dpi=120)
-    plt.close(fig)
-    return name
+    return save_figure(fig, out_dir, "lammps_convergence.png")
 
 
 def speed(n: int = 20000, steps: int = 1000, seed: int = 1,

@@ -57,7 +57,7 @@ from ..floes import FloeField, max_overlap
 from ..params import ContactParams, check_range
 
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
-           "find_mpi_library"]
+           "lammps_version", "find_mpi_library"]
 
 _MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
 
@@ -82,7 +82,7 @@ def find_mpi_library() -> str | None:
     return None
 
 
-_LOADED = {"module": None, "error": None}
+_LOADED = {"module": None, "error": None, "version": None}
 
 
 def load_lammps():
@@ -105,6 +105,7 @@ def load_lammps():
         try:
             if not lmp.has_package("GRANULAR"):
                 raise ImportError("this LAMMPS build has no GRANULAR package")
+            _LOADED["version"] = str(lmp.version())
         finally:
             lmp.close()
     except (ImportError, OSError) as exc:
@@ -127,6 +128,12 @@ def lammps_available() -> tuple[bool, str]:
     except ImportError as exc:
         return False, str(exc)
     return True, ""
+
+
+def lammps_version() -> str:
+    """The version of the LAMMPS library (e.g. "20250722"); loads it first."""
+    load_lammps()
+    return _LOADED["version"]
 
 
 def lammps_restitution(contact: ContactParams) -> float:

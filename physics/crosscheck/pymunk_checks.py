@@ -81,7 +81,7 @@ from ..harddisk import HardDiskSimulation
 from ..hertz import HertzSimulation
 from ..params import HERMAN2011, ContactParams
 from .pymunk_runner import PymunkSimulation
-from .results import Check
+from .results import Check, save_figure
 
 __all__ = ["binary_frictionless", "binary_friction", "gas_cooling", "drag_relaxation", "speed",
            "run", "smooth_impact_law", "rigid_coulomb_impact", "hertz_pair_impact",
@@ -112,14 +112,6 @@ def _new_figure(size=(6.0, 4.0), ncols=1):
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(1, ncols, k + 1) for k in range(ncols)]
     return fig, axes
-
-
-def _save(fig, out_dir: Path, name: str) -> str:
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(out_dir / name, dpi=120)
-    return name
 
 
 def _masses(radii, thickness):
@@ -377,7 +369,7 @@ def binary_frictionless(out_dir: Path | None = None, quick: bool = False, seed: 
         ax.set_ylabel("|u' − u'_law| / |u_i − u_j|")
         ax.set_title(f"{n_imp} smooth oblique impacts, e in (0.1, 1]")
         ax.legend(fontsize=7)
-        figures.append(_save(fig, out_dir, "pymunk_binary_frictionless.png"))
+        figures.append(save_figure(fig, out_dir, "pymunk_binary_frictionless.png"))
     common = f"{n_imp} random impacts: r 0.5–20 m, |u_rel| 1e-3–1 m/s, b/(r_i+r_j) < 0.99, e in (0.1, 1]"
     return [
         Check("binary/frictionless/harddisk-vs-law",
@@ -520,7 +512,7 @@ def binary_friction(out_dir: Path | None = None, quick: bool = False, seed: int 
         ax2.set_xlabel("ψ")
         ax2.set_ylabel("spin after impact ω r / v_s")
         ax2.legend(fontsize=7)
-        figures.append(_save(fig, out_dir, "pymunk_binary_friction.png"))
+        figures.append(save_figure(fig, out_dir, "pymunk_binary_friction.png"))
 
     n_w, n_d = int(np.sum(weak & sliding)), int(np.sum(damped & sliding))
     return [
@@ -679,7 +671,7 @@ def gas_cooling(out_dir: Path | None = None, quick: bool = False, seed: int = 0,
         ax2.set_xlabel("t / τ_H")
         ax2.set_ylabel("relative difference of KE/KE₀")
         ax2.legend(fontsize=8)
-        figures.append(_save(fig, out_dir, "pymunk_gas_cooling.png"))
+        figures.append(save_figure(fig, out_dir, "pymunk_gas_cooling.png"))
     common = (f"N = {n}, A = {GAS_ETA:g}, e = {GAS_RESTITUTION:g}, {seeds} seeds, "
               f"{samples + 1} samples over 2 τ_H")
     return [
@@ -776,7 +768,7 @@ def drag_relaxation(out_dir: Path | None = None, quick: bool = False, seed: int 
         ax.set_ylabel("mean velocity ū_x [m/s]")
         ax.set_title(f"Stokes drag, N = {n}, A = {DRAG_ETA:g}, τ = {tau:.0f} s")
         ax.legend(fontsize=8)
-        figures.append(_save(fig, out_dir, "pymunk_drag_relaxation.png"))
+        figures.append(save_figure(fig, out_dir, "pymunk_drag_relaxation.png"))
     common = (f"N = {n} equal floes, A = {DRAG_ETA:g} (inner square), e = {GAS_RESTITUTION:g}, "
               f"τ = {tau:.4g} s, |ū_eq| = {scale:.4g} m/s, t = {relaxation_times:g} τ; "
               f"collisions {hd.collision_count} / {pm.collision_count}, "

@@ -54,12 +54,10 @@ def _versions() -> dict:
         v["pymunk"] = pymunk.version
     except ImportError:
         pass
-    from .lammps_runner import lammps_available, load_lammps
+    from .lammps_runner import lammps_available, lammps_version
 
     if lammps_available()[0]:
-        lmp = load_lammps().lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-        v["lammps"] = str(lmp.version())
-        lmp.close()
+        v["lammps"] = lammps_version()
     return v
 
 

@@ -1,10 +1,11 @@
-"""One row of a cross-check report, and the table they make."""
+"""One row of a cross-check report, the table they make, and its figures."""
 from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
-__all__ = ["Check", "format_table"]
+__all__ = ["Check", "format_table", "save_figure"]
 
 
 @dataclass
@@ -60,3 +61,15 @@ def format_table(checks: list[Check]) -> str:
         tol = "–" if c.tolerance is None else f"≤ {_num(c.tolerance)}{unit}"
         lines.append(f"| {c.name} | {_num(c.measured)}{unit} | {tol} | {verdict} | {c.detail} |")
     return "\n".join(lines)
+
+
+def save_figure(fig, out_dir: Path, name: str) -> str:
+    """Save ``fig`` as ``out_dir/name`` (tight layout, 120 dpi, the
+    scenarios' :func:`~physics.scenarios.plots.savefig`), creating the
+    directory; returns ``name`` for :attr:`Check.figures`."""
+    from ..scenarios.plots import savefig
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    savefig(fig, out_dir / name)
+    return name

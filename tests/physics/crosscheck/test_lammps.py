@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from physics import ContactParams, DeformingPeriodicBox, FloeField, HertzSimulation, PeriodicBox
+from physics import ContactParams, FloeField, HertzSimulation, PeriodicBox
 from physics.contact import lammps_damping_alpha
 from physics.crosscheck import lammps_available
 from physics.crosscheck.lammps_runner import lammps_restitution
