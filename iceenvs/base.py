@@ -50,7 +50,15 @@ class ControlEnv(gym.Env):
     ``_info``. A physics failure (FloatingPointError, RuntimeError,
     ValueError) or a non-finite reward ends the episode with
     ``info["error"]`` and ``failure_reward``; the episode is truncated after
-    ``episode_steps`` steps. Subclasses build their model in ``reset`` and
+    ``episode_steps`` steps.
+
+    Failures are absorbing: when an episode is terminated (task failure
+    of ``_terminated`` or a physics failure) before its last step, the
+    steps it had left are charged the failing step's reward if that is
+    negative (:meth:`_failure_return`). Ending an episode early therefore
+    never pays more than living on in the failed state; without this, a
+    task whose per-step rewards are negative would reward breaking the
+    ice. Subclasses build their model in ``reset`` and
     then call ``_begin_episode``; they provide the hooks named above,
     ``_ready`` (a model exists) and ``_frame`` (an RGB array).
     """
@@ -93,6 +101,13 @@ class ControlEnv(gym.Env):
     def _frame(self) -> np.ndarray:
         raise NotImplementedError
 
+    def _failure_return(self, reward: float) -> float:
+        """The reward of a terminating step: ``reward`` plus, for each step
+        the episode had left, ``min(reward, 0)`` (the failed state is
+        absorbing)."""
+        left = max(int(self.episode_steps) - int(self._steps), 0)
+        return reward + left * min(reward, 0.0)
+
     # -- the loop -----------------------------------------------------------------------
     def _begin_episode(self):
         """Zero action, first measurement and observation of a new episode;
@@ -121,13 +136,16 @@ class ControlEnv(gym.Env):
             # a physics failure ends the episode instead of crashing the caller
             info = self._info(self._prev)
             info["error"] = f"{type(err).__name__}: {err}"
-            return self._obs.copy(), float(self.failure_reward), True, False, info
+            return (self._obs.copy(), self._failure_return(float(self.failure_reward)), True,
+                    False, info)
         reward = self._reward(a, now)
         info = self._info(now)
         terminated = bool(self._terminated(now))
         if not math.isfinite(reward):
             info["error"] = f"non-finite reward {reward}"
             reward, terminated = float(self.failure_reward), True
+        if terminated:
+            reward = self._failure_return(reward)
         self._prev = now
         self._obs = self._vector(now)
         truncated = self._steps >= self.episode_steps and not terminated

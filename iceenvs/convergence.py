@@ -55,7 +55,9 @@ class ConvergenceEnv(HertzEnv):
     ## Episode End
     Terminated when the pressure passes `failure_pressure` (default 1e5 N/m)
     or the physics fails (`info["error"]`); truncated after
-    `episode_steps` (default 150 × 2 s).
+    `episode_steps` (default 150 × 2 s). Failure is absorbing: the failing
+    step's reward is also charged for each step the episode had left, so
+    that breaking the ice never ends the (negative) rewards early.
 
     ## Arguments
     `n_floes=200`, `preset=HERMAN2013`, `control_interval=2.0` [s],

@@ -144,7 +144,8 @@ class ThicknessDistributionEnv(ControlEnv):
     ∫ |G(h) − G*(h)| dh with G the cumulative fractions (0 when g equals the
     target). `reward_fn=` replaces it; it is called as
     `reward_fn(prev, action, now, target=..., h=...)` with the physics dicts.
-    A physics failure gives `failure_reward` (−10).
+    A physics failure gives `failure_reward` (−10) for the failing step and
+    for each step the episode had left (failures are absorbing).
 
     ## Starting State
     Day 0 (mid-winter). The default target is an exponential-tailed

@@ -221,3 +221,27 @@ def test_marginal_ice_zone_onshore_wind_loads_the_edge():
     for stress, load in onshore:
         assert 0.3 * load < stress < 1.2 * load, (f"edge stress {stress:.3g} vs wind load "
                                                   f"{load:.3g} N/m")
+
+
+def test_convergence_failure_is_absorbing():
+    """Breaking the ice (p > failure_pressure) ends the episode with the
+    failing step's reward charged once more for each step left, so that a
+    policy cannot escape the negative concentration rewards by crushing the
+    ice; a truncated episode gets the plain reward."""
+    env = gym.make("iceenvs/Convergence-v0", n_floes=100, stiffness_scale=0.01,
+                   failure_pressure=1.0, episode_steps=400)
+    try:
+        env.reset(seed=1, options={"concentration": 0.84})
+        base = env.unwrapped
+        for k in range(1, 401):
+            _, reward, terminated, truncated, info = env.step(np.array([1.0], dtype=np.float32))
+            assert "error" not in info
+            if terminated:
+                break
+            assert reward == pytest.approx(base._reward(np.array([1.0]), info["physics"]))
+        assert terminated and not truncated and k < 400
+        step_reward = base._reward(np.array([1.0]), info["physics"])
+        assert step_reward < -1.0
+        assert reward == pytest.approx(step_reward * (1 + 400 - k), rel=1e-12)
+    finally:
+        env.close()

@@ -363,7 +363,8 @@ def test_physics_failure_ends_the_episode(env):
     env.model.step = broken
     obs, reward, terminated, truncated, info = env.step([0, 0])
     assert terminated and not truncated
-    assert reward == env.failure_reward
+    # absorbing failure: −10 for this step and each of the steps left
+    assert reward == env.failure_reward * (1 + env.episode_steps - 2)
     assert "FloatingPointError" in info["error"]
     assert np.array_equal(obs, obs0)
 
@@ -372,7 +373,8 @@ def test_non_finite_custom_reward_terminates():
     e = ThicknessDistributionEnv(reward_fn=lambda prev, action, now, **p: float("nan"))
     e.reset(seed=0)
     _, reward, terminated, _, info = e.step([0, 0])
-    assert terminated and reward == e.failure_reward and "error" in info
+    assert terminated and "error" in info
+    assert reward == e.failure_reward * e.episode_steps
 
 
 def test_step_before_reset_raises():
