@@ -90,28 +90,24 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
                 terminated=bool(terminated), final=final, rewards=rewards, trace=trace)
 
 
-def evaluate(env_id: str, policies: dict, *, episodes: int, seed: int,
-             env_kwargs: dict | None = None, progress: bool = True) -> dict:
-    """Run every policy of ``{name: policy}`` on episodes seeded
-    ``seed, seed + 1, …``; returns ``{name: [episode dicts]}``."""
-    import gymnasium as gym
+def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = True) -> dict:
+    """Run every policy of ``{name: policy}`` in ``env`` on episodes seeded
+    ``seed, seed + 1, …``; returns ``{name: [episode dicts]}``.
+
+    The baselines must have been made for this very ``env``
+    (:func:`agents.baselines.make_baseline`): the model-based controllers
+    read its state."""
     from tqdm.auto import tqdm
 
-    import iceenvs  # noqa: F401
-
-    main_metric = MAIN_METRIC.get(env_name(env_id))
-    env = gym.make(env_id, **(env_kwargs or {}))
+    main_metric = MAIN_METRIC.get(env_name(env.spec.id))
     results = {}
-    try:
-        with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
-                  disable=not progress) as bar:
-            for name, policy in policies.items():
-                results[name] = []
-                for k in range(episodes):
-                    results[name].append(run_episode(env, policy, seed + k, main_metric))
-                    bar.update()
-    finally:
-        env.close()
+    with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
+              disable=not progress) as bar:
+        for name, policy in policies.items():
+            results[name] = []
+            for k in range(episodes):
+                results[name].append(run_episode(env, policy, seed + k, main_metric))
+                bar.update()
     return results
 
 
@@ -266,11 +262,14 @@ def main(argv: list[str] | None = None) -> dict:
 
     import iceenvs  # noqa: F401
 
-    probe = gym.make(env_id, **env_kwargs)
-    for name in names:
-        policies[name] = make_baseline(name, probe, seed=args.seed)
-    results = evaluate(env_id, policies, episodes=args.episodes, seed=args.seed,
-                       env_kwargs=env_kwargs, progress=not args.no_progress)
+    env = gym.make(env_id, **env_kwargs)
+    try:
+        for name in names:
+            policies[name] = make_baseline(name, env, seed=args.seed)
+        results = evaluate(env, policies, episodes=args.episodes, seed=args.seed,
+                           progress=not args.no_progress)
+    finally:
+        env.close()
     summaries = {name: summarise(eps) for name, eps in results.items()}
     comparisons = {}
     if args.baseline is None:
@@ -288,7 +287,6 @@ def main(argv: list[str] | None = None) -> dict:
     with open(out / "evaluation.json", "w") as fh:
         json.dump(report, fh, indent=2)
     plot_trajectories(env_id, results, out / "evaluation.png")
-    probe.close()
     return summaries
 
 
