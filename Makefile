@@ -21,6 +21,7 @@ $(STAMP): pyproject.toml Makefile
 
 demo: setup
 	$(PY) -m physics.demo
+	$(PY) -m agents.demo
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"

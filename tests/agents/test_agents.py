@@ -245,6 +245,22 @@ def test_convergence_heuristic_beats_zero_action():
         assert abs(p_h["concentration"] - 0.9) < abs(p_z["concentration"] - 0.9) - 0.02
 
 
+def test_thickness_heuristic_beats_zero_action_through_the_evaluator(tmp_path):
+    # one seasonal cycle: the zero action (kernel scale 1) ends near
+    # W1 = 0.73 m with a return near -205; the receding-horizon controller
+    # keeps g(h) closer (about -180). Run through agents.evaluate, whose
+    # baselines must act on the env it steps (they read its model).
+    from agents.evaluate import main as evaluate_main
+
+    summaries = evaluate_main(["--baseline", "heuristic", "--env", ITD, "--episodes", "1",
+                               "--no-progress", "--out", str(tmp_path / "h")])
+    zero = evaluate_main(["--baseline", "zero", "--env", ITD, "--episodes", "1",
+                          "--no-progress", "--out", str(tmp_path / "z")])
+    r_h = summaries["heuristic"]["return"]["mean"]
+    r_z = zero["zero"]["return"]["mean"]
+    assert r_h > r_z + 10.0, (r_h, r_z)
+
+
 def test_baseline_alone_from_the_command_line(tmp_path):
     from agents.evaluate import main as evaluate_main
 
@@ -280,3 +296,36 @@ def test_existing_run_directory_needs_force(tmp_path):
     assert proc.returncode == 2
     assert "--force" in proc.stderr
     assert (out / "model.zip").read_text() == "earlier run"
+
+
+def test_demo_trains_evaluates_and_prints_the_table(tmp_path, capsys):
+    from agents.demo import main as demo_main
+
+    summaries = demo_main(["--timesteps", "256", "--episodes", "1", "--no-progress",
+                           "--out", str(tmp_path / "demo")])
+    out = capsys.readouterr().out
+    assert set(summaries) == {"ppo policy", "random", "zero", "heuristic"}
+    assert "| ppo policy |" in out and "| heuristic |" in out
+    assert (tmp_path / "demo" / "model.zip").is_file()
+    assert (tmp_path / "demo" / "evaluation.png").is_file()
+    with pytest.raises(SystemExit):
+        demo_main(["--timesteps", "0"])
+
+
+def test_learning_curve_from_progress_csv(tmp_path):
+    from agents.curves import main as curves_main, read_progress
+
+    run = tmp_path / "run"
+    (run / "logs").mkdir(parents=True)
+    (run / "logs" / "progress.csv").write_text(
+        "time/total_timesteps,rollout/ep_rew_mean,eval/mean_reward,time/time_elapsed\n"
+        "1000,-5.0,,10\n2000,-4.0,-3.5,20\n3000,-3.0,,30\n")
+    (run / "evaluation.json").write_text(json.dumps({"summaries": {
+        "ppo policy": {"return": {"mean": -3.0}}, "zero": {"return": {"mean": -6.0}}}}))
+    progress = read_progress(run)
+    assert progress["train"] == [(1000, -5.0), (2000, -4.0), (3000, -3.0)]
+    assert progress["eval"] == [(2000, -3.5)]
+    assert curves_main([str(run)]) == run / "learning_curve.png"
+    assert (run / "learning_curve.png").stat().st_size > 1000
+    with pytest.raises(SystemExit):
+        curves_main([str(tmp_path / "missing")])
