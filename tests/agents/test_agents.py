@@ -120,6 +120,8 @@ def test_ppo_run_saves_reloads_and_evaluates(ppo_runs, env_id, tmp_path):
     progress = (run / "logs" / "progress.csv").read_text().splitlines()[0].split(",")
     assert "rollout/ep_rew_mean" in progress
     assert any(col.startswith("physics/final_") for col in progress)
+    # TensorBoard events next to the CSV (tensorboard is in the rl extra)
+    assert list((run / "logs").glob("events.out.tfevents.*"))
 
     # reloading gives the same deterministic actions on a batch of observations
     obs = observations(env_id)
