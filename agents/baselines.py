@@ -251,6 +251,8 @@ class ThicknessDistributionController(Baseline):
     levels = (-1.0, -0.5, 0.0, 0.5, 1.0)
     horizon = 60
     replan = 10
+    _step = 0          # steps of the episode so far
+    _choice = 0.0      # the redistribution action held until the next plan
 
     def reset(self, seed=None):
         self._step = 0
@@ -278,7 +280,7 @@ class ThicknessDistributionController(Baseline):
         env = self.env.unwrapped
         target = env.target
         rafting = 1.0 if float(obs[1]) > float(env.coarse(target)[1]) else -1.0
-        step = getattr(self, "_step", 0)
+        step = self._step
         self._step = step + 1
         if env.model is None:
             return np.array([0.0, rafting])

@@ -44,11 +44,9 @@ def read_progress(run_dir: str | Path) -> dict[str, list[tuple[float, float]]]:
 def plot_learning_curve(run_dir: str | Path, path: str | Path | None = None) -> Path:
     """Draw the learning curve of ``run_dir`` to ``path`` (default
     ``RUN_DIR/learning_curve.png``); returns the path."""
-    import matplotlib
+    from physics.scenarios import plots
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = plots.pyplot()
     run_dir = Path(run_dir)
     path = Path(path) if path is not None else run_dir / "learning_curve.png"
     progress = read_progress(run_dir)
@@ -78,11 +76,8 @@ def plot_learning_curve(run_dir: str | Path, path: str | Path | None = None) -> 
         top.set_xlabel("wall time [min]")
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return plots.savefig(fig, path, dpi=110)
 
 
 def main(argv: list[str] | None = None) -> Path:

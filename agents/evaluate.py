@@ -165,11 +165,9 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
 def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
     """Reward and the main physics metric against step, one colour per
     policy (thin lines: episodes, thick: the mean over episodes)."""
-    import matplotlib
+    from physics.scenarios import plots
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = plots.pyplot()
     metric = MAIN_METRIC.get(env_name(env_id), "")
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for k, (name, episodes) in enumerate(results.items()):
@@ -189,9 +187,7 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
     axes[1].set_ylabel(metric or "physics metric")
     axes[1].set_xlabel("step")
     fig.suptitle(env_id)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    plots.savefig(fig, path, dpi=100)
 
 
 def build_parser() -> argparse.ArgumentParser:
