@@ -91,7 +91,8 @@ def snapshot_panels(ds, path: Path, *, title: str, labels, forces: bool = True,
     ``labels``; a shared speed colour bar."""
     plt = pyplot()
     k = len(select)
-    fig, axes = plt.subplots(1, k, figsize=(4.2 * k, 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, k, figsize=(4.8 * k + 0.8, 4.4), squeeze=False,
+                             layout="constrained")
     vmax = 0.0
     snaps = [ds.isel(s) for s in select]
     for s in snaps:
@@ -102,8 +103,10 @@ def snapshot_panels(ds, path: Path, *, title: str, labels, forces: bool = True,
     coll = None
     for ax, s, lab in zip(axes[0], snaps, labels):
         coll = draw_snapshot(ax, s, forces=forces, vmax=vmax or None, title=lab)
+    for ax in axes[0][1:]:
+        ax.set_ylabel("")
     if coll is not None:
-        fig.colorbar(coll, ax=axes[0].tolist(), shrink=0.8, label="speed [m/s]")
+        fig.colorbar(coll, ax=axes[0].tolist(), shrink=0.9, label="speed [m/s]")
     fig.suptitle(title, fontsize=9)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
