@@ -253,6 +253,22 @@ def owner_chunks(start, n_chunks):
     return owners, bounds
 
 
+@njit(cache=True, error_model="numpy")
+def scatter_mask(owners, bounds, start, nbr, n):
+    """1 for the floes that chunks 1, 2, ... of :func:`owner_chunks` can
+    write (their owners and the partners of those), 0 elsewhere: only these
+    floes have non-zero entries in the private buffers fbuf[1:], tbuf[1:]
+    that the next kick must add up. In loose ice most floes own no pair and
+    are nobody's partner, and the kick skips their extra buffers."""
+    mask = np.zeros(n, dtype=np.uint8)
+    for k in range(bounds[1], bounds[bounds.shape[0] - 1]):
+        i = owners[k]
+        mask[i] = 1
+        for p in range(start[i], start[i + 1]):
+            mask[nbr[p]] = 1
+    return mask
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
                          hist, dt_history, fbuf, tbuf):
@@ -276,15 +292,16 @@ def wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, 
 
 
 @njit(cache=True, error_model="numpy")
-def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, inv_inertia,
-               lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
+def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+               inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """Kick–drift of floes i_lo..i_hi−1, their displacement since the list
     build, and their new drag forces.
 
     The force of the kick is the sum of the force buffers (fbuf[b, i],
-    tbuf[b, i] over b); afterwards buffer 0 holds the drag force (it needs
-    only the new half-step velocities; done here to save a pass over
-    memory; skipped when ``has_drag`` is false, i.e. without forcing) and
+    tbuf[b, i] over b; buffers b ≥ 1 only where ``shared`` (the
+    :func:`scatter_mask`) is set, as they are zero elsewhere); afterwards
+    buffer 0 holds the drag force (it needs only the new half-step
+    velocities; done here to save a pass over memory; skipped when ``has_drag`` is false, i.e. without forcing) and
     the others are zero, ready for the pair scatter. ``ref``
     (the positions at the build) is remapped with the box. Returns (largest
     squared distance of a displacement from (cx, cy), sum of the
@@ -301,7 +318,7 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, i
         fx = fbuf[0, i, 0]
         fy = fbuf[0, i, 1]
         tq = tbuf[0, i]
-        for b in range(1, n_buf):
+        for b in range(1, n_buf if shared[i] else 1):
             fx += fbuf[b, i, 0]
             fy += fbuf[b, i, 1]
             tq += tbuf[b, i]
@@ -345,15 +362,15 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, i
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf, inv_mass, inv_inertia, lx, ly,
-                        px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
+def first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
+                        lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """:func:`first_half` over all floes in parallel chunks (no race)."""
     n = pos.shape[0]
     part = np.zeros((N_CHUNKS, 4))
     for c in prange(N_CHUNKS):
         w, sx_, sy_, v2 = first_half(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, dt_kick, dt, pos,
-                                     vel, omega, fbuf, tbuf, inv_mass, inv_inertia, lx, ly, px,
-                                     py, sx, sy, ref, cx, cy, drag, fv, has_drag)
+                                     vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
+                                     ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag)
         part[c, 0] = w
         part[c, 1] = sx_
         part[c, 2] = sy_
@@ -420,6 +437,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     tbuf[0] = torque
     n_rebuilds = 0
     owners, bounds = owner_chunks(start, n_buf)
+    shared = scatter_mask(owners, bounds, start, nbr, n)
     done = 0
     status = STATUS_OK
     for step in range(n_steps):
@@ -433,15 +451,14 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         box[BOX_LY] = ly
         dt_kick = 0.5 * dt if step == 0 else dt
         if parallel:
-            worst, mx, my, vmax2 = first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf,
-                                                       inv_mass, inv_inertia, lx, ly, px, py,
-                                                       lx / lx_old, ly / ly_old, ref, centre[0],
-                                                       centre[1], drag, fv, has_drag)
+            worst, mx, my, vmax2 = first_half_parallel(
+                dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx, ly,
+                px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv, has_drag)
         else:
-            worst, mx, my, vmax2 = first_half(0, n, dt_kick, dt, pos, vel, omega, fbuf, tbuf,
-                                              inv_mass, inv_inertia, lx, ly, px, py, lx / lx_old,
-                                              ly / ly_old, ref, centre[0], centre[1], drag, fv,
-                                              has_drag)
+            worst, mx, my, vmax2 = first_half(
+                0, n, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
+                ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv,
+                has_drag)
         done += 1
         if not math.isfinite(worst + mx + my + vmax2):
             status = STATUS_NONFINITE
@@ -468,6 +485,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
             centre[0] = 0.0
             centre[1] = 0.0
             owners, bounds = owner_chunks(start, n_buf)
+            shared = scatter_mask(owners, bounds, start, nbr, n)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces
         if parallel:
