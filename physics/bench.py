@@ -14,9 +14,12 @@ radius 4 m, no external forcing):
 Each case is timed with the serial kernels, the parallel kernels on one
 thread and the parallel kernels on all threads, each in a fresh process,
 after a warm-up that compiles everything (compile time is excluded). Figures are floe-steps per
-second (floes × steps / wall time), the best of three timed segments. A
-scalar control loop, timed the same way, shows how much two threads can
-give on the machine at all. The peak memory of a run with
+second (floes × steps / wall time), the best of three timed segments. Two
+control loops, timed the same way, show how much two threads can give on
+the machine at all: scalar arithmetic with no memory traffic (the ceiling
+of compute-bound work such as the jammed pair loop) and a kick-drift-like
+pass over a cached (20000 × 8) state array (the ceiling of the per-floe
+passes that dominate loose ice). The peak memory of a run with
 N = 100000 floes is measured in a fresh process.
 
 Hard-disc engine (collisions per second, one core, compile time excluded):
@@ -138,20 +141,47 @@ def _control_loop(reps):
     return out
 
 
-def _control_child() -> None:
-    _control_loop(10)
+@numba.njit(parallel=True, cache=True)
+def _stream_loop(state, steps):
+    """A kick-drift-like pass over an (N, 8) floe-state array per step, in
+    64 chunks: how well the machine runs two threads on a streaming kernel
+    whose data, like the Hertz engine's at N = 20000, sits in the caches."""
+    n = state.shape[0]
+    for _ in range(steps):
+        for c in numba.prange(64):
+            for i in range(c * n // 64, (c + 1) * n // 64):
+                state[i, 2] += 1e-6 * state[i, 4]
+                state[i, 3] += 1e-6 * state[i, 5]
+                state[i, 0] += 1e-3 * state[i, 2]
+                state[i, 1] += 1e-3 * state[i, 3]
+                state[i, 6] = state[i, 2] * state[i, 2] + state[i, 3] * state[i, 3]
+
+
+def _control_child(kind: str = "scalar") -> None:
+    if kind == "stream":
+        state = np.random.default_rng(0).random((20000, 8))
+        _stream_loop(state, 2)
+        reps, work = 2000, 20000 * 2000
+        run = lambda: _stream_loop(state, reps)  # noqa: E731
+    else:
+        _control_loop(10)
+        work = 64 * 500000
+        run = lambda: _control_loop(500000)  # noqa: E731
     best = 0.0
     for _ in range(REPEATS):
         t0 = time.perf_counter()
-        _control_loop(500000)
-        best = max(best, 64 * 500000 / (time.perf_counter() - t0))
+        run()
+        best = max(best, work / (time.perf_counter() - t0))
     print(json.dumps(dict(rate=best)))
 
 
-def machine_scaling(threads: int) -> float:
-    """Speed-up of the control loop on ``threads`` threads over one thread,
-    each in a fresh process: the ceiling the hardware puts on any kernel."""
-    return _child("_control", threads=threads)["rate"] / _child("_control", threads=1)["rate"]
+def machine_scaling(threads: int, kind: str = "scalar") -> float:
+    """Speed-up of a control kernel on ``threads`` threads over one thread,
+    each in a fresh process: ``kind="scalar"``, arithmetic with no memory
+    traffic (the ceiling for compute-bound kernels), or ``"stream"``, a pass
+    over cached floe-state arrays (the ceiling for the per-floe passes)."""
+    return (_child("_control", kind, threads=threads)["rate"]
+            / _child("_control", kind, threads=1)["rate"])
 
 
 def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float = JAMMED):
@@ -230,10 +260,11 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
             rows.append(dict(case=name, kernel=label, threads=threads, dt=dt, steps=steps, **r))
             log(f"  {name:22s} {label:8s} {threads} thread(s): {r['rate']:.3g} floe-steps/s")
     if threads_all > 1:
-        ratio = machine_scaling(threads_all)
-        rows.append(dict(case="control", kernel="", threads=threads_all, rate=ratio,
-                         contacts_per_floe=float("nan"), dt=0.0, rebuilds=0, steps=0))
-        log(f"  control loop, {threads_all} threads / 1 thread: {ratio:.2f}")
+        for kind in ("scalar", "stream"):
+            ratio = machine_scaling(threads_all, kind)
+            rows.append(dict(case="control", kernel=kind, threads=threads_all, rate=ratio,
+                             contacts_per_floe=float("nan"), dt=0.0, rebuilds=0, steps=0))
+            log(f"  {kind} control loop, {threads_all} threads / 1 thread: {ratio:.2f}")
     if memory_floes:
         mem = peak_memory(memory_floes)
         rows.append(dict(case=f"memory, N = {memory_floes}", kernel="", threads=0, rate=mem,
@@ -260,9 +291,13 @@ def format_table(rows: list[dict], n: int) -> str:
             lines.append(f"Peak resident memory of a whole process running N = "
                          f"{r['case'].split('= ')[1]} floes: {r['rate'] / 2 ** 20:.0f} MiB")
         if r["case"] == "control":
-            lines.append("")
-            lines.append(f"Machine ceiling: a scalar control loop with no memory traffic runs "
-                         f"{r['rate']:.2f}x faster on {r['threads']} threads than on one")
+            if r["kernel"] != "stream":
+                lines.append("")
+            what = ("a streaming control loop over cached floe arrays (20000 × 8)"
+                    if r["kernel"] == "stream" else
+                    "a scalar control loop with no memory traffic")
+            lines.append(f"Machine ceiling: {what} runs {r['rate']:.2f}x faster on "
+                         f"{r['threads']} threads than on one")
     by = {(r["case"], r["kernel"], r["threads"]): r["rate"] for r in rows}
     for case in dict.fromkeys(r["case"] for r in rows if not r["case"].startswith(special)):
         one = by.get((case, "parallel", 1))
@@ -511,7 +546,8 @@ def main(argv=None) -> int:
     ob.add_argument("--seed", type=int, default=1)
     ob.add_argument("--quiet", action="store_true")
     sub.add_parser("itd", help="wall time of the ice-thickness-distribution models")
-    sub.add_parser("_control")
+    ctl = sub.add_parser("_control")
+    ctl.add_argument("kind", nargs="?", default="scalar", choices=("scalar", "stream"))
     m = sub.add_parser("_memory")
     m.add_argument("n", type=int)
     t = sub.add_parser("_time")
@@ -534,7 +570,7 @@ def main(argv=None) -> int:
         print(format_itd_table(bench_itd()))
         return 0
     if args.engine == "_control":
-        _control_child()
+        _control_child(args.kind)
         return 0
     if args.engine == "_memory":
         _memory_child(args.n)
