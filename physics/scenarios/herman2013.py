@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -546,7 +547,7 @@ class MarginalIceZone(Experiment):
                 ratio = pr[ok] / ta[ok]
             ratio = ratio[np.isfinite(ratio)]
             width, outer = shear_zone(ds["y"].values,
-                                      np.nanmean(ds["u_x_profile"].values[c][late], axis=0),
+                                      late_profile(ds["u_x_profile"].values[c][late]),
                                       p["edge_width"])
             rows += [
                 (f"u_a,y = {v:g}: shear-zone width (10–90 % of the outer u_x)",
@@ -576,7 +577,7 @@ class MarginalIceZone(Experiment):
             k = int(np.isfinite(ds["snapshot_time"].values[c, 0]).sum()) - 1
             snap = ds.isel(case=c, member=0, snapshot=k)
             mob = (snap["floe_frozen"].values == 0) & np.isfinite(snap["floe_x"].values)
-            line, = ax.plot(np.nanmean(ds["u_x_profile"].values[c, 0][late], axis=0), y,
+            line, = ax.plot(late_profile(ds["u_x_profile"].values[c, 0][late]), y,
                             lw=2, label=f"u_a,y = {v:g} m/s")
             ax.scatter(snap["floe_u"].values[mob], snap["floe_y"].values[mob], s=2,
                        color=line.get_color(), alpha=0.4)
@@ -608,6 +609,14 @@ class MarginalIceZone(Experiment):
             labels=[f"u_a,y = {v:g} m/s" for v in wy],
             select=[{"case": c, "member": 0, "snapshot": last[c]} for c in range(len(wy))]))
         return out
+
+
+def late_profile(profiles: np.ndarray) -> np.ndarray:
+    """Mean of u_x(y) profiles (samples × bins), NaN in bins that stayed
+    empty (open water behind the drifting ice) without a warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(profiles, axis=0)
 
 
 def shear_zone(y, profile, edge_width: float):
