@@ -257,17 +257,32 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
     update(0, fractions[0])
     args = [(info["config"], info["parameters"], j["case"], j["seed"], str(out), j["c"],
              j["m"], checkpoint_every, k) for k, j in enumerate(todo)]
-    previous = signal.getsignal(signal.SIGTERM)
     in_main = threading.current_thread() is threading.main_thread()
+    stop = []      # the signal that asked an in-process job to stop
 
-    def on_term(signum, frame):
+    def on_signal(signum, frame):
+        # An exception raised here while a compiled kernel runs in this
+        # process would surface as a SystemError from inside Numba, so an
+        # in-process job stops at its next progress report (at most one
+        # output interval later); a second signal stops at once.
+        if workers == 1 and not stop:
+            stop.append(signum)
+            return
         raise KeyboardInterrupt
+
+    def in_process_update(k, f):
+        update(k, f)
+        if stop:
+            raise KeyboardInterrupt
+    previous = {}
     if in_main:
-        signal.signal(signal.SIGTERM, on_term)
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            if signal.getsignal(sig) is not signal.SIG_IGN:    # nohup'ed: leave it ignored
+                previous[sig] = signal.signal(sig, on_signal)
     try:
         if workers == 1:
             for k, a in enumerate(args):
-                _run_job(*a, on_progress=lambda f, k=k: update(k, f))
+                _run_job(*a, on_progress=lambda f, k=k: in_process_update(k, f))
                 update(k, 1.0)
         else:
             _run_pool(args, workers, update)
@@ -277,8 +292,8 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
               f"  ice-scenarios run --resume {shlex.quote(str(out))}", file=sys.stderr)
         raise
     finally:
-        if in_main:
-            signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         bar.close()
 
 

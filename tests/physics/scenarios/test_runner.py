@@ -132,6 +132,38 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path, monkeypat
     assert not list((out / "jobs").glob("*.ckpt"))
 
 
+def test_sigterm_during_a_kernel_stops_cleanly_and_resumes(tmp_path):
+    """kill (SIGTERM) while a run works in its own process, most likely
+    inside a compiled kernel: the command stops with the resume hint (not a
+    SystemError from inside Numba), keeps its checkpoint, and --resume
+    finishes the run."""
+    import signal
+    import time
+
+    out = tmp_path / "killed"
+    cmd = [sys.executable, "-m", "physics.scenarios", "run", "herman2013-miz", "--quick",
+           "--floes", "200", "--set", "wind_y=[-5.0]", "--set", "duration=2000", "--out", str(out),
+           "--workers", "1", "--checkpoint-every", "0", "--no-progress", "--no-plots"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while not list((out / "jobs").glob("*.ckpt")) and time.monotonic() < deadline:
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(0.2)
+    time.sleep(1.0)                      # well inside the run, between two progress reports
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode != 0
+    assert "SystemError" not in err, err
+    assert "interrupted" in err and "--resume" in err, err
+    assert list((out / "jobs").glob("*.ckpt")) and not (out / "results.nc").exists()
+    done = subprocess.run([sys.executable, "-m", "physics.scenarios", "run", "--resume", str(out),
+                           "--no-progress", "--no-plots"],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    ds = xr.open_dataset(out / "results.nc")
+    assert float(ds["time"].values[0, 0][-1]) == pytest.approx(2000.0)
+
+
 def test_ensemble_in_worker_processes(tmp_path):
     res = run_scenario("herman2013-convergence", overrides=TINY, ensemble=2, workers=2,
                        out=tmp_path / "ens", progress=False, plots=False, log=lambda *a: None)
