@@ -364,13 +364,20 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
 @njit(cache=True, parallel=True, error_model="numpy")
 def first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
                         lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
-    """:func:`first_half` over all floes in parallel chunks (no race)."""
+    """:func:`first_half` over all floes in parallel chunks (no race).
+
+    Each chunk gets views of its floes and loops from a start index known
+    at compile time to be 0: with a start known only at run time the loop
+    compiles to slower code (about 10 % of a pass over 20000 floes)."""
     n = pos.shape[0]
     part = np.zeros((N_CHUNKS, 4))
     for c in prange(N_CHUNKS):
-        w, sx_, sy_, v2 = first_half(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, dt_kick, dt, pos,
-                                     vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
-                                     ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag)
+        lo = c * n // N_CHUNKS
+        hi = (c + 1) * n // N_CHUNKS
+        w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi],
+                                     omega[lo:hi], fbuf[:, lo:hi], tbuf[:, lo:hi], shared[lo:hi],
+                                     inv_mass[lo:hi], inv_inertia[lo:hi], lx, ly, px, py, sx, sy,
+                                     ref[lo:hi], cx, cy, drag[lo:hi], fv, has_drag)
         part[c, 0] = w
         part[c, 1] = sx_
         part[c, 2] = sy_
