@@ -123,13 +123,10 @@ class WindDriftController(_FloeController):
 
     gain = 0.3
     max_turn = math.pi / 4
+    turn = 0.0         # the current turn of the wind from the heading
 
     def reset(self, seed=None):
         self.turn = 0.0
-
-    def __init__(self, env, seed: int = 0):
-        super().__init__(env, seed)
-        self.reset()
 
     def act(self, obs):
         hx, hy = self._get(obs, "heading_cos"), self._get(obs, "heading_sin")
@@ -208,12 +205,10 @@ class FloeClusteringController(_FloeController):
     target the wind is off.
     """
 
+    _sign = 1.0        # direction of the last alternating wind
+
     def reset(self, seed=None):
         self._sign = 1.0
-
-    def __init__(self, env, seed: int = 0):
-        super().__init__(env, seed)
-        self.reset()
 
     def act(self, obs):
         error = self._get(obs, "target") - self._get(obs, "largest_cluster")
