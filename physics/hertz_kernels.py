@@ -301,9 +301,10 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
     tbuf[b, i] over b; buffers b ≥ 1 only where ``shared`` (the
     :func:`scatter_mask`) is set, as they are zero elsewhere); afterwards
     buffer 0 holds the drag force (it needs only the new half-step
-    velocities; done here to save a pass over memory; skipped when ``has_drag`` is false, i.e. without forcing) and
-    the others are zero, ready for the pair scatter. ``ref``
-    (the positions at the build) is remapped with the box. Returns (largest
+    velocities; done here to save a pass over memory; skipped when
+    ``has_drag`` is false, i.e. without forcing) and the others are zero,
+    ready for the pair scatter. ``ref`` (the positions at the build) is
+    remapped with the box. Returns (largest
     squared distance of a displacement from (cx, cy), sum of the
     displacements along x, along y, largest squared speed)."""
     uax, uay, uwx, uwy = fv[FV_UAX], fv[FV_UAY], fv[FV_UWX], fv[FV_UWY]
