@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .atomics import fetch_add
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image, wrap_coordinate
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
@@ -35,7 +36,8 @@ CP_SIZE = 8
 FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
 STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
-N_CHUNKS = 64   # chunks of the parallel per-floe reductions
+N_CHUNKS = 64   # chunks of the parallel wall-force loop
+MIN_KICK_CHUNKS = 16   # fewest chunks of the parallel kick-drift pass (claimed dynamically)
 
 
 # ---------------------------------------------------------------------------
@@ -363,26 +365,40 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def first_half_parallel(dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
-                        lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
-    """:func:`first_half` over all floes in parallel chunks (no race).
+def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                        inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
+    """:func:`first_half` over all floes in parallel (no race).
+
+    The floes are cut into ``4 × n_threads`` (at least 16) chunks that the
+    ``n_threads`` threads claim one at a time (:mod:`physics.atomics`): a thread on a
+    core that is momentarily slower does fewer chunks instead of holding
+    the others up at the join. Each chunk writes only its own floes and its
+    own row of the partial results, which are reduced in chunk order, so
+    the outcome does not depend on which thread did what.
 
     Each chunk gets views of its floes and loops from a start index known
     at compile time to be 0: with a start known only at run time the loop
     compiles to slower code (about 10 % of a pass over 20000 floes)."""
     n = pos.shape[0]
-    part = np.zeros((N_CHUNKS, 4))
-    for c in prange(N_CHUNKS):
-        lo = c * n // N_CHUNKS
-        hi = (c + 1) * n // N_CHUNKS
-        w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi],
-                                     omega[lo:hi], fbuf[:, lo:hi], tbuf[:, lo:hi], shared[lo:hi],
-                                     inv_mass[lo:hi], inv_inertia[lo:hi], lx, ly, px, py, sx, sy,
-                                     ref[lo:hi], cx, cy, drag[lo:hi], fv, has_drag)
-        part[c, 0] = w
-        part[c, 1] = sx_
-        part[c, 2] = sy_
-        part[c, 3] = v2
+    n_chunks = max(MIN_KICK_CHUNKS, 4 * n_threads)
+    part = np.zeros((n_chunks, 4))
+    claimed = np.zeros(1, dtype=np.int64)
+    for _ in prange(n_threads):
+        while True:
+            c = fetch_add(claimed, 0, 1)
+            if c >= n_chunks:
+                break
+            lo = c * n // n_chunks
+            hi = (c + 1) * n // n_chunks
+            w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi],
+                                         omega[lo:hi], fbuf[:, lo:hi], tbuf[:, lo:hi],
+                                         shared[lo:hi], inv_mass[lo:hi], inv_inertia[lo:hi], lx,
+                                         ly, px, py, sx, sy, ref[lo:hi], cx, cy, drag[lo:hi], fv,
+                                         has_drag)
+            part[c, 0] = w
+            part[c, 1] = sx_
+            part[c, 2] = sy_
+            part[c, 3] = v2
     return part[:, 0].max(), part[:, 1].sum(), part[:, 2].sum(), part[:, 3].max()
 
 
@@ -460,8 +476,9 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         dt_kick = 0.5 * dt if step == 0 else dt
         if parallel:
             worst, mx, my, vmax2 = first_half_parallel(
-                dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx, ly,
-                px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv, has_drag)
+                n_buf, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
+                ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv,
+                has_drag)
         else:
             worst, mx, my, vmax2 = first_half(
                 0, n, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
