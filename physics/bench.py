@@ -12,16 +12,19 @@ radius 4 m, no external forcing):
   because the compression takes about a minute.
 
 Each case is timed with the serial kernels, the parallel kernels on one
-thread and the parallel kernels on all threads, each in a fresh process,
-after a warm-up that compiles everything (compile time is excluded). Figures are floe-steps per
-second (floes × steps / wall time): the best of three fresh processes, each
-the best of three timed segments (the range over the processes is shown). Two
-control loops, timed the same way, show how much two threads can give on
-the machine at all: scalar arithmetic with no memory traffic (the ceiling
-of compute-bound work such as the jammed pair loop) and a kick-drift-like
-pass over a cached (20000 × 8) state array (the ceiling of the per-floe
-passes that dominate loose ice). The peak memory of a run with
-N = 100000 floes is measured in a fresh process.
+thread and the parallel kernels on all threads, after a warm-up that
+compiles everything (compile time is excluded). The three take turns in
+one process, five rounds of one segment each, so that all three see the
+same moments of a shared machine whose speed drifts; three such fresh
+processes are run. Figures are floe-steps per second (floes × steps / wall
+time): the best segment of all processes (the range of the processes'
+best is shown), and the all-threads / one-thread ratio of the segments of
+one round. Two control loops, timed the same way, show how much two
+threads can give on the machine at all: scalar arithmetic with no memory
+traffic (the ceiling of compute-bound work such as the jammed pair loop)
+and a kick-drift-like pass over a cached (20000 × 8) state array (the
+ceiling of the per-floe passes that dominate loose ice). The peak memory
+of a run with N = 100000 floes is measured in a fresh process.
 
 Hard-disc engine (collisions per second, one core, compile time excluded):
 
@@ -84,27 +87,48 @@ def _load_state(path: Path):
     return field, PeriodicBox(float(d["lx"]), float(d["ly"]))
 
 
-REPEATS = 3   # timed segments per case; the best is reported (host noise only slows a run)
-PROCESSES = 3   # fresh processes per case and kernel; the best is reported
+REPEATS = 5   # rounds of timed segments per process; the best segment of each kind is reported
+PROCESSES = 3   # fresh processes per case; the best is reported (host noise only slows a run)
 
 
-def _time_child(path: str, parallel: bool, steps: int, dt: float) -> None:
-    """Run in a fresh process (its thread count set by NUMBA_NUM_THREADS):
-    print the best and median rate of ``REPEATS`` segments of ``steps``
-    steps, contacts per floe and list rebuilds as JSON."""
-    field, box = _load_state(Path(path))
-    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=parallel,
-                          allow_overlap=True)
-    sim.step(5)                                   # compile / load from cache, warm up
-    rebuilds0 = sim.n_rebuilds
-    rates = []
+def _kernel_configs(threads_all: int) -> list[tuple[str, bool, int]]:
+    """(label, parallel kernels?, threads) of every timed configuration."""
+    configs = [("serial", False, 1), ("parallel", True, 1)]
+    if threads_all > 1:
+        configs.append(("parallel", True, threads_all))
+    return configs
+
+
+def _time_child(path: str, steps: int, dt: float) -> None:
+    """Run in a fresh process whose thread pool has all threads: time every
+    configuration of :func:`_kernel_configs` on its own copy of the saved
+    state, in ``REPEATS`` rounds of one segment of ``steps`` steps each,
+    the configurations taking turns within a round. On a shared machine
+    whose speed drifts over seconds, the turns put each configuration
+    through the same good and bad moments, and the ratio of two
+    configurations in one round compares like with like. Prints, as JSON,
+    the rates of every segment per configuration, contacts per floe and
+    list rebuilds per segment."""
+    configs = _kernel_configs(numba.config.NUMBA_NUM_THREADS)
+    sims = []
+    for _, parallel, threads in configs:
+        numba.set_num_threads(threads)
+        field, box = _load_state(Path(path))
+        sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=parallel,
+                              allow_overlap=True)
+        sim.step(5)                               # compile / load from cache, warm up
+        sims.append(sim)
+    rebuilds0 = sims[0].n_rebuilds
+    rates = [[] for _ in configs]
     for _ in range(REPEATS):
-        t0 = time.perf_counter()
-        sim.step(steps)
-        rates.append(field.n * steps / (time.perf_counter() - t0))
-    print(json.dumps(dict(rate=max(rates), median=float(np.median(rates)),
-                          contacts_per_floe=2.0 * len(sim.contacts()) / field.n,
-                          rebuilds=round((sim.n_rebuilds - rebuilds0) / REPEATS))))
+        for k, ((_, _, threads), sim) in enumerate(zip(configs, sims)):
+            numba.set_num_threads(threads)
+            t0 = time.perf_counter()
+            sim.step(steps)
+            rates[k].append(sim.n_floes * steps / (time.perf_counter() - t0))
+    print(json.dumps(dict(
+        rates=rates, contacts_per_floe=2.0 * len(sims[0].contacts()) / sims[0].n_floes,
+        rebuilds=round((sims[0].n_rebuilds - rebuilds0) / REPEATS))))
 
 
 def _child(*args: str, threads: int | None = None):
@@ -119,11 +143,10 @@ def _child(*args: str, threads: int | None = None):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _timed_steps(path: Path, dt: float, steps: int, parallel: bool, threads: int) -> dict:
-    """Time ``steps`` steps of the saved state in a fresh process, so that the
-    thread pool has exactly ``threads`` threads and nothing else is running."""
-    return _child("_time", str(path), "1" if parallel else "0", str(steps), repr(dt),
-                  threads=threads)
+def _timed_steps(path: Path, dt: float, steps: int, threads: int) -> dict:
+    """:func:`_time_child` in a fresh process with a pool of ``threads``
+    threads and nothing else running in it."""
+    return _child("_time", str(path), str(steps), repr(dt), threads=threads)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -164,31 +187,35 @@ def _stream_loop(state, steps):
 
 
 def _control_child(kind: str = "scalar") -> None:
+    """Time a control loop on one thread and on all threads, taking turns
+    as :func:`_time_child` does; print the all-threads / one-thread ratio
+    of every round as JSON."""
     if kind == "stream":
         state = np.random.default_rng(0).random((20000, 8))
         _stream_loop(state, 2)
-        reps, work = 2000, 20000 * 2000
-        run = lambda: _stream_loop(state, reps)  # noqa: E731
+        run = lambda: _stream_loop(state, 2000)  # noqa: E731
     else:
         _control_loop(10)
-        work = 64 * 500000
         run = lambda: _control_loop(500000)  # noqa: E731
-    best = 0.0
+    ratios = []
     for _ in range(REPEATS):
-        t0 = time.perf_counter()
-        run()
-        best = max(best, work / (time.perf_counter() - t0))
-    print(json.dumps(dict(rate=best)))
+        seconds = []
+        for threads in (1, numba.config.NUMBA_NUM_THREADS):
+            numba.set_num_threads(threads)
+            t0 = time.perf_counter()
+            run()
+            seconds.append(time.perf_counter() - t0)
+        ratios.append(seconds[0] / seconds[1])
+    print(json.dumps(dict(ratios=ratios)))
 
 
-def machine_scaling(threads: int, kind: str = "scalar") -> float:
-    """Speed-up of a control kernel on ``threads`` threads over one thread,
-    each in a fresh process: ``kind="scalar"``, arithmetic with no memory
-    traffic (the ceiling for compute-bound kernels), or ``"stream"``, a pass
-    over cached floe-state arrays (the ceiling for the per-floe passes)."""
-    def best(t):
-        return max(_child("_control", kind, threads=t)["rate"] for _ in range(PROCESSES))
-    return best(threads) / best(1)
+def machine_scaling(threads: int, kind: str = "scalar") -> list[float]:
+    """Speed-ups of a control kernel on ``threads`` threads over one thread,
+    one per round of :func:`_control_child` in ``PROCESSES`` fresh
+    processes: ``kind="scalar"``, arithmetic with no memory traffic (the
+    ceiling for compute-bound kernels), or ``"stream"``, a pass over cached
+    floe-state arrays (the ceiling for the per-floe passes)."""
+    return [x for _ in range(PROCESSES) for x in _child("_control", kind, threads=threads)["ratios"]]
 
 
 def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float = JAMMED):
@@ -258,24 +285,31 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
     log(f"  ready (prepared in {prep:.0f} s), Ā = {conc:.4f}")
     cases = [("Ā = 0.70", loose_path, HERMAN2013.time_step),
              (f"jammed, Ā = {conc:.2f}", jam_path, 1e-3)]
-    configs = [("serial", False, 1), ("parallel", True, 1)]
-    if threads_all > 1:
-        configs.append(("parallel", True, threads_all))
+    configs = _kernel_configs(threads_all)
     for name, path, dt in cases:
-        for label, parallel, threads in configs:
-            # the same run differs by up to 1.7x between processes on a shared
-            # virtual machine: the best of PROCESSES fresh processes, and their range
-            runs = [_timed_steps(path, dt, steps, parallel, threads) for _ in range(PROCESSES)]
-            r = max(runs, key=lambda x: x["rate"])
-            r["spread"] = [min(x["rate"] for x in runs), r["rate"]]
-            rows.append(dict(case=name, kernel=label, threads=threads, dt=dt, steps=steps, **r))
+        # the same run differs by up to 1.7x between processes on a shared
+        # virtual machine: the best of PROCESSES fresh processes, and their range
+        runs = [_timed_steps(path, dt, steps, threads_all) for _ in range(PROCESSES)]
+        for k, (label, _, threads) in enumerate(configs):
+            best = [max(run["rates"][k]) for run in runs]
+            r = dict(case=name, kernel=label, threads=threads, dt=dt, steps=steps,
+                     rate=max(best), spread=[min(best), max(best)],
+                     contacts_per_floe=runs[0]["contacts_per_floe"],
+                     rebuilds=runs[0]["rebuilds"])
+            if threads > 1:
+                # the same round's two segments, all threads against one thread
+                r["paired"] = [a / b for run in runs
+                               for a, b in zip(run["rates"][k], run["rates"][1])]
+            rows.append(r)
             log(f"  {name:22s} {label:8s} {threads} thread(s): {r['rate']:.3g} floe-steps/s")
     if threads_all > 1:
         for kind in ("scalar", "stream"):
-            ratio = machine_scaling(threads_all, kind)
-            rows.append(dict(case="control", kernel=kind, threads=threads_all, rate=ratio,
+            ratios = machine_scaling(threads_all, kind)
+            rows.append(dict(case="control", kernel=kind, threads=threads_all,
+                             rate=float(np.median(ratios)), paired=ratios,
                              contacts_per_floe=float("nan"), dt=0.0, rebuilds=0, steps=0))
-            log(f"  {kind} control loop, {threads_all} threads / 1 thread: {ratio:.2f}")
+            log(f"  {kind} control loop, {threads_all} threads / 1 thread: "
+                f"median {np.median(ratios):.2f} (range {min(ratios):.2f}–{max(ratios):.2f})")
     if memory_floes:
         mem = peak_memory(memory_floes)
         rows.append(dict(case=f"memory, N = {memory_floes}", kernel="", threads=0, rate=mem,
@@ -311,15 +345,19 @@ def format_table(rows: list[dict], n: int) -> str:
                     if r["kernel"] == "stream" else
                     "a scalar control loop with no memory traffic")
             lines.append(f"Machine ceiling: {what} runs {r['rate']:.2f}x faster on "
-                         f"{r['threads']} threads than on one")
-    by = {(r["case"], r["kernel"], r["threads"]): r["rate"] for r in rows}
+                         f"{r['threads']} threads than on one (median of {len(r['paired'])} "
+                         f"rounds; range {min(r['paired']):.2f}–{max(r['paired']):.2f})")
+    by = {(r["case"], r["kernel"], r["threads"]): r for r in rows}
     for case in dict.fromkeys(r["case"] for r in rows if not r["case"].startswith(special)):
         one = by.get((case, "parallel", 1))
         ser = by.get((case, "serial", 1))
         allt = [v for (c, k, t), v in by.items() if c == case and k == "parallel" and t > 1]
         if one and allt:
-            lines.append(f"{case}: all threads / one thread (parallel kernels) = {allt[0] / one:.2f}; "
-                         f"all threads / serial kernels = {allt[0] / ser:.2f}")
+            paired = allt[0]["paired"]
+            lines.append(f"{case}: all threads / one thread (parallel kernels): best / best = "
+                         f"{allt[0]['rate'] / one['rate']:.2f}, same round: median "
+                         f"{np.median(paired):.2f}, best {max(paired):.2f}; "
+                         f"all threads / serial kernels = {allt[0]['rate'] / ser['rate']:.2f}")
     return "\n".join(lines)
 
 
@@ -566,7 +604,6 @@ def main(argv=None) -> int:
     m.add_argument("n", type=int)
     t = sub.add_parser("_time")
     t.add_argument("path")
-    t.add_argument("parallel", type=int)
     t.add_argument("steps", type=int)
     t.add_argument("dt", type=float)
     args = p.parse_args(argv)
@@ -590,7 +627,7 @@ def main(argv=None) -> int:
         _memory_child(args.n)
         return 0
     if args.engine == "_time":
-        _time_child(args.path, bool(args.parallel), args.steps, args.dt)
+        _time_child(args.path, args.steps, args.dt)
         return 0
     if args.floes < 100 or args.steps < 1:
         p.error("--floes must be >= 100 and --steps >= 1")
