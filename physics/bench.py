@@ -262,6 +262,48 @@ def peak_memory(n: int) -> int:
     return int(_child("_memory", str(n)))
 
 
+def _pinned_child(path: str, steps: int, dt: float, cpu: int) -> None:
+    """Pin this process to core ``cpu`` and print, as JSON, the rates of
+    ``REPEATS`` segments of ``steps`` steps of the serial kernels."""
+    os.sched_setaffinity(0, {cpu})
+    field, box = _load_state(Path(path))
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=False,
+                          allow_overlap=True)
+    sim.step(5)
+    rates = []
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        sim.step(steps)
+        rates.append(field.n * steps / (time.perf_counter() - t0))
+    print(json.dumps(dict(rates=rates)))
+
+
+def core_speeds(path: Path, dt: float, steps: int) -> dict:
+    """How much the host gives when all its cores are busy: the median rate
+    of the serial kernels in a single-threaded process pinned to the first
+    core, alone (before and after), and in one such process pinned to each
+    core, all started together. If the cores were independent, the sum of
+    the second would be the first times the number of cores; the ratio of
+    the two is the most that any number of threads can gain over one
+    thread on this code at that time."""
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    cpus = sorted(os.sched_getaffinity(0))
+
+    def run(which):
+        procs = [subprocess.Popen([sys.executable, "-m", "physics.bench", "_pinned", str(path),
+                                   str(steps), repr(dt), str(cpu)], stdout=subprocess.PIPE,
+                                  text=True, env=env) for cpu in which]
+        outs = [p.communicate()[0] for p in procs]
+        if any(p.returncode for p in procs):
+            raise RuntimeError("a pinned benchmark process failed")
+        return [float(np.median(json.loads(o.strip().splitlines()[-1])["rates"])) for o in outs]
+
+    before = run(cpus[:1])[0]
+    together = run(cpus)
+    after = run(cpus[:1])[0]
+    return dict(alone=0.5 * (before + after), together=together)
+
+
 def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Path | None = None,
                 memory_floes: int = 100000, quiet: bool = False) -> list[dict]:
     """Time every case and kernel (see the module docstring); one row each."""
@@ -302,6 +344,15 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
                                for a, b in zip(run["rates"][k], run["rates"][1])]
             rows.append(r)
             log(f"  {name:22s} {label:8s} {threads} thread(s): {r['rate']:.3g} floe-steps/s")
+    if threads_all > 1 and hasattr(os, "sched_setaffinity") and len(os.sched_getaffinity(0)) > 1:
+        speeds = core_speeds(loose_path, HERMAN2013.time_step, steps)
+        gain = sum(speeds["together"]) / speeds["alone"]
+        rows.append(dict(case="cores", kernel="serial", threads=len(speeds["together"]),
+                         rate=gain, contacts_per_floe=float("nan"), dt=HERMAN2013.time_step,
+                         rebuilds=0, steps=steps, **speeds))
+        log(f"  serial kernels, one core alone: {speeds['alone']:.3g} floe-steps/s; all cores "
+            f"at once: " + ", ".join(f"{v:.3g}" for v in speeds["together"])
+            + f" (together {gain:.2f}x)")
     if threads_all > 1:
         for kind in ("scalar", "stream"):
             ratios = machine_scaling(threads_all, kind)
@@ -325,7 +376,7 @@ def format_table(rows: list[dict], n: int) -> str:
              "| case | kernels | threads | floe-steps/s | range over processes | contacts per floe "
              "| Δt [s] | list rebuilds |",
              "|---|---|---|---|---|---|---|---|"]
-    special = ("memory", "control")
+    special = ("memory", "control", "cores")
     for r in rows:
         if r["case"].startswith(special):
             continue
@@ -347,6 +398,13 @@ def format_table(rows: list[dict], n: int) -> str:
             lines.append(f"Machine ceiling: {what} runs {r['rate']:.2f}x faster on "
                          f"{r['threads']} threads than on one (median of {len(r['paired'])} "
                          f"rounds; range {min(r['paired']):.2f}–{max(r['paired']):.2f})")
+        if r["case"] == "cores":
+            lines.append("")
+            lines.append(f"Host ceiling: the serial kernels at Ā = 0.70 in a process pinned to one "
+                         f"core run at {r['alone']:.3g} floe-steps/s alone, and at "
+                         + " + ".join(f"{v:.3g}" for v in r["together"])
+                         + f" with one such process on each core at once: all cores together "
+                         f"give {r['rate']:.2f}x one core (medians of {REPEATS} segments)")
     by = {(r["case"], r["kernel"], r["threads"]): r for r in rows}
     for case in dict.fromkeys(r["case"] for r in rows if not r["case"].startswith(special)):
         one = by.get((case, "parallel", 1))
@@ -600,6 +658,11 @@ def main(argv=None) -> int:
     sub.add_parser("itd", help="wall time of the ice-thickness-distribution models")
     ctl = sub.add_parser("_control")
     ctl.add_argument("kind", nargs="?", default="scalar", choices=("scalar", "stream"))
+    pin = sub.add_parser("_pinned")
+    pin.add_argument("path")
+    pin.add_argument("steps", type=int)
+    pin.add_argument("dt", type=float)
+    pin.add_argument("cpu", type=int)
     m = sub.add_parser("_memory")
     m.add_argument("n", type=int)
     t = sub.add_parser("_time")
@@ -622,6 +685,9 @@ def main(argv=None) -> int:
         return 0
     if args.engine == "_control":
         _control_child(args.kind)
+        return 0
+    if args.engine == "_pinned":
+        _pinned_child(args.path, args.steps, args.dt, args.cpu)
         return 0
     if args.engine == "_memory":
         _memory_child(args.n)
