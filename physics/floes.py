@@ -465,22 +465,27 @@ def _grow(pos, r, scale, box: Box, growth_steps: int) -> None:
 def make_floe_field(n: int, *, concentration: float, alpha: float, mean_diameter: float,
                     thickness: float = 1.5, density: float = 910.0, seed: int | None = 0,
                     fsd: str = "rank", aspect: float = 1.0, velocity_std: float = 0.0,
-                    box_type=PeriodicBox):
+                    box_type=PeriodicBox, repeat: int = 1):
     """A floe field at a target concentration in a new box.
 
     Diameters from :func:`power_law_diameters` (``fsd`` = "rank" or "random"),
-    a box of the right size (:func:`domain_size`), non-overlapping placement
+    each of the ``n`` repeated ``repeat`` times (n · repeat floes: the same
+    sizes in a box ``sqrt(repeat)`` times wider), a box of the right size (:func:`domain_size`), non-overlapping placement
     (:func:`place_floes`) and Gaussian velocities of standard deviation
     ``velocity_std`` [m/s] per component; every random number comes from
     ``np.random.default_rng(seed)``.
 
     Returns (field, box).
     """
+    check_range("repeat", repeat, 1, None)
+    if int(repeat) != repeat:
+        raise ValueError(f"repeat must be a whole number, got {repeat!r}")
     rng = np.random.default_rng(seed)
-    d = power_law_diameters(n, alpha, mean_diameter, method=fsd, rng=rng)
+    d = np.repeat(power_law_diameters(n, alpha, mean_diameter, method=fsd, rng=rng), int(repeat))
     lx, ly = domain_size(d, concentration, aspect)
     box = box_type(lx, ly)
     r = 0.5 * d
     pos = place_floes(r, box, rng)
-    vel = rng.normal(0.0, velocity_std, size=(n, 2)) if velocity_std > 0 else np.zeros((n, 2))
+    vel = (rng.normal(0.0, velocity_std, size=(d.size, 2)) if velocity_std > 0
+           else np.zeros((d.size, 2)))
     return FloeField(pos, r, thickness, vel, density=density), box

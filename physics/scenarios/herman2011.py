@@ -113,7 +113,7 @@ def _rank_sample_fits(p: dict, a: float) -> None:
 
     pre = _preset()
     d = rank_order_diameters(int(p["floes"]), float(p["fsd_exponent"]), pre.mean_diameter)
-    lx, _ = domain_size(d, a)
+    lx, _ = domain_size(np.repeat(d, int(p.get("repeat", 1))), a)
     reach = float(d[0]) + float(p["cluster_gap"])
     if reach >= 0.5 * lx:
         raise ValueError(
@@ -233,7 +233,8 @@ class Herman2011Clustering(Experiment):
     def workload(self, p: dict, case: dict) -> float:
         a = float(case["concentration"])
         # collisions (and their cost) grow steeply as the ice closes up
-        return float(p["floes"]) * float(p["duration"]) * (1.0 + a / (1.0 - a) / 9.0)
+        return (float(p["floes"]) * int(p["repeat"]) * float(p["duration"])
+                * (1.0 + a / (1.0 - a) / 9.0))
 
     def simulate(self, p: dict, case: dict, seed: int, rec) -> None:
         from .. import HardDiskSimulation, make_floe_field
@@ -241,7 +242,7 @@ class Herman2011Clustering(Experiment):
         pre = _preset()
         n_out = max(1, int(round(float(p["duration"]) / float(p["output_interval"]))))
         interval = float(p["duration"]) / n_out
-        n_floes = int(p["floes"])
+        n_floes = int(p["floes"]) * int(p["repeat"])
         rdf_x, _ = _grid(p["rdf_range"], p["rdf_bins"])
         ffd_x, _ = _grid(p["ffd_range"], p["ffd_bins"])
         rec.coord("x_rdf", rdf_x, "m", "centre-to-centre distance (bin centres)")
@@ -255,7 +256,8 @@ class Herman2011Clustering(Experiment):
         if st is None:
             a = float(case["concentration"])
             field, box = make_floe_field(
-                n_floes, concentration=a, alpha=float(p["fsd_exponent"]),
+                int(p["floes"]), repeat=int(p["repeat"]), concentration=a,
+                alpha=float(p["fsd_exponent"]),
                 mean_diameter=pre.mean_diameter, thickness=pre.thickness,
                 density=pre.forcing.ice_density, seed=int(seed), fsd=str(p["fsd"]),
                 velocity_std=float(p["initial_velocity_std"]))

@@ -173,3 +173,26 @@ def test_impossible_concentrations_raise_placement_error():
     r = np.full(60, 1.0)
     with pytest.raises(PlacementError):
         place_floes(r, PeriodicBox(math.sqrt(math.pi * 60 / 0.93)), rng)
+
+
+@pytest.mark.parametrize("fsd", ["rank", "random"])
+def test_repeated_sample_has_the_same_sizes_in_a_wider_box(fsd):
+    """make_floe_field(repeat=4): each of the n sampled diameters four times,
+    at the target concentration, without overlaps, in a box twice as wide as
+    that of the sample alone (same seed, same sizes)."""
+    one, box1 = make_floe_field(300, concentration=0.6, alpha=1.5, mean_diameter=2.0, seed=3,
+                                fsd=fsd)
+    four, box4 = make_floe_field(300, concentration=0.6, alpha=1.5, mean_diameter=2.0, seed=3,
+                                 fsd=fsd, repeat=4, velocity_std=0.01)
+    assert four.n == 1200
+    np.testing.assert_array_equal(np.sort(four.radii), np.sort(np.repeat(one.radii, 4)))
+    assert box4.lx == pytest.approx(2.0 * box1.lx, rel=1e-12)
+    assert four.total_area / box4.area == pytest.approx(0.6, rel=1e-12)
+    assert max_overlap(four.positions, four.radii, box4) <= 0.0
+    assert four.velocities.shape == (1200, 2) and four.velocities.std() > 0.005
+
+
+@pytest.mark.parametrize("repeat", [0, 1.5, -2])
+def test_repeat_must_be_a_positive_whole_number(repeat):
+    with pytest.raises(ValueError, match="repeat"):
+        make_floe_field(100, concentration=0.5, alpha=1.5, mean_diameter=2.0, repeat=repeat)
