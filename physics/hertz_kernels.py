@@ -36,6 +36,11 @@ CP_SIZE = 8
 FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
 STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
+# Parallel kernels that other compiled kernels call are never cached on disk
+# (cache=False): when a caller is compiled in a process that loaded such a
+# callee from Numba's cache, the caller's own cache entry crashes every later
+# process that loads it (seen with numba 0.68). Compiled in the same process
+# as its caller, the callee is embedded in the caller's (cached) code.
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
 MIN_KICK_CHUNKS = 16   # fewest chunks of the parallel kick-drift pass (claimed dynamically)
 
@@ -271,7 +276,7 @@ def scatter_mask(owners, bounds, start, nbr, n):
     return mask
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=False, parallel=True, error_model="numpy")
 def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
                          hist, dt_history, fbuf, tbuf):
     """:func:`owner_pairs` over the chunks of :func:`owner_chunks` in
@@ -282,7 +287,7 @@ def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, 
                     start, nbr, hist, dt_history, fbuf[c], tbuf[c])
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=False, parallel=True, error_model="numpy")
 def wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
                          force, torque):
     """:func:`wall_forces` over all floes in parallel chunks (each floe only
@@ -364,7 +369,7 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
     return worst, sdx, sdy, vmax2
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=False, parallel=True, error_model="numpy")
 def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                         inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """:func:`first_half` over all floes in parallel (no race).

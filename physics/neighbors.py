@@ -168,7 +168,9 @@ def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx
             counts[i + 1] = count
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+# not cached on disk: the Hertz step calls it from its own cached kernels
+# (see the note in hertz_kernels.py); pair_list uses a cached copy
+@njit(cache=False, parallel=True, error_model="numpy")
 def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     """Verlet list of all pairs with centre distance < r_i + r_j + skin.
 
@@ -212,6 +214,10 @@ def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size):
 
 PARALLEL_MIN_FLOES = 5000   # smaller fields are scanned on the calling thread
 
+# build_pair_list compiled for calls from Python only, cached on disk
+_build_pair_list_cached = njit(cache=True, parallel=True, error_model="numpy")(
+    build_pair_list.py_func)
+
 
 def pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     """:func:`build_pair_list` for large fields, :func:`build_pair_list_serial`
@@ -219,7 +225,8 @@ def pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
     than the scan of a small field, and a process that never starts the
     OpenMP pool can still be forked safely (``gymnasium.make_vec`` with
     ``vectorization_mode="async"``)."""
-    build = build_pair_list if pos.shape[0] >= PARALLEL_MIN_FLOES else build_pair_list_serial
+    big = pos.shape[0] >= PARALLEL_MIN_FLOES
+    build = _build_pair_list_cached if big else build_pair_list_serial
     return build(pos, radius, rank, lx, ly, px, py, skin, cell_size)
 
 
