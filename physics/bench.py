@@ -113,22 +113,33 @@ def _time_child(path: str, steps: int, dt: float) -> None:
     sims = []
     for _, parallel, threads in configs:
         numba.set_num_threads(threads)
-        field, box = _load_state(Path(path))
-        sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=parallel,
-                              allow_overlap=True)
-        sim.step(5)                               # compile / load from cache, warm up
-        sims.append(sim)
+        sims.append(_warm_sim(path, dt, parallel))
     rebuilds0 = sims[0].n_rebuilds
     rates = [[] for _ in configs]
     for _ in range(REPEATS):
         for k, ((_, _, threads), sim) in enumerate(zip(configs, sims)):
             numba.set_num_threads(threads)
-            t0 = time.perf_counter()
-            sim.step(steps)
-            rates[k].append(sim.n_floes * steps / (time.perf_counter() - t0))
+            rates[k].append(_segment_rate(sim, steps))
     print(json.dumps(dict(
         rates=rates, contacts_per_floe=2.0 * len(sims[0].contacts()) / sims[0].n_floes,
         rebuilds=round((sims[0].n_rebuilds - rebuilds0) / REPEATS))))
+
+
+def _warm_sim(path: str, dt: float, parallel: bool) -> HertzSimulation:
+    """A simulation of the saved state, its kernels compiled (or loaded from
+    the cache) by a few warm-up steps."""
+    field, box = _load_state(Path(path))
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=parallel,
+                          allow_overlap=True)
+    sim.step(5)
+    return sim
+
+
+def _segment_rate(sim: HertzSimulation, steps: int) -> float:
+    """Floe-steps per second of ``steps`` steps."""
+    t0 = time.perf_counter()
+    sim.step(steps)
+    return sim.n_floes * steps / (time.perf_counter() - t0)
 
 
 def _child(*args: str, threads: int | None = None):
@@ -215,7 +226,8 @@ def machine_scaling(threads: int, kind: str = "scalar") -> list[float]:
     processes: ``kind="scalar"``, arithmetic with no memory traffic (the
     ceiling for compute-bound kernels), or ``"stream"``, a pass over cached
     floe-state arrays (the ceiling for the per-floe passes)."""
-    return [x for _ in range(PROCESSES) for x in _child("_control", kind, threads=threads)["ratios"]]
+    return [x for _ in range(PROCESSES)
+            for x in _child("_control", kind, threads=threads)["ratios"]]
 
 
 def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float = JAMMED):
@@ -266,16 +278,8 @@ def _pinned_child(path: str, steps: int, dt: float, cpu: int) -> None:
     """Pin this process to core ``cpu`` and print, as JSON, the rates of
     ``REPEATS`` segments of ``steps`` steps of the serial kernels."""
     os.sched_setaffinity(0, {cpu})
-    field, box = _load_state(Path(path))
-    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=dt, parallel=False,
-                          allow_overlap=True)
-    sim.step(5)
-    rates = []
-    for _ in range(REPEATS):
-        t0 = time.perf_counter()
-        sim.step(steps)
-        rates.append(field.n * steps / (time.perf_counter() - t0))
-    print(json.dumps(dict(rates=rates)))
+    sim = _warm_sim(path, dt, parallel=False)
+    print(json.dumps(dict(rates=[_segment_rate(sim, steps) for _ in range(REPEATS)])))
 
 
 def core_speeds(path: Path, dt: float, steps: int) -> dict:
@@ -400,8 +404,8 @@ def format_table(rows: list[dict], n: int) -> str:
                          f"rounds; range {min(r['paired']):.2f}–{max(r['paired']):.2f})")
         if r["case"] == "cores":
             lines.append("")
-            lines.append(f"Host ceiling: the serial kernels at Ā = 0.70 in a process pinned to one "
-                         f"core run at {r['alone']:.3g} floe-steps/s alone, and at "
+            lines.append(f"Host ceiling: the serial kernels at Ā = 0.70 in a process pinned to "
+                         f"one core run at {r['alone']:.3g} floe-steps/s alone, and at "
                          + " + ".join(f"{v:.3g}" for v in r["together"])
                          + f" with one such process on each core at once: all cores together "
                          f"give {r['rate']:.2f}x one core (medians of {REPEATS} segments)")

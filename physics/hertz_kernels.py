@@ -36,11 +36,6 @@ CP_SIZE = 8
 FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
 STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
-# Parallel kernels that other compiled kernels call are never cached on disk
-# (cache=False): when a caller is compiled in a process that loaded such a
-# callee from Numba's cache, the caller's own cache entry crashes every later
-# process that loads it (seen with numba 0.68). Compiled in the same process
-# as its caller, the callee is embedded in the caller's (cached) code.
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
 MIN_KICK_CHUNKS = 16   # fewest chunks of the parallel kick-drift pass (claimed dynamically)
 
@@ -276,6 +271,11 @@ def scatter_mask(owners, bounds, start, nbr, n):
     return mask
 
 
+# Parallel kernels that other compiled kernels call are never cached on disk
+# (cache=False): when a caller is compiled in a process that loaded such a
+# callee from Numba's cache, the caller's own cache entry crashes every later
+# process that loads it (seen with numba 0.68). Compiled in the same process
+# as its caller, the callee is embedded in the caller's (cached) code.
 @njit(cache=False, parallel=True, error_model="numpy")
 def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
                          hist, dt_history, fbuf, tbuf):
@@ -311,9 +311,9 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
     velocities; done here to save a pass over memory; skipped when
     ``has_drag`` is false, i.e. without forcing) and the others are zero,
     ready for the pair scatter. ``ref`` (the positions at the build) is
-    remapped with the box. Returns (largest
-    squared distance of a displacement from (cx, cy), sum of the
-    displacements along x, along y, largest squared speed)."""
+    remapped with the box. Returns (largest squared distance of a
+    displacement from (cx, cy), sum of the displacements along x, along y,
+    largest squared speed)."""
     uax, uay, uwx, uwy = fv[FV_UAX], fv[FV_UAY], fv[FV_UWX], fv[FV_UWY]
     wind_speed = math.sqrt(uax * uax + uay * uay)
     n_buf = fbuf.shape[0]
@@ -375,9 +375,9 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
     """:func:`first_half` over all floes in parallel (no race).
 
     The floes are cut into ``4 × n_threads`` (at least 16) chunks that the
-    ``n_threads`` threads claim one at a time (:mod:`physics.atomics`): a thread on a
-    core that is momentarily slower does fewer chunks instead of holding
-    the others up at the join. Each chunk writes only its own floes and its
+    ``n_threads`` threads claim one at a time (:mod:`physics.atomics`): a
+    thread on a core that is momentarily slower does fewer chunks instead
+    of holding the others up at the join. Each chunk writes only its own floes and its
     own row of the partial results, which are reduced in chunk order, so
     the outcome does not depend on which thread did what.
 
