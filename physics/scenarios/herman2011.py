@@ -17,7 +17,9 @@ clusters, and without the largest one, which deviates from the power law at
 high Ā), the pair distributions g_rdf and g_ffd (Fig 7), the mean speed,
 the mass-weighted drift velocity, the slip |u − u_eq| and the collision
 rate. The rank-ordered r_e of the final state (Fig 8) are recorded in the
-last sample over the dimension ``rank``. Snapshots (positions, radii,
+last sample over the dimension ``rank``. The largest-cluster fraction is
+also recorded for every d_m of ``gap_sweep`` (dimension ``gap``), since
+the paper states that d_m of 0.1–1.0 m gave very similar results. Snapshots (positions, radii,
 velocities) are taken at ``snapshots`` evenly spaced times, the first at
 t = 0 and the last at the end (with one snapshot, only the end).
 
@@ -105,6 +107,11 @@ def _pair_distribution(kind: str, pos, radii, box, x_max: float, bins: int) -> n
     return out
 
 
+def _widest_gap(p: dict) -> float:
+    """The largest d_m the run uses (``cluster_gap`` and ``gap_sweep``)."""
+    return max([float(p["cluster_gap"])] + [float(g) for g in p.get("gap_sweep", [])])
+
+
 def _rank_sample_fits(p: dict, a: float) -> None:
     """``ValueError`` if the largest floe of the rank-ordered sample is too
     large for the box at concentration ``a`` (cluster search and the
@@ -114,12 +121,13 @@ def _rank_sample_fits(p: dict, a: float) -> None:
     pre = _preset()
     d = rank_order_diameters(int(p["floes"]), float(p["fsd_exponent"]), pre.mean_diameter)
     lx, _ = domain_size(np.repeat(d, int(p.get("repeat", 1))), a)
-    reach = float(d[0]) + float(p["cluster_gap"])
+    reach = float(d[0]) + _widest_gap(p)
     if reach >= 0.5 * lx:
         raise ValueError(
             f"with {p['floes']} floes at concentration {a:g} the largest floe (diameter "
             f"{d[0]:.3g} m) spans {d[0] / lx:.0%} of the box ({lx:.4g} m); clusters can only be "
-            f"found if its diameter plus cluster_gap stays below half the box: use more floes "
+            f"found if its diameter plus cluster_gap (and every gap_sweep value) stays below half "
+            f"the box: use more floes "
             f"or lower concentrations")
 
 
@@ -155,10 +163,22 @@ def _window_stats(ds, p: dict) -> dict:
             out[name] = np.nanmean(v, axis=1)
             out[name + "_std"] = np.nanstd(v, axis=1)
             out[name + "_valid"] = np.sum(np.isfinite(v), axis=1)
+        if "largest_fraction_by_gap" in ds and "gap" in ds.dims:
+            v = np.asarray(ds["largest_fraction_by_gap"].transpose("case", "member", "sample",
+                                                                   "gap"), dtype=float)
+            v = np.where(mask[..., None], v, np.nan).reshape(v.shape[0], -1, v.shape[-1])
+            out["fc_by_gap"] = np.nanmean(v, axis=1)           # (case, gap)
     out["largest_floe"] = np.asarray(ds["largest_floe_fraction"], dtype=float).reshape(
         len(conc), -1).mean(axis=1)
     order = np.argsort(conc, kind="stable")
     return {k: np.asarray(v)[order] for k, v in out.items()}
+
+
+def _gaps(ds) -> np.ndarray:
+    """The d_m values of ``largest_fraction_by_gap`` (empty without it)."""
+    if "largest_fraction_by_gap" not in ds or "gap" not in ds.dims:
+        return np.zeros(0)
+    return np.asarray(ds["gap"], dtype=float)
 
 
 def _crossings(x, y, level: float) -> list[float]:
@@ -191,6 +211,8 @@ class Herman2011Clustering(Experiment):
 
     variables = {
         "largest_fraction": ("1", "largest-cluster fraction F_c,1/F_tot"),
+        "largest_fraction_by_gap": ("1", "largest-cluster fraction F_c,1/F_tot with clusters "
+                                         "of gap d_m (one per gap_sweep value)"),
         "n_clusters": ("1", "number of clusters N_c"),
         "alpha": ("1", f"ML exponent alpha of P(r_e) ~ r_e^(-1-alpha) from all clusters "
                        f"(NaN with fewer than {MIN_CLUSTERS_FOR_ALPHA} clusters)"),
@@ -248,6 +270,9 @@ class Herman2011Clustering(Experiment):
         rec.coord("x_rdf", rdf_x, "m", "centre-to-centre distance (bin centres)")
         rec.coord("x_ffd", ffd_x, "m", "edge-to-edge distance (bin centres)")
         rec.coord("rank", np.arange(1, n_floes + 1), "1", "rank of the cluster by size")
+        if p["gap_sweep"]:
+            rec.coord("gap", np.asarray(p["gap_sweep"], dtype=float), "m",
+                      "cluster gap d_m of largest_fraction_by_gap")
         k_snap = int(p["snapshots"])
         snap_times = [n_out] if k_snap == 1 else np.linspace(0, n_out, k_snap)
         snap_steps = sorted({int(round(x)) for x in snap_times})
@@ -261,12 +286,13 @@ class Herman2011Clustering(Experiment):
                 mean_diameter=pre.mean_diameter, thickness=pre.thickness,
                 density=pre.forcing.ice_density, seed=int(seed), fsd=str(p["fsd"]),
                 velocity_std=float(p["initial_velocity_std"]))
-            reach = 2.0 * float(field.radii.max()) + float(p["cluster_gap"])
+            reach = 2.0 * float(field.radii.max()) + _widest_gap(p)
             if reach >= 0.5 * box.lx:
                 raise ValueError(
                     f"the largest floe (diameter {2 * field.radii.max():.3g} m) is too large for "
                     f"the box ({box.lx:.4g} m) at concentration {a:g}: its diameter plus "
-                    f"cluster_gap must stay below half the box; use more floes")
+                    f"cluster_gap (and every gap_sweep value) must stay below half the box; use "
+                    f"more floes")
             sim = HardDiskSimulation(field, box, restitution=float(p["restitution"]),
                                      forcing=_forcing(p),
                                      max_velocity_step=pre.max_velocity_step,
@@ -330,6 +356,10 @@ class Herman2011Clustering(Experiment):
                                                p["rdf_bins"])),
             g_ffd=("x_ffd", _pair_distribution("ffd", pos, r, sim.box, p["ffd_range"],
                                                p["ffd_bins"])))
+        if p["gap_sweep"]:
+            values["largest_fraction_by_gap"] = ("gap", np.array([
+                cluster_statistics(find_clusters(pos, r, sim.box, float(g)), r).largest_fraction
+                for g in p["gap_sweep"]]))
         if st["step"] == n_out:
             ranked = np.full(sim.n, np.nan)
             ranked[:cs.n_clusters] = cs.effective_radius
@@ -359,6 +389,11 @@ class Herman2011Clustering(Experiment):
                          f"{s['fc_mean'][i]:.3f} [{s['fc_min'][i]:.3f}, {s['fc_max'][i]:.3f}] "
                          f"= {s['fc_mean'][i] / s['largest_floe'][i]:.1f} × largest floe",
                          paper))
+        gaps = _gaps(ds)
+        for i, a in enumerate(s["concentration"] if gaps.size else []):
+            rows.append((f"F_c,1/F_tot at Ā = {a:.3g} against the cluster gap d_m",
+                         ", ".join(f"{g:g} m: {f:.2f}" for g, f in zip(gaps, s["fc_by_gap"][i])),
+                         "very similar for d_m = 0.1–1.0 m"))
         for i, a in enumerate(s["concentration"]):
             if a < LOW_REGIME_MAX:
                 paper = f"< α_r = {alpha_r:g}"
@@ -552,7 +587,13 @@ class Herman2011Clustering(Experiment):
         fig, ax = plt.subplots(figsize=(6, 4.5))
         x = s["concentration"]
         ax.errorbar(x, s["fc_mean"], yerr=[s["fc_mean"] - s["fc_min"], s["fc_max"] - s["fc_mean"]],
-                    fmt="o-", capsize=3, label="F_c,1/F_tot (mean, min–max)")
+                    fmt="o-", capsize=3,
+                    label=f"F_c,1/F_tot, d_m = {float(p['cluster_gap']):g} m (mean, min–max)")
+        for k, g in enumerate(_gaps(ds)):
+            if g == float(p["cluster_gap"]):
+                continue                        # the same as the main curve
+            ax.plot(x, s["fc_by_gap"][:, k], "-", lw=0.8, alpha=0.7, marker=".",
+                    label=f"d_m = {g:g} m (window mean)")
         ax.plot(x, s["largest_floe"], "k:", label="largest floe / F_tot")
         ax.axhline(MEGA_FRACTION, color="0.5", ls="--", lw=1, label="0.85")
         ax.set_ylim(0, 1.05)

@@ -18,7 +18,7 @@ from physics.scenarios.runner import find_config, member_seeds  # noqa: E402
 NAME = "herman2011-clustering"
 # two concentrations, 500 floes, 600 model seconds: a few seconds of wall time
 TINY = dict(floes=500, concentrations=[0.6, 0.9], duration=600.0, output_interval=100.0,
-            snapshots=2)
+            snapshots=2, gap_sweep=[0.1, 0.2, 0.5])
 
 
 @pytest.fixture(scope="module")
@@ -56,6 +56,27 @@ def test_largest_cluster_much_larger_in_close_ice(sweep):
     # at Ā = 0.6 the largest cluster is of the order of the largest floe (0.21 of F_tot)
     largest_floe = float(ds["largest_floe_fraction"].isel(case=0, member=0))
     assert low < 3.5 * largest_floe
+
+
+def test_largest_cluster_against_the_gap(sweep):
+    """``largest_fraction_by_gap``: at d_m = cluster_gap it is the
+    recorded largest fraction exactly; a wider gap only joins clusters, so
+    the fraction never falls as d_m grows; at t = 0 (random placement) the
+    narrowest gap gives at Ā = 0.6 the largest floe or a little more and
+    at Ā = 0.9 (a compressed packing) nearly all the ice."""
+    _, ds = sweep
+    gaps = ds["gap"].values
+    np.testing.assert_array_equal(gaps, [0.1, 0.2, 0.5])
+    by_gap = ds["largest_fraction_by_gap"].transpose("case", "member", "sample", "gap").values
+    k = int(np.flatnonzero(gaps == 0.5)[0])
+    np.testing.assert_array_equal(by_gap[..., k], ds["largest_fraction"].values)
+    assert np.all(np.diff(by_gap, axis=-1) >= 0.0)
+    largest_floe = ds["largest_floe_fraction"].values          # (case, member)
+    start = by_gap[:, 0, 0, 0]
+    a = ds["concentration"].values
+    low, high = np.argmin(a), np.argmax(a)
+    assert largest_floe[low, 0] - 1e-12 <= start[low] < 1.5 * largest_floe[low, 0]
+    assert start[high] > 0.95
 
 
 def test_final_clusters_hold_all_the_floe_area(sweep):
@@ -131,6 +152,7 @@ def test_resume_equals_an_uninterrupted_run(tmp_path):
 @pytest.mark.parametrize("key, value, message", [
     ("concentrations", [0.6, 0.95], r"'concentrations' must be a list of numbers in \[0.1, 0.9\]"),
     ("cluster_gap", 0.0, r"'cluster_gap' must be a number in \(0, 5\]"),
+    ("gap_sweep", [0.1, 0.0], r"'gap_sweep' must be a list of numbers in \[0.01, 5\]"),
     ("restitution", 1.5, r"'restitution' must be a number in \(0, 1\]"),
     ("fsd", "lognormal", "'fsd' must be one of rank, random"),
     ("floes", 50, r"'floes' must be an integer in \[100, 200000\]"),
