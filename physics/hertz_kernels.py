@@ -24,7 +24,6 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .atomics import fetch_add
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image, wrap_coordinate
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
@@ -37,7 +36,7 @@ FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
 STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
-MIN_KICK_CHUNKS = 16   # fewest chunks of the parallel kick-drift pass (claimed dynamically)
+MIN_KICK_CHUNKS = 16   # fewest chunks of the parallel kick-drift pass
 
 
 # ---------------------------------------------------------------------------
@@ -193,7 +192,12 @@ def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
 def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
                 dt_history, force, torque):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
-    both floes of its pair at once (a scatter into ``force``, ``torque``)."""
+    both floes of its pair at once (a scatter into ``force``, ``torque``).
+
+    Only floes that touch are written: in loose ice most listed pairs are
+    apart, and a write of zero would still claim the cache line for this
+    thread, so that the thread doing the kick of that floe would have to
+    fetch it back (see :func:`first_half_parallel`)."""
     lx, ly = box[BOX_LX], box[BOX_LY]
     px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
@@ -220,9 +224,10 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
                 force[j, 0] -= res[1]
                 force[j, 1] -= res[2]
                 torque[j] += res[4]
-        force[i, 0] += fxi
-        force[i, 1] += fyi
-        torque[i] += tqi
+        if fxi != 0.0 or fyi != 0.0 or tqi != 0.0:
+            force[i, 0] += fxi
+            force[i, 1] += fyi
+            torque[i] += tqi
 
 
 @njit(cache=True, error_model="numpy")
@@ -327,12 +332,15 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv
         fy = fbuf[0, i, 1]
         tq = tbuf[0, i]
         for b in range(1, n_buf if shared[i] else 1):
-            fx += fbuf[b, i, 0]
-            fy += fbuf[b, i, 1]
-            tq += tbuf[b, i]
-            fbuf[b, i, 0] = 0.0
-            fbuf[b, i, 1] = 0.0
-            tbuf[b, i] = 0.0
+            if fbuf[b, i, 0] != 0.0 or fbuf[b, i, 1] != 0.0 or tbuf[b, i] != 0.0:
+                # reset only what was written: a line left clean stays in
+                # the cache of the pair-loop thread that reads it next
+                fx += fbuf[b, i, 0]
+                fy += fbuf[b, i, 1]
+                tq += tbuf[b, i]
+                fbuf[b, i, 0] = 0.0
+                fbuf[b, i, 1] = 0.0
+                tbuf[b, i] = 0.0
         im = inv_mass[i]
         x = pos[i, 0]
         y = pos[i, 1]
@@ -374,12 +382,16 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
                         inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """:func:`first_half` over all floes in parallel (no race).
 
-    The floes are cut into ``4 × n_threads`` (at least 16) chunks that the
-    ``n_threads`` threads claim one at a time (:mod:`physics.atomics`): a
-    thread on a core that is momentarily slower does fewer chunks instead
-    of holding the others up at the join. Each chunk writes only its own floes and its
-    own row of the partial results, which are reduced in chunk order, so
-    the outcome does not depend on which thread did what.
+    The floes are cut into ``4 × n_threads`` (at least 16) chunks; thread t
+    always does the same consecutive run of them, so from step to step each
+    core keeps its floes in its own caches (the chunks of the pair loop,
+    :func:`owner_chunks`, cover roughly the same floes in the same order).
+    Handing the chunks out dynamically instead, to whichever thread is free
+    first, was measured just as fast (median over 15 interleaved rounds at
+    N = 20000, Ā = 0.7, 2 threads: 79 µs a pass dynamically, 82 µs with
+    the fixed split, within the noise of the machine). Each chunk writes only its own floes and its own
+    row of the partial results, which are reduced in chunk order, so the
+    outcome is the same for 1, 2 and 4 threads.
 
     Each chunk gets views of its floes and loops from a start index known
     at compile time to be 0: with a start known only at run time the loop
@@ -387,12 +399,8 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
     n = pos.shape[0]
     n_chunks = max(MIN_KICK_CHUNKS, 4 * n_threads)
     part = np.zeros((n_chunks, 4))
-    claimed = np.zeros(1, dtype=np.int64)
-    for _ in prange(n_threads):
-        while True:
-            c = fetch_add(claimed, 0, 1)
-            if c >= n_chunks:
-                break
+    for t in prange(n_threads):
+        for c in range(t * n_chunks // n_threads, (t + 1) * n_chunks // n_threads):
             lo = c * n // n_chunks
             hi = (c + 1) * n // n_chunks
             w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi],
