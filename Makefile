@@ -31,6 +31,7 @@ test-slow: setup
 
 bench: setup
 	$(PY) -m physics.bench hertz
+	$(PY) -m physics.bench phases
 	$(PY) -m physics.bench harddisk
 	$(PY) -m physics.bench observables
 	$(PY) -m physics.bench itd

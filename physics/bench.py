@@ -26,6 +26,10 @@ and a kick-drift-like pass over a cached (20000 × 8) state array (the
 ceiling of the per-floe passes that dominate loose ice). The peak memory
 of a run with N = 100000 floes is measured in a fresh process.
 
+``python -m physics.bench phases`` times the phases of a Hertz step one by
+one on the Ā = 0.7 field: the kick–drift pass, the pair loop, both, and a
+Verlet-list rebuild, with the same three kernel configurations taking turns.
+
 Hard-disc engine (collisions per second, one core, compile time excluded):
 
 * elastic equal discs, N = 10000, packing fraction 0.5, no drag, Gaussian
@@ -65,6 +69,7 @@ import numpy as np
 
 from .domain import PeriodicBox
 from .floes import FloeField, make_floe_field
+from . import hertz_kernels as K
 from .hertz import HertzSimulation
 from .params import HERMAN2013
 
@@ -89,6 +94,18 @@ def _load_state(path: Path):
 
 REPEATS = 5   # rounds of timed segments per process; the best segment of each kind is reported
 PROCESSES = 3   # fresh processes per case; the best is reported (host noise only slows a run)
+
+
+def _loose_state(n: int, seed: int, cache_dir: Path) -> Path:
+    """Path of the saved Ā = 0.7 field (random velocities of 3 cm/s per
+    component), made on first use."""
+    path = Path(cache_dir) / f"hertz_a070_n{n}_seed{seed}_v1.npz"
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA,
+                                     mean_diameter=MEAN_DIAMETER, seed=seed, velocity_std=0.03)
+        _save_state(path, field, box)
+    return path
 
 
 def _kernel_configs(threads_all: int) -> list[tuple[str, bool, int]]:
@@ -319,11 +336,7 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
         if not quiet:
             print(msg, flush=True)
 
-    loose_path = cache_dir / f"hertz_a070_n{n}_seed{seed}_v1.npz"
-    if not loose_path.exists():
-        field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA,
-                                     mean_diameter=MEAN_DIAMETER, seed=seed, velocity_std=0.03)
-        _save_state(loose_path, field, box)
+    loose_path = _loose_state(n, seed, cache_dir)
     log(f"dense ice (N = {n}) ...")
     jam_path, prep = _jammed_state(n, seed, cache_dir, quiet)
     jam, jam_box = _load_state(jam_path)
@@ -371,6 +384,115 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
                          contacts_per_floe=float("nan"), dt=HERMAN2013.time_step, rebuilds=0,
                          steps=200))
     return rows
+
+
+# The phases of a Hertz step, timed one by one. Compiled in this process,
+# like the parallel kernels it calls (see physics.hertz_kernels).
+@numba.njit(cache=False)
+def _phase_loop(passes, parallel, n_threads, kick, pairs, owners, bounds, shared, pos, vel, omega,
+                radius, inv_mass, inv_inertia, cp, box, start, nbr, hist, fbuf, tbuf, ref, drag,
+                fv, lx, ly):
+    """``passes`` kick–drift passes and/or pair loops of the Hertz step with
+    Δt = 0 (the same work as a real step, but the state stays as it is, so
+    that every pass is alike and no list rebuild is due)."""
+    n = pos.shape[0]
+    for _ in range(passes):
+        if kick:
+            if parallel:
+                K.first_half_parallel(n_threads, 0.0, 0.0, pos, vel, omega, fbuf, tbuf, shared,
+                                      inv_mass, inv_inertia, lx, ly, True, True, 1.0, 1.0, ref,
+                                      0.0, 0.0, drag, fv, False)
+            else:
+                K.first_half(0, n, 0.0, 0.0, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                             inv_inertia, lx, ly, True, True, 1.0, 1.0, ref, 0.0, 0.0, drag, fv,
+                             False)
+        if pairs:
+            if parallel:
+                K.pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp,
+                                       box, start, nbr, hist, 0.002, fbuf, tbuf)
+            else:
+                K.owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp,
+                              box, start, nbr, hist, 0.002, fbuf[0], tbuf[0])
+
+
+PHASES = ("kick–drift pass", "pair loop", "kick–drift pass + pair loop", "list rebuild")
+
+
+def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
+                 cache_dir: Path | None = None, quiet: bool = False) -> list[dict]:
+    """Wall time of each phase of a Hertz step at Ā = 0.7 (the field of
+    :func:`bench_hertz`): the kick–drift pass, the pair loop, both, and a
+    Verlet-list rebuild, with the serial kernels, the parallel kernels on
+    one thread and on all threads, taking turns in ``REPEATS`` rounds. One
+    row per phase and configuration: the median time and the same-round
+    speed-ups over the serial kernels."""
+    threads_all = numba.config.NUMBA_NUM_THREADS
+    cache_dir = Path(cache_dir) if cache_dir is not None else Path.cwd() / ".bench_cache"
+    path = _loose_state(n, seed, cache_dir)
+    sim = _warm_sim(str(path), HERMAN2013.time_step, parallel=False)
+    box = sim.box.kernel_array(sim.time)
+    fv = sim._forcing_vector()
+
+    def arrays(n_buf):
+        owners, bounds = K.owner_chunks(sim._start, n_buf)
+        shared = K.scatter_mask(owners, bounds, sim._start, sim._nbr, sim.n_floes)
+        return (owners, bounds, shared, sim.positions.copy(), sim.velocities.copy(),
+                sim.angular_velocities.copy(), sim.radius, sim.inv_mass, sim.inv_inertia,
+                sim._cp, box, sim._start, sim._nbr, sim._hist.copy(),
+                np.zeros((n_buf, sim.n_floes, 2)), np.zeros((n_buf, sim.n_floes)),
+                sim._ref.copy(), sim._drag, fv, sim.box.lx, sim.box.ly)
+
+    configs = _kernel_configs(threads_all)
+    data = [arrays(threads if parallel else 1) for _, parallel, threads in configs]
+
+    def run(k, phase, count):
+        _, parallel, threads = configs[k]
+        numba.set_num_threads(threads)
+        t0 = time.perf_counter()
+        if phase == 3:
+            for _ in range(count):
+                K.rebuild(sim.positions, sim.radius, sim.rank, sim.box.lx, sim.box.ly, True, True,
+                          sim.skin, sim.cell_size, sim._start, sim._nbr, sim._hist, parallel)
+        else:
+            _phase_loop(count, parallel, threads, phase in (0, 2), phase in (1, 2), *data[k])
+        return (time.perf_counter() - t0) / count
+
+    if not quiet:
+        print(f"phases of a step, N = {n}, Ā = 0.70 ...", flush=True)
+    for k in range(len(configs)):
+        for phase in range(len(PHASES)):
+            run(k, phase, 2)                      # compile
+    times = np.zeros((REPEATS, len(configs), len(PHASES)))
+    rebuild_count = max(1, passes // 200)
+    for r in range(REPEATS):
+        for k in range(len(configs)):
+            for phase in range(len(PHASES)):
+                times[r, k, phase] = run(k, phase, rebuild_count if phase == 3 else passes)
+    numba.set_num_threads(threads_all)
+    rows = []
+    for phase, name in enumerate(PHASES):
+        for k, (label, _, threads) in enumerate(configs):
+            ratio = times[:, 0, phase] / times[:, k, phase]
+            rows.append(dict(phase=name, kernel=label, threads=threads,
+                             seconds=float(np.median(times[:, k, phase])),
+                             speedup=float(np.median(ratio)), speedup_best=float(ratio.max())))
+    rows.append(dict(phase="pairs", n_pairs=int(sim._start[-1]), n=n))
+    return rows
+
+
+def format_phases_table(rows: list[dict]) -> str:
+    info = rows[-1]
+    lines = [f"Phases of a Hertz step, N = {info['n']}, Ā = 0.70 ({info['n_pairs']} listed "
+             f"pairs), median of {REPEATS} rounds",
+             "",
+             "| phase | kernels | threads | time | serial / this (same round: median, best) |",
+             "|---|---|---|---|---|"]
+    for r in rows[:-1]:
+        t = r["seconds"]
+        shown = f"{t * 1e3:.2f} ms" if t > 1e-3 else f"{t * 1e6:.1f} µs"
+        lines.append(f"| {r['phase']} | {r['kernel']} | {r['threads']} | {shown} | "
+                     f"{r['speedup']:.2f}, {r['speedup_best']:.2f} |")
+    return "\n".join(lines)
 
 
 def format_table(rows: list[dict], n: int) -> str:
@@ -653,6 +775,13 @@ def main(argv=None) -> int:
     h.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
                    help="where the prepared floe fields are kept (default ./.bench_cache)")
     h.add_argument("--quiet", action="store_true")
+    ph = sub.add_parser("phases", help="time of each phase of a Hertz step (kick-drift pass, "
+                                       "pair loop, list rebuild) on one and on all threads")
+    ph.add_argument("--floes", type=int, default=20000)
+    ph.add_argument("--passes", type=int, default=2000, help="timed passes per phase and round")
+    ph.add_argument("--seed", type=int, default=1)
+    ph.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"))
+    ph.add_argument("--quiet", action="store_true")
     hd = sub.add_parser("harddisk", help="collisions per second of the hard-disc engine")
     hd.add_argument("--seed", type=int, default=1)
     hd.add_argument("--quiet", action="store_true")
@@ -674,6 +803,12 @@ def main(argv=None) -> int:
     t.add_argument("steps", type=int)
     t.add_argument("dt", type=float)
     args = p.parse_args(argv)
+    if args.engine == "phases":
+        if args.floes < 100 or args.passes < 1:
+            p.error("--floes must be >= 100 and --passes >= 1")
+        print(format_phases_table(bench_phases(args.floes, args.seed, args.passes, args.cache_dir,
+                                               args.quiet)))
+        return 0
     if args.engine == "harddisk":
         hd_rows = bench_harddisk(args.seed, args.quiet)
         print()

@@ -41,3 +41,21 @@ def test_table_reports_rows_ratios_and_ceilings():
     assert "all threads / serial kernels = 1.20" in text
     assert "give 1.50x one core" in text and "8e+07 + 7e+07" in text
     assert "runs 1.40x faster on 2 threads than on one (median of 3 rounds; range 1.30–2.00)" in text
+
+
+def test_phase_benchmark_times_every_phase_and_configuration(tmp_path):
+    """``python -m physics.bench phases`` on 400 floes: one row per phase
+    and kernel configuration, positive times, the serial kernels' speed-up
+    over themselves exactly 1, and a table that shows them."""
+    rows = bench.bench_phases(n=400, seed=1, passes=5, cache_dir=tmp_path, quiet=True)
+    configs = bench._kernel_configs(bench.numba.config.NUMBA_NUM_THREADS)
+    timed = rows[:-1]
+    assert len(timed) == len(bench.PHASES) * len(configs)
+    assert [r["phase"] for r in timed[::len(configs)]] == list(bench.PHASES)
+    for r in timed:
+        assert r["seconds"] > 0.0 and math.isfinite(r["seconds"])
+        if r["kernel"] == "serial":
+            assert r["speedup"] == r["speedup_best"] == 1.0
+    assert rows[-1]["n"] == 400 and rows[-1]["n_pairs"] >= 0
+    text = bench.format_phases_table(rows)
+    assert "| list rebuild | serial | 1 |" in text and "Ā = 0.70" in text
