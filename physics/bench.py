@@ -389,12 +389,13 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
 # The phases of a Hertz step, timed one by one. Compiled in this process,
 # like the parallel kernels it calls (see physics.hertz_kernels).
 @numba.njit(cache=False)
-def _phase_loop(passes, parallel, n_threads, kick, pairs, owners, bounds, shared, pos, vel, omega,
-                radius, inv_mass, inv_inertia, cp, box, start, nbr, hist, fbuf, tbuf, ref, drag,
-                fv, lx, ly):
+def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, owners, bounds, shared, pos, vel,
+                omega, radius, inv_mass, inv_inertia, cp, box, start, nbr, hist, fbuf, tbuf, ref,
+                drag, fv, lx, ly):
     """``passes`` kick–drift passes and/or pair loops of the Hertz step with
-    Δt = 0 (the same work as a real step, but the state stays as it is, so
-    that every pass is alike and no list rebuild is due)."""
+    a kick and drift of Δt = 0 (the same work as a real step, but the state
+    stays as it is, so that every pass is alike and no list rebuild is due);
+    ``dt`` is the step of the contact history."""
     n = pos.shape[0]
     for _ in range(passes):
         if kick:
@@ -409,27 +410,32 @@ def _phase_loop(passes, parallel, n_threads, kick, pairs, owners, bounds, shared
         if pairs:
             if parallel:
                 K.pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp,
-                                       box, start, nbr, hist, 0.002, fbuf, tbuf)
+                                       box, start, nbr, hist, dt, fbuf, tbuf)
             else:
                 K.owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp,
-                              box, start, nbr, hist, 0.002, fbuf[0], tbuf[0])
+                              box, start, nbr, hist, dt, fbuf[0], tbuf[0])
 
 
-PHASES = ("kick–drift pass", "pair loop", "kick–drift pass + pair loop", "list rebuild")
+# phases: (name, kick–drift pass?, pair loop?); the last one is a list rebuild
+PHASES = (("kick–drift pass", True, False), ("pair loop", False, True),
+          ("kick–drift pass + pair loop", True, True), ("list rebuild", False, False))
+REBUILD = len(PHASES) - 1
 
 
 def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
-                 cache_dir: Path | None = None, quiet: bool = False) -> list[dict]:
+                 cache_dir: Path | None = None, quiet: bool = False) -> dict:
     """Wall time of each phase of a Hertz step at Ā = 0.7 (the field of
     :func:`bench_hertz`): the kick–drift pass, the pair loop, both, and a
     Verlet-list rebuild, with the serial kernels, the parallel kernels on
-    one thread and on all threads, taking turns in ``REPEATS`` rounds. One
-    row per phase and configuration: the median time and the same-round
-    speed-ups over the serial kernels."""
+    one thread and on all threads, taking turns in ``REPEATS`` rounds.
+    Returns the field size ``n``, its listed pairs ``n_pairs`` and
+    ``rows``, one per phase and configuration: the median time and the
+    same-round speed-ups over the serial kernels."""
     threads_all = numba.config.NUMBA_NUM_THREADS
     cache_dir = Path(cache_dir) if cache_dir is not None else Path.cwd() / ".bench_cache"
     path = _loose_state(n, seed, cache_dir)
-    sim = _warm_sim(str(path), HERMAN2013.time_step, parallel=False)
+    dt = HERMAN2013.time_step
+    sim = _warm_sim(str(path), dt, parallel=False)
     box = sim.box.kernel_array(sim.time)
     fv = sim._forcing_vector()
 
@@ -449,12 +455,13 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
         _, parallel, threads = configs[k]
         numba.set_num_threads(threads)
         t0 = time.perf_counter()
-        if phase == 3:
+        if phase == REBUILD:
             for _ in range(count):
                 K.rebuild(sim.positions, sim.radius, sim.rank, sim.box.lx, sim.box.ly, True, True,
                           sim.skin, sim.cell_size, sim._start, sim._nbr, sim._hist, parallel)
         else:
-            _phase_loop(count, parallel, threads, phase in (0, 2), phase in (1, 2), *data[k])
+            _, kick, pairs = PHASES[phase]
+            _phase_loop(count, parallel, threads, kick, pairs, dt, *data[k])
         return (time.perf_counter() - t0) / count
 
     if not quiet:
@@ -467,27 +474,25 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
     for r in range(REPEATS):
         for k in range(len(configs)):
             for phase in range(len(PHASES)):
-                times[r, k, phase] = run(k, phase, rebuild_count if phase == 3 else passes)
+                times[r, k, phase] = run(k, phase, rebuild_count if phase == REBUILD else passes)
     numba.set_num_threads(threads_all)
     rows = []
-    for phase, name in enumerate(PHASES):
+    for phase, (name, _, _) in enumerate(PHASES):
         for k, (label, _, threads) in enumerate(configs):
             ratio = times[:, 0, phase] / times[:, k, phase]
             rows.append(dict(phase=name, kernel=label, threads=threads,
                              seconds=float(np.median(times[:, k, phase])),
                              speedup=float(np.median(ratio)), speedup_best=float(ratio.max())))
-    rows.append(dict(phase="pairs", n_pairs=int(sim._start[-1]), n=n))
-    return rows
+    return dict(n=n, n_pairs=int(sim._start[-1]), rows=rows)
 
 
-def format_phases_table(rows: list[dict]) -> str:
-    info = rows[-1]
-    lines = [f"Phases of a Hertz step, N = {info['n']}, Ā = 0.70 ({info['n_pairs']} listed "
+def format_phases_table(result: dict) -> str:
+    lines = [f"Phases of a Hertz step, N = {result['n']}, Ā = 0.70 ({result['n_pairs']} listed "
              f"pairs), median of {REPEATS} rounds",
              "",
              "| phase | kernels | threads | time | serial / this (same round: median, best) |",
              "|---|---|---|---|---|"]
-    for r in rows[:-1]:
+    for r in result["rows"]:
         t = r["seconds"]
         shown = f"{t * 1e3:.2f} ms" if t > 1e-3 else f"{t * 1e6:.1f} µs"
         lines.append(f"| {r['phase']} | {r['kernel']} | {r['threads']} | {shown} | "

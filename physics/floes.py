@@ -471,8 +471,9 @@ def make_floe_field(n: int, *, concentration: float, alpha: float, mean_diameter
     Diameters from :func:`power_law_diameters` (``fsd`` = "rank" or "random"),
     each of the ``n`` repeated ``repeat`` times (n · repeat floes: the same
     sizes in a box ``sqrt(repeat)`` times wider), a box of the right size
-    (:func:`domain_size`), non-overlapping placement (:func:`place_floes`) and Gaussian velocities of standard deviation
-    ``velocity_std`` [m/s] per component; every random number comes from
+    (:func:`domain_size`), non-overlapping placement (:func:`place_floes`)
+    and Gaussian velocities of standard deviation ``velocity_std`` [m/s] per
+    component; every random number comes from
     ``np.random.default_rng(seed)``.
 
     Returns (field, box).

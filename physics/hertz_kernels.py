@@ -384,14 +384,16 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
 
     The floes are cut into ``4 × n_threads`` (at least 16) chunks; thread t
     always does the same consecutive run of them, so from step to step each
-    core keeps its floes in its own caches (the chunks of the pair loop,
-    :func:`owner_chunks`, cover roughly the same floes in the same order).
-    Handing the chunks out dynamically instead, to whichever thread is free
-    first, was measured just as fast (median over 15 interleaved rounds at
-    N = 20000, Ā = 0.7, 2 threads: 79 µs a pass dynamically, 82 µs with
-    the fixed split, within the noise of the machine). Each chunk writes only its own floes and its own
-    row of the partial results, which are reduced in chunk order, so the
-    outcome is the same for 1, 2 and 4 threads.
+    core keeps its floes in its own caches. (The chunks of the pair loop,
+    :func:`owner_chunks`, hold equal numbers of pairs and so do not line up
+    with these: the floes are numbered by size, and the large floes at the
+    front own most pairs.) Handing the chunks out dynamically instead, to
+    whichever thread is free first, was measured just as fast (median over
+    15 interleaved rounds at N = 20000, Ā = 0.7, 2 threads: 79 µs a pass
+    dynamically, 82 µs with the fixed split, within the noise of the
+    machine). Each chunk writes only its own floes and its own row of the
+    partial results, which are reduced in chunk order, so the outcome is the
+    same for 1, 2 and 4 threads.
 
     Each chunk gets views of its floes and loops from a start index known
     at compile time to be 0: with a start known only at run time the loop

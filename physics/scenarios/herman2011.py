@@ -19,8 +19,8 @@ the mass-weighted drift velocity, the slip |u − u_eq| and the collision
 rate. The rank-ordered r_e of the final state (Fig 8) are recorded in the
 last sample over the dimension ``rank``. The largest-cluster fraction is
 also recorded for every d_m of ``gap_sweep`` (dimension ``gap``), since
-the paper states that d_m of 0.1–1.0 m gave very similar results. Snapshots (positions, radii,
-velocities) are taken at ``snapshots`` evenly spaced times, the first at
+the paper states that d_m of 0.1–1.0 m gave very similar results.
+Snapshots (positions, radii, velocities) are taken at ``snapshots`` evenly spaced times, the first at
 t = 0 and the last at the end (with one snapshot, only the end).
 
 Summaries and figures average the statistics over the last
@@ -109,7 +109,7 @@ def _pair_distribution(kind: str, pos, radii, box, x_max: float, bins: int) -> n
 
 def _widest_gap(p: dict) -> float:
     """The largest d_m the run uses (``cluster_gap`` and ``gap_sweep``)."""
-    return max([float(p["cluster_gap"])] + [float(g) for g in p.get("gap_sweep", [])])
+    return max([float(p["cluster_gap"])] + [float(g) for g in p["gap_sweep"]])
 
 
 def _rank_sample_fits(p: dict, a: float) -> None:
@@ -120,15 +120,14 @@ def _rank_sample_fits(p: dict, a: float) -> None:
 
     pre = _preset()
     d = rank_order_diameters(int(p["floes"]), float(p["fsd_exponent"]), pre.mean_diameter)
-    lx, _ = domain_size(np.repeat(d, int(p.get("repeat", 1))), a)
+    lx, _ = domain_size(np.repeat(d, int(p["repeat"])), a)
     reach = float(d[0]) + _widest_gap(p)
     if reach >= 0.5 * lx:
         raise ValueError(
             f"with {p['floes']} floes at concentration {a:g} the largest floe (diameter "
             f"{d[0]:.3g} m) spans {d[0] / lx:.0%} of the box ({lx:.4g} m); clusters can only be "
             f"found if its diameter plus cluster_gap (and every gap_sweep value) stays below half "
-            f"the box: use more floes "
-            f"or lower concentrations")
+            f"the box: use more floes or lower concentrations")
 
 
 def _window_mask(ds, p: dict) -> np.ndarray:
@@ -163,7 +162,7 @@ def _window_stats(ds, p: dict) -> dict:
             out[name] = np.nanmean(v, axis=1)
             out[name + "_std"] = np.nanstd(v, axis=1)
             out[name + "_valid"] = np.sum(np.isfinite(v), axis=1)
-        if "largest_fraction_by_gap" in ds and "gap" in ds.dims:
+        if _gaps(ds).size:
             v = np.asarray(ds["largest_fraction_by_gap"].transpose("case", "member", "sample",
                                                                    "gap"), dtype=float)
             v = np.where(mask[..., None], v, np.nan).reshape(v.shape[0], -1, v.shape[-1])
@@ -357,7 +356,9 @@ class Herman2011Clustering(Experiment):
             g_ffd=("x_ffd", _pair_distribution("ffd", pos, r, sim.box, p["ffd_range"],
                                                p["ffd_bins"])))
         if p["gap_sweep"]:
+            # the main gap's clusters are found above already
             values["largest_fraction_by_gap"] = ("gap", np.array([
+                cs.largest_fraction if float(g) == float(p["cluster_gap"]) else
                 cluster_statistics(find_clusters(pos, r, sim.box, float(g)), r).largest_fraction
                 for g in p["gap_sweep"]]))
         if st["step"] == n_out:

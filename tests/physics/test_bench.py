@@ -47,15 +47,15 @@ def test_phase_benchmark_times_every_phase_and_configuration(tmp_path):
     """``python -m physics.bench phases`` on 400 floes: one row per phase
     and kernel configuration, positive times, the serial kernels' speed-up
     over themselves exactly 1, and a table that shows them."""
-    rows = bench.bench_phases(n=400, seed=1, passes=5, cache_dir=tmp_path, quiet=True)
+    result = bench.bench_phases(n=400, seed=1, passes=5, cache_dir=tmp_path, quiet=True)
     configs = bench._kernel_configs(bench.numba.config.NUMBA_NUM_THREADS)
-    timed = rows[:-1]
+    timed = result["rows"]
     assert len(timed) == len(bench.PHASES) * len(configs)
-    assert [r["phase"] for r in timed[::len(configs)]] == list(bench.PHASES)
+    assert [r["phase"] for r in timed[::len(configs)]] == [name for name, _, _ in bench.PHASES]
     for r in timed:
         assert r["seconds"] > 0.0 and math.isfinite(r["seconds"])
         if r["kernel"] == "serial":
             assert r["speedup"] == r["speedup_best"] == 1.0
-    assert rows[-1]["n"] == 400 and rows[-1]["n_pairs"] >= 0
-    text = bench.format_phases_table(rows)
+    assert result["n"] == 400 and result["n_pairs"] >= 0
+    text = bench.format_phases_table(result)
     assert "| list rebuild | serial | 1 |" in text and "Ā = 0.70" in text
