@@ -12,7 +12,10 @@
 * :func:`place_floes` — non-overlapping random positions: random sequential
   insertion, largest floes first; where insertion stalls, the floes are
   inserted at reduced size and grown back while overlaps are relaxed away.
-* :func:`make_floe_field` — all of the above in one call.
+* :func:`spatial_order` — a numbering of floes along a Z-order (Morton)
+  curve, so that floes near in space are near in memory.
+* :func:`make_floe_field` — all of the above in one call; its floes are
+  numbered in :func:`spatial_order`.
 """
 from __future__ import annotations
 
@@ -35,6 +38,7 @@ __all__ = [
     "place_floes",
     "max_overlap",
     "make_floe_field",
+    "spatial_order",
     "PlacementError",
 ]
 
@@ -142,6 +146,19 @@ class FloeField:
         return FloeField(self.positions.copy(), self.radii.copy(), self.thickness.copy(),
                          self.velocities.copy(), self.angular_velocities.copy(),
                          self.density, self.frozen.copy())
+
+    def take(self, order) -> "FloeField":
+        """A new field of the floes ``order`` (indices into this one), e.g. a
+        renumbering by :func:`spatial_order`."""
+        order = np.asarray(order)
+        if order.ndim != 1 or not np.issubdtype(order.dtype, np.integer):
+            raise ValueError(f"order must be a 1-D integer array, got {order.dtype} of shape "
+                             f"{order.shape}")
+        if order.size and (order.min() < -self.n or order.max() >= self.n):
+            raise ValueError(f"order holds indices outside 0..{self.n - 1}")
+        return FloeField(self.positions[order], self.radii[order], self.thickness[order],
+                         self.velocities[order], self.angular_velocities[order],
+                         self.density, self.frozen[order])
 
 
 # ---------------------------------------------------------------------------
@@ -462,6 +479,38 @@ def _grow(pos, r, scale, box: Box, growth_steps: int) -> None:
         raise PlacementError(f"placement left an overlap of {worst:.2e} of a radius")
 
 
+def _spread_bits(v: np.ndarray) -> np.ndarray:
+    """The 16 low bits of ``v`` moved to the even bit positions (0, 2, 4, ...)."""
+    v = v.astype(np.uint64) & np.uint64(0xFFFF)
+    for shift, mask in ((8, 0x00FF00FF), (4, 0x0F0F0F0F), (2, 0x33333333), (1, 0x55555555)):
+        v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+    return v
+
+
+def spatial_order(positions, box: Box, levels: int = 12) -> np.ndarray:
+    """Indices that number floes along a Z-order (Morton) curve through the
+    box, divided into 2^levels × 2^levels cells (ties keep their order).
+
+    With this numbering, floes near in space are near in memory. The
+    parallel kernels of the Hertz engine give each thread a consecutive run
+    of floes; in Z order each run is a compact patch of the box (the floes of
+    the lower half of the box come first, and among them those of its
+    lower-left quarter), so a thread's contacts are mostly between its own
+    floes and little memory moves between the cores. At N = 20000,
+    Ā = 0.7, two threads ran about 1.3 times faster on a field in this
+    order than on the same field numbered by size (README, benchmarks).
+    """
+    p = np.asarray(positions, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise ValueError(f"positions must have shape (N, 2), got {p.shape}")
+    check_range("levels", levels, 1, 16)
+    top = (1 << int(levels)) - 1
+    ix = np.clip(np.floor(p[:, 0] / box.lx * (top + 1)), 0, top).astype(np.int64)
+    iy = np.clip(np.floor(p[:, 1] / box.ly * (top + 1)), 0, top).astype(np.int64)
+    key = _spread_bits(ix) | (_spread_bits(iy) << np.uint64(1))
+    return np.argsort(key, kind="stable")
+
+
 def make_floe_field(n: int, *, concentration: float, alpha: float, mean_diameter: float,
                     thickness: float = 1.5, density: float = 910.0, seed: int | None = 0,
                     fsd: str = "rank", aspect: float = 1.0, velocity_std: float = 0.0,
@@ -474,7 +523,9 @@ def make_floe_field(n: int, *, concentration: float, alpha: float, mean_diameter
     (:func:`domain_size`), non-overlapping placement (:func:`place_floes`)
     and Gaussian velocities of standard deviation ``velocity_std`` [m/s] per
     component; every random number comes from
-    ``np.random.default_rng(seed)``.
+    ``np.random.default_rng(seed)``. The floes are then numbered in
+    :func:`spatial_order` (not by size: use ``np.argsort(-field.radii)`` for
+    that order).
 
     Returns (field, box).
     """
@@ -489,4 +540,5 @@ def make_floe_field(n: int, *, concentration: float, alpha: float, mean_diameter
     pos = place_floes(r, box, rng)
     vel = (rng.normal(0.0, velocity_std, size=(d.size, 2)) if velocity_std > 0
            else np.zeros((d.size, 2)))
-    return FloeField(pos, r, thickness, vel, density=density), box
+    field_ = FloeField(pos, r, thickness, vel, density=density)
+    return field_.take(spatial_order(field_.positions, box)), box

@@ -11,7 +11,7 @@ from scipy import stats
 from physics import (FloeField, PeriodicBox, PlacementError, WalledBox, domain_size,
                      make_floe_field, place_floes, power_law_diameters, rank_order_diameters,
                      sample_power_law_diameters)
-from physics.floes import max_overlap
+from physics.floes import max_overlap, spatial_order
 
 
 def ml_exponent(x, k=1):
@@ -196,3 +196,38 @@ def test_repeated_sample_has_the_same_sizes_in_a_wider_box(fsd):
 def test_repeat_must_be_a_positive_whole_number(repeat):
     with pytest.raises(ValueError, match="repeat"):
         make_floe_field(100, concentration=0.5, alpha=1.5, mean_diameter=2.0, repeat=repeat)
+
+
+def test_spatial_order_numbers_floes_along_a_z_curve():
+    """Four floes in the four quadrants of a box come out in Z order (lower
+    left, lower right, upper left, upper right), and a generated field is
+    numbered so that the floes of the lower half of the box come first (the
+    top level of the curve) and consecutive floes are close: the mean
+    distance between floes i and i + 1 is under a tenth of the box side
+    (about half of it for a random numbering)."""
+    box = PeriodicBox(100.0)
+    pos = np.array([[70.0, 80.0], [20.0, 80.0], [80.0, 10.0], [10.0, 30.0]])
+    assert list(spatial_order(pos, box)) == [3, 2, 1, 0]
+    floes, box = make_floe_field(2000, concentration=0.6, alpha=1.8, mean_diameter=8.0, seed=4)
+    upper = (floes.positions[:, 1] >= 0.5 * box.ly).astype(int)
+    assert np.all(np.diff(upper) >= 0) and 0.3 < upper.mean() < 0.7
+    step = np.linalg.norm(np.diff(floes.positions, axis=0), axis=1)
+    assert step.mean() < 0.1 * box.lx
+    with pytest.raises(ValueError, match="shape"):
+        spatial_order(np.zeros(3), box)
+
+
+def test_take_renumbers_every_floe_property():
+    """``take`` keeps each floe's radius, thickness, velocities and frozen
+    flag together, and rejects indices out of range."""
+    f = FloeField(np.array([[0.0, 0.0], [5.0, 0.0], [10.0, 0.0]]), [1.0, 2.0, 1.5],
+                  thickness=[1.0, 2.0, 3.0], velocities=[[1.0, 0.0], [0.0, 0.0], [3.0, 0.0]],
+                  angular_velocities=[0.1, 0.0, 0.3], frozen=[False, True, False])
+    g = f.take([2, 0, 1])
+    np.testing.assert_array_equal(g.radii, [1.5, 1.0, 2.0])
+    np.testing.assert_array_equal(g.thickness, [3.0, 1.0, 2.0])
+    np.testing.assert_array_equal(g.velocities[:, 0], [3.0, 1.0, 0.0])
+    np.testing.assert_array_equal(g.angular_velocities, [0.3, 0.1, 0.0])
+    np.testing.assert_array_equal(g.frozen, [False, False, True])
+    with pytest.raises(ValueError, match="outside"):
+        f.take([0, 3])
