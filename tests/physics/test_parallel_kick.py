@@ -29,19 +29,21 @@ def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
     fv = np.array([6.0, -3.0, 0.0, 0.0])
     ref = sim.positions + rng.normal(0.0, 0.05, (n, 2))
 
+    def fresh_state():
+        return [sim.positions.copy(), sim.velocities.copy(), sim.angular_velocities.copy(),
+                fbuf.copy(), tbuf.copy()]
+
     def run(kernel, *lead):
-        state = [sim.positions.copy(), sim.velocities.copy(), sim.angular_velocities.copy(),
-                 fbuf.copy(), tbuf.copy()]
+        state = fresh_state()
         out = kernel(*lead, 0.002, 0.002, *state, shared, sim.inv_mass, sim.inv_inertia,
                      box.lx, box.ly, True, True, 1.0, 1.0, ref.copy(), 0.01, -0.02, sim._drag,
                      fv, True)
         return np.array(out), state
 
-    def serial_pass(*lead, shared_mask=shared):
+    def serial_pass():
         """The serial path: the buffers added up, then the kick of buffer 0."""
-        state = [sim.positions.copy(), sim.velocities.copy(), sim.angular_velocities.copy(),
-                 fbuf.copy(), tbuf.copy()]
-        K.gather_buffers(0, n, state[3], state[4], shared_mask)
+        state = fresh_state()
+        K.gather_buffers(0, n, state[3], state[4], shared)
         out = K.first_half(0, n, 0.002, 0.002, *state[:3], state[3][0], state[4][0],
                            sim.inv_mass, sim.inv_inertia, box.lx, box.ly, True, True, 1.0, 1.0,
                            ref.copy(), 0.01, -0.02, sim._drag, fv, True)
