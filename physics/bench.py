@@ -451,7 +451,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
 
     def arrays(n_buf):
         owners, bounds = K.owner_chunks(sim._start, n_buf)
-        shared = K.scatter_mask(owners, bounds, sim._start, sim._nbr, sim.n_floes)
+        shared = K.scatter_floes(owners, bounds, sim._start, sim._nbr, sim.n_floes)
         return (owners, bounds, shared, sim.positions.copy(), sim.velocities.copy(),
                 sim.angular_velocities.copy(), sim.radius, sim.inv_mass, sim.inv_inertia,
                 sim._cp, box, sim._start, sim._nbr, sim._hist.copy(),

@@ -368,24 +368,24 @@ def test_parallel_path_equals_serial_path(box_type):
 
 
 @pytest.mark.parametrize("n_chunks", [2, 3])
-def test_scatter_mask_marks_every_floe_the_extra_buffers_can_hold(n_chunks):
-    """The kick adds the private force buffers 1, 2, ... only where
-    ``scatter_mask`` is set: every floe that a pair of chunk c ≥ 1 touches
-    (owner or partner) must be marked, and in loose ice (A = 0.6) most
-    floes must not be, or the mask would save nothing."""
-    from physics.hertz_kernels import owner_chunks, scatter_mask
+def test_scatter_floes_lists_every_floe_the_extra_buffers_can_hold(n_chunks):
+    """The kick adds the private force buffers 1, 2, ... only for the floes
+    ``scatter_floes`` lists (sorted): every floe that a pair of chunk c ≥ 1
+    touches (owner or partner) must be listed, and in loose ice (A = 0.6)
+    most floes must not be, or the list would save nothing."""
+    from physics.hertz_kernels import owner_chunks, scatter_floes
 
     floes, box = make_floe_field(800, concentration=0.6, alpha=1.8, mean_diameter=8.0, seed=5)
     rank = radius_rank(floes.radii)
     start, nbr = build_pair_list(floes.positions, floes.radii, rank, box.lx, box.ly, True, True,
                                  0.4, choose_cell_size(floes.radii, box.lx, box.ly, 0.4))
     owners, bounds = owner_chunks(start, n_chunks)
-    mask = scatter_mask(owners, bounds, start, nbr, 800)
+    shared = scatter_floes(owners, bounds, start, nbr, 800)
     touched = set()
     for c in range(1, n_chunks):
         for i in owners[bounds[c]:bounds[c + 1]]:
             touched.add(int(i))
             touched.update(int(j) for j in nbr[start[i]:start[i + 1]])
     assert len(touched) > 0
-    assert set(np.flatnonzero(mask).tolist()) == touched
-    assert mask.sum() < 0.5 * 800
+    assert shared.tolist() == sorted(touched)
+    assert len(shared) < 0.5 * 800
