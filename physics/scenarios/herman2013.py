@@ -70,11 +70,14 @@ def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None) -> Hert
 
 def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_type=PeriodicBox):
     """Herman (2013) floe field (α = 1.8, mean radius 4 m, h = 1.5 m) at
-    ``concentration``; above the random-placement limit (0.85) it is placed
-    at 0.85 and compressed affinely with FIRE relaxation (below the jamming
-    point the floes then do not overlap; above it they form a jammed packing
-    in force balance)."""
-    place = min(concentration, 0.85)
+    ``concentration``. In a periodic box, above the random-placement limit
+    (0.85) it is placed at 0.85 and compressed affinely with FIRE relaxation
+    (below the jamming point the floes then do not overlap; above it they
+    form a jammed packing in force balance). A box with walls cannot be
+    compressed that way: the floes are placed at the concentration itself,
+    which works up to about 0.88 (beyond, placement fails with a
+    :class:`physics.floes.PlacementError` saying so)."""
+    place = min(concentration, 0.85) if box_type is PeriodicBox else concentration
     field, box = make_floe_field(n, concentration=place, alpha=HERMAN2013.fsd_exponent,
                                  mean_diameter=HERMAN2013.mean_diameter,
                                  thickness=HERMAN2013.thickness,
@@ -508,6 +511,9 @@ class MarginalIceZone(Experiment):
         if st is None:
             field, box = _field(p["floes"], p["concentration"], seed, aspect=p["aspect"],
                                 box_type=ChannelBox)
+            if p["open_water"] > 0.0:
+                # open water above the ice: the wall at the top moves away
+                box = ChannelBox(box.lx, box.ly * (1.0 + p["open_water"]))
             frozen = field.positions[:, 1] < p["edge_width"]
             if frozen.all() or not frozen.any():
                 raise ValueError(f"edge_width = {p['edge_width']} m freezes {int(frozen.sum())} "

@@ -104,3 +104,30 @@ def test_miz_fast_ice_holds_and_ice_moves_along_the_edge(tmp_path):
     prof = np.nanmean(ds["u_x_profile"].values[0, 0][-5:], axis=0)
     assert np.nanmean(prof[-3:]) > 0.01
     assert prof[0] < 0.5 * np.nanmean(prof[-3:])
+
+
+def test_miz_open_water_moves_the_top_wall_away(tmp_path):
+    """With open_water = 1 the channel is twice as wide as the ice: at the
+    start every floe lies in the lower half, and the upper half of the
+    u_x(y) profile is open water (NaN) at the first output."""
+    ds = _run("herman2013-miz", tmp_path / "o", floes=200, wind_y=[-5.0], duration=20.0,
+              output_interval=10.0, snapshot_times=[], profile_bins=8, open_water=1.0)
+    ly = float(ds["snapshot_ly"].values[0, 0, 0])
+    y = ds["floe_y"].values[0, 0, 0]
+    r = ds["floe_radius"].values[0, 0, 0]
+    assert np.all(y + r <= 0.5 * ly + 1.0)
+    assert np.all(np.isnan(ds["u_x_profile"].values[0, 0, 0, 4:]))
+    assert np.all(np.isfinite(ds["u_x_profile"].values[0, 0, 0, :4]))
+
+
+def test_channel_fields_are_placed_above_the_random_placement_limit():
+    """A channel (walls, no periodic compression) is filled directly at
+    A = 0.87: the floe area over the box area is 0.87 to 1e-9, and no two
+    floes overlap by more than 1 % of the smaller radius."""
+    from physics.domain import ChannelBox
+    from physics.floes import max_overlap
+    from physics.scenarios.herman2013 import _field
+
+    field, box = _field(400, 0.87, 3, aspect=0.5, box_type=ChannelBox)
+    assert field.total_area / (box.lx * box.ly) == pytest.approx(0.87, rel=1e-9)
+    assert max_overlap(field.positions, field.radii, box) <= 0.01
