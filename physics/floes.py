@@ -498,7 +498,8 @@ def spatial_order(positions, box: Box, levels: int = 12) -> np.ndarray:
     lower-left quarter), so a thread's contacts are mostly between its own
     floes and little memory moves between the cores. At N = 20000,
     Ā = 0.7, two threads ran about 1.3 times faster on a field in this
-    order than on the same field numbered by size (README, benchmarks).
+    order than on the same field numbered by size (2.26e8 against 1.74e8
+    floe-steps/s, with the scalar kick pass of the engine at the time).
     """
     p = np.asarray(positions, dtype=float)
     if p.ndim != 2 or p.shape[1] != 2:

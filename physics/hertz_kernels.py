@@ -361,9 +361,9 @@ def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, force, torque, inv_mass
     The loop body has no branch and no call (selects for the frozen floes,
     the wrap and the minimum image; maxima over the bits of non-negative
     floats, :func:`order_key`), and the (N, k) arrays are read as flat
-    arrays: so it vectorises (AVX2/AVX-512), about 2.5 times as fast as the
-    scalar loop (39 against 96 µs for 20000 floes, one core, timed on the
-    benchmark field). Its per-floe arithmetic is the same in the vector body
+    arrays: so it vectorises (AVX2/AVX-512), about 2.7 times as fast as the
+    scalar loop (34 against 94 µs for 20000 floes on one thread,
+    ``python -m physics.bench phases``). Its per-floe arithmetic is the same in the vector body
     and in the scalar remainder, so the new state does not depend on how the
     floes are cut into chunks; only the sums are reassociated."""
     if sx != 1.0 or sy != 1.0:

@@ -84,8 +84,6 @@ def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_
                                  density=HERMAN2013.forcing.ice_density, seed=seed,
                                  aspect=aspect, box_type=box_type)
     if concentration > place:
-        if box_type is not PeriodicBox:
-            raise ValueError(f"concentrations above 0.85 need a periodic box, got {concentration}")
         from ..jamming import compress_floes
         # above the field's jamming point the result is a jammed packing in force
         # balance (small overlaps), which the engine accepts as a start
