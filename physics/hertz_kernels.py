@@ -14,6 +14,14 @@ kernels run them over all pairs or floes, each in a serial and a parallel
   same floes (:func:`gather_buffers`). The threads share little memory when
   the floes are numbered in space (:func:`physics.floes.spatial_order`).
 
+In a periodic box the parallel step runs as a team of threads
+(:func:`team_steps`, :mod:`physics.thread_team`) that stays in one parallel
+region from one list rebuild to the next and meets at spin barriers between
+the kick–drift pass and the pair loop, instead of starting a parallel region
+for each (1–2.5 µs each on two threads). Boxes with walls use the kernels
+:func:`first_half_parallel`, :func:`wall_forces_parallel` and
+:func:`pair_forces_parallel`, one region each.
+
 Step (LAMMPS ``fix nve/sphere`` order): half kick with F(t) → drift →
 affine remap of a deforming box → drag and wall forces (they need only the
 floe itself) → Verlet-list check (and rebuild) → pair forces at t + Δt with
@@ -30,6 +38,8 @@ from numba.extending import intrinsic
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
+from .thread_team import (claim, overtaken, sync_size, take_token, task_done,
+                          wait_generation)
 
 # contact parameter vector layout
 CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL = range(8)
@@ -38,6 +48,8 @@ CP_SIZE = 8
 FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
 STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
+# why a team run (team_steps) returned early: the Verlet list must be rebuilt
+TEAM_ALL_DONE, TEAM_REBUILD = 0, 1
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
 
 
@@ -495,6 +507,138 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
     return combine_chunks(part)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def pass_status(worst, mx, my, vmax2, dt, skin):
+    """Status after a kick–drift pass with results (worst, mx, my, vmax2)
+    (:func:`first_half`): non-finite state, or a floe that crossed half the
+    skin in one step (the dynamics blew up), or OK."""
+    if not math.isfinite(worst + mx + my + vmax2):
+        return STATUS_NONFINITE
+    if vmax2 * dt * dt > 0.25 * skin * skin:
+        return STATUS_UNSTABLE
+    return STATUS_OK
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
+    """Whether the Verlet list may miss a pair: twice the largest
+    displacement since the build, plus what a shrinking box takes off the
+    distances (up to the longest cut-off), reaches the skin."""
+    shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
+    return 2.0 * math.sqrt(worst) + shrink * max_cut >= skin
+
+
+@njit(cache=True, error_model="numpy")
+def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
+              lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part):
+    """Task k of the kick–drift pass of a team (:func:`team_member`): the
+    k-th of ``n_tasks`` equal runs of floes, as in :func:`first_half_parallel`."""
+    n = pos.shape[0]
+    lo = k * n // n_tasks
+    hi = (k + 1) * n // n_tasks
+    gather_buffers(lo, hi, fbuf, tbuf, shared)
+    w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi], omega[lo:hi],
+                                 fbuf[0, lo:hi], tbuf[0, lo:hi], inv_mass[lo:hi],
+                                 inv_inertia[lo:hi], lx, ly, px, py, sx, sy, ref[lo:hi], cx, cy,
+                                 drag[lo:hi], fv, has_drag)
+    part[k, 0] = w
+    part[k, 1] = sx_
+    part[k, 2] = sy_
+    part[k, 3] = v2
+
+
+@njit(cache=True, error_model="numpy")
+def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel,
+                omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
+                max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
+                ref, ref_lengths, cx, cy, fbuf, tbuf):
+    """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
+    periodic box, each a kick–drift phase and a pair phase of ``n_tasks``
+    tasks (:mod:`physics.thread_team`).
+
+    Every thread makes the same decisions (stop, rebuild) from the same
+    partial results ``part`` of the kick pass. The thread that takes the
+    token writes (steps done, status, reason, centre x, centre y) to
+    ``out``."""
+    n = pos.shape[0]
+    px = box[BOX_PX] != 0.0
+    py = box[BOX_PY] != 0.0
+    deform = box[BOX_DEFORM] != 0.0
+    lx_old, ly_old = lx0, ly0
+    status = STATUS_OK
+    reason = TEAM_ALL_DONE
+    done = 0
+    g = 0
+    for s in range(n_steps):
+        if deform:
+            lx, ly, conc = box_lengths_at(box, time + (step0 + s + 1) * dt)
+            if conc >= max_concentration or conc <= 0.0:
+                status = STATUS_CONCENTRATION
+                break
+        else:
+            lx, ly = lx_old, ly_old
+        dt_kick = 0.5 * dt if step0 + s == 0 else dt
+        g += 1
+        for m in range(n_tasks):
+            k = (t + m) % n_tasks          # its own task first
+            if claim(sync, k, g):
+                if k == 0:
+                    # only the pair phase reads the box lengths
+                    box[BOX_LX] = lx
+                    box[BOX_LY] = ly
+                kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                          inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, cx, cy,
+                          drag, fv, has_drag, part)
+                task_done(sync, n_tasks)
+        wait_generation(sync, n_tasks, g)
+        worst, mx, my, vmax2 = combine_chunks(part)
+        if overtaken(sync, n_tasks, g + 1):
+            return                          # left behind: the others finish the run
+        done += 1
+        status = pass_status(worst, mx, my, vmax2, dt, skin)
+        if status != STATUS_OK:
+            break
+        cx = mx / n
+        cy = my / n
+        if list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
+            reason = TEAM_REBUILD
+            break
+        g += 1
+        for m in range(n_tasks):
+            k = (t + m) % n_tasks
+            if claim(sync, k, g):
+                run = owners[bounds[k]:bounds[k + 1]]
+                owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box,
+                            start, nbr, hist, dt, fbuf[k], tbuf[k])
+                task_done(sync, n_tasks)
+        wait_generation(sync, n_tasks, g)
+        lx_old, ly_old = lx, ly
+    if take_token(sync, n_tasks):
+        out[0] = done
+        out[1] = status
+        out[2] = reason
+        out[3] = cx
+        out[4] = cy
+
+
+@njit(cache=False, parallel=True, error_model="numpy")
+def team_steps(n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel, omega,
+               radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box, max_concentration,
+               skin, max_cut, owners, bounds, shared, start, nbr, hist, ref, ref_lengths, cx, cy,
+               fbuf, tbuf):
+    """Steps of a periodic box by a team of threads that stays in one
+    parallel region (:func:`team_member`; :mod:`physics.thread_team`) until
+    the run ends or the Verlet list must be rebuilt. Same arithmetic, in
+    the same order, as the step of :func:`run_steps` with
+    :func:`first_half_parallel` and :func:`pair_forces_parallel`: the new
+    state is the same bit for bit."""
+    for t in prange(n_tasks):
+        team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel,
+                    omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
+                    max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
+                    ref, ref_lengths, cx, cy, fbuf, tbuf)
+
+
 @njit(cache=True, error_model="numpy")
 def half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt):
     """v += Δt/2 F/m, ω += Δt/2 T/I (the last half kick of a run)."""
@@ -557,7 +701,42 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     shared = scatter_floes(owners, bounds, start, nbr, n)
     done = 0
     status = STATUS_OK
-    for step in range(n_steps):
+    # parallel path in a periodic box: a team of threads that stays in one
+    # parallel region between list rebuilds (same arithmetic as the loop
+    # below, which does the serial path and boxes with walls)
+    team = parallel and not walls
+    sync = np.zeros(sync_size(n_buf), dtype=np.int64)
+    part = np.empty((n_buf, 4))
+    out = np.empty(5)
+    step = 0
+    while step < n_steps:
+        if team:
+            sync[:] = 0
+            team_steps(n_buf, sync, part, out, n_steps - step, step, dt, time, box[BOX_LX],
+                       box[BOX_LY], pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv,
+                       has_drag, cp, box, max_concentration, skin, max_cut, owners, bounds,
+                       shared, start, nbr, hist, ref, ref_lengths, centre[0], centre[1], fbuf,
+                       tbuf)
+            k = int(out[0])
+            status = int(out[1])
+            centre[0] = out[3]
+            centre[1] = out[4]
+            done += k
+            step += k
+            if status != STATUS_OK or int(out[2]) != TEAM_REBUILD:
+                break
+            start, nbr, hist, ref = rebuild(pos, radius, rank, box[BOX_LX], box[BOX_LY], px, py,
+                                            skin, cell_size, start, nbr, hist, parallel)
+            ref_lengths[0] = box[BOX_LX]
+            ref_lengths[1] = box[BOX_LY]
+            centre[0] = 0.0
+            centre[1] = 0.0
+            owners, bounds = owner_chunks(start, n_buf)
+            shared = scatter_floes(owners, bounds, start, nbr, n)
+            n_rebuilds += 1
+            pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box,
+                                 start, nbr, hist, dt, fbuf, tbuf)
+            continue
         t_new = time + (step + 1) * dt
         lx_old, ly_old = box[BOX_LX], box[BOX_LY]
         lx, ly, conc = box_lengths_at(box, t_new)
@@ -578,12 +757,8 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
                 ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv,
                 has_drag)
         done += 1
-        if not math.isfinite(worst + mx + my + vmax2):
-            status = STATUS_NONFINITE
-            break
-        if vmax2 * dt * dt > 0.25 * skin * skin:
-            # a floe crossed half the skin in one step: the dynamics blew up
-            status = STATUS_UNSTABLE
+        status = pass_status(worst, mx, my, vmax2, dt, skin)
+        if status != STATUS_OK:
             break
         if walls:
             if parallel:
@@ -594,8 +769,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
                             fbuf[0], tbuf[0])
         centre[0] = mx / n
         centre[1] = my / n
-        shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
-        if 2.0 * math.sqrt(worst) + shrink * max_cut >= skin:
+        if list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
             start, nbr, hist, ref = rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size,
                                             start, nbr, hist, parallel)
             ref_lengths[0] = lx
@@ -612,6 +786,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         else:
             owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
                         start, nbr, hist, dt, fbuf[0], tbuf[0])
+        step += 1
     # total force of the last step, and the closing half kick
     force[:] = fbuf.sum(axis=0)
     torque[:] = tbuf.sum(axis=0)
