@@ -295,6 +295,17 @@ def scatter_floes(owners, bounds, start, nbr, n):
     return np.nonzero(mask)[0]
 
 
+@njit(cache=True, error_model="numpy")
+def pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
+              dt_history, fbuf, tbuf):
+    """Chunk k of the parallel pair loop (:func:`pair_forces_parallel`, a
+    task of :func:`team_member`): :func:`owner_pairs` over the k-th run of
+    owners of :func:`owner_chunks`, into the private buffers fbuf[k], tbuf[k]."""
+    run = owners[bounds[k]:bounds[k + 1]]
+    owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
+                hist, dt_history, fbuf[k], tbuf[k])
+
+
 # Parallel kernels that other compiled kernels call are never cached on disk
 # (cache=False): when a caller is compiled in a process that loaded such a
 # callee from Numba's cache, the caller's own cache entry crashes every later
@@ -307,9 +318,8 @@ def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, 
     parallel, chunk c scattering into its private buffers fbuf[c], tbuf[c]:
     race-free (see the module docstring)."""
     for c in prange(bounds.shape[0] - 1):
-        run = owners[bounds[c]:bounds[c + 1]]
-        owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box,
-                    start, nbr, hist, dt_history, fbuf[c], tbuf[c])
+        pair_task(c, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
+                  dt_history, fbuf, tbuf)
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
@@ -464,6 +474,27 @@ def combine_chunks(part):
     return worst, sx, sy, vmax2
 
 
+@njit(cache=True, error_model="numpy")
+def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
+              lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part):
+    """Part k of a parallel kick–drift pass (:func:`first_half_parallel`, a
+    task of :func:`team_member`): :func:`gather_buffers` and
+    :func:`first_half` over the k-th of ``n_tasks`` equal runs of floes,
+    its results in part[k]."""
+    n = pos.shape[0]
+    lo = k * n // n_tasks
+    hi = (k + 1) * n // n_tasks
+    gather_buffers(lo, hi, fbuf, tbuf, shared)
+    w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi], omega[lo:hi],
+                                 fbuf[0, lo:hi], tbuf[0, lo:hi], inv_mass[lo:hi],
+                                 inv_inertia[lo:hi], lx, ly, px, py, sx, sy, ref[lo:hi], cx, cy,
+                                 drag[lo:hi], fv, has_drag)
+    part[k, 0] = w
+    part[k, 1] = sx_
+    part[k, 2] = sy_
+    part[k, 3] = v2
+
+
 @njit(cache=False, parallel=True, error_model="numpy")
 def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                         inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
@@ -486,24 +517,14 @@ def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, sha
     not depend on the number of threads, cost 2 µs more per pass at N =
     20000 on two threads, about 10 %.)
 
-    Each run gets views of its floes and loops from a start index known at
-    compile time to be 0: with a start known only at run time the compiler
-    cannot rule out negative indices, and the loop does not vectorise (2.5
-    times as slow)."""
-    n = pos.shape[0]
+    Each run gets views of its floes (:func:`kick_task`) and loops from a
+    start index known at compile time to be 0: with a start known only at
+    run time the compiler cannot rule out negative indices, and the loop
+    does not vectorise (2.5 times as slow)."""
     part = np.empty((n_threads, 4))
     for t in prange(n_threads):
-        lo = t * n // n_threads
-        hi = (t + 1) * n // n_threads
-        gather_buffers(lo, hi, fbuf, tbuf, shared)
-        w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi],
-                                     omega[lo:hi], fbuf[0, lo:hi], tbuf[0, lo:hi],
-                                     inv_mass[lo:hi], inv_inertia[lo:hi], lx, ly, px, py, sx,
-                                     sy, ref[lo:hi], cx, cy, drag[lo:hi], fv, has_drag)
-        part[t, 0] = w
-        part[t, 1] = sx_
-        part[t, 2] = sy_
-        part[t, 3] = v2
+        kick_task(t, n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                  inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part)
     return combine_chunks(part)
 
 
@@ -526,25 +547,6 @@ def list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
     distances (up to the longest cut-off), reaches the skin."""
     shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
     return 2.0 * math.sqrt(worst) + shrink * max_cut >= skin
-
-
-@njit(cache=True, error_model="numpy")
-def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
-              lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part):
-    """Task k of the kick–drift pass of a team (:func:`team_member`): the
-    k-th of ``n_tasks`` equal runs of floes, as in :func:`first_half_parallel`."""
-    n = pos.shape[0]
-    lo = k * n // n_tasks
-    hi = (k + 1) * n // n_tasks
-    gather_buffers(lo, hi, fbuf, tbuf, shared)
-    w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi], omega[lo:hi],
-                                 fbuf[0, lo:hi], tbuf[0, lo:hi], inv_mass[lo:hi],
-                                 inv_inertia[lo:hi], lx, ly, px, py, sx, sy, ref[lo:hi], cx, cy,
-                                 drag[lo:hi], fv, has_drag)
-    part[k, 0] = w
-    part[k, 1] = sx_
-    part[k, 2] = sy_
-    part[k, 3] = v2
 
 
 @njit(cache=True, error_model="numpy")
@@ -607,9 +609,8 @@ def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0,
         for m in range(n_tasks):
             k = (t + m) % n_tasks
             if claim(sync, k, g):
-                run = owners[bounds[k]:bounds[k + 1]]
-                owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box,
-                            start, nbr, hist, dt, fbuf[k], tbuf[k])
+                pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start,
+                          nbr, hist, dt, fbuf, tbuf)
                 task_done(sync, n_tasks)
         wait_generation(sync, n_tasks, g)
         lx_old, ly_old = lx, ly
@@ -702,8 +703,9 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     done = 0
     status = STATUS_OK
     # parallel path in a periodic box: a team of threads that stays in one
-    # parallel region between list rebuilds (same arithmetic as the loop
-    # below, which does the serial path and boxes with walls)
+    # parallel region between list rebuilds; the serial path and boxes with
+    # walls kick one step at a time. Both end a step whose list expired with
+    # the same rebuild and pair loop.
     team = parallel and not walls
     sync = np.zeros(sync_size(n_buf), dtype=np.int64)
     part = np.empty((n_buf, 4))
@@ -725,51 +727,45 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
             step += k
             if status != STATUS_OK or int(out[2]) != TEAM_REBUILD:
                 break
-            start, nbr, hist, ref = rebuild(pos, radius, rank, box[BOX_LX], box[BOX_LY], px, py,
-                                            skin, cell_size, start, nbr, hist, parallel)
-            ref_lengths[0] = box[BOX_LX]
-            ref_lengths[1] = box[BOX_LY]
-            centre[0] = 0.0
-            centre[1] = 0.0
-            owners, bounds = owner_chunks(start, n_buf)
-            shared = scatter_floes(owners, bounds, start, nbr, n)
-            n_rebuilds += 1
-            pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box,
-                                 start, nbr, hist, dt, fbuf, tbuf)
-            continue
-        t_new = time + (step + 1) * dt
-        lx_old, ly_old = box[BOX_LX], box[BOX_LY]
-        lx, ly, conc = box_lengths_at(box, t_new)
-        if box[BOX_DEFORM] != 0.0 and (conc >= max_concentration or conc <= 0.0):
-            status = STATUS_CONCENTRATION
-            break
-        box[BOX_LX] = lx
-        box[BOX_LY] = ly
-        dt_kick = 0.5 * dt if step == 0 else dt
-        if parallel:
-            worst, mx, my, vmax2 = first_half_parallel(
-                n_buf, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia, lx,
-                ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv,
-                has_drag)
+            # the team stopped after the kick of a step whose list expired:
+            # rebuild and finish that step below
+            lx, ly = box[BOX_LX], box[BOX_LY]
+            expired = True
         else:
-            worst, mx, my, vmax2 = first_half(
-                0, n, dt_kick, dt, pos, vel, omega, fbuf[0], tbuf[0], inv_mass, inv_inertia, lx,
-                ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag, fv,
-                has_drag)
-        done += 1
-        status = pass_status(worst, mx, my, vmax2, dt, skin)
-        if status != STATUS_OK:
-            break
-        if walls:
+            lx_old, ly_old = box[BOX_LX], box[BOX_LY]
+            lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
+            if box[BOX_DEFORM] != 0.0 and (conc >= max_concentration or conc <= 0.0):
+                status = STATUS_CONCENTRATION
+                break
+            box[BOX_LX] = lx
+            box[BOX_LY] = ly
+            dt_kick = 0.5 * dt if step == 0 else dt
             if parallel:
-                wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
-                                     fbuf[0], tbuf[0])
+                worst, mx, my, vmax2 = first_half_parallel(
+                    n_buf, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                    inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0],
+                    centre[1], drag, fv, has_drag)
             else:
-                wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
-                            fbuf[0], tbuf[0])
-        centre[0] = mx / n
-        centre[1] = my / n
-        if list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
+                worst, mx, my, vmax2 = first_half(
+                    0, n, dt_kick, dt, pos, vel, omega, fbuf[0], tbuf[0], inv_mass, inv_inertia,
+                    lx, ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag,
+                    fv, has_drag)
+            done += 1
+            step += 1
+            status = pass_status(worst, mx, my, vmax2, dt, skin)
+            if status != STATUS_OK:
+                break
+            if walls:
+                if parallel:
+                    wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist,
+                                         dt, fbuf[0], tbuf[0])
+                else:
+                    wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
+                                fbuf[0], tbuf[0])
+            centre[0] = mx / n
+            centre[1] = my / n
+            expired = list_expired(worst, lx, ly, ref_lengths, max_cut, skin)
+        if expired:
             start, nbr, hist, ref = rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size,
                                             start, nbr, hist, parallel)
             ref_lengths[0] = lx
@@ -786,7 +782,6 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
         else:
             owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
                         start, nbr, hist, dt, fbuf[0], tbuf[0])
-        step += 1
     # total force of the last step, and the closing half kick
     force[:] = fbuf.sum(axis=0)
     torque[:] = tbuf.sum(axis=0)
