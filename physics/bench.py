@@ -407,10 +407,10 @@ def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, owners, bounds, sh
     for _ in range(passes):
         if kick:
             if parallel:
-                res = K.first_half_parallel(n_threads, still, still, pos, vel, omega, fbuf, tbuf,
-                                            shared, inv_mass, inv_inertia, lx, ly, periodic,
-                                            periodic, unit, unit, ref, still, still, drag, fv,
-                                            False)
+                res = K.first_half_parallel(n_threads * K.KICK_TASKS_PER_THREAD, still, still,
+                                            pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                                            inv_inertia, lx, ly, periodic, periodic, unit, unit,
+                                            ref, still, still, drag, fv, False)
             else:
                 res = K.first_half(0, n, still, still, pos, vel, omega, fbuf[0], tbuf[0],
                                    inv_mass, inv_inertia, lx, ly, periodic, periodic, unit, unit,
@@ -422,7 +422,8 @@ def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, owners, bounds, sh
                                        box, start, nbr, hist, dt, fbuf, tbuf)
             else:
                 K.owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp,
-                              box, start, nbr, hist, dt, fbuf[0], tbuf[0])
+                              box, start, nbr, hist, dt, fbuf[0], tbuf[0], 0, n, fbuf[0],
+                              tbuf[0])
     return total
 
 
@@ -449,8 +450,9 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
     box = sim.box.kernel_array(sim.time)
     fv = sim._forcing_vector()
 
-    def arrays(n_buf):
-        owners, bounds = K.owner_chunks(sim._start, n_buf)
+    def arrays(n_chunks):
+        owners, bounds = K.owner_chunks(sim._start, n_chunks)
+        n_buf = n_chunks + 1 if n_chunks > 1 else 1      # as in K.run_steps
         shared = K.scatter_floes(owners, bounds, sim._start, sim._nbr, sim.n_floes)
         return (owners, bounds, shared, sim.positions.copy(), sim.velocities.copy(),
                 sim.angular_velocities.copy(), sim.radius, sim.inv_mass, sim.inv_inertia,

@@ -7,12 +7,19 @@ kernels run them over all pairs or floes, each in a serial and a parallel
 * serial pair loop: one pass over the Verlet list, the force of a pair is
   added to i and subtracted from j at once (a scatter);
 * parallel pair loop: the owners of the list are split into as many chunks
-  as there are threads, with equal numbers of pairs; each chunk scatters into
-  its own private force buffer (``fbuf[c]``, ``tbuf[c]``), so no two chunks
-  ever write the same memory. The buffers are summed per floe at the start
-  of the next step, chunk by chunk just before the kick and drift of the
-  same floes (:func:`gather_buffers`). The threads share little memory when
-  the floes are numbered in space (:func:`physics.floes.spatial_order`).
+  as there are threads, with equal numbers of pairs. The owners of chunk c
+  lie in a range of floe numbers of their own (:func:`chunk_range`; the
+  ranges of the chunks cut 0 … N−1 into consecutive pieces): a chunk adds
+  the forces of floes in its range straight to the shared buffer
+  (``fbuf[0]``, ``tbuf[0]``), which no other chunk writes there, and those
+  of partners outside it to its private buffer (``fbuf[c + 1]``,
+  ``tbuf[c + 1]``). So no two chunks ever write the same memory. The
+  private buffers are added per floe at the start of the next step, just
+  before the kick and drift of the same floes (:func:`gather_buffers`).
+  When the floes are numbered in space
+  (:func:`physics.floes.spatial_order`) partners are mostly in the same
+  range, the private buffers hold only the floes along the cuts, and the
+  threads share little memory.
 
 In a periodic box the parallel step runs as a team of threads
 (:func:`team_steps`, :mod:`physics.thread_team`) that stays in one parallel
@@ -38,7 +45,7 @@ from numba.extending import intrinsic
 from .contact import hertz_mindlin_force
 from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
-from .thread_team import (claim, overtaken, sync_size, take_token, task_done,
+from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
                           wait_generation)
 
 # contact parameter vector layout
@@ -51,6 +58,10 @@ STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
 # why a team run (team_steps) returned early: the Verlet list must be rebuilt
 TEAM_ALL_DONE, TEAM_REBUILD = 0, 1
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
+# tasks per thread of the parallel kick–drift pass: in the thread team
+# (team_steps) a thread that is done with its own tasks takes over the last
+# ones of a slower thread
+KICK_TASKS_PER_THREAD = 2
 
 
 # ---------------------------------------------------------------------------
@@ -208,9 +219,11 @@ def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
 
 @njit(cache=True, error_model="numpy")
 def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                dt_history, force, torque):
+                dt_history, force, torque, j_lo, j_hi, force_out, torque_out):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
-    both floes of its pair at once (a scatter into ``force``, ``torque``).
+    both floes of its pair at once (a scatter into ``force``, ``torque``;
+    for a partner j outside j_lo ≤ j < j_hi into ``force_out``,
+    ``torque_out`` instead).
 
     Only floes that touch are written: in loose ice most listed pairs are
     apart, and a write of zero would still claim the cache line for this
@@ -239,9 +252,14 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
                 fxi += res[1]
                 fyi += res[2]
                 tqi += res[3]
-                force[j, 0] -= res[1]
-                force[j, 1] -= res[2]
-                torque[j] += res[4]
+                if j_lo <= j < j_hi:
+                    force[j, 0] -= res[1]
+                    force[j, 1] -= res[2]
+                    torque[j] += res[4]
+                else:
+                    force_out[j, 0] -= res[1]
+                    force_out[j, 1] -= res[2]
+                    torque_out[j] += res[4]
         if fxi != 0.0 or fyi != 0.0 or tqi != 0.0:
             force[i, 0] += fxi
             force[i, 1] += fyi
@@ -259,7 +277,7 @@ def forces_serial(pos, vel, omega, radius, inv_mass, drag, fv, cp, box, start, n
                     force, torque)
     owners = np.nonzero(start[1:] > start[:-1])[0]
     owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                hist, dt_history, force, torque)
+                hist, dt_history, force, torque, 0, n, force, torque)
 
 
 @njit(cache=True, error_model="numpy")
@@ -278,20 +296,38 @@ def owner_chunks(start, n_chunks):
     return owners, bounds
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def chunk_range(c, owners, bounds, n):
+    """(lo, hi): the floe numbers lo ≤ i < hi whose forces chunk c of
+    :func:`owner_chunks` writes to the shared buffer, from its first owner
+    to the first owner of the next chunk (0 for the first chunk, N for the
+    last): consecutive pieces of 0 … N−1 that hold every owner of the
+    chunk."""
+    n_owners = owners.shape[0]
+    lo = 0 if c == 0 else (owners[bounds[c]] if bounds[c] < n_owners else n)
+    last = bounds.shape[0] - 2
+    hi = n if c == last else (owners[bounds[c + 1]] if bounds[c + 1] < n_owners else n)
+    return lo, hi
+
+
 @njit(cache=True, error_model="numpy")
 def scatter_floes(owners, bounds, start, nbr, n):
-    """The floes, in increasing order, that chunks 1, 2, ... of
-    :func:`owner_chunks` can write (their owners and the partners of
-    those): only these floes have non-zero entries in the private buffers
-    fbuf[1:], tbuf[1:] that the next kick must add up. In loose ice most
-    floes own no pair and are nobody's partner, and the kick does not look
-    at their extra buffers at all."""
+    """The floes, in increasing order, that the chunks of
+    :func:`owner_chunks` can write to their private buffers (partners
+    outside the chunk's :func:`chunk_range`): only these floes can have
+    non-zero entries in fbuf[1:], tbuf[1:] that the next kick must add up.
+    With the floes numbered in space they are the few along the cuts
+    between the ranges; the kick does not look at the private buffers of
+    the others at all."""
     mask = np.zeros(n, dtype=np.uint8)
-    for k in range(bounds[1], bounds[bounds.shape[0] - 1]):
-        i = owners[k]
-        mask[i] = 1
-        for p in range(start[i], start[i + 1]):
-            mask[nbr[p]] = 1
+    for c in range(bounds.shape[0] - 1):
+        lo, hi = chunk_range(c, owners, bounds, n)
+        for k in range(bounds[c], bounds[c + 1]):
+            i = owners[k]
+            for p in range(start[i], start[i + 1]):
+                j = nbr[p]
+                if j < lo or j >= hi:
+                    mask[j] = 1
     return np.nonzero(mask)[0]
 
 
@@ -300,10 +336,15 @@ def pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, sta
               dt_history, fbuf, tbuf):
     """Chunk k of the parallel pair loop (:func:`pair_forces_parallel`, a
     task of :func:`team_member`): :func:`owner_pairs` over the k-th run of
-    owners of :func:`owner_chunks`, into the private buffers fbuf[k], tbuf[k]."""
+    owners of :func:`owner_chunks`, into the shared buffers fbuf[0],
+    tbuf[0] for the floes of its :func:`chunk_range` and into its private
+    buffers fbuf[k + 1], tbuf[k + 1] for the others (with one chunk,
+    every floe is in its range)."""
     run = owners[bounds[k]:bounds[k + 1]]
+    lo, hi = chunk_range(k, owners, bounds, pos.shape[0])
+    b = min(k + 1, fbuf.shape[0] - 1)
     owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                hist, dt_history, fbuf[k], tbuf[k])
+                hist, dt_history, fbuf[0], tbuf[0], lo, hi, fbuf[b], tbuf[b])
 
 
 # Parallel kernels that other compiled kernels call are never cached on disk
@@ -315,8 +356,7 @@ def pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, sta
 def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
                          hist, dt_history, fbuf, tbuf):
     """:func:`owner_pairs` over the chunks of :func:`owner_chunks` in
-    parallel, chunk c scattering into its private buffers fbuf[c], tbuf[c]:
-    race-free (see the module docstring)."""
+    parallel (:func:`pair_task`): race-free (see the module docstring)."""
     for c in prange(bounds.shape[0] - 1):
         pair_task(c, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
                   dt_history, fbuf, tbuf)
@@ -496,34 +536,34 @@ def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def first_half_parallel(n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+def first_half_parallel(n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                         inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
     """:func:`first_half` over all floes in parallel (no race), each thread
     first adding up its floes' private pair-force buffers
     (:func:`gather_buffers`).
 
-    Thread t always does the same consecutive run of floes, so from step to
-    step each core keeps its floes in its own caches. The chunks of the
-    pair loop (:func:`owner_chunks`) hold equal numbers of pairs; when the
-    floes are numbered in space (:func:`physics.floes.spatial_order`, as
+    The floes are cut into ``n_tasks`` consecutive runs (a few per
+    thread, :data:`KICK_TASKS_PER_THREAD`); the runtime gives each thread
+    the same consecutive block of runs every step, so each core keeps its
+    floes in its own caches. The chunks of the pair loop
+    (:func:`owner_chunks`) hold equal numbers of pairs; when the floes are
+    numbered in space (:func:`physics.floes.spatial_order`, as
     :func:`physics.floes.make_floe_field` does) both splits cut the box into
     about the same patches, and a thread mostly reads and writes its own
-    floes in both loops. Each thread writes only its own floes and its own
-    row of the partial results, which are reduced in thread order: the new
+    floes in both loops. Each task writes only its own floes and its own
+    row of the partial results, which are reduced in task order: the new
     state of every floe is the same bit for bit for any number of threads
-    (and equal to the serial pass), the sums of the displacements equal to
-    rounding, and the outcome for a given number of threads is repeatable.
-    (One run per thread: twelve smaller runs, whose reduced results did
-    not depend on the number of threads, cost 2 µs more per pass at N =
-    20000 on two threads, about 10 %.)
+    and tasks (and equal to the serial pass), the sums of the displacements
+    equal to rounding, and the outcome for a given number of tasks is
+    repeatable whatever thread did which task.
 
     Each run gets views of its floes (:func:`kick_task`) and loops from a
     start index known at compile time to be 0: with a start known only at
     run time the compiler cannot rule out negative indices, and the loop
     does not vectorise (2.5 times as slow)."""
-    part = np.empty((n_threads, 4))
-    for t in prange(n_threads):
-        kick_task(t, n_threads, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+    part = np.empty((n_tasks, 4))
+    for t in prange(n_tasks):
+        kick_task(t, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                   inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part)
     return combine_chunks(part)
 
@@ -550,13 +590,14 @@ def list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
 
 
 @njit(cache=True, error_model="numpy")
-def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel,
-                omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
-                max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
+def team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt, time,
+                lx0, ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp,
+                box, max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
                 ref, ref_lengths, cx, cy, fbuf, tbuf):
     """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
-    periodic box, each a kick–drift phase and a pair phase of ``n_tasks``
-    tasks (:mod:`physics.thread_team`).
+    periodic box, each a kick–drift phase of ``n_kick`` tasks and a pair
+    phase of ``n_threads`` tasks (one per force buffer), with their own
+    ``sync`` arrays (:mod:`physics.thread_team`).
 
     Every thread makes the same decisions (stop, rebuild) from the same
     partial results ``part`` of the kick pass. The thread that takes the
@@ -570,7 +611,8 @@ def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0,
     status = STATUS_OK
     reason = TEAM_ALL_DONE
     done = 0
-    g = 0
+    gk = 0                                  # generation of the kick phase
+    gp = 0                                  # and of the pair phase
     for s in range(n_steps):
         if deform:
             lx, ly, conc = box_lengths_at(box, time + (step0 + s + 1) * dt)
@@ -580,21 +622,21 @@ def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0,
         else:
             lx, ly = lx_old, ly_old
         dt_kick = 0.5 * dt if step0 + s == 0 else dt
-        g += 1
-        for m in range(n_tasks):
-            k = (t + m) % n_tasks          # its own task first
-            if claim(sync, k, g):
+        gk += 1
+        for m in range(n_kick):
+            k = task_order(t, m, n_threads, n_kick)     # its own tasks first
+            if claim(sync_kick, k, gk):
                 if k == 0:
                     # only the pair phase reads the box lengths
                     box[BOX_LX] = lx
                     box[BOX_LY] = ly
-                kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                kick_task(k, n_kick, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                           inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, cx, cy,
                           drag, fv, has_drag, part)
-                task_done(sync, n_tasks)
-        wait_generation(sync, n_tasks, g)
+                task_done(sync_kick, n_kick)
+        wait_generation(sync_kick, n_kick, gk)
         worst, mx, my, vmax2 = combine_chunks(part)
-        if overtaken(sync, n_tasks, g + 1):
+        if overtaken(sync_kick, n_kick, gk):
             return                          # left behind: the others finish the run
         done += 1
         status = pass_status(worst, mx, my, vmax2, dt, skin)
@@ -605,16 +647,16 @@ def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0,
         if list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
             reason = TEAM_REBUILD
             break
-        g += 1
-        for m in range(n_tasks):
-            k = (t + m) % n_tasks
-            if claim(sync, k, g):
+        gp += 1
+        for m in range(n_threads):
+            k = task_order(t, m, n_threads, n_threads)
+            if claim(sync_pair, k, gp):
                 pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start,
                           nbr, hist, dt, fbuf, tbuf)
-                task_done(sync, n_tasks)
-        wait_generation(sync, n_tasks, g)
+                task_done(sync_pair, n_threads)
+        wait_generation(sync_pair, n_threads, gp)
         lx_old, ly_old = lx, ly
-    if take_token(sync, n_tasks):
+    if take_token(sync_pair, n_threads):
         out[0] = done
         out[1] = status
         out[2] = reason
@@ -623,21 +665,21 @@ def team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0,
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def team_steps(n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel, omega,
-               radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box, max_concentration,
-               skin, max_cut, owners, bounds, shared, start, nbr, hist, ref, ref_lengths, cx, cy,
-               fbuf, tbuf):
+def team_steps(n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt, time, lx0,
+               ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
+               max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist, ref,
+               ref_lengths, cx, cy, fbuf, tbuf):
     """Steps of a periodic box by a team of threads that stays in one
     parallel region (:func:`team_member`; :mod:`physics.thread_team`) until
     the run ends or the Verlet list must be rebuilt. Same arithmetic, in
     the same order, as the step of :func:`run_steps` with
     :func:`first_half_parallel` and :func:`pair_forces_parallel`: the new
     state is the same bit for bit."""
-    for t in prange(n_tasks):
-        team_member(t, n_tasks, sync, part, out, n_steps, step0, dt, time, lx0, ly0, pos, vel,
-                    omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
-                    max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
-                    ref, ref_lengths, cx, cy, fbuf, tbuf)
+    for t in prange(n_threads):
+        team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt,
+                    time, lx0, ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv,
+                    has_drag, cp, box, max_concentration, skin, max_cut, owners, bounds, shared,
+                    start, nbr, hist, ref, ref_lengths, cx, cy, fbuf, tbuf)
 
 
 @njit(cache=True, error_model="numpy")
@@ -670,7 +712,7 @@ def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist
 def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, inv_mass,
               inv_inertia, drag, fv, cp, box, max_concentration,
               skin, cell_size, max_cut, start, nbr, hist, ref, ref_lengths, centre, wall_hist,
-              parallel, n_buf):
+              parallel, n_pair, n_kick):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
@@ -680,8 +722,10 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     for a deforming box; the Verlet list is rebuilt whenever the
     displacement criterion of :mod:`physics.neighbors` could be violated.
 
-    ``n_buf`` is the number of private force buffers and of pair chunks of
-    the parallel path (the number of threads; 1 for the serial path).
+    ``n_pair`` is the number of chunks of the pair loop of the parallel
+    path (the number of threads; 1 for the serial path), each with a
+    private force buffer, and ``n_kick`` the number of tasks of its
+    kick–drift pass (see :data:`KICK_TASKS_PER_THREAD`).
 
     Returns (steps done, status, n_rebuilds, start, nbr, hist, ref). A
     non-zero status stops the run early: non-finite state, a blow-up, or a
@@ -692,13 +736,17 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     walls = not (px and py)
     n = pos.shape[0]
     has_drag = np.any(drag != 0.0)
-    n_buf = n_buf if parallel else 1
+    n_pair = n_pair if parallel else 1
+    n_kick = n_kick if parallel else 1
+    # the shared buffer, then one private buffer per chunk if there are two
+    # or more (pair_task)
+    n_buf = n_pair + 1 if n_pair > 1 else 1
     fbuf = np.zeros((n_buf, n, 2))
     tbuf = np.zeros((n_buf, n))
     fbuf[0] = force
     tbuf[0] = torque
     n_rebuilds = 0
-    owners, bounds = owner_chunks(start, n_buf)
+    owners, bounds = owner_chunks(start, n_pair)
     shared = scatter_floes(owners, bounds, start, nbr, n)
     done = 0
     status = STATUS_OK
@@ -707,18 +755,20 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     # walls kick one step at a time. Both end a step whose list expired with
     # the same rebuild and pair loop.
     team = parallel and not walls
-    sync = np.zeros(sync_size(n_buf), dtype=np.int64)
-    part = np.empty((n_buf, 4))
+    sync_kick = np.zeros(sync_size(n_kick), dtype=np.int64)
+    sync_pair = np.zeros(sync_size(n_pair), dtype=np.int64)
+    part = np.empty((n_kick, 4))
     out = np.empty(5)
     step = 0
     while step < n_steps:
         if team:
-            sync[:] = 0
-            team_steps(n_buf, sync, part, out, n_steps - step, step, dt, time, box[BOX_LX],
-                       box[BOX_LY], pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv,
-                       has_drag, cp, box, max_concentration, skin, max_cut, owners, bounds,
-                       shared, start, nbr, hist, ref, ref_lengths, centre[0], centre[1], fbuf,
-                       tbuf)
+            sync_kick[:] = 0
+            sync_pair[:] = 0
+            team_steps(n_pair, n_kick, sync_kick, sync_pair, part, out, n_steps - step, step, dt,
+                       time, box[BOX_LX], box[BOX_LY], pos, vel, omega, radius, inv_mass,
+                       inv_inertia, drag, fv, has_drag, cp, box, max_concentration, skin, max_cut,
+                       owners, bounds, shared, start, nbr, hist, ref, ref_lengths, centre[0],
+                       centre[1], fbuf, tbuf)
             k = int(out[0])
             status = int(out[1])
             centre[0] = out[3]
@@ -742,7 +792,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
             dt_kick = 0.5 * dt if step == 0 else dt
             if parallel:
                 worst, mx, my, vmax2 = first_half_parallel(
-                    n_buf, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
+                    n_kick, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
                     inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0],
                     centre[1], drag, fv, has_drag)
             else:
@@ -772,7 +822,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
             ref_lengths[1] = ly
             centre[0] = 0.0
             centre[1] = 0.0
-            owners, bounds = owner_chunks(start, n_buf)
+            owners, bounds = owner_chunks(start, n_pair)
             shared = scatter_floes(owners, bounds, start, nbr, n)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces
@@ -781,7 +831,7 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
                                  start, nbr, hist, dt, fbuf, tbuf)
         else:
             owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
-                        start, nbr, hist, dt, fbuf[0], tbuf[0])
+                        start, nbr, hist, dt, fbuf[0], tbuf[0], 0, n, fbuf[0], tbuf[0])
     # total force of the last step, and the closing half kick
     force[:] = fbuf.sum(axis=0)
     torque[:] = tbuf.sum(axis=0)

@@ -8,21 +8,23 @@ tenth of the step. Here the threads enter one region for a run of steps
 and meet between phases at a spin barrier instead.
 
 The barrier cannot deadlock, however the runtime schedules the iterations
-of ``prange(n_tasks)``: every phase is a set of tasks (one per thread),
-each task is claimed by exactly one thread with an atomic compare-and-swap,
-and a thread first does its own task and then claims any task that nobody
-has claimed yet before it waits for the phase to be complete. If only one
-thread ever runs, it does every task itself and never waits for another.
-So a thread normally keeps its own floes in its own caches from step to
-step, and a thread that is late (a busy host, a slow core) only loses its
-task to the other one.
+of ``prange(n_threads)``: every phase is a set of tasks (one or more per
+thread), each task is claimed by exactly one thread with an atomic
+compare-and-swap, and a thread first does its own tasks and then claims
+any task that nobody has claimed yet (:func:`task_order`) before it waits
+for the phase to be complete. If only one thread ever runs, it does every
+task itself and never waits for another. So a thread normally keeps its
+own floes in its own caches from step to step, and a thread that is late
+(a busy host, a slow core) only loses some of its tasks to the others.
 
 Phases are numbered 1, 2, 3, ... (generations). ``sync`` is an int64 array
 of ``sync_size(n_tasks)`` zeros at the start of a run: ``sync[k]`` is the
 last generation in which task k was claimed, ``sync[n_tasks]`` counts the
 tasks done so far (generation g is complete when g * n_tasks tasks are
 done), and ``sync[n_tasks + 1]`` is a token that one thread takes to write
-the results of the run.
+the results of the run. Phases of different kinds with different numbers
+of tasks (the kick–drift pass and the pair loop of a step) keep a ``sync``
+array and a generation count each.
 
 A phase is complete when its tasks are done, not when every thread has
 arrived: a thread that was held up may find the others already a phase or
@@ -116,6 +118,22 @@ def spin_pause(typingctx):
 def sync_size(n_tasks):
     """Length of the ``sync`` array of a team with ``n_tasks`` tasks per phase."""
     return n_tasks + 2
+
+
+@njit(cache=True, inline="always")
+def task_order(t, m, n_threads, n_tasks):
+    """The m-th task (m = 0 … n_tasks − 1) that thread t tries to claim in
+    a phase of ``n_tasks`` tasks shared by ``n_threads`` threads: first its
+    own consecutive block (t·n/T up to (t+1)·n/T, in order), then the
+    others from the end of the block before its own backwards, wrapping
+    round. Every task appears once. A thread thus keeps the same floes
+    from step to step, and a thread that is done early takes over the
+    tasks that the thread before it would reach last."""
+    lo = t * n_tasks // n_threads
+    own = (t + 1) * n_tasks // n_threads - lo
+    if m < own:
+        return lo + m
+    return (lo - 1 - (m - own)) % n_tasks
 
 
 @njit(cache=True, inline="always")

@@ -367,25 +367,32 @@ def test_parallel_path_equals_serial_path(box_type):
     assert np.abs(results[0][1]).max() > 0.1     # the overlaps did push floes apart
 
 
-@pytest.mark.parametrize("n_chunks", [2, 3])
-def test_scatter_floes_lists_every_floe_the_extra_buffers_can_hold(n_chunks):
-    """The kick adds the private force buffers 1, 2, ... only for the floes
-    ``scatter_floes`` lists (sorted): every floe that a pair of chunk c ≥ 1
-    touches (owner or partner) must be listed, and in loose ice (A = 0.6)
-    most floes must not be, or the list would save nothing."""
-    from physics.hertz_kernels import owner_chunks, scatter_floes
+@pytest.mark.parametrize("n_chunks", [2, 3, 5])
+def test_pair_chunks_write_disjoint_memory_and_scatter_floes_lists_the_rest(n_chunks):
+    """The parallel pair loop is race-free: the ranges of floe numbers
+    that the chunks write to the shared force buffer (``chunk_range``) cut
+    0 … N−1 into consecutive pieces and hold every owner of their chunk;
+    every other floe a chunk can write (a partner outside its range, into
+    the chunk's private buffer) is listed by ``scatter_floes`` (sorted), so
+    the kick adds it up. With the floes numbered in space (as
+    ``make_floe_field`` does) these are only the few floes along the cuts."""
+    from physics.hertz_kernels import chunk_range, owner_chunks, scatter_floes
 
-    floes, box = make_floe_field(800, concentration=0.6, alpha=1.8, mean_diameter=8.0, seed=5)
+    n = 800
+    floes, box = make_floe_field(n, concentration=0.6, alpha=1.8, mean_diameter=8.0, seed=5)
     rank = radius_rank(floes.radii)
     start, nbr = build_pair_list(floes.positions, floes.radii, rank, box.lx, box.ly, True, True,
                                  0.4, choose_cell_size(floes.radii, box.lx, box.ly, 0.4))
     owners, bounds = owner_chunks(start, n_chunks)
-    shared = scatter_floes(owners, bounds, start, nbr, 800)
-    touched = set()
-    for c in range(1, n_chunks):
+    ranges = [chunk_range(c, owners, bounds, n) for c in range(n_chunks)]
+    assert ranges[0][0] == 0 and ranges[-1][1] == n
+    assert all(ranges[c][1] == ranges[c + 1][0] for c in range(n_chunks - 1))
+    outside = set()
+    for c, (lo, hi) in enumerate(ranges):
         for i in owners[bounds[c]:bounds[c + 1]]:
-            touched.add(int(i))
-            touched.update(int(j) for j in nbr[start[i]:start[i + 1]])
-    assert len(touched) > 0
-    assert shared.tolist() == sorted(touched)
-    assert len(shared) < 0.5 * 800
+            assert lo <= i < hi
+            outside.update(int(j) for j in nbr[start[i]:start[i + 1]] if not lo <= j < hi)
+    shared = scatter_floes(owners, bounds, start, nbr, n)
+    assert len(outside) > 0
+    assert shared.tolist() == sorted(outside)
+    assert len(shared) < 0.1 * n

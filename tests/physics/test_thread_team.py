@@ -13,7 +13,7 @@ import physics.hertz
 from physics import (DeformingPeriodicBox, FloeField, Forcing, HertzSimulation, PeriodicBox,
                      make_floe_field)
 from physics.params import HERMAN2013
-from physics.thread_team import claim, sync_size, task_done, wait_generation
+from physics.thread_team import claim, sync_size, task_done, task_order, wait_generation
 
 
 @njit(parallel=True)
@@ -56,6 +56,25 @@ def test_every_task_is_done_once_and_phases_do_not_overlap(threads, n_tasks):
     assert (sync[:n_tasks] == n_gen).all()
     if threads == 1 and n_tasks > 1:
         assert (doer[1:] == 0).all()      # the first iteration did everything
+
+
+@pytest.mark.parametrize("n_threads,n_tasks", [(1, 1), (1, 4), (2, 2), (2, 4), (2, 5), (3, 6),
+                                               (3, 7)])
+def test_task_order_visits_every_task_once_own_block_first(n_threads, n_tasks):
+    """Each thread tries every task of a phase exactly once, its own
+    consecutive block first and in order; the blocks of the threads cut the
+    tasks into consecutive pieces; the first task a thread would take from
+    others is the last of the block before its own."""
+    blocks = []
+    for t in range(n_threads):
+        order = [task_order(t, m, n_threads, n_tasks) for m in range(n_tasks)]
+        assert sorted(order) == list(range(n_tasks))
+        lo, hi = t * n_tasks // n_threads, (t + 1) * n_tasks // n_threads
+        assert order[:hi - lo] == list(range(lo, hi))
+        if hi - lo < n_tasks:
+            assert order[hi - lo] == (lo - 1) % n_tasks
+        blocks.extend(order[:hi - lo])
+    assert blocks == list(range(n_tasks))
 
 
 def run(floes, box, steps, parallel, n_tasks=None, monkeypatch=None, forcing=True):
