@@ -700,10 +700,11 @@ def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist
     at the build.
     """
     if parallel:
-        new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size)
+        new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size,
+                                             nbr.shape[0])
     else:
         new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin,
-                                                    cell_size)
+                                                    cell_size, nbr.shape[0])
     new_hist = transfer_history(start, nbr, hist, new_start, new_nbr, 2)
     return new_start, new_nbr, new_hist, pos.copy()
 

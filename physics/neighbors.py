@@ -105,17 +105,26 @@ def _axis_range(c, reach, cell_width, ncell, periodic):
     return lo, hi - lo + 1
 
 
+# modes of _scan_floes
+COUNT, FILL, APPEND = 0, 1, 2
+
+
 @njit(cache=True, error_model="numpy")
 def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
-                cell_start, cell_floes, cell_of, counts, start, out, write):
+                cell_start, cell_floes, cell_of, counts, start, out, mode, base, cap):
     """Partners of lower rank within r_i + r_j + skin of floes
     i_lo, i_lo + i_step, ... < i_hi.
 
-    Counting pass (``write`` False): counts[i + 1] = number of partners.
-    Filling pass: partners of i written at out[start[i]:], sorted by index.
+    ``mode`` COUNT: counts[i + 1] = number of partners. FILL: the partners
+    of i written at out[start[i]:], sorted by index. APPEND: the partners of
+    each floe in turn written one slice after the other from out[base] on,
+    each slice sorted, and counts[i + 1] set; they must end before
+    out[base + cap]. Returns the end of what APPEND wrote, or −1 if it
+    would not fit (the other modes return ``base``).
     """
     wx = lx / ncx
     wy = ly / ncy
+    end = base
     for i in range(i_lo, i_hi, i_step):
         xi = pos[i, 0]
         yi = pos[i, 1]
@@ -130,7 +139,7 @@ def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx
         if y0 < 0:
             y0 += ncy
         count = 0
-        at = start[i] if write else 0
+        at = start[i] if mode == FILL else end
         gy = y0
         for _ in range(nyc):
             if gy >= ncy:
@@ -149,66 +158,143 @@ def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx
                     dy = minimum_image(pos[j, 1] - yi, ly, py)
                     cut = ri + radius[j] + skin
                     if dx * dx + dy * dy < cut * cut:
-                        if write:
+                        if mode != COUNT:
+                            if mode == APPEND and at + count >= base + cap:
+                                return -1
                             out[at + count] = j
                         count += 1
                 gx += 1
             gy += 1
-        if write:
+        if mode != COUNT:
             # insertion sort of the slice by partner index (slices are short)
-            s0 = at
-            for a in range(s0 + 1, s0 + count):
+            for a in range(at + 1, at + count):
                 v = out[a]
                 b = a - 1
-                while b >= s0 and out[b] > v:
+                while b >= at and out[b] > v:
                     out[b + 1] = out[b]
                     b -= 1
                 out[b + 1] = v
-        else:
+        if mode != FILL:
             counts[i + 1] = count
+        if mode == APPEND:
+            end += count
+    return end
+
+
+@njit(cache=True, error_model="numpy")
+def _append_capacity(n, expected, n_chunks):
+    """Room per chunk for the single pass of a list build: twice its share
+    of ``expected`` pairs (the size of the previous list), four per floe,
+    and a margin; a chunk that needs more makes the build fall back to a
+    counting pass and a filling pass."""
+    return (2 * expected + 4 * n) // n_chunks + 256
+
+
+BLOCK = 32     # floes per block of a chunk of the parallel list build
+
+
+@njit(cache=True, error_model="numpy")
+def _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start, cell_floes,
+                cell_of, counts, start, out, mode, base, cap):
+    """:func:`_scan_floes` over chunk c of the parallel build: the blocks
+    c, c + N_CHUNKS, c + 2 N_CHUNKS, ... of ``BLOCK`` consecutive floes.
+    Consecutive floes are neighbours in space when the floes are numbered in
+    space, so a block reuses the cells it reads; and the few large floes,
+    whose scans cost most, fall into blocks spread over all chunks and so
+    over all threads. Returns the end of what APPEND wrote, or −1."""
+    end = base
+    for b in range(c * BLOCK, n, N_CHUNKS * BLOCK):
+        end = _scan_floes(b, min(b + BLOCK, n), 1, pos, radius, rank, lx, ly, px, py, skin, ncx,
+                          ncy, cell_start, cell_floes, cell_of, counts, start, out, mode, end,
+                          base + cap - end)
+        if end < 0:
+            return -1
+    return end
+
+
+@njit(cache=True, error_model="numpy")
+def _copy_chunk(c, n, buf, base, start, nbr):
+    """Copy the slices that chunk c (:func:`_scan_chunk`) appended to
+    ``buf`` from ``base`` on to their places in ``nbr``."""
+    at = base
+    for b in range(c * BLOCK, n, N_CHUNKS * BLOCK):
+        lo = start[b]
+        hi = start[min(b + BLOCK, n)]
+        nbr[lo:hi] = buf[at:at + hi - lo]
+        at += hi - lo
+
+
+@njit(cache=True, error_model="numpy")
+def _all_fit(ends):
+    for e in ends:
+        if e < 0:
+            return False
+    return True
 
 
 # not cached on disk: the Hertz step calls it from its own cached kernels
 # (see the note in hertz_kernels.py); pair_list uses a cached copy
 @njit(cache=False, parallel=True, error_model="numpy")
-def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
+def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size, expected=0):
     """Verlet list of all pairs with centre distance < r_i + r_j + skin.
 
     Each pair appears once, in the slice of its owner (higher rank).
     Returns (start (N+1,), nbr (M,)) with every slice sorted by partner index.
     Requires the largest cut-off to be below half of each periodic side
     (checked by the callers).
+
+    The cells are scanned once, each chunk of floes appending its slices to
+    a buffer of its own that is then copied into place; ``expected`` (the
+    number of pairs of the previous list, if any) sizes the buffers. If a
+    chunk's buffer is too small, the list is built by a counting pass and a
+    filling pass instead (twice the scanning, the same list).
     """
     n = pos.shape[0]
     ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
     counts = np.zeros(n + 1, dtype=np.int64)
-    dummy = np.empty(0, dtype=np.int64)
-    # interleaved chunks: the few large floes, whose scans cost most, are
-    # spread over all threads whatever their indices
+    cap = _append_capacity(n, expected, N_CHUNKS)
+    buf = np.empty(cap * N_CHUNKS, dtype=np.int64)
+    ends = np.empty(N_CHUNKS, dtype=np.int64)
     for c in prange(N_CHUNKS):
-        _scan_floes(c, n, N_CHUNKS, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
-                    cell_start, cell_floes, cell_of, counts, counts, dummy, False)
+        ends[c] = _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+                              cell_start, cell_floes, cell_of, counts, counts, buf, APPEND,
+                              c * cap, cap)
+    fit = _all_fit(ends)
+    if not fit:
+        for c in prange(N_CHUNKS):
+            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+                        cell_floes, cell_of, counts, counts, buf, COUNT, 0, 0)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
     for c in prange(N_CHUNKS):
-        _scan_floes(c, n, N_CHUNKS, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
-                    cell_start, cell_floes, cell_of, counts, start, nbr, True)
+        if fit:
+            _copy_chunk(c, n, buf, c * cap, start, nbr)
+        else:
+            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+                        cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
     return start, nbr
 
 
 @njit(cache=True, error_model="numpy")
-def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size):
+def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size, expected=0):
     """:func:`build_pair_list` on the calling thread only (for the serial
-    engine path, which must not wake a thread pool)."""
+    engine path, which must not wake a thread pool). With one chunk the
+    appended slices are already in floe order: the buffer is the list."""
     n = pos.shape[0]
     ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
     counts = np.zeros(n + 1, dtype=np.int64)
+    cap = _append_capacity(n, expected, 1)
+    buf = np.empty(cap, dtype=np.int64)
+    end = _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+                      cell_floes, cell_of, counts, counts, buf, APPEND, 0, cap)
+    if end >= 0:
+        return np.cumsum(counts), buf[:end].copy()
     _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
-                cell_floes, cell_of, counts, counts, counts, False)
+                cell_floes, cell_of, counts, counts, counts, COUNT, 0, 0)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
     _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
-                cell_floes, cell_of, counts, start, nbr, True)
+                cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
     return start, nbr
 
 

@@ -79,6 +79,38 @@ def test_pair_list_equals_brute_force(box_name, skin, cell):
     assert brute == expected
 
 
+@pytest.mark.parametrize("skin", [0.7, 20.0])
+def test_single_pass_build_and_its_fallback_give_the_same_list(skin):
+    """The list is built in one scan, each chunk of floes appending to a
+    buffer sized from the previous list. With a skin of 20 m the 600 floes
+    have 37 partners each, more than the buffers hold when no previous list
+    is known: the build falls back to a counting and a filling scan.
+    Serial and parallel builders, with and without a size hint, give the
+    same arrays, and the brute-force pairs."""
+    from physics.neighbors import BLOCK, N_CHUNKS, _append_capacity, build_pair_list_serial
+
+    rng = np.random.default_rng(11)
+    box = PeriodicBox(110.0)
+    pos, radius = random_floes(rng, 600, box)
+    rank = radius_rank(radius)
+    cell = choose_cell_size(radius, box.lx, box.ly, skin)
+    args = (pos, radius, rank, box.lx, box.ly, True, True, skin, cell)
+    ref_start, ref_nbr = build_pair_list_serial(*args)
+    counts = np.diff(ref_start)
+    overflow = (counts.sum() > _append_capacity(600, 0, 1),
+                max(sum(counts[b:b + BLOCK].sum() for b in range(c * BLOCK, 600, N_CHUNKS * BLOCK))
+                    for c in range(N_CHUNKS)) > _append_capacity(600, 0, N_CHUNKS))
+    assert overflow == ((True, True) if skin > 10 else (False, False))
+    for build in (build_pair_list, build_pair_list_serial):
+        for hint in (0, len(ref_nbr)):
+            start, nbr = build(*args, hint)
+            np.testing.assert_array_equal(start, ref_start)
+            np.testing.assert_array_equal(nbr, ref_nbr)
+    owner = np.repeat(np.arange(600), counts)
+    found = set(zip(np.minimum(owner, ref_nbr).tolist(), np.maximum(owner, ref_nbr).tolist()))
+    assert found == all_pairs_within(pos, radius, box, skin)
+
+
 # ---------------------------------------------------------------------------
 # Contact forces against an independent all-pairs evaluation
 # ---------------------------------------------------------------------------
