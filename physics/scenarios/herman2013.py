@@ -56,7 +56,8 @@ IMPACT_SPEED = 1.0   # m/s: the time-step check admits impacts up to this relati
 
 def _contact_law(p: dict):
     c = dataclasses.replace(HERMAN2013.contact, friction=p["friction"],
-                            restitution=p["restitution"])
+                            restitution=p["restitution"],
+                            tangential_damping=p["tangential_damping"])
     return scaled_contact(c, p["stiffness_scale"])
 
 

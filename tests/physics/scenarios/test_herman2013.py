@@ -131,3 +131,20 @@ def test_channel_fields_are_placed_above_the_random_placement_limit():
     field, box = _field(400, 0.87, 3, aspect=0.5, box_type=ChannelBox)
     assert field.total_area / (box.lx * box.ly) == pytest.approx(0.87, rel=1e-9)
     assert max_overlap(field.positions, field.radii, box) <= 0.01
+
+
+@pytest.mark.parametrize("name", ["herman2013-convergence", "herman2013-wind", "herman2013-miz"])
+def test_contact_parameters_reach_the_contact_law(name):
+    """friction, restitution and tangential_damping of every Herman (2013)
+    scenario end up in the ContactParams of its simulations (defaults:
+    the paper's friction, our restitution 0.5, no tangential damping)."""
+    from physics.params import HERMAN2013
+    from physics.scenarios.herman2013 import _contact_law
+    from physics.scenarios.runner import find_config
+
+    defaults = find_config(name).defaults()
+    c = _contact_law(defaults)
+    assert (c.friction, c.restitution, c.tangential_damping) == (HERMAN2013.contact.friction,
+                                                                 0.5, 0.0)
+    c = _contact_law(dict(defaults, friction=0.3, restitution=0.9, tangential_damping=0.5))
+    assert (c.friction, c.restitution, c.tangential_damping) == (0.3, 0.9, 0.5)
