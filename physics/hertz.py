@@ -177,10 +177,12 @@ class HertzSimulation:
         box.bind(f.total_area)
         self.max_concentration = getattr(box, "max_concentration", 1.0)
         self._cp = np.array([
-            4.0 / 3.0 * contact.effective_modulus, 8.0 * contact.effective_shear_modulus,
+            4.0 / 3.0 * contact.effective_modulus,
+            8.0 * contact.effective_shear_modulus * contact.tangential_stiffness,
             contact.damping_alpha, contact.tangential_damping, contact.friction,
             float(contact.limit_damping),
-            4.0 / 3.0 * contact.wall_effective_modulus, 8.0 * contact.wall_effective_shear_modulus,
+            4.0 / 3.0 * contact.wall_effective_modulus,
+            8.0 * contact.wall_effective_shear_modulus * contact.tangential_stiffness,
         ])
         self._set_drag()
         self.force = np.zeros((n, 2))

@@ -82,6 +82,12 @@ class ContactParams:
         Default 0: with damping, the Coulomb cap of the Mindlin law can leave
         the spring pointing along the slip when a sliding contact starts, so
         that friction briefly pushes instead of brakes (see physics.contact).
+    tangential_stiffness : float
+        Multiplies the Mindlin tangential stiffness k_t = 8 G* √(R* δ) [-],
+        > 0. Default 1 (Mindlin). Written as F_n = K_n √(R* δ) δ and
+        F_t = K_t √(R* δ) Δs, Mindlin has K_t = 8 G* ≈ 1.2 K_n for ν = 0.33;
+        LAMMPS's ``gran/hertz/history`` takes K_t = 2/7 K_n by default,
+        i.e. ``tangential_stiffness`` = (2/7)(4/3) E* / (8 G*) ≈ 0.24.
     damping_model : str
         How the damping coefficient α is set from ``restitution``:
         ``"exact"`` (default) solves the dimensionless Hertz impact so that the
@@ -99,6 +105,7 @@ class ContactParams:
     restitution: float = 0.5
     friction: float = 0.7
     tangential_damping: float = 0.0
+    tangential_stiffness: float = 1.0
     damping_model: str = "exact"
     limit_damping: bool = True
 
@@ -109,6 +116,7 @@ class ContactParams:
             "restitution": (0.0, 1.0, True, False),
             "friction": _NONNEG,
             "tangential_damping": _NONNEG,
+            "tangential_stiffness": _POSITIVE,
         })
         if self.damping_model not in ("exact", "lammps"):
             raise ValueError(

@@ -57,7 +57,8 @@ IMPACT_SPEED = 1.0   # m/s: the time-step check admits impacts up to this relati
 def _contact_law(p: dict):
     c = dataclasses.replace(HERMAN2013.contact, friction=p["friction"],
                             restitution=p["restitution"],
-                            tangential_damping=p["tangential_damping"])
+                            tangential_damping=p["tangential_damping"],
+                            tangential_stiffness=p["tangential_stiffness"])
     return scaled_contact(c, p["stiffness_scale"])
 
 

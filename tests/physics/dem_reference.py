@@ -154,7 +154,7 @@ def run_impact(radii, speed, contact: ContactParams, *, angle_deg=0.0, thickness
     floes = FloeField(pos, r, h, vel)
     sim = HertzSimulation(floes, PeriodicBox(length), contact, None, dt, impact_speed=speed)
 
-    kt_coef = 8.0 * effective_shear_modulus(contact)
+    kt_coef = 8.0 * effective_shear_modulus(contact) * contact.tangential_stiffness
 
     def overlap():
         d = sim.positions[1] - sim.positions[0]

@@ -221,3 +221,35 @@ def test_sticking_contact_energy_never_increases(restitution, angle, allowed):
                      tangential_energy=True)
     assert np.diff(res.energies).max() <= allowed * res.energies[0]
     assert res.energies[-1] < res.energies[0]
+
+
+def test_tangential_stiffness_scales_the_sticking_tangential_force():
+    """Two floes held at an overlap of 0.1 mm slide past each other at 1 mm/s
+    for 20 steps, far below the Coulomb limit: the tangential force is the
+    Mindlin spring k_t √(R* δ) Δs, so ``tangential_stiffness`` = 0.25 gives
+    a quarter of the force (to 1 %: the force itself nudges the floes), and
+    the normal force does not change. A non-positive factor is refused."""
+    from physics import FloeField, HertzSimulation, PeriodicBox
+
+    r = np.array([5.0, 5.0])
+    delta, v_t, dt, steps = 1e-4, 1e-3, 1e-4, 20
+    pos = np.array([[50.0, 50.0], [50.0 + 2 * 5.0 - delta, 50.0]])
+    vel = np.array([[0.0, -0.5 * v_t], [0.0, 0.5 * v_t]])
+    forces = {}
+    for factor in (1.0, 0.25):
+        contact = ContactParams(restitution=0.5, friction=0.7, tangential_stiffness=factor)
+        sim = HertzSimulation(FloeField(pos, r, np.full(2, 1.5), vel), PeriodicBox(100.0),
+                              contact, None, dt, impact_speed=0.01, allow_overlap=True)
+        sim.step(steps)
+        c = sim.contacts()
+        assert len(c.i) == 1
+        forces[factor] = (abs(float(c.tangential_force[0])), float(c.normal_force[0]))
+    f_t, f_n = forces[1.0]
+    k_t = 8.0 * ContactParams().effective_shear_modulus * np.sqrt(2.5 * delta)   # R* = 2.5 m
+    expected = k_t * v_t * steps * dt
+    assert f_t == pytest.approx(expected, rel=0.05)
+    assert f_t < 0.1 * 0.7 * f_n                      # sticking, far from the Coulomb limit
+    assert forces[0.25][0] == pytest.approx(0.25 * f_t, rel=0.01)
+    assert forces[0.25][1] == pytest.approx(f_n, rel=1e-6)
+    with pytest.raises(ValueError, match="tangential_stiffness"):
+        ContactParams(tangential_stiffness=0.0)

@@ -135,16 +135,19 @@ def test_channel_fields_are_placed_above_the_random_placement_limit():
 
 @pytest.mark.parametrize("name", ["herman2013-convergence", "herman2013-wind", "herman2013-miz"])
 def test_contact_parameters_reach_the_contact_law(name):
-    """friction, restitution and tangential_damping of every Herman (2013)
-    scenario end up in the ContactParams of its simulations (defaults:
-    the paper's friction, our restitution 0.5, no tangential damping)."""
+    """friction, restitution, tangential_damping and tangential_stiffness
+    of every Herman (2013) scenario end up in the ContactParams of its
+    simulations (defaults: the paper's friction, our restitution 0.5, no
+    tangential damping, the Mindlin stiffness)."""
     from physics.params import HERMAN2013
     from physics.scenarios.herman2013 import _contact_law
     from physics.scenarios.runner import find_config
 
     defaults = find_config(name).defaults()
-    c = _contact_law(defaults)
-    assert (c.friction, c.restitution, c.tangential_damping) == (HERMAN2013.contact.friction,
-                                                                 0.5, 0.0)
-    c = _contact_law(dict(defaults, friction=0.3, restitution=0.9, tangential_damping=0.5))
-    assert (c.friction, c.restitution, c.tangential_damping) == (0.3, 0.9, 0.5)
+    def law(c):
+        return c.friction, c.restitution, c.tangential_damping, c.tangential_stiffness
+
+    assert law(_contact_law(defaults)) == (HERMAN2013.contact.friction, 0.5, 0.0, 1.0)
+    changed = dict(defaults, friction=0.3, restitution=0.9, tangential_damping=0.5,
+                   tangential_stiffness=0.24)
+    assert law(_contact_law(changed)) == (0.3, 0.9, 0.5, 0.24)
