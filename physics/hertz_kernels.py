@@ -596,8 +596,9 @@ def team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, 
                 ref, ref_lengths, cx, cy, fbuf, tbuf):
     """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
     periodic box, each a kick–drift phase of ``n_kick`` tasks and a pair
-    phase of ``n_threads`` tasks (one per force buffer), with their own
-    ``sync`` arrays (:mod:`physics.thread_team`).
+    phase of ``n_threads`` tasks (the chunks of :func:`owner_chunks`, each
+    with its private force buffer), with a ``sync`` array each
+    (:mod:`physics.thread_team`).
 
     Every thread makes the same decisions (stop, rebuild) from the same
     partial results ``part`` of the kick pass. The thread that takes the
