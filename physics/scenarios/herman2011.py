@@ -294,8 +294,8 @@ class Herman2011Clustering(Experiment):
                     f"more floes")
             sim = HardDiskSimulation(field, box, restitution=float(p["restitution"]),
                                      forcing=_forcing(p),
-                                     max_velocity_step=pre.max_velocity_step,
-                                     collision_duration=pre.collision_duration)
+                                     max_velocity_step=float(p["max_velocity_step"]),
+                                     collision_duration=float(p["collision_duration"]))
             st = dict(sim=sim, step=0, count=0)
             self._constants(p, sim, rec)
             self._output(p, st, rec, interval, n_out, snap_steps)

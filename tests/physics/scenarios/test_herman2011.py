@@ -169,3 +169,28 @@ def test_too_few_floes_for_close_ice_is_explained():
     with pytest.raises(ValueError, match="use more floes"):
         exp.cases(p)
     assert math.isfinite(exp.workload(find_config(NAME).resolve(), {"concentration": 0.9}))
+
+
+def test_drag_update_interval_and_tc_duration_reach_the_engine(monkeypatch):
+    """max_velocity_step and collision_duration default to Table I of the
+    paper (1 s, 0.1 s) and are handed to the hard-disc engine as set."""
+    import physics
+    from physics.params import HERMAN2011
+
+    cfg = find_config(NAME)
+    defaults = cfg.defaults()
+    assert defaults["max_velocity_step"] == HERMAN2011.max_velocity_step == 1.0
+    assert defaults["collision_duration"] == HERMAN2011.collision_duration == 0.1
+    seen = {}
+
+    class Spy(physics.HardDiskSimulation):
+        def __init__(self, *args, **kwargs):
+            seen.update(kwargs)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(physics, "HardDiskSimulation", Spy)
+    exp = get_experiment(NAME)
+    p = cfg.resolve(dict(floes=200, concentrations=[0.6], duration=20.0, output_interval=10.0,
+                         max_velocity_step=0.25, collision_duration=0.0))
+    exp.simulate(p, exp.cases(p)[0], 1, Recorder(variables=exp.variables))
+    assert (seen["max_velocity_step"], seen["collision_duration"]) == (0.25, 0.0)
