@@ -104,6 +104,13 @@ def main(argv=None) -> int:
     except (ValueError, FileExistsError, FileNotFoundError) as exc:
         print(f"ice-scenarios: error: {exc}", file=sys.stderr)
         return 2
+    except (RuntimeError, FloatingPointError) as exc:
+        # the physics stopped a run (a blow-up, inelastic collapse, a box at
+        # its concentration limit): say why, without a traceback
+        print(f"ice-scenarios: the run stopped: {exc}\n"
+              "The outputs and checkpoints written before are kept in the run directory.",
+              file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
 
