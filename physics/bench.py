@@ -452,12 +452,11 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
 
     def arrays(n_chunks):
         owners, bounds = K.owner_chunks(sim._start, n_chunks)
-        n_buf = n_chunks + 1 if n_chunks > 1 else 1      # as in K.run_steps
         shared = K.scatter_floes(owners, bounds, sim._start, sim._nbr, sim.n_floes)
         return (owners, bounds, shared, sim.positions.copy(), sim.velocities.copy(),
                 sim.angular_velocities.copy(), sim.radius, sim.inv_mass, sim.inv_inertia,
                 sim._cp, box, sim._start, sim._nbr, sim._hist.copy(),
-                np.zeros((n_buf, sim.n_floes, 2)), np.zeros((n_buf, sim.n_floes)),
+                *K.force_buffers(n_chunks, sim.n_floes),
                 sim._ref.copy(), sim._drag, fv, sim.box.lx, sim.box.ly)
 
     configs = _kernel_configs(threads_all)

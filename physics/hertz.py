@@ -240,14 +240,13 @@ class HertzSimulation:
         if self.forcing is not None:
             self._set_drag_if_changed()
         box_arr = self.box.kernel_array(self.time)
-        threads = numba.get_num_threads()
         done, status, nreb, self._start, self._nbr, self._hist, self._ref = K.run_steps(
             n, self.dt, self.time, self.positions, self.velocities, self.angular_velocities,
             self.force, self.torque, self.radius, self.rank, self.inv_mass, self.inv_inertia,
             self._drag, self._forcing_vector(), self._cp, box_arr, self.max_concentration,
             self.skin, self.cell_size, self.max_cut, self._start, self._nbr, self._hist,
             self._ref, self._ref_lengths, self._centre, self._wall_hist, self.parallel,
-            threads, threads * K.KICK_TASKS_PER_THREAD)
+            numba.get_num_threads())
         self.time += done * self.dt
         self.n_steps += done
         self.n_rebuilds += nreb

@@ -347,6 +347,15 @@ def pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, sta
                 hist, dt_history, fbuf[0], tbuf[0], lo, hi, fbuf[b], tbuf[b])
 
 
+@njit(cache=True, error_model="numpy")
+def force_buffers(n_chunks, n):
+    """Zeroed force and torque buffers (fbuf (B, N, 2), tbuf (B, N)) for a
+    pair loop in ``n_chunks`` chunks: the shared buffer 0, then a private
+    buffer per chunk if there are two or more (:func:`pair_task`)."""
+    n_buf = n_chunks + 1 if n_chunks > 1 else 1
+    return np.zeros((n_buf, n, 2)), np.zeros((n_buf, n))
+
+
 # Parallel kernels that other compiled kernels call are never cached on disk
 # (cache=False): when a caller is compiled in a process that loaded such a
 # callee from Numba's cache, the caller's own cache entry crashes every later
@@ -714,7 +723,7 @@ def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist
 def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, inv_mass,
               inv_inertia, drag, fv, cp, box, max_concentration,
               skin, cell_size, max_cut, start, nbr, hist, ref, ref_lengths, centre, wall_hist,
-              parallel, n_pair, n_kick):
+              parallel, n_pair):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
@@ -726,8 +735,8 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
 
     ``n_pair`` is the number of chunks of the pair loop of the parallel
     path (the number of threads; 1 for the serial path), each with a
-    private force buffer, and ``n_kick`` the number of tasks of its
-    kick–drift pass (see :data:`KICK_TASKS_PER_THREAD`).
+    private force buffer; its kick–drift pass has
+    :data:`KICK_TASKS_PER_THREAD` tasks per chunk.
 
     Returns (steps done, status, n_rebuilds, start, nbr, hist, ref). A
     non-zero status stops the run early: non-finite state, a blow-up, or a
@@ -739,12 +748,8 @@ def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, i
     n = pos.shape[0]
     has_drag = np.any(drag != 0.0)
     n_pair = n_pair if parallel else 1
-    n_kick = n_kick if parallel else 1
-    # the shared buffer, then one private buffer per chunk if there are two
-    # or more (pair_task)
-    n_buf = n_pair + 1 if n_pair > 1 else 1
-    fbuf = np.zeros((n_buf, n, 2))
-    tbuf = np.zeros((n_buf, n))
+    n_kick = n_pair * KICK_TASKS_PER_THREAD if parallel else 1
+    fbuf, tbuf = force_buffers(n_pair, n)
     fbuf[0] = force
     tbuf[0] = torque
     n_rebuilds = 0

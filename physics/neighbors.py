@@ -110,10 +110,10 @@ COUNT, FILL, APPEND = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+def _scan_floes(i_lo, i_hi, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
                 cell_start, cell_floes, cell_of, counts, start, out, mode, base, cap):
     """Partners of lower rank within r_i + r_j + skin of floes
-    i_lo, i_lo + i_step, ... < i_hi.
+    i_lo ≤ i < i_hi.
 
     ``mode`` COUNT: counts[i + 1] = number of partners. FILL: the partners
     of i written at out[start[i]:], sorted by index. APPEND: the partners of
@@ -125,7 +125,7 @@ def _scan_floes(i_lo, i_hi, i_step, pos, radius, rank, lx, ly, px, py, skin, ncx
     wx = lx / ncx
     wy = ly / ncy
     end = base
-    for i in range(i_lo, i_hi, i_step):
+    for i in range(i_lo, i_hi):
         xi = pos[i, 0]
         yi = pos[i, 1]
         ri = radius[i]
@@ -204,7 +204,7 @@ def _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_st
     over all threads. Returns the end of what APPEND wrote, or −1."""
     end = base
     for b in range(c * BLOCK, n, N_CHUNKS * BLOCK):
-        end = _scan_floes(b, min(b + BLOCK, n), 1, pos, radius, rank, lx, ly, px, py, skin, ncx,
+        end = _scan_floes(b, min(b + BLOCK, n), pos, radius, rank, lx, ly, px, py, skin, ncx,
                           ncy, cell_start, cell_floes, cell_of, counts, start, out, mode, end,
                           base + cap - end)
         if end < 0:
@@ -226,6 +226,9 @@ def _copy_chunk(c, n, buf, base, start, nbr):
 
 @njit(cache=True, error_model="numpy")
 def _all_fit(ends):
+    """Whether every chunk's appended slices fit (no end is −1); a plain
+    loop, since ``(ends >= 0).all()`` inside a parallel function would start
+    a parallel region of its own."""
     for e in ends:
         if e < 0:
             return False
@@ -285,15 +288,15 @@ def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size, e
     counts = np.zeros(n + 1, dtype=np.int64)
     cap = _append_capacity(n, expected, 1)
     buf = np.empty(cap, dtype=np.int64)
-    end = _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    end = _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
                       cell_floes, cell_of, counts, counts, buf, APPEND, 0, cap)
     if end >= 0:
         return np.cumsum(counts), buf[:end].copy()
-    _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
                 cell_floes, cell_of, counts, counts, counts, COUNT, 0, 0)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
-    _scan_floes(0, n, 1, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
                 cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
     return start, nbr
 
