@@ -30,6 +30,13 @@ Conventions (one contact between floes i and j)
   sliding contact and push the floes instead of braking them.
 * Torques: ``τ_i = F_t (r_i − δ/2)``, ``τ_j = F_t (r_j − δ/2)`` (lever arms to the
   contact point).
+* By default F_t also acts on the floes' translation, as Newton's third law
+  at the contact point requires (and as LAMMPS does). Herman (2013) writes
+  its eqs 6–7 with the normal force alone in the linear momentum equation
+  and F_t only in the angular one; ``ContactParams.tangential_translation``
+  = False follows that (friction turns the floes but does not resist their
+  sliding). The force the kernels report for a contact, and that enters the
+  stress tensor, is the one acting on translation.
 """
 from __future__ import annotations
 

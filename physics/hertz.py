@@ -183,6 +183,7 @@ class HertzSimulation:
             float(contact.limit_damping),
             4.0 / 3.0 * contact.wall_effective_modulus,
             8.0 * contact.wall_effective_shear_modulus * contact.tangential_stiffness,
+            float(contact.tangential_translation),
         ])
         self._set_drag()
         self.force = np.zeros((n, 2))

@@ -49,8 +49,8 @@ from .thread_team import (claim, overtaken, sync_size, take_token, task_done, ta
                           wait_generation)
 
 # contact parameter vector layout
-CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL = range(8)
-CP_SIZE = 8
+CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL, CP_TT = range(9)
+CP_SIZE = 9
 # forcing vector layout: wind (x, y), current (x, y)
 FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
 # status codes of run_steps
@@ -71,7 +71,7 @@ KICK_TASKS_PER_THREAD = 2
 
 @njit(cache=True, inline="always", error_model="numpy")
 def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last, dt_history,
-                 kn, kt, alpha, gamma_t, mu, limit_damping):
+                 kn, kt, alpha, gamma_t, mu, limit_damping, tt):
     """Force of floe j on floe i, given their minimum-image separation
     (dx, dy) = x_j − x_i and relative velocity (vrx, vry) = u_i − u_j.
 
@@ -94,15 +94,15 @@ def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last,
     fn, ft, spring, a_last = hertz_mindlin_force(delta, ri * rj / rsum, 1.0 / inv_mass_sum,
                                                  v_normal, v_slip, spring, a_last, dt_history,
                                                  kn, kt, alpha, gamma_t, mu, limit_damping)
-    fx = -fn * nx - ft * ny
-    fy = -fn * ny + ft * nx
+    fx = -fn * nx - tt * ft * ny
+    fy = -fn * ny + tt * ft * nx
     return (True, fx, fy, ft * (ri - 0.5 * delta), ft * (rj - 0.5 * delta), spring, a_last,
             fn, ft, nx, ny, delta)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_history,
-                 kn, kt, alpha, gamma_t, mu, limit_damping):
+                 kn, kt, alpha, gamma_t, mu, limit_damping, tt):
     """Force of a rigid wall on a floe; ``side`` 0..3 = wall at x=0, x=lx,
     y=0, y=ly. Returns (fx, fy, torque, spring, a_last)."""
     if side == 0:
@@ -120,7 +120,7 @@ def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_
     fn, ft, spring, a_last = hertz_mindlin_force(delta, r, 1.0 / inv_mass, v_normal, v_slip,
                                                  spring, a_last, dt_history, kn, kt, alpha,
                                                  gamma_t, mu, limit_damping)
-    return -fn * nx - ft * ny, -fn * ny + ft * nx, ft * (r - delta), spring, a_last
+    return -fn * nx - tt * ft * ny, -fn * ny + tt * ft * nx, ft * (r - delta), spring, a_last
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -187,6 +187,7 @@ def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_his
     walls_y = box[BOX_PY] == 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN_WALL], cp[CP_KT_WALL], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
     limit = cp[CP_LIMIT] != 0.0
+    tt = cp[CP_TT]
     for i in range(i_lo, i_hi):
         for side in range(4):
             if (side < 2 and not walls_x) or (side >= 2 and not walls_y):
@@ -195,7 +196,7 @@ def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_his
                                                  vel[i, 1], omega[i], radius[i], inv_mass[i],
                                                  lx, ly, wall_hist[i, side, 0],
                                                  wall_hist[i, side, 1], dt_history, kn, kt,
-                                                 alpha, gt, mu, limit)
+                                                 alpha, gt, mu, limit, tt)
             wall_hist[i, side, 0] = sp
             wall_hist[i, side, 1] = al
             force[i, 0] += wfx
@@ -233,6 +234,7 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
     px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
     limit = cp[CP_LIMIT] != 0.0
+    tt = cp[CP_TT]
     for k in range(k_lo, k_hi):
         i = owners[k]
         xi_, yi_ = pos[i, 0], pos[i, 1]
@@ -245,7 +247,8 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
             res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
                                minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
                                vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit)
+                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit,
+                               tt)
             hist[p, 0] = res[5]
             hist[p, 1] = res[6]
             if res[0]:
@@ -858,6 +861,7 @@ def contact_list(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist):
     px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
     kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
     limit = cp[CP_LIMIT] != 0.0
+    tt = cp[CP_TT]
     n = radius.shape[0]
     m = nbr.shape[0]
     ii = np.empty(m, dtype=np.int64)
@@ -871,7 +875,7 @@ def contact_list(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist):
                                minimum_image(pos[j, 1] - pos[i, 1], ly, py), radius[i], radius[j],
                                vel[i, 0] - vel[j, 0], vel[i, 1] - vel[j, 1], omega[i], omega[j],
                                inv_mass[i] + inv_mass[j], hist[p, 0], hist[p, 1], 0.0, kn, kt,
-                               alpha, gt, mu, limit)
+                               alpha, gt, mu, limit, tt)
             if res[0]:
                 ii[k] = i
                 jj[k] = j

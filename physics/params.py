@@ -16,6 +16,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 __all__ = [
     "ContactParams",
     "ForcingParams",
@@ -88,6 +90,15 @@ class ContactParams:
         F_t = K_t √(R* δ) Δs, Mindlin has K_t = 8 G* ≈ 1.2 K_n for ν = 0.33;
         LAMMPS's ``gran/hertz/history`` takes K_t = 2/7 K_n by default,
         i.e. ``tangential_stiffness`` = (2/7)(4/3) E* / (8 G*) ≈ 0.24.
+    tangential_translation : bool
+        Whether the tangential (friction) force of a contact acts on the
+        floes' translation as well as on their rotation. Default True
+        (Newton's third law at the contact point, as in LAMMPS). Herman
+        (2013) writes its eqs 6–7 with only the normal force in the linear
+        momentum equation and the tangential force in the angular momentum
+        equation; False follows those equations as written. Then friction
+        only turns floes: it does not resist sliding, and a sliding contact
+        can spin floes up (towards rolling) without slowing them.
     damping_model : str
         How the damping coefficient α is set from ``restitution``:
         ``"exact"`` (default) solves the dimensionless Hertz impact so that the
@@ -106,6 +117,7 @@ class ContactParams:
     friction: float = 0.7
     tangential_damping: float = 0.0
     tangential_stiffness: float = 1.0
+    tangential_translation: bool = True
     damping_model: str = "exact"
     limit_damping: bool = True
 
@@ -118,6 +130,10 @@ class ContactParams:
             "tangential_damping": _NONNEG,
             "tangential_stiffness": _POSITIVE,
         })
+        for name in ("tangential_translation", "limit_damping"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise ValueError(f"ContactParams.{name} must be True or False, "
+                                 f"got {getattr(self, name)!r}")
         if self.damping_model not in ("exact", "lammps"):
             raise ValueError(
                 f"ContactParams.damping_model must be 'exact' or 'lammps', got {self.damping_model!r}")

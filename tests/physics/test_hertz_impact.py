@@ -253,3 +253,34 @@ def test_tangential_stiffness_scales_the_sticking_tangential_force():
     assert forces[0.25][1] == pytest.approx(f_n, rel=1e-6)
     with pytest.raises(ValueError, match="tangential_stiffness"):
         ContactParams(tangential_stiffness=0.0)
+
+
+@pytest.mark.parametrize("case", SLIDING_CASES, ids=_sliding_id)
+def test_friction_that_only_turns_floes(case):
+    """``tangential_translation=False`` (Herman 2013, eqs 6-7 as written:
+    the tangential force enters only the angular momentum equation). In an
+    oblique impact that slides throughout, the floes' centres move exactly
+    as in the same impact without friction (relative velocity after the
+    impact within 1e-12 of the impact speed: only the normal force moves
+    them), while the spins change by the Coulomb impulse,
+    Delta omega = J_t r / I with J_t = -mu m* (1 + e) u_n (3 %, as in the
+    sliding test above), and the normal restitution is unchanged (0.01)."""
+    radii, e, mu, angle = case
+    contact = ContactParams(restitution=e, friction=mu, tangential_translation=False)
+    res = run_impact(radii, 0.1, contact, angle_deg=angle)
+    smooth = run_impact(radii, 0.1, ContactParams(restitution=e, friction=0.0),
+                        angle_deg=angle)
+    _, d_spin, _ = coulomb_sliding_changes(res, e, mu)
+    assert np.abs(res.u_rel_after - smooth.u_rel_after).max() < 1e-12 * 0.1
+    assert np.abs(smooth.spin_after).max() == 0.0
+    assert res.spin_after == pytest.approx(d_spin, rel=0.03)
+    assert res.restitution == pytest.approx(e, abs=0.01)
+
+
+@pytest.mark.parametrize("name", ["tangential_translation", "limit_damping"])
+def test_contact_switches_must_be_booleans(name):
+    """A switch given as a number or a string is refused, naming the field."""
+    with pytest.raises(ValueError, match=name):
+        ContactParams(**{name: "no"})
+    with pytest.raises(ValueError, match=name):
+        ContactParams(**{name: 0})
