@@ -10,6 +10,7 @@ plot the papers' experiments.
     ice-scenarios run my-copy.yaml --out runs/mine
     ice-scenarios run --resume runs/herman2013-convergence
     ice-scenarios plot runs/herman2013-convergence
+    ice-scenarios summary runs/herman2013-convergence
 """
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ import sys
 import textwrap
 
 from .config import bundled_configs, load_config, parse_set
-from .runner import find_config, plot_run, resume_run, run_scenario
+from .runner import find_config, plot_run, resume_run, run_scenario, summarise_run
 
 
 def _list() -> int:
@@ -72,6 +73,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     p = sub.add_parser("plot", help="(re)make the figures of a run directory")
     p.add_argument("run_dir")
+    m = sub.add_parser("summary", help="print the summary table of a run directory, "
+                                       "computed afresh from its results")
+    m.add_argument("run_dir")
     return ap
 
 
@@ -86,6 +90,9 @@ def main(argv=None) -> int:
         if args.command == "plot":
             for path in plot_run(args.run_dir):
                 print(path)
+            return 0
+        if args.command == "summary":
+            print(summarise_run(args.run_dir))
             return 0
         common = dict(workers=args.workers, checkpoint_every=args.checkpoint_every,
                       progress=not args.no_progress, plots=not args.no_plots)

@@ -58,7 +58,8 @@ def _contact_law(p: dict):
     c = dataclasses.replace(HERMAN2013.contact, friction=p["friction"],
                             restitution=p["restitution"],
                             tangential_damping=p["tangential_damping"],
-                            tangential_stiffness=p["tangential_stiffness"])
+                            tangential_stiffness=p["tangential_stiffness"],
+                            tangential_translation=p["friction_moves_floes"])
     return scaled_contact(c, p["stiffness_scale"])
 
 
@@ -559,6 +560,8 @@ class MarginalIceZone(Experiment):
                 (f"u_a,y = {v:g}: shear-zone width (10–90 % of the outer u_x)",
                  f"{_fmt(width, '.1f')} m; outer u_x {_fmt(outer, '.3f')} m/s",
                  "narrow shear zone by the edge"),
+                (f"u_a,y = {v:g}: σ_xy, σ_yy on the fast ice (end of run), ratio",
+                 self._edge_row(ds, p, c, v), "not given"),
                 (f"u_a,y = {v:g}: corr(p, τ)", f"{_fmt(corr, '.2f')}", "0.68"),
                 (f"u_a,y = {v:g}: p/τ, 5th–95th percentile",
                  (f"{np.percentile(ratio, 5):.1f}–{np.percentile(ratio, 95):.1f}"
@@ -570,6 +573,19 @@ class MarginalIceZone(Experiment):
                  "Z_c ≈ 1.6, Z_a in 0.04–0.08"),
             ]
         return rows
+
+    @staticmethod
+    def _edge_row(ds, p, c, wind_y):
+        """Mean over the members of the edge stress of the last snapshot."""
+        k = int(np.isfinite(ds["snapshot_time"].values[c, 0]).sum()) - 1
+        if k < 0:
+            return "n/a"
+        wind = (math.sqrt(p["wind_speed"] ** 2 - wind_y ** 2), wind_y)
+        res = np.array([edge_stress(ds.isel(case=c, member=m, snapshot=k), wind)
+                        for m in range(ds.sizes["member"])])
+        sxy, syy = res.mean(axis=0)
+        ratio = sxy / syy if syy > 0 else math.nan
+        return f"{sxy:.1f}, {syy:.1f} N/m; {_fmt(ratio, '.2f')}"
 
     def plot(self, ds, p, out_dir):
         plt = plots.pyplot()
@@ -615,6 +631,34 @@ class MarginalIceZone(Experiment):
             labels=[f"u_a,y = {v:g} m/s" for v in wy],
             select=[{"case": c, "member": 0, "snapshot": last[c]} for c in range(len(wy))]))
         return out
+
+
+def edge_stress(snap, wind, thickness: float = HERMAN2013.thickness,
+                forcing_params=HERMAN2013.forcing):
+    """Stress (σ_xy, σ_yy) [N/m] that the mobile ice exerts on the fast ice,
+    from the momentum balance of the mobile floes in one snapshot.
+
+    In a steady state (on average) the frozen floes take up the sum of the
+    external forces on the mobile ones: wind, water drag and Coriolis (eq 6)
+    at the snapshot's velocities. Divided by the length of the edge, that
+    is the shear and normal stress across the edge, and σ_xy/σ_yy is the
+    friction the ice mobilises there. Floes at rest under a wind (u_a,x,
+    u_a,y) give σ_xy/σ_yy = u_a,x/u_a,y whatever their sizes.
+    """
+    r = np.asarray(snap["floe_radius"], float)
+    ok = np.isfinite(r) & (np.asarray(snap["floe_frozen"]) == 0)
+    r = r[ok]
+    u = np.asarray(snap["floe_u"], float)[ok]
+    v = np.asarray(snap["floe_v"], float)[ok]
+    forcing = Forcing(forcing_params, wind=wind)
+    k = forcing.coefficients(r, np.full_like(r, thickness),
+                             forcing_params.ice_density * thickness * math.pi * r ** 2)
+    ua = np.asarray(forcing.wind, float)
+    speed = float(np.hypot(*ua))
+    fx = k.wind * speed * ua[0] - k.water * u + k.coriolis_mass * v
+    fy = k.wind * speed * ua[1] - k.water * v - k.coriolis_mass * u
+    lx = float(snap["snapshot_lx"])
+    return float(fx.sum()) / lx, float(-fy.sum()) / lx
 
 
 def late_profile(profiles: np.ndarray) -> np.ndarray:

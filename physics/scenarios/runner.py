@@ -28,6 +28,7 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -385,9 +386,32 @@ def make_figures(out: Path, ds, exp, params) -> list[Path]:
     return [Path(p) for p in exp.plot(ds, params, fig_dir)]
 
 
-def format_summary(cfg: ScenarioConfig, rows, wall: float, out: Path, notes: str = "") -> str:
+def summarise_run(directory) -> str:
+    """The summary table of a finished run directory, computed afresh from
+    its results (the analysis may be newer than the run); summary.md, with
+    the run's wall time, is left as it is."""
+    import xarray as xr
+    import yaml
+
+    out = Path(directory)
+    if not (out / RESULTS_FILE).exists():
+        raise FileNotFoundError(f"{out} holds no {RESULTS_FILE}: not a finished run directory")
+    info = yaml.safe_load((out / RUN_FILE).read_text())
+    exp = get_experiment(info["scenario"])
+    with xr.open_dataset(out / RESULTS_FILE, engine="h5netcdf") as ds:
+        ds = ds.load()
+    # the header from the run's own record: its scenario file may be a copy
+    cfg = SimpleNamespace(name=info["scenario"], title=info.get("title", ""),
+                          reproduces=info.get("reproduces", ""))
+    rows = exp.summarise(ds, info["parameters"])
+    return format_summary(cfg, rows, None, out, ds.attrs.get("notes", ""))
+
+
+def format_summary(cfg: ScenarioConfig, rows, wall: float | None, out: Path,
+                   notes: str = "") -> str:
+    when = "" if wall is None else f" Wall time {_hms(wall)}."
     lines = [f"## {cfg.name}: {cfg.title}", "",
-             f"Reproduces {cfg.reproduces}. Output: {out}. Wall time {_hms(wall)}.", ""]
+             f"Reproduces {cfg.reproduces}. Output: {out}.{when}", ""]
     if rows:
         lines += ["| quantity | this run | paper |", "|---|---|---|"]
         lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]

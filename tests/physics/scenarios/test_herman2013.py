@@ -120,6 +120,37 @@ def test_miz_open_water_moves_the_top_wall_away(tmp_path):
     assert np.all(np.isfinite(ds["u_x_profile"].values[0, 0, 0, :4]))
 
 
+def test_edge_stress_of_ice_at_rest_and_in_free_drift():
+    """Momentum balance of the mobile ice (herman2013-miz summary). Floes of
+    many sizes at rest under a wind (8, -6) m/s: Coriolis and water drag
+    vanish, so the fast ice takes the wind force alone, σ_xy/σ_yy = 8/6
+    (1e-12), with σ_yy > 0 (pushed onto the edge) and σ_xy the x wind force
+    over the edge length (1e-12). The same floes in their eq 6 free drift
+    (with Coriolis) exert nothing: both stresses below 1e-9 of that at
+    rest. Frozen floes and NaN padding are left out."""
+    from physics.forcing import Forcing, steady_drift
+    from physics.params import HERMAN2013
+    from physics.scenarios.herman2013 import edge_stress
+
+    h = HERMAN2013.thickness
+    r = np.array([1.0, 2.5, 4.0, 30.0, 200.0, 5.0, np.nan])
+    frozen = np.array([0, 0, 0, 0, 0, 1, 0])
+    wind = (8.0, -6.0)
+    snap = {"floe_radius": r, "floe_frozen": frozen, "floe_u": np.zeros(7),
+            "floe_v": np.zeros(7), "snapshot_lx": 500.0}
+    sxy, syy = edge_stress(snap, wind)
+    f = Forcing(HERMAN2013.forcing, wind=wind)
+    rm = r[:5]
+    a = f.coefficients(rm, np.full(5, h), np.ones(5)).wind
+    assert sxy == pytest.approx(float((a * 10.0 * 8.0).sum()) / 500.0, rel=1e-12)
+    assert syy > 0 and sxy / syy == pytest.approx(8.0 / 6.0, rel=1e-12)
+    drift = np.full((7, 2), np.nan)
+    drift[:5] = steady_drift(f, rm, np.full(5, h),
+                             HERMAN2013.forcing.ice_density * h * math.pi * rm ** 2)
+    sxy_d, syy_d = edge_stress(dict(snap, floe_u=drift[:, 0], floe_v=drift[:, 1]), wind)
+    assert abs(sxy_d) < 1e-9 * abs(sxy) and abs(syy_d) < 1e-9 * syy
+
+
 def test_channel_fields_are_placed_above_the_random_placement_limit():
     """A channel (walls, no periodic compression) is filled directly at
     A = 0.87: the floe area over the box area is 0.87 to 1e-9, and no two
@@ -135,19 +166,21 @@ def test_channel_fields_are_placed_above_the_random_placement_limit():
 
 @pytest.mark.parametrize("name", ["herman2013-convergence", "herman2013-wind", "herman2013-miz"])
 def test_contact_parameters_reach_the_contact_law(name):
-    """friction, restitution, tangential_damping and tangential_stiffness
-    of every Herman (2013) scenario end up in the ContactParams of its
-    simulations (defaults: the paper's friction, our restitution 0.5, no
-    tangential damping, the Mindlin stiffness)."""
+    """friction, restitution, tangential_damping, tangential_stiffness and
+    friction_moves_floes of every Herman (2013) scenario end up in the
+    ContactParams of its simulations (defaults: the paper's friction, our
+    restitution 0.5, no tangential damping, the Mindlin stiffness, friction
+    acting on translation)."""
     from physics.params import HERMAN2013
     from physics.scenarios.herman2013 import _contact_law
     from physics.scenarios.runner import find_config
 
     defaults = find_config(name).defaults()
     def law(c):
-        return c.friction, c.restitution, c.tangential_damping, c.tangential_stiffness
+        return (c.friction, c.restitution, c.tangential_damping, c.tangential_stiffness,
+                c.tangential_translation)
 
-    assert law(_contact_law(defaults)) == (HERMAN2013.contact.friction, 0.5, 0.0, 1.0)
+    assert law(_contact_law(defaults)) == (HERMAN2013.contact.friction, 0.5, 0.0, 1.0, True)
     changed = dict(defaults, friction=0.3, restitution=0.9, tangential_damping=0.5,
-                   tangential_stiffness=0.24)
-    assert law(_contact_law(changed)) == (0.3, 0.9, 0.5, 0.24)
+                   tangential_stiffness=0.24, friction_moves_floes=False)
+    assert law(_contact_law(changed)) == (0.3, 0.9, 0.5, 0.24, False)

@@ -201,3 +201,7 @@ def test_command_line_quick_run_end_to_end(tmp_path):
     replot = subprocess.run([sys.executable, "-m", "physics.scenarios", "plot", str(out)],
                             capture_output=True, text=True, timeout=600)
     assert replot.returncode == 0 and "convergence_pressure_contacts.png" in replot.stdout
+    summary = subprocess.run([sys.executable, "-m", "physics.scenarios", "summary", str(out)],
+                             capture_output=True, text=True, timeout=600)
+    assert summary.returncode == 0 and "| A_J, knee of ln p(A) |" in summary.stdout
+    assert "Wall time" not in summary.stdout and "Wall time" in (out / "summary.md").read_text()
