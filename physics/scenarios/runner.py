@@ -386,20 +386,29 @@ def make_figures(out: Path, ds, exp, params) -> list[Path]:
     return [Path(p) for p in exp.plot(ds, params, fig_dir)]
 
 
-def summarise_run(directory) -> str:
-    """The summary table of a finished run directory, computed afresh from
-    its results (the analysis may be newer than the run); summary.md, with
-    the run's wall time, is left as it is."""
+def _load_run(directory):
+    """(directory, run.yaml contents, experiment, results) of a finished
+    run directory; a clear error if it holds no results."""
     import xarray as xr
     import yaml
 
     out = Path(directory)
     if not (out / RESULTS_FILE).exists():
-        raise FileNotFoundError(f"{out} holds no {RESULTS_FILE}: not a finished run directory")
+        raise FileNotFoundError(f"{out} holds no {RESULTS_FILE}: not a finished run directory"
+                                + (" (resume it with ice-scenarios run --resume)"
+                                   if (out / RUN_FILE).exists() else ""))
     info = yaml.safe_load((out / RUN_FILE).read_text())
     exp = get_experiment(info["scenario"])
     with xr.open_dataset(out / RESULTS_FILE, engine="h5netcdf") as ds:
         ds = ds.load()
+    return out, info, exp, ds
+
+
+def summarise_run(directory) -> str:
+    """The summary table of a finished run directory, computed afresh from
+    its results (the analysis may be newer than the run); summary.md, with
+    the run's wall time, is left as it is."""
+    out, info, exp, ds = _load_run(directory)
     # the header from the run's own record: its scenario file may be a copy
     cfg = SimpleNamespace(name=info["scenario"], title=info.get("title", ""),
                           reproduces=info.get("reproduces", ""))
@@ -428,16 +437,5 @@ def _hms(seconds: float) -> str:
 
 def plot_run(directory) -> list[Path]:
     """(Re)make the figures of a finished run directory."""
-    import xarray as xr
-    import yaml
-
-    out = Path(directory)
-    if not (out / RESULTS_FILE).exists():
-        raise FileNotFoundError(f"{out} holds no {RESULTS_FILE}: not a finished run directory"
-                                + (" (resume it with ice-scenarios run --resume)"
-                                   if (out / RUN_FILE).exists() else ""))
-    info = yaml.safe_load((out / RUN_FILE).read_text())
-    exp = get_experiment(info["scenario"])
-    with xr.open_dataset(out / RESULTS_FILE, engine="h5netcdf") as ds:
-        ds = ds.load()
+    out, info, exp, ds = _load_run(directory)
     return make_figures(out, ds, exp, info["parameters"])
