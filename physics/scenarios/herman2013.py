@@ -29,6 +29,7 @@ from ..domain import ChannelBox, DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, make_floe_field
 from ..forcing import Forcing, steady_drift
 from ..hertz import HertzSimulation, hertz_time_step, scaled_contact
+from ..hertz_kernels import floe_drag
 from ..observables import fabric, stress
 from ..params import HERMAN2013
 from . import plots
@@ -639,8 +640,9 @@ def edge_stress(snap, wind, thickness: float = HERMAN2013.thickness,
     from the momentum balance of the mobile floes in one snapshot.
 
     In a steady state (on average) the frozen floes take up the sum of the
-    external forces on the mobile ones: wind, water drag and Coriolis (eq 6)
-    at the snapshot's velocities. Divided by the length of the edge, that
+    external forces on the mobile ones: wind, water drag and Coriolis (eq 6,
+    the engine's own :func:`physics.hertz_kernels.floe_drag`) at the
+    snapshot's velocities. Divided by the length of the edge, that
     is the shear and normal stress across the edge, and σ_xy/σ_yy is the
     friction the ice mobilises there. Floes at rest under a wind (u_a,x,
     u_a,y) give σ_xy/σ_yy = u_a,x/u_a,y whatever their sizes.
@@ -653,10 +655,9 @@ def edge_stress(snap, wind, thickness: float = HERMAN2013.thickness,
     forcing = Forcing(forcing_params, wind=wind)
     k = forcing.coefficients(r, np.full_like(r, thickness),
                              forcing_params.ice_density * thickness * math.pi * r ** 2)
-    ua = np.asarray(forcing.wind, float)
-    speed = float(np.hypot(*ua))
-    fx = k.wind * speed * ua[0] - k.water * u + k.coriolis_mass * v
-    fy = k.wind * speed * ua[1] - k.water * v - k.coriolis_mass * u
+    uax, uay, uwx, uwy = forcing.kernel_vector()
+    fx, fy, _ = floe_drag(u, v, np.zeros_like(u), k.wind, k.water, k.rotation,
+                          k.coriolis_mass, uax, uay, uwx, uwy, math.hypot(uax, uay))
     lx = float(snap["snapshot_lx"])
     return float(fx.sum()) / lx, float(-fy.sum()) / lx
 

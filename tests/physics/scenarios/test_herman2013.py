@@ -126,8 +126,9 @@ def test_edge_stress_of_ice_at_rest_and_in_free_drift():
     vanish, so the fast ice takes the wind force alone, σ_xy/σ_yy = 8/6
     (1e-12), with σ_yy > 0 (pushed onto the edge) and σ_xy the x wind force
     over the edge length (1e-12). The same floes in their eq 6 free drift
-    (with Coriolis) exert nothing: both stresses below 1e-9 of that at
-    rest. Frozen floes and NaN padding are left out."""
+    (with Coriolis, and with an ocean current as well) exert nothing: both
+    stresses below 1e-9 of that at rest. Frozen floes and NaN padding are
+    left out."""
     from physics.forcing import Forcing, steady_drift
     from physics.params import HERMAN2013
     from physics.scenarios.herman2013 import edge_stress
@@ -149,6 +150,15 @@ def test_edge_stress_of_ice_at_rest_and_in_free_drift():
                              HERMAN2013.forcing.ice_density * h * math.pi * rm ** 2)
     sxy_d, syy_d = edge_stress(dict(snap, floe_u=drift[:, 0], floe_v=drift[:, 1]), wind)
     assert abs(sxy_d) < 1e-9 * abs(sxy) and abs(syy_d) < 1e-9 * syy
+    # with an ocean current too: the free drift changes, the fast ice still carries nothing
+    import dataclasses
+    flow = dataclasses.replace(HERMAN2013.forcing, current_speed=0.2, current_angle=1.0)
+    f = Forcing(flow, wind=wind)
+    drift[:5] = steady_drift(f, rm, np.full(5, h),
+                             HERMAN2013.forcing.ice_density * h * math.pi * rm ** 2)
+    sxy_c, syy_c = edge_stress(dict(snap, floe_u=drift[:, 0], floe_v=drift[:, 1]), wind,
+                               forcing_params=flow)
+    assert abs(sxy_c) < 1e-9 * abs(sxy) and abs(syy_c) < 1e-9 * syy
 
 
 def test_channel_fields_are_placed_above_the_random_placement_limit():
