@@ -1,4 +1,8 @@
-"""Kernels loaded from Numba's on-disk cache in a later process must run.
+"""The kernel cache: kernels loaded from Numba's on-disk cache in a later
+process must run; the cache directories of other checkouts and versions and
+anything foreign under the base directory survive (only stale marked ones
+are pruned); the first compilation in a process prints one line, a warm
+cache nothing.
 
 A cached kernel that calls a parallel kernel crashed every process that
 loaded it when it had been compiled in a process that took the parallel
@@ -12,6 +16,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 
 BUILD_LIST = """
 from physics import make_floe_field
@@ -42,3 +47,108 @@ def test_kernels_compiled_in_one_process_run_when_loaded_in_the_next(tmp_path):
         outputs.append(run.stdout.strip().splitlines()[-1])
     assert outputs[0].startswith("pairs ") and int(outputs[0].split()[1]) > 0
     assert outputs[1] == outputs[2] == "steps 20"
+
+
+# -- the cache directories: what configure() keeps and what it prunes ---------
+
+def _configure_under(tmp_path, monkeypatch):
+    """configure() with the base under tmp_path, leaving this process's Numba
+    cache where it was."""
+    import numba
+
+    from physics import _jit_cache
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(numba.config, "CACHE_DIR", numba.config.CACHE_DIR)
+    return _jit_cache, _jit_cache.configure()
+
+
+def test_configure_marks_its_directory_and_keeps_what_it_did_not_write(tmp_path, monkeypatch):
+    base = tmp_path / "seaice-gym"
+    foreign = base / "not-ours"
+    foreign.mkdir(parents=True)
+    (foreign / "data.bin").write_bytes(b"x")
+    stray = base / "notes.txt"
+    stray.write_text("keep")
+    old = time.time() - 400 * 86400
+    os.utime(foreign, (old, old))
+    jc, target = _configure_under(tmp_path, monkeypatch)
+    assert target is not None and target.parent == base
+    assert (target / jc.MARKER).is_file()
+    assert (foreign / "data.bin").read_bytes() == b"x"
+    assert stray.read_text() == "keep"
+
+
+def test_configure_keeps_other_versions_used_recently_and_prunes_stale_ones(tmp_path,
+                                                                             monkeypatch):
+    from physics import _jit_cache as jc
+
+    base = tmp_path / "seaice-gym"
+    recent, stale = base / "0123456789abcdef", base / "fedcba9876543210"
+    for d in (recent, stale):
+        d.mkdir(parents=True)
+        (d / jc.MARKER).touch()
+        (d / "kernel.nbi").write_bytes(b"index")
+    days = 86400.0
+    t_recent = time.time() - (jc.MAX_AGE_DAYS - 1) * days
+    t_stale = time.time() - (jc.MAX_AGE_DAYS + 1) * days
+    os.utime(recent / jc.MARKER, (t_recent, t_recent))
+    os.utime(stale / jc.MARKER, (t_stale, t_stale))
+    _, target = _configure_under(tmp_path, monkeypatch)
+    assert (recent / "kernel.nbi").is_file()
+    assert not stale.exists()
+    # the directory in use is renewed on every use, however old its marker
+    os.utime(target / jc.MARKER, (t_stale, t_stale))
+    _configure_under(tmp_path, monkeypatch)
+    assert (target / jc.MARKER).stat().st_mtime > time.time() - days
+
+
+# -- the line printed before the first compilation ---------------------------
+
+COMPILE_SMALL_KERNELS = """
+from physics import domain
+assert domain.wrap_coordinate(1.25, 1.0, True) == 0.25
+assert domain.minimum_image(0.75, 1.0, True) == -0.25
+print("ok")
+"""
+
+
+def _run_small_kernels(cache_dir, **extra):
+    env = {k: v for k, v in os.environ.items() if k != "SEAICE_QUIET"}
+    env.update(NUMBA_CACHE_DIR=str(cache_dir), NUMBA_NUM_THREADS="1", **extra)
+    run = subprocess.run([sys.executable, "-c", COMPILE_SMALL_KERNELS], capture_output=True,
+                         text=True, env=env, timeout=300)
+    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr[-2000:]
+    return run.stderr
+
+
+def test_first_compilation_prints_one_line_and_a_warm_cache_none(tmp_path):
+    from physics._jit_cache import compile_notice
+
+    first = _run_small_kernels(tmp_path)
+    lines = [ln for ln in first.splitlines() if ln.startswith("seaice-gym: compiling")]
+    assert len(lines) == 1, first
+    target = tmp_path / "seaice-gym"
+    assert lines[0] == compile_notice(next(p for p in target.iterdir() if p.is_dir()))
+    assert _run_small_kernels(tmp_path) == ""                    # loaded from the cache
+    assert _run_small_kernels(tmp_path / "quiet", SEAICE_QUIET="1") == ""
+
+
+def test_warmup_reports_a_failing_item_and_runs_the_others(monkeypatch, capsys):
+    from physics import warmup
+
+    ran = []
+
+    def broken():
+        raise TypeError("unknown argument n_floes")
+
+    monkeypatch.setattr(warmup, "items", lambda steps: [
+        ("first", lambda: ran.append("first")), ("broken", broken),
+        ("last", lambda: ran.append("last") or " (note)")])
+    monkeypatch.setenv("SEAICE_QUIET", "1")
+    assert warmup.main([]) == 1
+    assert ran == ["first", "last"]
+    out, err = capsys.readouterr()
+    assert "[1/3] first:" in out and "[3/3] last:" in out and "(note)" in out
+    assert "[2/3] broken: FAILED: TypeError: unknown argument n_floes" in err
+    assert "1 failed)" in out

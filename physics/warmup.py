@@ -1,0 +1,191 @@
+"""Compile the kernels in advance: ``python -m physics.warmup``.
+
+Numba compiles the kernels on their first use and keeps them in an on-disk
+cache (see :mod:`physics._jit_cache`); the first run of an environment or
+of ``make demo`` otherwise spends a minute or two compiling. This module
+builds every registered environment on a small instance, resets it and
+steps it with a few random actions, then runs ``python -m physics.demo`` on
+a few floes and a short Hertz run on the multi-threaded kernels, so that
+later runs load everything from the cache. It prints one line per item and
+the total time; an item that fails is reported and the others still run
+(the exit status is then 1).
+
+    python -m physics.warmup [--steps 5] [--quiet] [--traceback]
+
+(``iceenvs`` and ``gymnasium`` are imported here only, never by the
+``physics`` package itself.)
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import sys
+import tempfile
+import time
+import traceback
+from typing import Callable
+
+# small instances: the kernels' types do not depend on the sizes
+ENV_KWARGS = {
+    "FloeClustering-v0": dict(n_floes=150),
+    "ThicknessDistribution-v0": dict(n_classes=60),
+}
+FLOE_ENV_KWARGS = dict(n_floes=60)
+
+
+class _CompileCounter:
+    """Counts the compilations of the package's cached kernels (top level
+    only: a kernel compiled inside another one's compilation is not counted
+    again)."""
+
+    def __init__(self):
+        from numba.core import event
+
+        from . import _jit_cache
+
+        self.count = 0
+        depth = [0]
+        counter = self
+
+        class Listener(event.Listener):
+            def on_start(self, ev):
+                if depth[0] == 0 and _jit_cache._is_package_kernel(ev.data.get("dispatcher")):
+                    counter.count += 1
+                depth[0] += 1
+
+            def on_end(self, ev):
+                depth[0] -= 1
+
+        self._event, self._listener = event, Listener()
+        event.register("numba:compile", self._listener)
+
+    def close(self) -> None:
+        self._event.unregister("numba:compile", self._listener)
+
+
+def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
+    """Make ``env_id`` small, reset it and take ``steps`` random actions
+    (resetting when an episode ends). Falls back to the default constructor
+    if the small-instance arguments are not accepted."""
+    import gymnasium as gym
+
+    name = env_id.split("/")[-1]
+    kwargs = ENV_KWARGS.get(name, FLOE_ENV_KWARGS)
+    note = ""
+    try:
+        env = gym.make(env_id, **kwargs)
+    except TypeError:
+        note = " (default size: the small-instance arguments were refused)"
+        env = gym.make(env_id)
+    try:
+        env.action_space.seed(seed)
+        env.reset(seed=seed)
+        for _ in range(steps):
+            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+            if terminated or truncated:
+                env.reset()
+    finally:
+        env.close()
+    return note
+
+
+def warm_demo() -> str:
+    """``python -m physics.demo`` on 300 floes for 2 model seconds, its
+    output discarded (the kernels are the same as for the full demo)."""
+    from . import demo
+
+    with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
+        try:
+            demo.main(["--floes", "300", "--duration", "2", "--out", out])
+        except ImportError as exc:         # matplotlib missing: only the picture fails
+            return f" (no picture: {exc})"
+    return ""
+
+
+def warm_parallel(steps: int = 5) -> str:
+    """A few steps of a small Hertz run with ``parallel=True`` (the kernels
+    that the engine picks for large fields when Numba has several threads)."""
+    from . import HERMAN2013, Forcing, HertzSimulation, make_floe_field
+
+    field, box = make_floe_field(300, concentration=0.7, alpha=HERMAN2013.fsd_exponent,
+                                 mean_diameter=HERMAN2013.mean_diameter, seed=1,
+                                 velocity_std=0.01)
+    sim = HertzSimulation(field, box, HERMAN2013.contact, Forcing(HERMAN2013.forcing),
+                          dt=HERMAN2013.time_step, parallel=True)
+    sim.step(steps)
+    sim.contacts()
+    return ""
+
+
+def _env_ids() -> tuple[str, ...]:
+    import iceenvs
+
+    return iceenvs.ENV_IDS
+
+
+def items(steps: int = 5) -> list[tuple[str, Callable[[], str | None]]]:
+    """The warm-up items, as (label, function) pairs."""
+    out = []
+    try:
+        ids = _env_ids()
+    except ImportError as exc:
+        def missing(exc=exc):
+            raise exc
+        out.append(("environments", missing))
+    else:
+        for env_id in ids:
+            out.append((env_id, lambda env_id=env_id: warm_env(env_id, steps)))
+    out.append(("physics.demo", warm_demo))
+    out.append(("Hertz engine, parallel kernels", lambda: warm_parallel(steps)))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m physics.warmup",
+                                description=__doc__.splitlines()[0])
+    p.add_argument("--steps", type=int, default=5, help="random steps per environment (default 5)")
+    p.add_argument("--quiet", action="store_true", help="print only failures")
+    p.add_argument("--traceback", action="store_true", help="print the traceback of a failure")
+    args = p.parse_args(argv)
+    # this module says what it compiles: the one-line notice is redundant
+    os.environ.setdefault("SEAICE_QUIET", "1")
+
+    from . import _jit_cache
+
+    def say(text: str) -> None:
+        if not args.quiet:
+            print(text, flush=True)
+
+    counter = _CompileCounter()
+    where = _jit_cache.CACHE_DIR or "of Numba's default location"
+    todo = items(args.steps)
+    say(f"seaice-gym: filling the kernel cache {where} "
+        f"(a minute or two when it is empty, a few seconds when it is not)")
+    failed = 0
+    t_start = time.perf_counter()
+    for k, (label, fn) in enumerate(todo, 1):
+        t0 = time.perf_counter()
+        before = counter.count
+        try:
+            note = fn() or ""
+        except Exception as exc:  # noqa: BLE001  (report and go on)
+            failed += 1
+            print(f"  [{k}/{len(todo)}] {label}: FAILED: {type(exc).__name__}: {exc}",
+                  file=sys.stderr, flush=True)
+            if args.traceback:
+                traceback.print_exc(file=sys.stderr)
+            continue
+        n = counter.count - before
+        what = f"compiled {n} kernel{'s' * (n != 1)}" if n else "all from the cache"
+        say(f"  [{k}/{len(todo)}] {label}: {time.perf_counter() - t0:.1f} s, {what}{note}")
+    total = time.perf_counter() - t_start
+    counter.close()
+    say(f"done in {total:.1f} s ({counter.count} kernels compiled"
+        f"{f', {failed} failed' if failed else ''})")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
