@@ -1,4 +1,5 @@
-"""Tests of iceenvs.rendering: floe and thickness-distribution pictures, and the window."""
+"""Tests of iceenvs.rendering: floe and thickness-distribution pictures, annotation panels,
+and the window."""
 import math
 import sys
 
@@ -9,8 +10,13 @@ from gymnasium.error import DependencyNotInstalled
 pygame = pytest.importorskip("pygame")
 
 from iceenvs.rendering import (  # noqa: E402
-    BACKGROUND, CHAIN, ITD_BACKGROUND, ITD_TARGET, Window, draw_floes, draw_itd,
+    ARROW_CIRCLE, ARROW_COLOURS, BACKGROUND, CHAIN, CLUSTER_LEGEND, CLUSTER_PALETTE, FROZEN,
+    ITD_BACKGROUND, ITD_TARGET, LARGEST_CLUSTER, PANEL_BACKGROUND, SINGLE_FLOE, SPEED_SCALE,
+    Window, annotate, draw_floes, draw_itd, season,
 )
+
+VIRIDIS_TOP = (253, 231, 37)
+VIRIDIS_BOTTOM = (68, 1, 84)
 
 
 def one_floe(x, y, r=10.0, box=(100.0, 100.0), size=200, **kw):
@@ -161,6 +167,252 @@ def test_draw_floes_rejects_bad_input(kwargs, name):
 def test_draw_itd_rejects_bad_input(h, g, name):
     with pytest.raises(ValueError, match=name):
         draw_itd(np.array(h), np.array(g))
+
+
+# -- fixed speed scale -------------------------------------------------------------------
+def two_floes(speeds, **kw):
+    pos = np.array([[25.0, 50.0], [75.0, 50.0]])
+    return draw_floes(pos, np.array([10.0, 10.0]), (100.0, 100.0), np.asarray(speeds, float),
+                      size=200, **kw)
+
+
+def test_same_speed_same_colour_whatever_the_fastest_floe():
+    assert SPEED_SCALE == 0.5
+    slow_max, fast_max = two_floes([0.2, 0.3]), two_floes([0.2, 0.5])
+    assert np.array_equal(slow_max[100, 50], fast_max[100, 50])
+    assert not np.array_equal(slow_max[100, 150], fast_max[100, 150])
+    assert np.array_equal(two_floes([0.2, 0.3], speed_scale=None)[100, 50], slow_max[100, 50])
+
+
+def test_speed_above_the_scale_saturates_to_the_top_colour():
+    frame = two_floes([0.0, 2.0])
+    assert tuple(frame[100, 150]) == VIRIDIS_TOP
+    assert tuple(frame[100, 50]) == VIRIDIS_BOTTOM
+    assert tuple(two_floes([0.0, 0.5])[100, 150]) == VIRIDIS_TOP
+    assert tuple(two_floes([0.0, 0.4])[100, 150]) != VIRIDIS_TOP
+
+
+# -- cluster colouring ---------------------------------------------------------------------
+CLUSTER_POS = np.array([[15.0, 80.0], [35.0, 80.0],                 # label 3: 2 big floes
+                        [15.0, 40.0], [30.0, 40.0], [45.0, 40.0],   # label 8: 3 small floes
+                        [80.0, 80.0],                               # label 1: alone, biggest
+                        [80.0, 30.0]])                              # label 4: alone, frozen
+
+
+def cluster_frame(labels, frozen=None):
+    radii = np.array([10.0, 10.0, 6.0, 6.0, 6.0, 14.0, 8.0])
+    return draw_floes(CLUSTER_POS, radii, (100.0, 100.0), np.zeros(7), labels=labels,
+                      frozen=frozen, size=200)
+
+
+def centre_colours(frame):
+    return [tuple(int(v) for v in frame[200 - round(2 * y), round(2 * x)]) for x, y in CLUSTER_POS]
+
+
+def test_labels_colour_floes_by_cluster():
+    frozen = np.array([False] * 6 + [True])
+    c = centre_colours(cluster_frame(np.array([3, 3, 8, 8, 8, 1, 4]), frozen))
+    assert c[0] == c[1] == LARGEST_CLUSTER            # largest by area, not by floe count
+    assert c[2] == c[3] == c[4] == CLUSTER_PALETTE[8 % len(CLUSTER_PALETTE)]
+    assert c[5] == SINGLE_FLOE                        # a lone floe is not a cluster
+    assert c[6] == FROZEN
+
+
+def test_largest_cluster_by_total_area():
+    c = centre_colours(cluster_frame(np.array([1, 1, 0, 0, 0, 11, 10])))
+    assert c[0] == c[1] == LARGEST_CLUSTER            # 2 r² = 200 m² against 3 r² = 108 m²
+    assert c[2] == c[3] == c[4] == CLUSTER_PALETTE[0]
+    c = centre_colours(cluster_frame(np.array([0, 1, 2, 2, 2, 5, 6])))
+    assert c[2] == c[3] == c[4] == LARGEST_CLUSTER    # the only cluster of several floes
+    assert c[0] == c[1] == c[5] == SINGLE_FLOE
+
+
+def test_only_single_floes_have_no_highlight():
+    frame = cluster_frame(np.arange(7))
+    assert not np.all(frame == np.array(LARGEST_CLUSTER, dtype=np.uint8), axis=-1).any()
+    assert set(centre_colours(frame)) == {SINGLE_FLOE}
+
+
+@pytest.mark.parametrize("labels", [np.zeros(6, dtype=int), np.zeros((7, 1), dtype=int),
+                                    np.zeros(7), np.array(["a"] * 7)])
+def test_bad_labels_raise(labels):
+    with pytest.raises(ValueError, match="labels"):
+        cluster_frame(labels)
+
+
+# -- annotate ------------------------------------------------------------------------------
+def panel_of(frame, picture):
+    return frame[:, picture.shape[1]:]
+
+
+def is_colour(a, colour):
+    return np.all(a == np.array(colour, dtype=np.uint8), axis=-1)
+
+
+def test_annotate_keeps_the_picture_and_adds_a_panel():
+    pic = one_floe(50.0, 50.0, size=600)
+    frame = annotate(pic, text=["t = 300 s", "A = 0.812"], colour_bar=("speed [m/s]", 0, 0.5),
+                     arrow=(0.3, 0.4), arrow_label="wind 10 m/s")
+    assert frame.dtype == np.uint8
+    assert frame.shape == (600, 600 + 180, 3)          # 0.3 x width
+    assert np.array_equal(frame[:, :600], pic)
+    assert annotate(one_floe(50.0, 50.0), text="x").shape[1] == 200 + 150   # minimum width
+    assert annotate(pic, text="x", panel_width=222).shape == (600, 822, 3)
+
+
+def test_annotate_pads_a_short_picture_with_the_panel_background():
+    pic = one_floe(50.0, 50.0, size=40)
+    frame = annotate(pic, text=["a", "b"], colour_bar=("v", 0, 1), legend=CLUSTER_LEGEND,
+                     arrow=(1, 0))
+    assert frame.shape[0] > 40
+    assert np.array_equal(frame[:40, :40], pic)
+    assert is_colour(frame[40:, :40], PANEL_BACKGROUND).all()
+
+
+def test_annotate_draws_the_colour_bar_top_high_bottom_low():
+    pic = one_floe(50.0, 50.0, size=300)
+    without = panel_of(annotate(pic, text="t = 0 s"), pic)
+    assert not is_colour(without, VIRIDIS_TOP).any()
+    panel = panel_of(annotate(pic, colour_bar=("speed [m/s]", 0.0, 0.5)), pic)
+    top_rows = np.nonzero(is_colour(panel, VIRIDIS_TOP).any(axis=1))[0]
+    bottom_rows = np.nonzero(is_colour(panel, VIRIDIS_BOTTOM).any(axis=1))[0]
+    assert top_rows.size and bottom_rows.size
+    assert top_rows.max() < bottom_rows.min() - 50     # a tall bar, high values at the top
+    assert is_colour(panel, VIRIDIS_TOP).sum() >= 12   # a bar, not a stray pixel
+
+
+def arrow_geometry(frame, picture, colour=ARROW_COLOURS[0]):
+    """(centre x, centre y, radius) of the arrow circle and the arrow-coloured pixels."""
+    panel = panel_of(frame, picture)
+    rows, cols = np.nonzero(is_colour(panel, ARROW_CIRCLE))
+    cx, cy = (cols.min() + cols.max()) / 2, (rows.min() + rows.max()) / 2
+    radius = (cols.max() - cols.min()) / 2
+    ar, ac = np.nonzero(is_colour(panel, colour))
+    return cx, cy, radius, ar, ac
+
+
+def test_arrow_points_plus_x():
+    pic = one_floe(50.0, 50.0, size=300)
+    cx, cy, radius, rows, cols = arrow_geometry(annotate(pic, arrow=(1.0, 0.0)), pic)
+    assert radius > 10
+    assert (cols > cx + 0.7 * radius).any()
+    assert not (cols < cx - 3).any()
+    assert np.all(np.abs(rows - cy) < 0.4 * radius)
+
+
+def test_arrow_y_points_up_and_long_arrows_are_clipped():
+    pic = one_floe(50.0, 50.0, size=300)
+    cx, cy, radius, rows, cols = arrow_geometry(annotate(pic, arrow=(0.0, 0.5)), pic)
+    assert (rows < cy - 0.3 * radius).any()
+    assert not (rows < cy - 0.6 * radius).any()       # half the full length
+    assert not (rows > cy + 3).any()
+    assert np.array_equal(annotate(pic, arrow=(0.0, 7.0)), annotate(pic, arrow=(0.0, 1.0)))
+
+
+def test_two_arrows_with_their_colours_and_labels():
+    pic = one_floe(50.0, 50.0, size=300)
+    frame = annotate(pic, arrow=[((1.0, 0.0), "wind 20 m/s"), ((0.0, -1.0), None, (255, 0, 0))])
+    cx, cy, radius, rows, cols = arrow_geometry(frame, pic)
+    assert (cols > cx + 0.7 * radius).any()            # first: white, +x
+    _, _, _, red_rows, red_cols = arrow_geometry(frame, pic, (255, 0, 0))
+    assert (red_rows > cy + 0.7 * radius).any()        # second: red, -y (down on screen)
+    assert not (red_rows < cy - 3).any()
+    labelled = panel_of(frame, pic)[int(cy + radius) + 3:]
+    assert (labelled.astype(int).sum(axis=-1) > 3 * 200).any()   # white label under the circle
+
+
+def test_legend_swatches_are_drawn():
+    pic = one_floe(50.0, 50.0, size=300)
+    panel = panel_of(annotate(pic, legend=[((255, 0, 0), "a"), ((0, 255, 0), "b")]), pic)
+    red, green = is_colour(panel, (255, 0, 0)), is_colour(panel, (0, 255, 0))
+    assert red.sum() > 20 and green.sum() > 20
+    assert np.nonzero(red)[0].mean() < np.nonzero(green)[0].mean()   # in order, top to bottom
+
+
+def test_text_is_written_and_skipped_without_fonts(monkeypatch):
+    pic = one_floe(50.0, 50.0, size=300)
+    panel = panel_of(annotate(pic, text=["t = 300 s", "A = 0.81"]), pic)
+    assert (~is_colour(panel, PANEL_BACKGROUND)).sum() > 50
+
+    def no_font(*args, **kwargs):
+        raise pygame.error("no fonts")
+
+    monkeypatch.setattr(pygame.font, "Font", no_font)
+    panel = panel_of(annotate(pic, text=["t = 300 s"], colour_bar=("v [m/s]", 0, 1)), pic)
+    assert is_colour(panel, VIRIDIS_TOP).any()        # the bar is still drawn
+    assert is_colour(panel[:40], PANEL_BACKGROUND).all()   # the text line is blank
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(picture=np.zeros((10, 10, 3))), "picture"),
+    (dict(picture=np.zeros((10, 10), dtype=np.uint8)), "picture"),
+    (dict(colour_bar=("v", 1.0, 1.0)), "colour_bar"),
+    (dict(colour_bar=("v", 0.0, np.nan)), "colour_bar"),
+    (dict(colour_bar=(0.0, 1.0)), "colour_bar"),
+    (dict(arrow=(1.0, 0.0, 0.0)), "arrow"),
+    (dict(arrow=(np.nan, 0.0)), "arrow"),
+    (dict(arrow=[((1, 0), "a"), ((0, 1), "b"), ((1, 1), "c")]), "arrow"),
+    (dict(arrow=[((1, 0), "a", (300, 0, 0))]), "arrow colour"),
+    (dict(arrow=[((1, 0), "a")], arrow_label="b"), "arrow_label"),
+    (dict(arrow_label="wind"), "arrow_label"),
+    (dict(legend=[((300, 0, 0), "a")]), "legend"),
+    (dict(legend=[((255, 0, 0),)]), "legend"),
+    (dict(text=[1, 2]), "text"),
+    (dict(panel_width=0), "panel_width"),
+])
+def test_annotate_rejects_bad_input(kwargs, name):
+    args = dict(picture=np.zeros((10, 10, 3), dtype=np.uint8))
+    args.update(kwargs)
+    picture = args.pop("picture")
+    with pytest.raises(ValueError, match=name):
+        annotate(picture, **args)
+
+
+# -- ITD labels ----------------------------------------------------------------------------
+ITD_H = np.array([0.0, 0.5, 1.0, 2.0])
+ITD_G = np.array([0.1, 0.6, 0.2, 0.1])
+
+
+def test_itd_title_with_day_and_axis_labels():
+    plain = draw_itd(ITD_H, ITD_G)
+    titled = draw_itd(ITD_H, ITD_G, day=123)
+    assert titled.shape == plain.shape == (360, 600, 3)
+    title_area = (slice(0, 28), slice(60, 600))
+    assert not painted(plain[title_area], ITD_BACKGROUND).any()
+    assert painted(titled[title_area], ITD_BACKGROUND).sum() > 50
+    assert painted(plain[:, :48], ITD_BACKGROUND)[61:300].sum() > 30   # y-tick values
+    assert painted(plain[335:], ITD_BACKGROUND).sum() > 50              # x-axis label
+    assert np.array_equal(titled[40:], plain[40:])                      # only the title differs
+
+
+def test_itd_legend_shows_the_target_line_above_the_plot():
+    frame = draw_itd(ITD_H, ITD_G, target=np.array([0.2, 0.3, 0.3, 0.2]), day=10)
+    above = frame[:61, 300:]
+    assert np.all(above == np.array(ITD_TARGET, dtype=np.uint8), axis=-1).sum() > 10
+
+
+def test_itd_without_fonts_still_draws_the_bars(monkeypatch):
+    def no_font(*args, **kwargs):
+        raise pygame.error("no fonts")
+
+    monkeypatch.setattr(pygame.font, "Font", no_font)
+    frame = draw_itd(ITD_H, ITD_G, day=123)
+    assert frame.shape == (360, 600, 3)
+    assert not painted(frame[:28], ITD_BACKGROUND).any()
+    assert painted(frame[100:290, 210:250], ITD_BACKGROUND).all()      # the tallest bar
+
+
+@pytest.mark.parametrize("day, name", [(0, "winter"), (44, "winter"), (45, "spring"),
+                                       (180, "summer"), (270, "autumn"), (-10, "winter"),
+                                       (359.5, "winter"), (400, "winter"),
+                                       (3 * 360 + 100, "spring")])
+def test_season(day, name):
+    assert season(day) == name
+
+
+def test_itd_rejects_a_bad_day():
+    with pytest.raises(ValueError, match="day"):
+        draw_itd(ITD_H, ITD_G, day=float("nan"))
 
 
 def test_missing_pygame_raises_dependency_not_installed(monkeypatch):
