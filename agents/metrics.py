@@ -15,16 +15,19 @@ __all__ = ["PHYSICS_METRICS", "MAIN_METRIC", "env_name", "metric_names", "physic
 
 #: per env name: ``{key of info["physics"]: logged name}``
 PHYSICS_METRICS: dict[str, dict[str, str]] = {
-    "WindDrift-v0": {"u_x": "u_x", "u_y": "u_y", "pressure": "pressure",
+    "WindDrift-v0": {"u_heading": "u_heading", "u_x": "u_x", "u_y": "u_y",
+                     "pressure": "pressure",
                      "z_c": "Z_c", "largest_cluster": "largest_cluster_fraction",
                      "temperature": "granular_temperature"},
-    "Convergence-v0": {"concentration": "concentration", "pressure": "pressure",
+    "Convergence-v0": {"concentration": "concentration", "target": "target",
+                       "pressure": "pressure",
                        "z_c": "Z_c", "f_nr": "non_rattler_fraction",
                        "largest_cluster": "largest_cluster_fraction"},
-    "MarginalIceZone-v0": {"u_x": "u_x", "edge_stress": "edge_stress",
+    "MarginalIceZone-v0": {"u_x": "u_x", "target_speed": "target_speed",
+                           "edge_stress": "edge_stress",
                            "edge_u_x": "edge_u_x", "pressure": "pressure", "z_c": "Z_c",
                            "largest_cluster": "largest_cluster_fraction"},
-    "FloeClustering-v0": {"largest_cluster": "largest_cluster_fraction",
+    "FloeClustering-v0": {"largest_cluster": "largest_cluster_fraction", "target": "target",
                           "clusters_per_floe": "clusters_per_floe",
                           "cluster_alpha": "cluster_alpha",
                           "collision_rate": "collision_rate", "pressure": "pressure"},
@@ -36,7 +39,7 @@ PHYSICS_METRICS: dict[str, dict[str, str]] = {
 
 #: per env name: the logged name of the metric that says most about the task
 MAIN_METRIC: dict[str, str] = {
-    "WindDrift-v0": "u_x",
+    "WindDrift-v0": "u_heading",
     "Convergence-v0": "concentration",
     "MarginalIceZone-v0": "u_x",
     "FloeClustering-v0": "largest_cluster_fraction",

@@ -20,20 +20,20 @@ from gymnasium.envs.registration import register
 
 __all__ = ["ENV_IDS"]
 
-# Episodes are truncated by the environments themselves (argument
-# ``episode_steps``, or ``episode_days`` for the ITD), so that changing the
-# control interval or the episode length through ``gymnasium.make`` kwargs
-# stays consistent; no TimeLimit wrapper is added.
+# Every id is registered with its episode length: ``env.spec.max_episode_steps``
+# is set, Gymnasium's TimeLimit truncates the episodes, and
+# ``gymnasium.make(id, max_episode_steps=N)`` changes the length. The
+# environments never truncate on their own.
 _ENVS = {
-    "WindDrift-v0": "iceenvs.wind_drift:WindDriftEnv",
-    "Convergence-v0": "iceenvs.convergence:ConvergenceEnv",
-    "MarginalIceZone-v0": "iceenvs.marginal_ice_zone:MarginalIceZoneEnv",
-    "FloeClustering-v0": "iceenvs.floe_clustering:FloeClusteringEnv",
-    "ThicknessDistribution-v0": "iceenvs.thickness_distribution:ThicknessDistributionEnv",
+    "WindDrift-v0": ("iceenvs.wind_drift:WindDriftEnv", 200),
+    "Convergence-v0": ("iceenvs.convergence:ConvergenceEnv", 150),
+    "MarginalIceZone-v0": ("iceenvs.marginal_ice_zone:MarginalIceZoneEnv", 200),
+    "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400),
+    "ThicknessDistribution-v0": ("iceenvs.thickness_distribution:ThicknessDistributionEnv", 360),
 }
 
 #: every registered id
 ENV_IDS = tuple(f"iceenvs/{name}" for name in _ENVS)
 
-for _name, _entry in _ENVS.items():
-    register(id=f"iceenvs/{_name}", entry_point=_entry)
+for _name, (_entry, _steps) in _ENVS.items():
+    register(id=f"iceenvs/{_name}", entry_point=_entry, max_episode_steps=_steps)

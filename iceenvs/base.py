@@ -1,26 +1,48 @@
-"""Shared plumbing of the floe environments: :class:`FloeEnv`.
+"""Shared plumbing of the environments: :class:`ControlEnv`, :class:`FloeEnv`
+and :class:`HertzEnv`.
 
 A floe environment owns one engine (``self.sim``), turns an action into
 forcing, advances the engine by the control interval, measures the
 observables of :mod:`iceenvs.observations` and scores them with a reward
 function of :mod:`iceenvs.rewards`. Subclasses say only what differs:
 
-* ``_make_sim(rng, options)`` — a new engine for an episode;
+* ``task_parameters`` — the task's :class:`TaskParameter` table;
+* ``_draw_episode(task, rng)`` — the episode's task values (targets and
+  start states drawn from their ranges);
+* ``_make_sim(rng)`` — a new engine for an episode;
 * ``_apply_action(action)`` — the (clipped) action into forcing;
 * ``_measure()`` — the raw physical observables (dict of SI values);
 * ``_terminated(now)`` — task failure;
 * class attributes ``extra_features`` (entries after the common ones),
-  ``action_names`` and the default ``reward_fn``.
+  ``action_names``, ``reward_task_keys`` and the default ``reward_fn``.
 
 Data flow of one step::
 
     action → NaN/inf → 0, clip → forcing → engine.advance(control interval)
       → observables (SI dict) → reward(prev, action, now) and float32 vector
+
+Conventions every environment keeps (see the environment docs):
+
+* **Task parameters** are keyword arguments of :func:`gymnasium.make`
+  (kept for every episode, also through a vector environment's autoreset)
+  and ``reset(options=...)`` entries (for that episode only). A parameter
+  whose value is ``None`` is drawn for each episode from its range.
+  Unknown names raise an error that lists the valid ones.
+* **Episode length** is the registered ``max_episode_steps`` (Gymnasium's
+  :class:`~gymnasium.wrappers.TimeLimit`); the environments never
+  truncate on their own. ``horizon=N`` adds the remaining fraction of an
+  N-step episode to the observation.
+* **Rewards** of the built-in tasks lie in [0, 1] every step. A failure
+  (a physics failure, or the task's own failure such as broken ice) ends
+  the episode with reward 0: the failed state is absorbing and worth
+  nothing, so ending early never pays and no step carries a lump.
 """
 from __future__ import annotations
 
+import inspect
 import math
-from typing import Callable
+from dataclasses import dataclass
+from typing import Any, Callable
 
 import gymnasium as gym
 import numpy as np
@@ -31,7 +53,16 @@ from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
 
-__all__ = ["ControlEnv", "FloeEnv", "sanitise_action", "scaled_contact", "hertz_time_step"]
+__all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
+           "sanitise_action", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
+           "TIME_FEATURE", "task_table"]
+
+#: every per-step reward of the built-in tasks lies in this range
+REWARD_RANGE = (0.0, 1.0)
+
+#: the observation entry that ``horizon=N`` appends
+TIME_FEATURE = Feature("time_left", "remaining fraction of the episode, 1 − t/N", "-", "none",
+                       0.0, 1.0)
 
 
 def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
@@ -42,30 +73,93 @@ def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
     return np.clip(a, space.low, space.high)
 
 
+# -- task parameters ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class TaskParameter:
+    """One parameter of a task.
+
+    It is set for every episode as a keyword of :func:`gymnasium.make`
+    (``gym.make(id, target=0.85)``) and for one episode as an entry of
+    ``reset(options=...)``. ``check(name, value)`` validates a value and
+    returns it converted (raising ``ValueError`` with the name, the value
+    and the allowed range); ``None`` means "drawn for every episode from
+    its range" where ``meaning`` says so.
+    """
+    name: str
+    default: Any
+    meaning: str
+    check: Callable[[str, Any], Any]
+
+
+def number(low=None, high=None, *, low_open: bool = False, high_open: bool = False,
+           optional: bool = False) -> Callable[[str, Any], Any]:
+    """A check for a finite number in a range (``None`` allowed when
+    ``optional``)."""
+    def check(name, value):
+        if value is None and optional:
+            return None
+        if isinstance(value, bool):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        check_range(name, value, low, high, low_open=low_open, high_open=high_open)
+        return float(value)
+    return check
+
+
+def interval(low=None, high=None, *, low_open: bool = False,
+             high_open: bool = False) -> Callable[[str, Any], Any]:
+    """A check for a range ``(lo, hi)``, ``lo <= hi``, both ends inside
+    [low, high]."""
+    def check(name, value):
+        try:
+            lo, hi = value
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a pair (low, high), got {value!r}") from None
+        ends = tuple(number(low, high, low_open=low_open, high_open=high_open)(f"{name}[{k}]", v)
+                     for k, v in enumerate((lo, hi)))
+        if ends[0] > ends[1]:
+            raise ValueError(f"{name} must have low <= high, got {value!r}")
+        return ends
+    return check
+
+
+def task_table(params) -> str:
+    """Markdown table of task parameters (for the docstrings)."""
+    lines = ["| name | default | meaning |", "|---|---|---|"]
+    for p in params:
+        default = "None" if p.default is None else (
+            f"({p.default[0]:g}, {p.default[1]:g})" if isinstance(p.default, tuple)
+            else f"{p.default:g}")
+        lines.append(f"| `{p.name}` | {default} | {p.meaning} |")
+    return "\n".join(lines)
+
+
+# -- the control loop ------------------------------------------------------------------------
+
 class ControlEnv(gym.Env):
     """The control loop every environment of the suite shares.
 
     One step: sanitise the action → ``_apply_action`` → ``_advance`` →
     ``_measure`` (raw SI dict) → ``_reward`` → observation ``_vector`` and
     ``_info``. A physics failure (FloatingPointError, RuntimeError,
-    ValueError) or a non-finite reward ends the episode with
-    ``info["error"]`` and ``failure_reward``; the episode is truncated after
-    ``episode_steps`` steps.
+    ValueError), a non-finite reward or the task's failure
+    (``_terminated``) ends the episode with ``failure_reward`` (0) and,
+    for a physics failure or a non-finite reward, ``info["error"]``.
+    Episodes are truncated by Gymnasium's ``TimeLimit`` (the registered
+    ``max_episode_steps``), never by the environment itself.
 
-    Failures are absorbing: when an episode is terminated (task failure
-    of ``_terminated`` or a physics failure) before its last step, the
-    steps it had left are charged the failing step's reward if that is
-    negative (:meth:`_failure_return`). Ending an episode early therefore
-    never pays more than living on in the failed state; without this, a
-    task whose per-step rewards are negative would reward breaking the
-    ice. Subclasses build their model in ``reset`` and
-    then call ``_begin_episode``; they provide the hooks named above,
-    ``_ready`` (a model exists) and ``_frame`` (an RGB array).
+    Subclasses build their model in ``reset`` and then call
+    ``_begin_episode``; they provide the hooks named above, ``_ready`` (a
+    model exists) and ``_frame`` (an RGB array).
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
-    failure_reward = -10.0
+    failure_reward = 0.0
+    task_parameters: tuple[TaskParameter, ...] = ()
+    #: episode task values passed to the reward function with ``reward_params``
+    reward_task_keys: tuple[str, ...] = ()
     _renderer = None
+    horizon = None
 
     def _set_render_mode(self, render_mode: str | None) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -73,7 +167,60 @@ class ControlEnv(gym.Env):
                              f"None, got {render_mode!r}")
         self.render_mode = render_mode
 
-    # -- hooks --------------------------------------------------------------------------
+    # -- task parameters --------------------------------------------------------------------
+    @classmethod
+    def valid_arguments(cls) -> list[str]:
+        """Every keyword :func:`gymnasium.make` accepts for this environment:
+        the constructor's arguments and the task parameters."""
+        names = set()
+        for klass in cls.__mro__:
+            init = klass.__dict__.get("__init__")
+            if init is None:
+                continue
+            for p in inspect.signature(init).parameters.values():
+                if p.name != "self" and p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL):
+                    names.add(p.name)
+        return sorted(names | {p.name for p in cls.task_parameters})
+
+    @classmethod
+    def _check_task(cls, values: dict, what: str) -> dict:
+        params = {p.name: p for p in cls.task_parameters}
+        unknown = sorted(set(values) - set(params))
+        if unknown:
+            raise ValueError(f"unknown {what} {unknown} for {cls.__name__}; valid: "
+                             f"{sorted(params)}")
+        return {name: params[name].check(name, value) for name, value in values.items()}
+
+    def _init_task(self, given: dict) -> None:
+        """Keep the task parameters given to the constructor (``TypeError``
+        for a name that is neither an argument nor a task parameter)."""
+        names = {p.name for p in self.task_parameters}
+        unknown = sorted(set(given) - names)
+        if unknown:
+            raise TypeError(f"{type(self).__name__} got unknown arguments {unknown}; valid "
+                            f"arguments: {', '.join(self.valid_arguments())}")
+        self.task = {p.name: p.check(p.name, p.default) for p in self.task_parameters}
+        self.task.update(self._check_task(given, "arguments"))
+        self._check_episode_task(self.task)
+        self.episode = dict(self.task)
+
+    def _check_episode_task(self, task: dict) -> None:
+        """Checks across parameters (e.g. a range against a limit); raise
+        ``ValueError``."""
+
+    def _episode_task(self, options: dict | None) -> dict:
+        """The task of a new episode: the constructor's parameters, then the
+        options of this episode, then the values drawn from their ranges."""
+        task = dict(self.task)
+        task.update(self._check_task(dict(options or {}), "reset options"))
+        self._check_episode_task(task)
+        return self._draw_episode(task, self.np_random)
+
+    def _draw_episode(self, task: dict, rng: np.random.Generator) -> dict:
+        """Replace the ``None`` entries of ``task`` by values drawn with ``rng``."""
+        return task
+
+    # -- hooks ------------------------------------------------------------------------------
     def _ready(self) -> bool:
         raise NotImplementedError
 
@@ -95,20 +242,19 @@ class ControlEnv(gym.Env):
     def _terminated(self, now: dict) -> bool:
         return False
 
+    def _reward_kwargs(self) -> dict:
+        return {**self.reward_params, **{k: self.episode[k] for k in self.reward_task_keys}}
+
     def _reward(self, action: np.ndarray, now: dict) -> float:
-        return float(self.reward_fn(self._prev, action, now, **self.reward_params))
+        return float(self.reward_fn(self._prev, action, now, **self._reward_kwargs()))
 
     def _frame(self) -> np.ndarray:
         raise NotImplementedError
 
-    def _failure_return(self, reward: float) -> float:
-        """The reward of a terminating step: ``reward`` plus, for each step
-        the episode had left, ``min(reward, 0)`` (the failed state is
-        absorbing)."""
-        left = max(int(self.episode_steps) - int(self._steps), 0)
-        return reward + left * min(reward, 0.0)
+    def _time_left(self) -> float:
+        return max(0.0, 1.0 - self._steps / self.horizon)
 
-    # -- the loop -----------------------------------------------------------------------
+    # -- the loop -----------------------------------------------------------------------------
     def _begin_episode(self):
         """Zero action, first measurement and observation of a new episode;
         returns what ``reset`` returns."""
@@ -136,24 +282,22 @@ class ControlEnv(gym.Env):
             # a physics failure ends the episode instead of crashing the caller
             info = self._info(self._prev)
             info["error"] = f"{type(err).__name__}: {err}"
-            return (self._obs.copy(), self._failure_return(float(self.failure_reward)), True,
-                    False, info)
+            return self._obs.copy(), float(self.failure_reward), True, False, info
         reward = self._reward(a, now)
         info = self._info(now)
         terminated = bool(self._terminated(now))
         if not math.isfinite(reward):
             info["error"] = f"non-finite reward {reward}"
-            reward, terminated = float(self.failure_reward), True
+            terminated = True
         if terminated:
-            reward = self._failure_return(reward)
+            reward = float(self.failure_reward)
         self._prev = now
         self._obs = self._vector(now)
-        truncated = self._steps >= self.episode_steps and not terminated
         if self.render_mode == "human":
             self.render()
-        return self._obs.copy(), reward, terminated, truncated, info
+        return self._obs.copy(), reward, terminated, False, info
 
-    # -- rendering ----------------------------------------------------------------------
+    # -- rendering ----------------------------------------------------------------------------
     def render(self):
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode="
@@ -178,49 +322,64 @@ class ControlEnv(gym.Env):
             self._renderer = None
 
 
+def _check_horizon(horizon) -> int | None:
+    if horizon is None:
+        return None
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ValueError(f"horizon must be None or an integer >= 1 (the episode's "
+                         f"max_episode_steps), got {horizon!r}")
+    return int(horizon)
+
+
 class FloeEnv(ControlEnv):
     """Base of the floe environments (not registered itself).
 
-    Parameters common to every floe environment
-    -------------------------------------------
+    Arguments common to every floe environment
+    ------------------------------------------
     n_floes : int — number of floes
-    concentration : float — ice concentration Ā of the start state
     preset : PaperPreset — parameter table (FSD, material, forcing)
     control_interval : float — model seconds per env step
-    episode_steps : int — env steps before the episode is truncated
-    reward_fn : callable, optional — ``reward(prev, action, now, **reward_params)``
-    reward_params : dict, optional — overrides of the task's reward parameters
+    reward_fn : callable, optional — ``reward(prev, action, now, **params)``
+    reward_params : dict, optional — overrides of the task's reward weights
     stiffness_scale : float — multiplies Young's modulus (Hertz envs); < 1
         trades contact stiffness for a longer time step (faster training)
     cluster_gap : float — largest gap [m] between two floes of a cluster
+    horizon : int, optional — adds ``time_left`` = 1 − t/horizon to the
+        observation (pass the episode's ``max_episode_steps``)
+    colour_scale : float — speed [m/s] at the top of the frames' colour bar
     render_mode : None, "rgb_array" or "human"
+    **task : the task parameters of the environment (its table)
     """
 
     extra_features: tuple[Feature, ...] = ()
     action_names: tuple[str, ...] = ()
     reward_fn: Callable = None
+    colour_label = "speed [m/s]"
 
-    def __init__(self, *, n_floes: int, concentration: float, preset: PaperPreset,
-                 control_interval: float, episode_steps: int, reward_fn=None,
-                 reward_params: dict | None = None, stiffness_scale: float = 1.0,
-                 cluster_gap: float = 0.1, render_mode: str | None = None):
+    def __init__(self, *, n_floes: int, preset: PaperPreset, control_interval: float,
+                 reward_fn=None, reward_params: dict | None = None,
+                 stiffness_scale: float = 1.0, cluster_gap: float = 0.1,
+                 horizon: int | None = None, colour_scale: float = 0.5,
+                 render_mode: str | None = None, **task):
+        if isinstance(n_floes, bool) or not isinstance(n_floes, (int, np.integer)):
+            raise ValueError(f"n_floes must be an integer >= 2, got {n_floes!r}")
         check_range("n_floes", n_floes, 2, None)
-        check_range("concentration", concentration, 0.0, 1.0, low_open=True, high_open=True)
         check_range("control_interval", control_interval, 0.0, None, low_open=True)
-        check_range("episode_steps", episode_steps, 1, None)
         check_range("cluster_gap", cluster_gap, 0.0, None)
+        check_range("colour_scale", colour_scale, 0.0, None, low_open=True)
         if not isinstance(preset, PaperPreset):
             raise TypeError(f"preset must be a PaperPreset (e.g. physics.HERMAN2013), "
                             f"got {type(preset).__name__}")
         self._set_render_mode(render_mode)
+        self._init_task(task)
         self.n_floes = int(n_floes)
-        self.concentration = float(concentration)
         self.preset = preset
         self.control_interval = float(control_interval)
-        self.episode_steps = int(episode_steps)
         self.stiffness_scale = float(stiffness_scale)
         self.contact = scaled_contact(preset.contact, stiffness_scale)
         self.cluster_gap = float(cluster_gap)
+        self.horizon = _check_horizon(horizon)
+        self.colour_scale = float(colour_scale)
         if reward_fn is not None:
             if not callable(reward_fn):
                 raise TypeError("reward_fn must be callable as reward(prev, action, now, **params)")
@@ -228,13 +387,18 @@ class FloeEnv(ControlEnv):
         else:
             self.reward_fn = type(self).reward_fn
         self.reward_params = self.default_reward_params()
+        if reward_params is not None and not isinstance(reward_params, dict):
+            raise TypeError(f"reward_params must be a dict, got {type(reward_params).__name__}")
         unknown = set(reward_params or ()) - set(self.reward_params)
         if unknown and reward_fn is None:
             raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
-                             f"{sorted(self.reward_params)}")
+                             f"{sorted(self.reward_params)} (task parameters such as a target "
+                             f"are arguments of their own)")
         self.reward_params.update(reward_params or {})
 
         self.features = FLOE_FEATURES + self.extra_features
+        if self.horizon is not None:
+            self.features = self.features + (TIME_FEATURE,)
         n_act = self.action_space.shape[0]
         low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
         high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
@@ -249,7 +413,7 @@ class FloeEnv(ControlEnv):
     def default_reward_params(self) -> dict:
         return {}
 
-    def _make_sim(self, rng: np.random.Generator, options: dict):
+    def _make_sim(self, rng: np.random.Generator):
         raise NotImplementedError
 
     def _ready(self) -> bool:
@@ -261,22 +425,29 @@ class FloeEnv(ControlEnv):
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        options = dict(options or {})
-        self._reset_options(options)
-        self.sim = self._make_sim(self.np_random, options)
+        self.episode = self._episode_task(options)
+        self.sim = self._make_sim(self.np_random)
         return self._begin_episode()
 
-    def _reset_options(self, options: dict) -> None:
-        """Task options of ``reset(options=...)`` (subclasses read theirs)."""
-        if options:
-            raise ValueError(f"unknown reset options {sorted(options)}")
-
     def _vector(self, now: dict) -> np.ndarray:
+        if self.horizon is not None:
+            now = {**now, "time_left": self._time_left()}
         vec = normalise(now, self.features)
         return np.concatenate([vec, self._last_action.astype(np.float32)])
 
     def _info(self, now: dict) -> dict:
-        return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps}
+        return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps,
+                "task": dict(self.episode)}
+
+    # -- frames -----------------------------------------------------------------------
+    def _frame_text(self) -> list[str]:
+        """Lines of text on a frame: time, concentration and the task."""
+        now = self._prev
+        return [f"t = {self.sim.time:.0f} s", f"A = {now['concentration']:.3f}"]
+
+    def _frame_arrow(self):
+        """Arrows on a frame (see :func:`iceenvs.rendering.annotate`)."""
+        return None
 
 
 class HertzEnv(FloeEnv):
@@ -317,11 +488,13 @@ class HertzEnv(FloeEnv):
         return self._contact_physics()
 
     def _frame(self) -> np.ndarray:
-        from .rendering import draw_floes
+        from .rendering import annotate, draw_floes
 
         sim = self.sim
         c = self._contacts
-        return draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
-                          np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
-                          frozen=sim.inv_mass == 0, contact_i=c.i, contact_j=c.j,
-                          contact_force=c.normal_force)
+        picture = draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
+                             np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
+                             frozen=sim.inv_mass == 0, contact_i=c.i, contact_j=c.j,
+                             contact_force=c.normal_force, speed_scale=self.colour_scale)
+        return annotate(picture, colour_bar=(self.colour_label, 0.0, self.colour_scale),
+                        arrow=self._frame_arrow(), text=self._frame_text())

@@ -5,15 +5,37 @@ import gymnasium as gym
 import numpy as np
 
 from physics import DeformingPeriodicBox, HERMAN2013, make_floe_field
-from physics.params import check_range
 
-from .base import HertzEnv
+from .base import HertzEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
 from .rewards import convergence_reward
+
+__all__ = ["ConvergenceEnv", "MAX_START"]
+
+MAX_EPISODE_STEPS = 150
+#: random placement of this floe-size distribution jams near 0.86
+MAX_START = 0.85
 
 _EXTRA = (
     Feature("target", "target concentration A*", "-", "none", 0.0, 1.0),
     Feature("error", "(A − A*) / 0.1", "-", "none", -10.0, 10.0),
+)
+
+_TASK = (
+    TaskParameter("target", None, "target concentration A*; None: drawn uniformly from "
+                  "`target_range` every episode", number(0.0, 1.0, low_open=True,
+                                                          high_open=True, optional=True)),
+    TaskParameter("target_range", (0.75, 0.84), "range of the drawn targets",
+                  interval(0.0, 1.0, low_open=True, high_open=True)),
+    TaskParameter("concentration", None, f"start concentration (at most {MAX_START:g}); "
+                  "None: drawn uniformly from `concentration_range` every episode",
+                  number(0.0, MAX_START, low_open=True, optional=True)),
+    TaskParameter("concentration_range", (0.70, 0.80), "range of the drawn start "
+                  "concentrations", interval(0.0, MAX_START, low_open=True)),
+    TaskParameter("max_rate", 2.0, "convergence rate dA/dt [1/h] at action +1",
+                  number(0.0, 100.0, low_open=True)),
+    TaskParameter("failure_pressure", 1e5, "pressure [N/m] at which the ice breaks (the "
+                  "episode terminates)", number(0.0, None, low_open=True)),
 )
 
 
@@ -25,102 +47,123 @@ class ConvergenceEnv(HertzEnv):
     Floes of the Herman (2013) set-up in a deforming, doubly periodic box
     (experiment 1 of the paper: pure convergence, no wind). The box area
     changes at the rate the agent sets; the floes are remapped affinely.
-    Pressure grows roughly exponentially with concentration and then
-    sharply as the ice jams (the paper finds A_J ≈ 0.92 for 20000 floes),
-    so the target just below jamming is reached safely only by slowing down
-    in time.
+    Pressure grows slowly with concentration and then sharply as the ice
+    jams: 200 floes compressed at 4 per hour jam at A = 0.85–0.86 and pass
+    the failure pressure (10⁵ N/m) there. Every episode has its own start
+    concentration and target, both in the observation.
+
+    ## Task analysis
+    * *Reachable:* starts lie in [0.70, 0.80] and targets in [0.75, 0.84]; at
+      the maximum rate of 2 per hour an episode of 150 × 2 s moves A by up
+      to 0.167, more than the largest distance (0.14), in either direction.
+    * *Best constant action:* a constant rate moves A linearly and cannot
+      stop at targets that differ from episode to episode; full convergence
+      also overshoots into jamming. The best of a grid of constant rates is
+      measured in the docs' training page.
+    * *What a good policy does:* converges (or diverges) at full rate while
+      far from the target, slows down as A approaches it (the pressure
+      rises steeply within 0.02 of jamming, and the top targets lie close
+      to it), then holds A at the target with zero rate.
 
     ## Action Space
     `Box(-1, 1, (1,), float32)`: the convergence rate dA/dt in units of
-    `max_rate` per hour (default 1 per hour, 25 times the 0.04 per hour of
+    `max_rate` per hour (default 2 per hour, 50 times the 0.04 per hour of
     the paper, so that an episode is short; positive: convergence).
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 1} entries: the common floe
-    features, the target and the last action:
+    features, the target and the last action (with `horizon=N`,
+    `time_left` before the action):
 
 {feature_table(FLOE_FEATURES + _EXTRA)}
     | {len(FLOE_FEATURES) + len(_EXTRA)} | `action` | the last action | - | none | [-1, 1] |
 
     ## Rewards
-    :func:`iceenvs.rewards.convergence_reward`: −|A − A*| / 0.01 − (relative
-    excess of the pressure over `pressure_max`, default 1e4 N/m).
+    :func:`iceenvs.rewards.convergence_reward`, in [0, 1] every step:
+    1 − |A − A*| / 0.1 (at least 0), times a safety factor that falls from
+    1 to 0 as the pressure goes from `pressure_max` (default 1e4 N/m) to
+    twice that. Broken ice (the pressure above `failure_pressure`) or a
+    physics failure ends the episode with reward 0, so breaking the ice
+    loses every reward the episode had left.
 
     ## Starting State
-    Floes placed at random without overlap at a concentration drawn
-    uniformly in [0.70, 0.80] (seeded), at rest. Options: `target` (default
-    0.90), `concentration` (a fixed start concentration, at most 0.85:
-    random placement of this floe-size distribution jams near 0.86).
+    Floes placed at random without overlap at the start concentration
+    (seeded), at rest.
+
+    ## Task parameters
+    Keywords of `gymnasium.make` (kept for every episode) and entries of
+    `reset(options=...)` (this episode only):
+
+{task_table(_TASK)}
 
     ## Episode End
-    Terminated when the pressure passes `failure_pressure` (default 1e5 N/m)
-    or the physics fails (`info["error"]`); truncated after
-    `episode_steps` (default 150 × 2 s). Failure is absorbing: the failing
-    step's reward is also charged for each step the episode had left, so
-    that breaking the ice never ends the (negative) rewards early.
+    Terminated when the pressure passes `failure_pressure` or the physics
+    fails (`info["error"]`); truncated after `max_episode_steps`
+    (registered: {MAX_EPISODE_STEPS} steps of 2 s).
 
     ## Arguments
     `n_floes=200`, `preset=HERMAN2013`, `control_interval=2.0` [s],
-    `episode_steps=150`, `max_rate=1.0` [1/h], `failure_pressure=1e5`
-    [N/m], `reward_fn`, `reward_params` (`pressure_max`,
-    `concentration_scale`, `pressure_weight`), `stiffness_scale`,
-    `cluster_gap`, `render_mode`.
+    `reward_fn`, `reward_params` (`pressure_max`, `concentration_scale`,
+    `pressure_weight`), `stiffness_scale`, `cluster_gap`, `horizon=None`,
+    `colour_scale=0.05` [m/s], `render_mode`, and the task parameters.
 
     ## Version History
-    * v0: initial version.
+    * v0: targets and start concentrations drawn per episode from ranges
+      that are reachable (the former fixed target 0.90 was not), maximum
+      rate 2 per hour, rewards in [0, 1] with broken ice worth 0, task
+      parameters as `gymnasium.make` keywords, episode length by
+      `max_episode_steps`.
     """
 
     action_space = gym.spaces.Box(-1.0, 1.0, (1,), dtype=np.float32)
     action_names = ("convergence_rate",)
     extra_features = _EXTRA
+    task_parameters = _TASK
+    reward_task_keys = ("target",)
     reward_fn = staticmethod(convergence_reward)
     impact_speed = 0.5
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 2.0,
-                 episode_steps: int = 150, max_rate: float = 1.0,
-                 failure_pressure: float = 1e5, **kwargs):
-        check_range("max_rate", max_rate, 0.0, None, low_open=True)
-        check_range("failure_pressure", failure_pressure, 0.0, None, low_open=True)
-        super().__init__(n_floes=n_floes, concentration=0.75, preset=preset,
-                         control_interval=control_interval, episode_steps=episode_steps,
-                         **kwargs)
-        self.max_rate = float(max_rate)
-        self.failure_pressure = float(failure_pressure)
-        self.target = 0.9
+                 colour_scale: float = 0.05, **kwargs):
+        super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,
+                         colour_scale=colour_scale, **kwargs)
 
     def default_reward_params(self) -> dict:
-        return dict(target=0.9, pressure_max=1e4, concentration_scale=0.01, pressure_weight=1.0)
+        return dict(pressure_max=1e4, concentration_scale=0.1, pressure_weight=1.0)
 
-    def _reset_options(self, options: dict) -> None:
-        target = options.pop("target", 0.9)
-        start = options.pop("concentration", None)
-        check_range("target", target, 0.0, 1.0, low_open=True, high_open=True)
-        if start is not None:
-            # random placement of this FSD jams near 0.86
-            check_range("concentration", start, 0.0, 0.85, low_open=True)
-        super()._reset_options(options)
-        self.target = float(target)
-        self._start = start
-        self.reward_params["target"] = self.target
+    def _draw_episode(self, task, rng):
+        # drawn in a fixed order, so that a seed gives the same episode
+        # whichever of the two is given
+        start = float(rng.uniform(*task["concentration_range"]))
+        target = float(rng.uniform(*task["target_range"]))
+        if task["concentration"] is None:
+            task["concentration"] = start
+        if task["target"] is None:
+            task["target"] = target
+        return task
 
-    def _make_sim(self, rng, options):
+    def _make_sim(self, rng):
         p = self.preset
-        start = float(rng.uniform(0.70, 0.80)) if self._start is None else float(self._start)
-        field, box = make_floe_field(self.n_floes, concentration=start, alpha=p.fsd_exponent,
-                                     mean_diameter=p.mean_diameter, thickness=p.thickness,
-                                     density=p.forcing.ice_density,
+        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
+                                     alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
+                                     thickness=p.thickness, density=p.forcing.ice_density,
                                      seed=int(rng.integers(2 ** 63)))
         self.box = DeformingPeriodicBox(box.lx, box.ly, concentration_rate=0.0)
         return self._hertz_sim(field, self.box, None)
 
     def _apply_action(self, action):
-        self.box.set_rate(float(action[0]) * self.max_rate / 3600.0)
+        self.box.set_rate(float(action[0]) * self.episode["max_rate"] / 3600.0)
 
     def _measure(self) -> dict:
         now = self._contact_physics()
-        now["target"] = self.target
-        now["error"] = (now["concentration"] - self.target) / 0.1
+        now["target"] = self.episode["target"]
+        now["error"] = (now["concentration"] - self.episode["target"]) / 0.1
         return now
 
     def _terminated(self, now: dict) -> bool:
-        return now["pressure"] > self.failure_pressure
+        return now["pressure"] > self.episode["failure_pressure"]
+
+    def _frame_text(self):
+        p = self._prev["pressure"]
+        return super()._frame_text() + [f"target A* = {self.episode['target']:.3f}",
+                                        f"p = {p:.3g} N/m"]

@@ -4,16 +4,15 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from physics import Forcing, HERMAN2011, make_floe_field
-from physics.params import check_range
+from physics import Forcing, HERMAN2011, find_clusters, make_floe_field
 
-from .base import FloeEnv
+from .base import FloeEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table, floe_physics
 from .rewards import floe_clustering_reward
 
 __all__ = ["FloeClusteringEnv"]
 
-MAX_WIND = 20.0   # m/s per component at |action| = 1
+MAX_EPISODE_STEPS = 400
 
 _EXTRA = (
     Feature("target", "target largest-cluster fraction", "-", "none", 0.0, 1.0),
@@ -21,10 +20,21 @@ _EXTRA = (
             "1/s", "log rate", 0.0, 10.0),
 )
 
+_TASK = (
+    TaskParameter("target", None, "target largest-cluster fraction F_c,1/F_tot; None: drawn "
+                  "uniformly from `target_range` every episode",
+                  number(0.0, 1.0, optional=True)),
+    TaskParameter("target_range", (0.3, 0.8), "range of the drawn targets", interval(0.0, 1.0)),
+    TaskParameter("concentration", 0.7, "ice concentration of the start state",
+                  number(0.0, 0.85, low_open=True)),
+    TaskParameter("max_wind", 20.0, "wind speed [m/s] per component at |action| = 1",
+                  number(0.0, 100.0, low_open=True)),
+)
+
 
 class FloeClusteringEnv(FloeEnv):
     __doc__ = f"""Herd floes with the wind until the largest cluster holds a target
-    fraction of the ice.
+    fraction of the ice, and hold it there.
 
     ## Description
     The Small Floe Collider of Herman (2011): hard-disc floes with a
@@ -33,73 +43,96 @@ class FloeClusteringEnv(FloeEnv):
     form (each floe relaxes to its own free-drift velocity, so floes of
     different sizes move differently and collide), with inelastic
     collisions (ε = 0.85) in a periodic box. Clusters are sets of floes
-    closer than `cluster_gap` (default 0.1 m; with 0.5 m nearly all floes of
-    the random start at Ā = 0.7 form one cluster) edge to edge. Strong steady
-    wind makes floes of different sizes drift apart and collide, building
-    large clusters at high concentration; changing the wind breaks them.
+    closer than `cluster_gap` (default 0.1 m) edge to edge. Each episode
+    has its own target, given in the observation.
+
+    ## Task analysis
+    * *Reachable:* the random start has a largest cluster of about 0.22 of
+      the ice. Under 20 m/s of steady wind it grows to 0.75–0.88 within
+      200–280 steps (seeds 1 and 2), so every target in [0.3, 0.8] is
+      reached within the 400-step episode.
+    * *Best constant action:* clusters grow under any steady wind and even
+      without wind (inelastic collisions gather the floes), and they break
+      up and re-form on their own; a constant wind therefore drifts through
+      the targets instead of holding one. The best of a grid of constant
+      actions is measured in the docs' training page.
+    * *What a good policy does:* blows steadily while the largest cluster
+      is below the target, and changes the wind (which shears clusters
+      apart) when it is above.
 
     ## Action Space
-    `Box(-1, 1, (2,), float32)`: the wind vector in units of {MAX_WIND:g} m/s.
+    `Box(-1, 1, (2,), float32)`: the wind vector in units of `max_wind`
+    (default 20 m/s).
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 2} entries. Contacts are pairs
     closer than 1 cm (hard discs touch only at collisions), the stress is
     the kinetic plus collision-virial stress averaged over the last control
-    interval:
+    interval (with `horizon=N`, `time_left` before the action):
 
 {feature_table(FLOE_FEATURES + _EXTRA)}
     | {len(FLOE_FEATURES) + len(_EXTRA)}, {len(FLOE_FEATURES) + len(_EXTRA) + 1} | `action` | the last action | - | none | [-1, 1] |
 
     ## Rewards
-    :func:`iceenvs.rewards.floe_clustering_reward`: −|F_c,1/F_tot − target|.
+    :func:`iceenvs.rewards.floe_clustering_reward`, in [0, 1] every step:
+    1 − |F_c,1/F_tot − target| / 0.25 (at least 0). A physics failure ends
+    the episode with reward 0.
 
     ## Starting State
     Floes placed at random without overlap (seeded) at `concentration`,
-    with Gaussian velocities of 1 cm/s. Option `target` (default 0.5).
+    with Gaussian velocities of 1 cm/s.
+
+    ## Task parameters
+    Keywords of `gymnasium.make` (kept for every episode) and entries of
+    `reset(options=...)` (this episode only):
+
+{task_table(_TASK)}
 
     ## Episode End
-    Truncated after `episode_steps` (default 400 × 5 s); terminated only on
-    a physics failure (`info["error"]`).
+    Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS} steps of
+    5 s); terminated only on a physics failure (`info["error"]`).
 
     ## Arguments
-    `n_floes=300`, `concentration=0.7`, `preset=HERMAN2011`,
-    `control_interval=5.0` [s], `episode_steps=400`, `cluster_gap=0.1`
-    [m], `reward_fn`, `reward_params` (`target`), `render_mode`.
+    `n_floes=300`, `preset=HERMAN2011`, `control_interval=5.0` [s],
+    `cluster_gap=0.1` [m], `reward_fn`, `reward_params`
+    (`fraction_scale`), `horizon=None`, `render_mode`, and the task
+    parameters. Frames colour the floes by cluster, the largest one
+    highlighted.
 
     ## Version History
-    * v0: initial version.
+    * v0: a target drawn per episode, rewards in [0, 1], frames coloured
+      by cluster, task parameters as `gymnasium.make` keywords, episode
+      length by `max_episode_steps`.
     """
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_x", "wind_y")
     extra_features = _EXTRA
+    task_parameters = _TASK
+    reward_task_keys = ("target",)
     reward_fn = staticmethod(floe_clustering_reward)
 
-    def __init__(self, n_floes: int = 300, concentration: float = 0.7, preset=HERMAN2011,
-                 control_interval: float = 5.0, episode_steps: int = 400,
+    def __init__(self, n_floes: int = 300, preset=HERMAN2011, control_interval: float = 5.0,
                  cluster_gap: float = 0.1, **kwargs):
         if kwargs.get("stiffness_scale", 1.0) != 1.0:
             raise ValueError("stiffness_scale has no meaning for hard discs")
-        super().__init__(n_floes=n_floes, concentration=concentration, preset=preset,
-                         control_interval=control_interval, episode_steps=episode_steps,
+        super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,
                          cluster_gap=cluster_gap, **kwargs)
-        self.target = 0.5
 
     def default_reward_params(self) -> dict:
-        return dict(target=0.5)
+        return dict(fraction_scale=0.25)
 
-    def _reset_options(self, options: dict) -> None:
-        target = options.pop("target", 0.5)
-        check_range("target", target, 0.0, 1.0)
-        super()._reset_options(options)
-        self.target = float(target)
-        self.reward_params["target"] = self.target
+    def _draw_episode(self, task, rng):
+        target = float(rng.uniform(*task["target_range"]))
+        if task["target"] is None:
+            task["target"] = target
+        return task
 
-    def _make_sim(self, rng, options):
+    def _make_sim(self, rng):
         from physics import HardDiskSimulation
 
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.concentration,
+        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
                                      alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
                                      thickness=p.thickness, density=p.forcing.ice_density,
                                      seed=int(rng.integers(2 ** 63)), velocity_std=0.01)
@@ -111,7 +144,7 @@ class FloeClusteringEnv(FloeEnv):
         return sim
 
     def _apply_action(self, action):
-        self.forcing.wind = MAX_WIND * action
+        self.forcing.wind = self.episode["max_wind"] * action
 
     def _advance(self) -> None:
         self.sim.reset_stress()
@@ -128,14 +161,23 @@ class FloeClusteringEnv(FloeEnv):
         now = floe_physics(sim.positions, sim.velocities, sim.mass, sim.radius, sim.box,
                            self._contacts, tensor, sim.box.area, mobile,
                            cluster_gap=self.cluster_gap)
-        now["target"] = self.target
+        now["target"] = self.episode["target"]
         now["collision_rate"] = (sim.collision_count - c0) / sim.n / span if span > 0 else 0.0
         return now
 
     def _frame(self) -> np.ndarray:
-        from .rendering import draw_floes
+        from .rendering import CLUSTER_LEGEND, annotate, draw_floes
 
         sim = self.sim
         v = sim.velocities
-        return draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
-                          np.hypot(v[:, 0], v[:, 1]))
+        labels = find_clusters(sim.positions, sim.radius, sim.box, self.cluster_gap)
+        picture = draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
+                             np.hypot(v[:, 0], v[:, 1]), labels=labels)
+        now = self._prev
+        text = [f"t = {sim.time:.0f} s", f"A = {now['concentration']:.3f}",
+                f"largest cluster {now['largest_cluster']:.2f}",
+                f"target {self.episode['target']:.2f}"]
+        wind = np.asarray(self.forcing.wind, dtype=float)
+        arrow = [(wind / (self.episode["max_wind"] * np.sqrt(2.0)),
+                  f"wind {np.hypot(*wind):.1f} m/s")]
+        return annotate(picture, legend=CLUSTER_LEGEND[:3], arrow=arrow, text=text)

@@ -1,4 +1,5 @@
-"""``iceenvs/MarginalIceZone-v0``: move ice along a fast-ice edge without loading the edge."""
+"""``iceenvs/MarginalIceZone-v0``: move ice along a fast-ice edge at a target speed
+without loading the edge."""
 from __future__ import annotations
 
 import math
@@ -7,26 +8,40 @@ import gymnasium as gym
 import numpy as np
 
 from physics import ChannelBox, FloeField, Forcing, HERMAN2013, make_floe_field
-from physics.params import check_range
 
-from .base import HertzEnv
+from .base import HertzEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
 from .rewards import marginal_ice_zone_reward
 
 __all__ = ["MarginalIceZoneEnv"]
 
-MAX_WIND = 20.0   # m/s at action[0] = 1
+MAX_EPISODE_STEPS = 200
 
 _EXTRA = (
     Feature("edge_stress", "force of the drifting floes on the fast ice per edge length, "
             "|Σ F| / L_x", "N/m", "log stress", -8.0, 8.0),
     Feature("edge_u_x", "mean u_x of the floes in the lowest quarter of the drifting ice", "m/s",
             "/ 1 m/s", -5.0, 5.0),
+    Feature("target_speed", "target along-edge transport u*", "m/s", "/ 1 m/s", -5.0, 5.0),
+)
+
+_TASK = (
+    TaskParameter("target_speed", None, "target along-edge transport u* [m/s] (mean u_x of "
+                  "the drifting floes); None: drawn uniformly from `target_speed_range` every "
+                  "episode", number(-5.0, 5.0, optional=True)),
+    TaskParameter("target_speed_range", (0.02, 0.08), "range of the drawn targets [m/s]",
+                  interval(-5.0, 5.0)),
+    TaskParameter("concentration", 0.75, "ice concentration of the start state",
+                  number(0.0, 0.85, low_open=True)),
+    TaskParameter("edge_width", 10.0, "floes whose centres lie within this distance [m] of "
+                  "the bottom are frozen (the fast ice)", number(0.0, None, low_open=True)),
+    TaskParameter("max_wind", 20.0, "wind speed [m/s] at action[0] = +1",
+                  number(0.0, 100.0, low_open=True)),
 )
 
 
 class MarginalIceZoneEnv(HertzEnv):
-    __doc__ = f"""Maximise ice transport along a fast-ice edge while keeping the
+    __doc__ = f"""Move ice along a fast-ice edge at a target speed while keeping the
     stress on the edge low.
 
     ## Description
@@ -35,75 +50,104 @@ class MarginalIceZoneEnv(HertzEnv):
     the left and right sides are periodic and a rigid wall closes the top.
     The agent sets wind speed and direction. Wind towards the edge presses
     the ice against it (large edge stress, a jammed band and a narrow shear
-    zone), wind away from it opens the ice; the best transport with little
-    edge stress is in between.
+    zone), wind away from it opens the ice. Each episode has its own target
+    transport speed along +x, given in the observation.
+
+    ## Task analysis
+    * *Reachable:* targets lie in [0.02, 0.08] m/s. With no wind the ice
+      drifts at about 0.03 m/s with the ocean current of the preset; 20 m/s
+      of wind along +x gives 0.09–0.14 m/s after 500 s (seeds 1 and 2),
+      with edge-stress bursts of several kN/m as the drift turns towards the
+      edge (Coriolis turns it to the right of the wind).
+    * *Best constant action:* the transport depends on the wind speed, so a
+      constant wind holds one speed and misses the other targets; strong
+      constant wind also loads the edge. The best of a grid of constant
+      actions is measured in the docs' training page.
+    * *What a good policy does:* sets the wind speed from the target and
+      the measured transport (more wind when too slow, less when too fast)
+      and turns the wind slightly away from the edge when the edge stress
+      rises.
 
     ## Action Space
-    `Box(-1, 1, (2,), float32)`: action[0] → wind speed {MAX_WIND:g} (a + 1)/2 m/s
-    (0 to {MAX_WIND:g} m/s), action[1] → wind direction π a [rad] from +x
+    `Box(-1, 1, (2,), float32)`: action[0] → wind speed `max_wind` (a + 1)/2
+    (0 to 20 m/s by default), action[1] → wind direction π a [rad] from +x
     (±π: along −x; −π/2: towards the edge).
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 2} entries: the common floe
     features (over all floes, frozen ones included for contacts, mobile
-    ones for velocities), the edge entries and the last action:
+    ones for velocities), the edge entries, the target and the last action
+    (with `horizon=N`, `time_left` before the action):
 
 {feature_table(FLOE_FEATURES + _EXTRA)}
     | {len(FLOE_FEATURES) + len(_EXTRA)}, {len(FLOE_FEATURES) + len(_EXTRA) + 1} | `action` | the last action | - | none | [-1, 1] |
 
     ## Rewards
-    :func:`iceenvs.rewards.marginal_ice_zone_reward`: mean u_x of the
-    mobile floes / 0.1 m/s − (relative excess of the edge stress over
-    `edge_stress_max`, default 500 N/m) − 0.01 |action|².
+    :func:`iceenvs.rewards.marginal_ice_zone_reward`, in [0, 1] every step:
+    1 − |u_x − u*| / 0.05 m/s (at least 0), times a safety factor that
+    falls from 1 to 0 as the edge stress goes from `edge_stress_max`
+    (default 500 N/m) to twice that. A physics failure ends the episode
+    with reward 0.
 
     ## Starting State
     Floes placed at random (seeded) in a channel of aspect 2 (x : y = 2 : 1)
     at `concentration`; floes whose centres lie within `edge_width` of the
     bottom are frozen. All at rest, no wind.
 
+    ## Task parameters
+    Keywords of `gymnasium.make` (kept for every episode) and entries of
+    `reset(options=...)` (this episode only):
+
+{task_table(_TASK)}
+
     ## Episode End
-    Truncated after `episode_steps` (default 200 × 5 s); terminated only on
-    a physics failure (`info["error"]`).
+    Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS} steps of
+    5 s); terminated only on a physics failure (`info["error"]`).
 
     ## Arguments
-    `n_floes=200`, `concentration=0.75`, `preset=HERMAN2013`,
-    `control_interval=5.0` [s], `episode_steps=200`, `edge_width=10.0`
-    [m], `reward_fn`, `reward_params` (`edge_stress_max`, `speed_scale`,
-    `stress_weight`, `action_weight`), `stiffness_scale`, `cluster_gap`,
-    `render_mode`.
+    `n_floes=200`, `preset=HERMAN2013`, `control_interval=5.0` [s],
+    `reward_fn`, `reward_params` (`edge_stress_max`, `speed_scale`,
+    `stress_weight`), `stiffness_scale`, `cluster_gap`, `horizon=None`,
+    `colour_scale=0.5` [m/s], `render_mode`, and the task parameters.
 
     ## Version History
-    * v0: initial version.
+    * v0: a target transport speed drawn per episode, rewards in [0, 1],
+      task parameters as `gymnasium.make` keywords, episode length by
+      `max_episode_steps`.
     """
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_speed", "wind_direction")
     extra_features = _EXTRA
+    task_parameters = _TASK
+    reward_task_keys = ("target_speed",)
     reward_fn = staticmethod(marginal_ice_zone_reward)
 
-    def __init__(self, n_floes: int = 200, concentration: float = 0.75, preset=HERMAN2013,
-                 control_interval: float = 5.0, episode_steps: int = 200,
-                 edge_width: float = 10.0, **kwargs):
-        check_range("edge_width", edge_width, 0.0, None, low_open=True)
-        super().__init__(n_floes=n_floes, concentration=concentration, preset=preset,
-                         control_interval=control_interval, episode_steps=episode_steps,
+    def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
+                 **kwargs):
+        super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,
                          **kwargs)
-        self.edge_width = float(edge_width)
 
     def default_reward_params(self) -> dict:
-        return dict(edge_stress_max=500.0, speed_scale=0.1, stress_weight=1.0,
-                    action_weight=0.01)
+        return dict(edge_stress_max=500.0, speed_scale=0.05, stress_weight=1.0)
 
-    def _make_sim(self, rng, options):
+    def _draw_episode(self, task, rng):
+        target = float(rng.uniform(*task["target_speed_range"]))
+        if task["target_speed"] is None:
+            task["target_speed"] = target
+        return task
+
+    def _make_sim(self, rng):
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.concentration,
+        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
                                      alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
                                      thickness=p.thickness, density=p.forcing.ice_density,
                                      seed=int(rng.integers(2 ** 63)), aspect=0.5,
                                      box_type=ChannelBox)
-        frozen = field.positions[:, 1] < self.edge_width
+        edge_width = self.episode["edge_width"]
+        frozen = field.positions[:, 1] < edge_width
         if frozen.all() or not frozen.any():
-            raise ValueError(f"edge_width={self.edge_width:g} m freezes "
+            raise ValueError(f"edge_width={edge_width:g} m freezes "
                              f"{int(frozen.sum())} of {field.n} floes; choose it so that some "
                              f"but not all floes are frozen")
         field = FloeField(field.positions, field.radii, field.thickness, field.velocities,
@@ -112,7 +156,7 @@ class MarginalIceZoneEnv(HertzEnv):
         return self._hertz_sim(field, box, self.forcing)
 
     def _apply_action(self, action):
-        speed = MAX_WIND * 0.5 * (float(action[0]) + 1.0)
+        speed = self.episode["max_wind"] * 0.5 * (float(action[0]) + 1.0)
         angle = math.pi * float(action[1])
         self.forcing.wind = (speed * math.cos(angle), speed * math.sin(angle))
 
@@ -127,8 +171,18 @@ class MarginalIceZoneEnv(HertzEnv):
         now["edge_stress"] = float(math.hypot(*on_edge) / sim.box.lx)
         mobile = ~frozen
         y = sim.positions[:, 1]
-        y0 = self.edge_width
+        y0 = self.episode["edge_width"]
         band = mobile & (y < y0 + 0.25 * (sim.box.ly - y0))
         now["edge_u_x"] = float(sim.velocities[band, 0].mean()) if band.any() else 0.0
+        now["target_speed"] = self.episode["target_speed"]
         return now
 
+    def _frame_text(self):
+        now = self._prev
+        return super()._frame_text() + [f"u_x = {now['u_x']:.3f} m/s",
+                                        f"target u* = {self.episode['target_speed']:.3f} m/s",
+                                        f"edge stress {now['edge_stress']:.3g} N/m"]
+
+    def _frame_arrow(self):
+        wind = np.asarray(self.forcing.wind, dtype=float)
+        return [(wind / self.episode["max_wind"], f"wind {np.hypot(*wind):.1f} m/s")]

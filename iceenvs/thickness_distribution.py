@@ -11,7 +11,7 @@ from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
 from physics.itd_figures import KERNELS, R0, RAFT_FACTOR
 from physics.params import check_range
 
-from .base import ControlEnv
+from .base import ControlEnv, TaskParameter
 from .rewards import thickness_distribution_reward, wasserstein1
 
 __all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
@@ -28,7 +28,21 @@ START_NOISE = 0.1                # log-normal perturbation of the default start
 # default kernel parameters: the calibrated rates, r0 for the constant kernel
 DEFAULT_KERNEL_PARAMS = {**KERNELS, "constant": dict(r=R0)}
 
-_OPTIONS = ("target", "g0")
+MAX_EPISODE_STEPS = 360         # one year of daily steps
+
+
+def _as_given(name, value):
+    """Distributions are checked against the env's classes in ``_check_episode_task``."""
+    return value
+
+
+_TASK = (
+    TaskParameter("target", None, "target g(h) on the fine classes (n_classes + 1 entries, "
+                  "open water first; normalised here); None: the default target", _as_given),
+    TaskParameter("g0", None, "start g(h), same form as `target`; None: the target with "
+                  "every ice class multiplied by exp(0.1 ξ), ξ standard normal, renormalised",
+                  _as_given),
+)
 
 
 def default_target(h, open_water: float = TARGET_OPEN_WATER,
@@ -139,30 +153,48 @@ class ThicknessDistributionEnv(ControlEnv):
     [m]); `info["target"]` is the target on the fine classes.
 
     ## Rewards
-    :func:`iceenvs.rewards.thickness_distribution_reward`: minus the
-    Wasserstein-1 distance [m] between the fine g(h) and the target,
+    :func:`iceenvs.rewards.thickness_distribution_reward`: built on the
+    Wasserstein-1 distance W1 [m] between the fine g(h) and the target,
     ∫ |G(h) − G*(h)| dh with G the cumulative fractions (0 when g equals the
     target). `reward_fn=` replaces it; it is called as
-    `reward_fn(prev, action, now, target=..., h=...)` with the physics dicts.
-    A physics failure gives `failure_reward` (−10) for the failing step and
-    for each step the episode had left (failures are absorbing).
+    `reward_fn(prev, action, now, distance_scale=..., target=..., h=...)` with
+    the physics dicts.
+    The reward in [0, 1] is 1 − W1 / `distance_scale` (default 1 m, a
+    `reward_params` entry), at least 0. A physics failure ends the episode
+    with reward 0.
 
     ## Starting State
     Day 0 (mid-winter). The default target is an exponential-tailed
     distribution like the Beaufort Sea mean: open water
     {TARGET_OPEN_WATER:g} and ice with g ∝ h exp(−h/λ), λ = {TARGET_EFOLDING:g} m (mean
-    ice thickness about 2 m), normalised. Option `target`: a target on the
-    fine classes (n_classes + 1 entries, open water first, finite, >= 0;
-    normalised here) for this episode. The start is the target with every
+    ice thickness about 2 m), normalised. The start is the target with every
     ice class multiplied by exp({START_NOISE:g} ξ), ξ standard normal from the
-    env's seeded generator, and renormalised; option `g0` (same form as
-    `target`, normalised here) sets the start instead. Options apply to the
-    episode they are given for; unknown options raise `ValueError`.
+    env's seeded generator, and renormalised.
+
+    ## Task parameters
+    Keywords of `gymnasium.make` (kept for every episode) and entries of
+    `reset(options=...)` (this episode only); unknown names raise an error
+    that lists the valid ones:
+
+    | name | default | meaning |
+    |---|---|---|
+    | `target` | None | target g(h) on the fine classes (n_classes + 1 entries, open water first, finite, >= 0; normalised here); None: the default target |
+    | `g0` | None | start g(h), same form as `target`; None: the target perturbed as above |
+
+    ## Task analysis
+    * *Reachable:* the start is the target perturbed by 10 % per class.
+    * *Best constant action:* the seasonal cycle of growth and melt pushes
+      g(h) away from the target in opposite directions in winter and
+      summer, so a fixed redistribution rate cannot hold it all year. The
+      best of a grid of constant actions is measured in the docs' training
+      page.
+    * *What a good policy does:* strengthens the redistribution when
+      thermodynamics thins the pack and weakens it when the pack thickens.
 
     ## Episode End
-    Truncated after ceil(`episode_days` / `days_per_step`) steps (360 with the
-    defaults: one year of 360 days in daily steps). Terminated only when
-    the physics fails (`info["error"]`).
+    Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS}
+    steps, one year of 360 days with `days_per_step=1`). Terminated only
+    when the physics fails (`info["error"]`).
 
     ## Arguments
     `kernel="constant"` (a kernel name of :func:`physics.itd.make_kernel`
@@ -170,27 +202,29 @@ class ThicknessDistributionEnv(ControlEnv):
     thicknesses [m]; or an n × n matrix), `kernel_params=None` (e.g.
     `dict(r=...)`, replacing the defaults; default: the calibrated rates of
     the named kernels),
-    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=1.0`, `episode_days=360.0`,
-    `reward_fn=None`, `render_mode=None` ("rgb_array" or "human").
+    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=1.0`,
+    `reward_fn=None`, `reward_params=None` (`distance_scale`),
+    `render_mode=None` ("rgb_array" or "human"), and the task parameters.
 
     ## Version History
-    * v0: initial version.
+    * v0: rewards in [0, 1], task parameters as `gymnasium.make` keywords,
+      episode length by `max_episode_steps`.
     """
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("redistribution", "rafting")
     reward_fn = staticmethod(thickness_distribution_reward)
+    task_parameters = _TASK
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
                  n_classes: int = 200, dh: float = 0.1, days_per_step: float = 1.0,
-                 episode_days: float = YEAR_DAYS, reward_fn=None,
-                 render_mode: str | None = None):
+                 reward_fn=None, reward_params: dict | None = None,
+                 render_mode: str | None = None, **task):
         if isinstance(n_classes, bool) or not isinstance(n_classes, (int, np.integer)) \
                 or n_classes < 2:
             raise ValueError(f"n_classes must be an integer >= 2, got {n_classes!r}")
         check_range("dh", dh, 0.0, None, low_open=True)
         check_range("days_per_step", days_per_step, 0.0, None, low_open=True)
-        check_range("episode_days", episode_days, 0.0, None, low_open=True)
         self._set_render_mode(render_mode)
         if kernel_params is not None and not isinstance(kernel_params, dict):
             raise ValueError(f"kernel_params must be a dict, got {type(kernel_params).__name__}")
@@ -209,8 +243,6 @@ class ThicknessDistributionEnv(ControlEnv):
         self.n_classes = int(n_classes)
         self.dh = float(dh)
         self.days_per_step = float(days_per_step)
-        self.episode_days = float(episode_days)
-        self.episode_steps = max(1, int(math.ceil(self.episode_days / self.days_per_step - 1e-9)))
         self.kernel = kernel
         self.kernel_params = dict(kernel_params)
         try:
@@ -221,6 +253,17 @@ class ThicknessDistributionEnv(ControlEnv):
             raise ValueError(f"bad kernel or kernel_params: {err}") from None
         self.reward_fn = reward_fn if reward_fn is not None else type(self).reward_fn
         self._default_reward = reward_fn is None
+        self.reward_params = {"distance_scale": 1.0}
+        if reward_params is not None and not isinstance(reward_params, dict):
+            raise TypeError(f"reward_params must be a dict, got {type(reward_params).__name__}")
+        unknown = set(reward_params or ()) - set(self.reward_params)
+        if unknown and reward_fn is None:
+            raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
+                             f"{sorted(self.reward_params)}")
+        self.reward_params.update(reward_params or {})
+        if self._default_reward:
+            check_range("distance_scale", self.reward_params["distance_scale"], 0.0, None,
+                        low_open=True)
 
         h = np.concatenate([[0.0], self.dh * np.arange(1, self.n_classes + 1)])
         h.setflags(write=False)
@@ -231,7 +274,7 @@ class ThicknessDistributionEnv(ControlEnv):
         self._default_target = default_target(h)
         self._default_target.setflags(write=False)
         self._target = self._default_target
-        self.reward_params = {"target": self._target, "h": self._h}
+        self._init_task(task)
 
         n_obs = N_COARSE + 6
         low = np.zeros(n_obs, dtype=np.float32)
@@ -299,29 +342,34 @@ class ThicknessDistributionEnv(ControlEnv):
         physics["h"] = now["h"].copy()
         return {"physics": physics, "target": self._target.copy(), "steps": self._steps}
 
+    # -- task --------------------------------------------------------------------------
+    def _check_episode_task(self, task: dict) -> None:
+        size = self.n_classes + 1
+        for name in ("target", "g0"):
+            if task[name] is not None:
+                g = _distribution(name, task[name], size)
+                g.setflags(write=False)
+                task[name] = g
+
+    def _draw_episode(self, task, rng):
+        if task["target"] is None:
+            task["target"] = self._default_target
+        if task["g0"] is None:
+            g0 = task["target"].copy()
+            g0[1:] *= np.exp(START_NOISE * rng.standard_normal(g0.size - 1))
+            task["g0"] = g0 / g0.sum()
+        return task
+
+    def _reward_kwargs(self) -> dict:
+        return {**self.reward_params, "target": self._target, "h": self._h}
+
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        options = dict(options or {})
-        unknown = set(options) - set(_OPTIONS)
-        if unknown:
-            raise ValueError(f"unknown reset options {sorted(unknown)}; this env takes "
-                             f"{list(_OPTIONS)}")
-        size = self.n_classes + 1
-        if options.get("target") is not None:
-            target = _distribution("target", options["target"], size)
-            target.setflags(write=False)
-        else:
-            target = self._default_target
-        if options.get("g0") is not None:
-            g0 = _distribution("g0", options["g0"], size)
-        else:
-            g0 = target.copy()
-            g0[1:] *= np.exp(START_NOISE * self.np_random.standard_normal(size - 1))
-            g0 /= g0.sum()
-        self._target = target
-        self.reward_params = {"target": target, "h": self._h}
-        self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh, g0=g0)
+        self.episode = self._episode_task(options)
+        self._target = self.episode["target"]
+        self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh,
+                                    g0=self.episode["g0"])
         return self._begin_episode()
 
     def _ready(self) -> bool:
@@ -331,8 +379,8 @@ class ThicknessDistributionEnv(ControlEnv):
         self.model.step(self.days_per_step)
 
     def _reward(self, action: np.ndarray, now: dict) -> float:
-        if self._default_reward:
-            return -now["w1"]              # thickness_distribution_reward, already computed
+        if self._default_reward:           # thickness_distribution_reward, W1 already computed
+            return min(1.0, max(0.0, 1.0 - now["w1"] / self.reward_params["distance_scale"]))
         return super()._reward(action, now)
 
     # -- rendering --------------------------------------------------------------------
@@ -340,4 +388,4 @@ class ThicknessDistributionEnv(ControlEnv):
         from .rendering import draw_itd
 
         return draw_itd(self._h_coarse, self.coarse(self.model.g),
-                        target=self.coarse(self._target))
+                        target=self.coarse(self._target), day=self.model.time)

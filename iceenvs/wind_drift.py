@@ -1,4 +1,4 @@
-"""``iceenvs/WindDrift-v0``: steer drifting ice with the wind."""
+"""``iceenvs/WindDrift-v0``: steer drifting ice along a heading with the wind."""
 from __future__ import annotations
 
 import math
@@ -8,15 +8,27 @@ import numpy as np
 
 from physics import Forcing, HERMAN2013, make_floe_field
 
-from .base import HertzEnv
+from .base import HertzEnv, TaskParameter, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
 from .rewards import wind_drift_reward
 
-MAX_WIND = 20.0   # m/s per component at |action| = 1
+__all__ = ["WindDriftEnv"]
+
+MAX_EPISODE_STEPS = 200
 
 _EXTRA = (
     Feature("heading_cos", "cos of the target heading", "-", "none", -1.0, 1.0),
     Feature("heading_sin", "sin of the target heading", "-", "none", -1.0, 1.0),
+)
+
+_TASK = (
+    TaskParameter("heading", None, "target direction of the ice drift [rad] from +x; None: "
+                  "drawn uniformly in [−π, π) every episode",
+                  number(optional=True)),
+    TaskParameter("concentration", 0.8, "ice concentration of the start state",
+                  number(0.0, 0.85, low_open=True)),
+    TaskParameter("max_wind", 20.0, "wind speed [m/s] per component at |action| = 1",
+                  number(0.0, 100.0, low_open=True)),
 )
 
 
@@ -30,76 +42,100 @@ class WindDriftEnv(HertzEnv):
     air and water drag, Coriolis f = 1.3e-4 1/s) in a doubly periodic box at
     fixed concentration. The agent sets the wind; the ice responds through
     drag (spin-up time of the order of 10³ s), collisions and, at high
-    concentration, a contact-force network. Because of Coriolis the drift
-    turns to the right of the wind: the agent has to learn the Ekman-like
-    turning and to avoid pressure build-ups.
+    concentration, a contact-force network. Every episode has its own
+    target heading, given in the observation, so one policy learns all
+    headings.
+
+    ## Task analysis
+    * *Reachable:* any heading. The drift keeps accelerating over the whole
+      episode (about 0.49 m/s after 1000 s under 20 m/s wind along x, and
+      0.98 m/s under the diagonal wind of 28 m/s): the task is never
+      "done", it rewards the fastest drift along the heading.
+    * *Best constant action:* over headings drawn uniformly, every constant
+      wind moves the ice along the heading as often as against it, so no
+      constant action scores much above the 0.5 per step of ice at rest
+      (measured in the docs' training page).
+    * *What a good policy does:* reads the heading and blows along it,
+      using the corners of the action box (the wind is limited per
+      component, so a diagonal wind is √2 stronger), turned left of the
+      heading by the small Coriolis turning of the drift (a few degrees at
+      these speeds).
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: the wind vector (u_a,x, u_a,y) in units of
-    {MAX_WIND:g} m/s. NaN/inf entries are set to 0 and entries clipped.
+    `max_wind` (default 20 m/s). NaN/inf entries are set to 0 and entries
+    clipped.
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 2} entries: the common floe
-    features, the target heading and the last action:
+    features, the target heading and the last action (with `horizon=N`,
+    `time_left` before the action):
 
 {feature_table(FLOE_FEATURES + _EXTRA)}
     | {len(FLOE_FEATURES) + len(_EXTRA)}, {len(FLOE_FEATURES) + len(_EXTRA) + 1} | `action` | the last action | - | none | [-1, 1] |
 
-    `info["physics"]` holds the same quantities unscaled, in SI units.
+    `info["physics"]` holds the same quantities unscaled, in SI units, and
+    `info["task"]` the episode's task parameters.
 
     ## Rewards
-    :func:`iceenvs.rewards.wind_drift_reward`: along-heading mean ice
-    velocity / 0.1 m/s − (relative excess of the pressure over
-    `pressure_max`, default 2000 N/m) − 0.01 |action|².
+    :func:`iceenvs.rewards.wind_drift_reward`, in [0, 1] every step:
+    (1 + u_h / 1 m/s)/2, clipped to [0, 1], with u_h the mean ice velocity
+    along the heading (0.5 for ice at rest), times a safety factor that
+    falls from 1 to 0 as the pressure goes from `pressure_max` (default
+    2000 N/m) to twice that. A physics failure ends the episode with
+    reward 0.
 
     ## Starting State
-    Floes placed at random without overlap at concentration `concentration`
-    (seeded by `reset(seed=...)`), at rest, no wind. Option `heading` [rad]
-    (default 0: along +x).
+    Floes placed at random without overlap at `concentration` (seeded by
+    `reset(seed=...)`), at rest, no wind; the heading drawn uniformly in
+    [−π, π) unless `heading` is given.
+
+    ## Task parameters
+    Keywords of `gymnasium.make` (kept for every episode) and entries of
+    `reset(options=...)` (this episode only):
+
+{task_table(_TASK)}
 
     ## Episode End
-    Truncated after `episode_steps` steps (default 200 × 5 s = 1000 s).
-    Terminated only when the physics fails (`info["error"]`).
+    Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS}
+    steps of 5 s); terminated only when the physics fails
+    (`info["error"]`).
 
     ## Arguments
-    `n_floes=200`, `concentration=0.8`, `preset=HERMAN2013`,
-    `control_interval=5.0` [s], `episode_steps=200`, `reward_fn`,
-    `reward_params` (`pressure_max`, `speed_scale`, `pressure_weight`,
-    `action_weight`), `stiffness_scale=1.0` (< 1: softer contacts and a
-    longer time step, faster), `cluster_gap=0.1` [m], `render_mode`.
+    `n_floes=200`, `preset=HERMAN2013`, `control_interval=5.0` [s],
+    `reward_fn`, `reward_params` (`pressure_max`, `speed_scale`,
+    `pressure_weight`), `stiffness_scale=1.0` (< 1: softer contacts and a
+    longer time step, faster), `cluster_gap=0.1` [m], `horizon=None`,
+    `colour_scale=0.5` [m/s], `render_mode`, and the task parameters.
 
     ## Version History
-    * v0: initial version.
+    * v0: a heading drawn per episode, rewards in [0, 1], task parameters
+      as `gymnasium.make` keywords, episode length by `max_episode_steps`.
     """
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_x", "wind_y")
     extra_features = _EXTRA
+    task_parameters = _TASK
+    reward_task_keys = ("heading",)
     reward_fn = staticmethod(wind_drift_reward)
 
-    def __init__(self, n_floes: int = 200, concentration: float = 0.8,
-                 preset=HERMAN2013, control_interval: float = 5.0, episode_steps: int = 200,
+    def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
                  **kwargs):
-        super().__init__(n_floes=n_floes, concentration=concentration, preset=preset,
-                         control_interval=control_interval, episode_steps=episode_steps,
+        super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,
                          **kwargs)
-        self.heading = 0.0
 
     def default_reward_params(self) -> dict:
-        return dict(heading=0.0, pressure_max=2000.0, speed_scale=0.1, pressure_weight=1.0,
-                    action_weight=0.01)
+        return dict(pressure_max=2000.0, speed_scale=1.0, pressure_weight=1.0)
 
-    def _reset_options(self, options: dict) -> None:
-        heading = options.pop("heading", 0.0)
-        if not math.isfinite(float(heading)):
-            raise ValueError(f"heading must be a finite angle [rad], got {heading!r}")
-        super()._reset_options(options)
-        self.heading = float(heading)
-        self.reward_params["heading"] = self.heading
+    def _draw_episode(self, task, rng):
+        if task["heading"] is None:
+            task["heading"] = float(rng.uniform(-math.pi, math.pi))
+        return task
 
-    def _make_sim(self, rng, options):
+    def _make_sim(self, rng):
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.concentration,
+        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
                                      alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
                                      thickness=p.thickness,
                                      density=p.forcing.ice_density,
@@ -108,10 +144,22 @@ class WindDriftEnv(HertzEnv):
         return self._hertz_sim(field, box, self.forcing)
 
     def _apply_action(self, action):
-        self.forcing.wind = MAX_WIND * action
+        self.forcing.wind = self.episode["max_wind"] * action
 
     def _measure(self) -> dict:
         now = self._contact_physics()
-        now["heading_cos"] = math.cos(self.heading)
-        now["heading_sin"] = math.sin(self.heading)
+        h = self.episode["heading"]
+        now["heading_cos"] = math.cos(h)
+        now["heading_sin"] = math.sin(h)
+        now["u_heading"] = now["u_x"] * now["heading_cos"] + now["u_y"] * now["heading_sin"]
         return now
+
+    def _frame_text(self):
+        return super()._frame_text() + [f"heading {math.degrees(self.episode['heading']):.0f}°"]
+
+    def _frame_arrow(self):
+        wind = np.asarray(self.forcing.wind, dtype=float)
+        h = self.episode["heading"]
+        return [((math.cos(h), math.sin(h)), "heading"),
+                (wind / (self.episode["max_wind"] * math.sqrt(2.0)),
+                 f"wind {np.hypot(*wind):.1f} m/s")]

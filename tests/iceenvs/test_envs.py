@@ -34,14 +34,8 @@ SMALL = {
     ITD: dict(n_classes=60),
 }
 
-# kwargs that end an episode after 3 steps
-THREE_STEPS = {
-    WIND: dict(episode_steps=3),
-    CONVERGENCE: dict(episode_steps=3),
-    MIZ: dict(episode_steps=3),
-    CLUSTERING: dict(episode_steps=3),
-    ITD: dict(days_per_step=5.0, episode_days=15.0),
-}
+# kwargs that end an episode after 3 steps (Gymnasium's TimeLimit)
+THREE_STEPS = {env_id: dict(max_episode_steps=3) for env_id in SMALL}
 
 DOC_SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards",
                 "Starting State", "Episode End", "Arguments", "Version History")

@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import iceenvs  # noqa: F401  (registers the ids)
+from iceenvs.base import REWARD_RANGE
 
 WIND = "iceenvs/WindDrift-v0"
 CONVERGENCE = "iceenvs/Convergence-v0"
@@ -46,7 +47,8 @@ OPTIONS = {
     CONVERGENCE: st.fixed_dictionaries({}, optional={
         "target": st.floats(min_value=0.0, max_value=1.0, exclude_min=True, exclude_max=True),
         "concentration": st.floats(min_value=0.05, max_value=0.8)}),
-    MIZ: st.just({}),
+    MIZ: st.fixed_dictionaries({}, optional={
+        "target_speed": st.floats(min_value=-0.5, max_value=0.5)}),
     CLUSTERING: st.fixed_dictionaries({}, optional={
         "target": st.floats(min_value=0.0, max_value=1.0)}),
 }
@@ -61,6 +63,7 @@ def check_step(env, obs, reward, info):
     assert np.all(np.isfinite(obs)), obs
     assert env.observation_space.contains(obs), obs
     assert math.isfinite(reward), reward
+    assert REWARD_RANGE[0] <= reward <= REWARD_RANGE[1], reward
     for name, value in info["physics"].items():
         if not np.isscalar(value):
             continue
@@ -128,8 +131,13 @@ INVALID = [
     (CONVERGENCE, {"target": float("nan")}),
     (CONVERGENCE, {"concentration": float("nan")}),
     (CONVERGENCE, {"concentration": 0.95}),
+    (CONVERGENCE, {"target_range": (0.9, 0.8)}),
+    (CONVERGENCE, {"max_rate": 0.0}),
     (CLUSTERING, {"target": 1.5}),
     (CLUSTERING, {"target": -0.1}),
+    (CLUSTERING, {"target": True}),
+    (MIZ, {"target_speed": "fast"}),
+    (ITD, {"target": [1.0, 2.0]}),
 ]
 
 

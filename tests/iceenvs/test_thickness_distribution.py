@@ -62,7 +62,10 @@ def test_spaces_and_defaults(env):
     # constant kernel with the calibrated rate r0 of the Godlovitch figures
     assert env.kernel == "constant" and env.kernel_params == {"r": R0}
     assert np.all(env._K == R0)
-    assert env.episode_steps == 360
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+    assert gym.spec("iceenvs/ThicknessDistribution-v0").max_episode_steps == 360
     assert RAFT_MAX == 2 * RAFT_FACTOR
 
 
@@ -127,12 +130,11 @@ def test_observations_stay_in_space_over_random_episode(env):
     rng = np.random.default_rng(1)
     obs, _ = env.reset(seed=1)
     assert env.observation_space.contains(obs)
-    truncated = False
-    while not truncated:
+    for _ in range(360):                 # one year
         obs, reward, terminated, truncated, info = env.step(rng.uniform(-1.5, 1.5, 2))
         assert not terminated
         assert env.observation_space.contains(obs) and np.all(np.isfinite(obs))
-        assert reward <= 0.0
+        assert 0.0 <= reward <= 1.0
 
 
 # -- observation layout -------------------------------------------------------------------
@@ -205,7 +207,7 @@ def test_area_is_conserved(env):
 
 # -- rewards and targets ------------------------------------------------------------------
 
-def test_reward_is_minus_w1_to_the_target(env):
+def test_reward_is_one_minus_w1_to_the_target(env):
     _, info0 = env.reset(seed=6)
     target = env.target
     assert info0["physics"]["w1"] == pytest.approx(wasserstein1(info0["physics"]["g"],
@@ -213,23 +215,27 @@ def test_reward_is_minus_w1_to_the_target(env):
     for a in ([1, 0], [-1, 1], [0.5, -0.5]):
         _, reward, _, _, info = env.step(a)
         p = info["physics"]
-        assert reward == pytest.approx(-wasserstein1(p["g"], target, p["h"]), rel=1e-12)
-        assert reward == pytest.approx(-p["w1"], rel=1e-12)
-        assert reward < 0
+        assert reward == pytest.approx(1 - wasserstein1(p["g"], target, p["h"]), rel=1e-12)
+        assert reward == pytest.approx(1 - p["w1"], rel=1e-12)
+        assert 0 < reward < 1
 
 
 def test_reward_function_directly():
     h = np.concatenate([[0.0], 0.1 * np.arange(1, 201)])
     target = default_target(h)
     now = {"g": target.copy()}
-    assert thickness_distribution_reward(None, np.zeros(2), now, target=target, h=h) == 0.0
+    assert thickness_distribution_reward(None, np.zeros(2), now, target=target, h=h) == 1.0
     # all ice of the target 0.1 m thicker: W1 = 0.1 m × ice fraction
     shifted = np.zeros_like(target)
     shifted[0] = target[0]
     shifted[2:] = target[1:-1]
     shifted[-1] += target[-1]
     r = thickness_distribution_reward(None, np.zeros(2), {"g": shifted}, target=target, h=h)
-    assert r == pytest.approx(-0.1 * (1 - target[0]), rel=1e-6)
+    assert r == pytest.approx(1 - 0.1 * (1 - target[0]), rel=1e-6)
+    # the distance in units of distance_scale, clipped at 0
+    r = thickness_distribution_reward(None, np.zeros(2), {"g": shifted}, target=target, h=h,
+                                      distance_scale=0.05)
+    assert r == pytest.approx(1 - 2 * (1 - target[0]) if 2 * (1 - target[0]) < 1 else 0.0)
 
 
 def test_default_target():
@@ -262,7 +268,7 @@ def test_target_and_g0_options(env):
     np.testing.assert_allclose(info["physics"]["g"], g0 / g0.sum())
     assert obs[0] == pytest.approx(0.25) and obs[7] == pytest.approx(0.75)   # 3.0 m → [3, 3.5)
     _, reward, *_ = env.step([0, 0])
-    assert reward == pytest.approx(-wasserstein1(env.model.g, target, h))
+    assert reward == pytest.approx(max(0.0, 1 - wasserstein1(env.model.g, target, h)))
     # the options hold for that episode only
     env.reset(seed=0)
     np.testing.assert_array_equal(env.target, default_target(h))
@@ -290,7 +296,11 @@ def test_bad_options_raise(env, options):
 
 # -- episode end, errors ------------------------------------------------------------------
 
-def test_truncated_after_one_year_with_defaults(env):
+def test_truncated_after_one_year_with_defaults():
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+    env = gym.make("iceenvs/ThicknessDistribution-v0")
     env.reset(seed=0)
     for k in range(1, 361):
         _, _, terminated, truncated, info = env.step([0, 0])
@@ -299,19 +309,25 @@ def test_truncated_after_one_year_with_defaults(env):
     assert info["physics"]["day"] == pytest.approx(360.0)
 
 
-def test_episode_length_from_arguments():
-    assert ThicknessDistributionEnv(days_per_step=10.0).episode_steps == 36
-    assert ThicknessDistributionEnv(days_per_step=7.0).episode_steps == 52   # ceil(360/7)
-    e = ThicknessDistributionEnv(days_per_step=30.0, episode_days=90.0)
+def test_episode_length_from_max_episode_steps():
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+    e = gym.make("iceenvs/ThicknessDistribution-v0", days_per_step=30.0, max_episode_steps=3)
     e.reset(seed=0)
     flags = [e.step([0, 0])[3] for _ in range(3)]
     assert flags == [False, False, True]
+    assert e.unwrapped.model.time == pytest.approx(90.0)
+    # the environment never truncates on its own
+    bare = ThicknessDistributionEnv(days_per_step=30.0)
+    bare.reset(seed=0)
+    assert not any(bare.step([0, 0])[3] for _ in range(20))
 
 
 @pytest.mark.parametrize("kwargs", [
     {"n_classes": 1}, {"n_classes": 2.5}, {"n_classes": True}, {"dh": 0.0}, {"dh": -0.1},
     {"dh": float("nan")}, {"days_per_step": 0.0}, {"days_per_step": float("inf")},
-    {"episode_days": -1.0}, {"render_mode": "ascii"}, {"kernel": "nope"},
+    {"render_mode": "ascii"}, {"kernel": "nope"},
     {"kernel": "rafting"}, {"kernel_params": {"r": -1.0}}, {"kernel_params": {"bogus": 1.0}},
     {"kernel_params": [1.0]}, {"reward_fn": 3},
     {"kernel": lambda x, y: x + y, "kernel_params": {"r": 1.0}},
@@ -319,6 +335,25 @@ def test_episode_length_from_arguments():
 def test_bad_constructor_arguments_raise(kwargs):
     with pytest.raises(ValueError):
         ThicknessDistributionEnv(**kwargs)
+
+
+def test_unknown_constructor_argument_lists_the_valid_ones():
+    with pytest.raises(TypeError, match="episode_days.*valid arguments:.*days_per_step.*g0"):
+        ThicknessDistributionEnv(episode_days=90.0)
+
+
+def test_target_keyword_holds_for_every_episode():
+    h = ThicknessDistributionEnv(n_classes=60).h
+    target = np.where(h < 1.0, 1.0, 0.0)
+    e = ThicknessDistributionEnv(n_classes=60, target=target)
+    for seed in range(3):
+        e.reset(seed=seed)
+        np.testing.assert_allclose(e.target, target / target.sum())
+    # an option replaces it for one episode
+    e.reset(seed=0, options={"target": np.ones(61)})
+    np.testing.assert_allclose(e.target, np.full(61, 1 / 61))
+    e.reset(seed=0)
+    np.testing.assert_allclose(e.target, target / target.sum())
 
 
 def test_other_kernels_and_grids():
@@ -339,7 +374,7 @@ def test_other_kernels_and_grids():
 def test_custom_reward_fn_receives_target_and_h():
     calls = []
 
-    def reward(prev, action, now, *, target, h):
+    def reward(prev, action, now, *, target, h, distance_scale):
         calls.append((prev, action, now, target, h))
         return 1.5
 
@@ -363,8 +398,8 @@ def test_physics_failure_ends_the_episode(env):
     env.model.step = broken
     obs, reward, terminated, truncated, info = env.step([0, 0])
     assert terminated and not truncated
-    # absorbing failure: −10 for this step and each of the steps left
-    assert reward == env.failure_reward * (1 + env.episode_steps - 2)
+    # the failed state is absorbing and worth nothing
+    assert reward == env.failure_reward == 0.0
     assert "FloatingPointError" in info["error"]
     assert np.array_equal(obs, obs0)
 
@@ -374,7 +409,7 @@ def test_non_finite_custom_reward_terminates():
     e.reset(seed=0)
     _, reward, terminated, _, info = e.step([0, 0])
     assert terminated and "error" in info
-    assert reward == e.failure_reward * e.episode_steps
+    assert reward == e.failure_reward == 0.0
 
 
 def test_step_before_reset_raises():
