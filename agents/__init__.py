@@ -4,15 +4,20 @@ Commands::
 
     python -m agents.train --env iceenvs/Convergence-v0 --algo ppo [--timesteps N]
         [--seed S] [--n-envs K] [--out DIR] [--force] [--eval-freq F]
-        [--eval-episodes E] [--hyperparams key=value ...]
+        [--eval-episodes E] [--hyperparams key=value ...] [--env-kwargs key=value ...]
     python -m agents.evaluate RUN_DIR [--episodes 20] [--seed S]
-        [--baselines random,zero,heuristic] [--out DIR]
+        [--baselines random,zero,heuristic[,constant]] [--constant FILE.json] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
+        [--env-kwargs key=value ...]
+    python -m agents.constant --env ID [--grid 9] [--seeds 5] [--processes 2]
+        [--env-kwargs key=value ...] [--out FILE.json]
 
 Modules: :mod:`agents.train` (training runs), :mod:`agents.evaluate`
 (policy against baselines), :mod:`agents.baselines` (random, zero and
-hand-written controllers), :mod:`agents.callbacks` (physics metrics,
-progress bar), :mod:`agents.envs` (vectorised environments),
+hand-written controllers), :mod:`agents.constant` (the best constant
+action of a grid search as a baseline), :mod:`agents.callbacks` (physics
+metrics, progress bar), :mod:`agents.envs` (vectorised environments,
+``--env-kwargs`` parsing and checking),
 :mod:`agents.metrics` (which physics entries each task logs) and the
 hyperparameter tables ``agents/hyperparams/{ppo,sac}.yaml``.
 

@@ -10,6 +10,7 @@ name              policy
 ================  ==========================================================
 ``random``        uniform samples of the action space, seeded
 ``zero``          the all-zero action, clipped into the space
+``constant``      one fixed action (``action=``; :mod:`agents.constant` finds the best)
 ``heuristic``     the hand-written controller of the environment (below)
 ================  ==========================================================
 
@@ -27,7 +28,7 @@ import numpy as np
 
 from iceenvs.observations import log_stress
 
-__all__ = ["Baseline", "RandomPolicy", "ZeroPolicy", "WindDriftController",
+__all__ = ["Baseline", "RandomPolicy", "ZeroPolicy", "ConstantPolicy", "WindDriftController",
            "ConvergenceController", "MarginalIceZoneController", "FloeClusteringController",
            "ThicknessDistributionController", "HEURISTICS", "BASELINES", "make_baseline"]
 
@@ -90,6 +91,78 @@ class ZeroPolicy(Baseline):
 
     def act(self, obs):
         return np.zeros(self.action_space.shape)
+
+
+def _check_action(space, action) -> np.ndarray:
+    """``action`` as an array of the space's shape, finite and inside the
+    bounds (a relative tolerance of 1e-6 of the box width for rounding)."""
+    try:
+        a = np.array(action, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"a constant action must be an array of numbers, got {action!r}: "
+                         f"{err}") from None
+    shape = tuple(space.shape)
+    if a.shape != shape:
+        raise ValueError(f"a constant action must have the action space's shape {shape}, got "
+                         f"{a.shape} ({action!r})")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"a constant action must be finite, got {action!r}")
+    low = np.asarray(space.low, dtype=np.float64)
+    high = np.asarray(space.high, dtype=np.float64)
+    width = np.where(np.isfinite(high - low), high - low, 1.0)
+    tol = 1e-6 * np.maximum(width, 1.0)
+    if np.any(a < low - tol) or np.any(a > high + tol):
+        raise ValueError(f"constant action {a.tolist()} is outside the action space "
+                         f"[{low.tolist()}, {high.tolist()}]")
+    return np.clip(a, low, high)
+
+
+class ConstantPolicy(Baseline):
+    """The same action at every step.
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        The environment (its action space must be a ``Box``).
+    seed : int
+        Unused (the policy is deterministic); kept for the baseline
+        interface ``(env, seed)``.
+    action : array-like, optional
+        The action, of the action space's shape and inside its bounds.
+        Default: the centre of the box, (low + high) / 2.
+
+    Raises
+    ------
+    ValueError
+        For an action of the wrong shape, not finite or out of bounds, or
+        no action with an unbounded box.
+    """
+
+    def __init__(self, env, seed: int = 0, *, action=None):
+        super().__init__(env, seed)
+        space = self.action_space
+        if action is None:
+            low = np.asarray(space.low, dtype=np.float64)
+            high = np.asarray(space.high, dtype=np.float64)
+            if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
+                raise ValueError("an unbounded action space has no centre; pass action=")
+            action = 0.5 * (low + high)
+        self.action = _check_action(space, action).astype(space.dtype)
+
+    @classmethod
+    def best(cls, env, results, seed: int = 0) -> "ConstantPolicy":
+        """The policy of the best action of a search: ``results`` is the list
+        of :func:`search_constant_actions`, or the path of the JSON file of
+        ``python -m agents.constant``."""
+        from .constant import best_action
+
+        return cls(env, seed, action=best_action(results))
+
+    def act(self, obs):
+        return self.action.copy()
+
+    def __repr__(self) -> str:
+        return f"ConstantPolicy(action={self.action.tolist()})"
 
 
 class _FloeController(Baseline):
@@ -170,27 +243,36 @@ class ConvergenceController(_FloeController):
 
 
 class MarginalIceZoneController(_FloeController):
-    """Full wind along the edge, turned away from the fast ice as the edge
-    stress rises.
+    """Integral control of the wind speed towards the target transport,
+    with the wind turned away from the fast ice as the edge stress rises.
 
-    Transport grows with the wind speed, so the speed is full
-    (action[0] = 1). With Coriolis the drift turns to the right of the
-    wind, i.e. towards the fast-ice edge for wind along +x; the wind is
-    therefore turned left (away from the edge) by a base angle of 0.1 π
-    (18°), plus up to a further 0.2 π in proportion to the log edge stress
-    between a quarter of the task's ``edge_stress_max`` and
+    The transport grows with the wind speed, so the speed command
+    (action[0]) is integrated from the observed transport error: each
+    step it changes by ``gain`` × (u* − u_x) / 0.05 m/s, within [−1, 1]
+    (starting from −1, no wind). With Coriolis the drift turns to the right
+    of the wind, i.e. towards the fast-ice edge for wind along +x; the wind
+    is therefore turned left (away from the edge) by a base angle of
+    0.1 π (18°), plus up to a further 0.2 π in proportion to the log edge
+    stress between a quarter of the task's ``edge_stress_max`` and
     ``edge_stress_max``, so that the ice is not pressed onto the edge.
     """
 
     base = 0.1
     extra = 0.2
+    gain = 0.1
+    _speed = -1.0      # the current speed command
+
+    def reset(self, seed=None):
+        self._speed = -1.0
 
     def act(self, obs):
+        error = (self._get(obs, "target_speed") - self._get(obs, "u_x")) / 0.05
+        self._speed = float(np.clip(self._speed + self.gain * error, -1.0, 1.0))
         s = self._get(obs, "edge_stress")
         s_max = log_stress(self.reward_params["edge_stress_max"])
         s_low = log_stress(0.25 * self.reward_params["edge_stress_max"])
         load = float(np.clip((s - s_low) / (s_max - s_low), 0.0, 1.0))
-        return np.array([1.0, self.base + self.extra * load])
+        return np.array([self._speed, self.base + self.extra * load])
 
 
 class FloeClusteringController(_FloeController):
@@ -304,11 +386,13 @@ def _heuristic(env, seed: int = 0) -> Baseline:
 
 
 #: baseline name → constructor ``(env, seed)``
-BASELINES = {"random": RandomPolicy, "zero": ZeroPolicy, "heuristic": _heuristic}
+BASELINES = {"random": RandomPolicy, "zero": ZeroPolicy, "heuristic": _heuristic,
+             "constant": ConstantPolicy}
 
 
-def make_baseline(name: str, env: gym.Env, seed: int = 0) -> Baseline:
-    """The baseline ``name`` (a key of :data:`BASELINES`) for ``env``.
+def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
+    """The baseline ``name`` (a key of :data:`BASELINES`) for ``env``;
+    ``kwargs`` go to its constructor (``action=`` for ``"constant"``).
 
     Raises
     ------
@@ -318,4 +402,4 @@ def make_baseline(name: str, env: gym.Env, seed: int = 0) -> Baseline:
     if name not in BASELINES:
         raise ValueError(f"unknown baseline {name!r}; valid baselines: "
                          f"{', '.join(BASELINES)}")
-    return BASELINES[name](env, seed)
+    return BASELINES[name](env, seed, **kwargs)

@@ -1,15 +1,112 @@
 """Environment construction for training and evaluation: a picklable
-factory (for worker processes) and the vectorised stack
+factory (for worker processes), the vectorised stack
 
     SubprocVecEnv (n_envs > 1) or DummyVecEnv → VecMonitor → VecNormalize
 
-with every sub-environment seeded ``seed + index``.
+with every sub-environment seeded ``seed + index``, and the command-line
+handling of environment arguments shared by the commands
+(``--env-kwargs KEY=VALUE ...``): :func:`parse_key_values` reads them and
+:func:`make_checked_env` / :func:`check_env_kwargs` try them on one
+environment in the current process, so that a bad keyword is reported
+before any worker process starts or any file is written.
 """
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
-__all__ = ["EnvFactory", "make_vec_env", "load_normalization"]
+__all__ = ["EnvFactory", "make_vec_env", "load_normalization", "parse_key_values",
+           "make_checked_env", "check_env_kwargs"]
+
+
+def _set_dotted(mapping: dict, key: str, value) -> None:
+    head, _, rest = key.partition(".")
+    if not rest:
+        mapping[head] = value
+        return
+    sub = mapping.get(head)
+    if not isinstance(sub, dict):
+        sub = {}
+    mapping[head] = sub
+    _set_dotted(sub, rest, value)
+
+
+def parse_key_values(items, *, into: dict | None = None, option: str = "--env-kwargs") -> dict:
+    """``KEY=VALUE`` strings set over a copy of ``into`` (default empty).
+
+    Parameters
+    ----------
+    items : iterable of str
+        ``key=value`` strings; the value is parsed as YAML (``40`` is an
+        int, ``0.5`` a float, ``{r: 0.1}`` a mapping, ``[1, 2]`` a list); a
+        dotted key (``kernel_params.r=0.1``) sets one entry of a nested
+        mapping and keeps its other entries. Later items win.
+    into : dict, optional
+        The mapping to start from (not modified).
+    option : str
+        The option name used in error messages.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ValueError
+        For an item without ``=``, an empty key or a value that is not
+        valid YAML.
+    """
+    import yaml
+
+    out = copy.deepcopy(dict(into or {}))
+    for item in items:
+        key, sep, text = str(item).partition("=")
+        key = key.strip()
+        if not sep or not key or any(not part for part in key.split(".")):
+            raise ValueError(f"{option} entries are key=value, got {item!r}")
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError as err:
+            raise ValueError(f"{option} {key}: the value {text!r} is not valid YAML "
+                             f"({err})") from None
+        _set_dotted(out, key, value)
+    return out
+
+
+def make_checked_env(env_id: str, env_kwargs: dict | None = None, *, seed: int | None = 0):
+    """``gymnasium.make(env_id, **env_kwargs)`` and one ``reset(seed=seed)``.
+
+    The environment is returned after the reset; a ``TypeError`` or
+    ``ValueError`` of the construction or of the reset (an unknown
+    keyword, a value out of range) is raised as a ``ValueError`` whose
+    message names the environment and the keywords and carries the
+    environment's own message.
+    """
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    env_kwargs = dict(env_kwargs or {})
+    try:
+        env = gym.make(env_id, **env_kwargs)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"invalid env_kwargs {env_kwargs} for {env_id}: {err}") from err
+    try:
+        env.reset(seed=seed)
+    except (TypeError, ValueError) as err:
+        env.close()
+        raise ValueError(f"invalid env_kwargs {env_kwargs} for {env_id}: reset failed: "
+                         f"{err}") from err
+    except BaseException:
+        env.close()
+        raise
+    return env
+
+
+def check_env_kwargs(env_id: str, env_kwargs: dict | None = None, *, seed: int | None = 0) -> None:
+    """Build one environment with ``env_kwargs``, reset it once and close it
+    (:func:`make_checked_env`); raises ``ValueError`` when it cannot."""
+    make_checked_env(env_id, env_kwargs, seed=seed).close()
 
 
 class EnvFactory:

@@ -1,14 +1,25 @@
 """Evaluate a trained policy against baselines on the same seeded episodes.
 
     python -m agents.evaluate RUN_DIR [--episodes 20] [--seed S]
-        [--baselines random,zero,heuristic] [--out DIR]
+        [--baselines random,zero,heuristic[,constant]] [--constant FILE.json]
+        [--env-kwargs key=value ...] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
-        [--env-kwargs key=value ...]
+        [--env-kwargs key=value ...] [--constant FILE.json]
 
 Episode k of every policy starts from ``reset(seed=S + k)``. The trained
 policy sees observations normalised with the run's saved statistics
 (``vecnormalize.pkl``, frozen); the baselines see raw observations. The
-environment is built with the run's ``env_kwargs``.
+environment is built with the run's ``env_kwargs``, with ``--env-kwargs``
+set over them (the observation and action spaces must stay those of the
+run); the arguments are tried on one environment first, and a bad keyword
+exits with status 2 and the environment's message.
+
+The baseline ``constant`` plays the best constant action of a grid search
+(:mod:`agents.constant`): the first result of ``--constant FILE.json``
+(written by ``python -m agents.constant``; giving the file implies the
+baseline), or else of a search run here with the defaults of
+:func:`agents.constant.search_constant_actions`, on episodes seeded apart
+from the evaluation episodes. Its row in the table names the action.
 
 Output (in ``--out``, default the run directory): ``evaluation.md`` (a
 Markdown table of mean ± std and standard error of the return and of the
@@ -139,9 +150,11 @@ def compare(policy: list[dict], baseline: list[dict]) -> dict:
 
 
 def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
-                   seed: int) -> str:
+                   seed: int, labels: dict | None = None) -> str:
     """The comparison as Markdown: one row per policy, one column per
-    quantity (mean ± std, standard error in brackets)."""
+    quantity (mean ± std, standard error in brackets); ``labels`` maps a
+    policy name to the text of its rows (default: the name)."""
+    labels = labels or {}
     keys = list(next(iter(summaries.values())))
     lines = [f"## Evaluation on `{env_id}`", "",
              f"{episodes} episodes per policy, episode k seeded {seed} + k; mean ± std "
@@ -151,13 +164,13 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
     for name, summary in summaries.items():
         cells = [f"{summary[k]['mean']:.4g} ± {summary[k]['std']:.3g} [{summary[k]['sem']:.2g}]"
                  for k in keys]
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        lines.append(f"| {labels.get(name, name)} | " + " | ".join(cells) + " |")
     if comparisons:
         lines += ["", "Return of the policy minus the baseline's, paired by seed "
                   "(mean [standard error of the difference]):", "",
                   "| baseline | difference | beaten by > 2 standard errors |", "|---|---|---|"]
         for name, c in comparisons.items():
-            lines.append(f"| {name} | {c['diff']:.4g} [{c['sem']:.2g}] | "
+            lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
                          f"{'yes' if c['beats'] else 'no'} |")
     return "\n".join(lines) + "\n"
 
@@ -205,7 +218,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--baseline", help="evaluate this baseline alone (with --env)")
     p.add_argument("--env", help="environment id for --baseline")
     p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
-                   help="gymnasium.make arguments for --baseline (VALUE is YAML)")
+                   help="gymnasium.make arguments (VALUE is YAML); with RUN_DIR set over the "
+                        "run's env_kwargs")
+    p.add_argument("--constant", type=Path, default=None, metavar="FILE.json",
+                   help="results of python -m agents.constant: the baseline 'constant' plays "
+                        "their best action (default: search here); implies 'constant'")
     p.add_argument("--out", type=Path, default=None,
                    help="output directory (default: the run directory, or "
                         "runs/agents/baseline_<env-name>_<name>)")
@@ -213,11 +230,65 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _disjoint_seed(first: int, count: int, avoid_first: int, avoid_count: int) -> int:
+    """``first``, or the seed right after the avoided range when the
+    episodes ``first … first + count − 1`` would overlap it."""
+    if first < avoid_first + avoid_count and avoid_first < first + count:
+        return avoid_first + avoid_count
+    return first
+
+
+def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, env_id: str,
+                    env_kwargs: dict) -> tuple[list[float], dict]:
+    """The action of the baseline ``constant`` and where it comes from:
+    the best result of ``--constant FILE.json``, or of a search run now
+    with the defaults of :func:`agents.constant.search_constant_actions`
+    on seeds apart from the evaluation episodes."""
+    from .constant import (GRID, SEARCH_SEED, SEEDS, best_action, format_action, load_results,
+                           search_constant_actions)
+
+    evaluated = (args.seed, args.episodes)
+    if args.constant is not None:
+        try:
+            report = load_results(args.constant)
+            action = best_action(report)
+        except (OSError, ValueError, KeyError, TypeError) as err:
+            parser.error(f"--constant {args.constant}: {err}")
+        if report.get("env") != env_id:
+            parser.error(f"--constant {args.constant} holds a search on {report.get('env')}, "
+                         f"not on {env_id}")
+        if (report.get("env_kwargs") or {}) != env_kwargs:
+            print(f"warning: --constant {args.constant} was searched with env_kwargs "
+                  f"{report.get('env_kwargs')}, the evaluation uses {env_kwargs}",
+                  file=sys.stderr)
+        seeds = report["results"][0].get("seeds") or []
+        if seeds and _disjoint_seed(min(seeds), len(seeds), *evaluated) != min(seeds):
+            print(f"warning: --constant {args.constant} was searched on seeds {min(seeds)}…"
+                  f"{max(seeds)}, which overlap the evaluation episodes", file=sys.stderr)
+        source = dict(file=str(args.constant), grid=report.get("grid"), seeds=seeds)
+    else:
+        seed = _disjoint_seed(SEARCH_SEED, SEEDS, *evaluated)
+        print(f"searching for the best constant action on {env_id} (grid of {GRID} points "
+              f"per action dimension, {SEEDS} episodes each seeded {seed} + k) ...",
+              flush=True)
+        results = search_constant_actions(env_id, env_kwargs=env_kwargs, grid=GRID,
+                                          seeds=SEEDS, seed=seed,
+                                          progress=not args.no_progress)
+        action = best_action(results)
+        source = dict(search=True, grid=GRID, seeds=results[0]["seeds"],
+                      mean=results[0]["mean"], sem=results[0]["sem"])
+        print(f"best constant action {format_action(action)}: mean return "
+              f"{results[0]['mean']:.4g} [{results[0]['sem']:.2g}]", flush=True)
+    return action, source
+
+
 def main(argv: list[str] | None = None) -> dict:
     """Command-line entry point; returns the summaries per policy."""
     from iceenvs import ENV_IDS
 
     from .baselines import BASELINES, make_baseline
+    from .constant import ConstantPolicy, format_action
+    from .envs import make_checked_env, parse_key_values
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -226,23 +297,22 @@ def main(argv: list[str] | None = None) -> dict:
     names = [n.strip() for n in args.baselines.split(",") if n.strip()]
     if args.baseline is not None:
         names = [args.baseline]
+    elif args.constant is not None and "constant" not in names:
+        names.append("constant")
     unknown = [n for n in names if n not in BASELINES]
     if unknown:
         parser.error(f"unknown baselines {unknown}; valid baselines: {', '.join(BASELINES)}")
+    if args.constant is not None and "constant" not in names:
+        parser.error(f"--constant is for the baseline 'constant', not {args.baseline!r}")
 
     policies = {}
+    trained = None
     if args.baseline is not None:
         if args.run_dir is not None:
             parser.error("give either RUN_DIR or --baseline, not both")
         if args.env not in ENV_IDS:
             parser.error(f"--baseline needs --env, one of: {', '.join(ENV_IDS)}")
-        env_id = args.env
-        env_kwargs = {}
-        for item in args.env_kwargs:
-            key, sep, text = item.partition("=")
-            if not sep:
-                parser.error(f"--env-kwargs entries are key=value, got {item!r}")
-            env_kwargs[key] = yaml.safe_load(text)
+        env_id, base_kwargs = args.env, {}
         out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{args.baseline}"
     else:
         if args.run_dir is None:
@@ -250,18 +320,37 @@ def main(argv: list[str] | None = None) -> dict:
         if not (args.run_dir / "model.zip").exists():
             parser.error(f"{args.run_dir} holds no model.zip")
         trained = TrainedPolicy(args.run_dir)
-        env_id, env_kwargs = trained.env_id, trained.env_kwargs
+        env_id, base_kwargs = trained.env_id, trained.env_kwargs
         policies[f"{trained.args['algo']} policy"] = trained
         out = args.out or args.run_dir
-
-    import gymnasium as gym
-
-    import iceenvs  # noqa: F401
-
-    env = gym.make(env_id, **env_kwargs)
     try:
+        env_kwargs = parse_key_values(args.env_kwargs, into=base_kwargs)
+        env = make_checked_env(env_id, env_kwargs, seed=args.seed)
+    except ValueError as err:
+        parser.error(str(err))
+
+    try:
+        if trained is not None:
+            for kind in ("observation_space", "action_space"):
+                run_shape = getattr(trained.model, kind).shape
+                if getattr(env, kind).shape != run_shape:
+                    parser.error(f"with env_kwargs {env_kwargs} the {kind.replace('_', ' ')} "
+                                 f"has shape {getattr(env, kind).shape}, the run's policy "
+                                 f"needs {run_shape}")
+        labels = {}
+        constant = None
+        if "constant" in names:
+            action, source = constant_action(parser, args, env_id, env_kwargs)
+            constant = dict(action=action, **source)
         for name in names:
-            policies[name] = make_baseline(name, env, seed=args.seed)
+            if name == "constant":
+                try:
+                    policies[name] = ConstantPolicy(env, args.seed, action=constant["action"])
+                except ValueError as err:
+                    parser.error(f"--constant {args.constant}: {err}")
+                labels[name] = f"constant {format_action(policies[name].action)}"
+            else:
+                policies[name] = make_baseline(name, env, seed=args.seed)
         results = evaluate(env, policies, episodes=args.episodes, seed=args.seed,
                            progress=not args.no_progress)
     finally:
@@ -271,12 +360,12 @@ def main(argv: list[str] | None = None) -> dict:
     if args.baseline is None:
         first = next(iter(results))
         comparisons = {n: compare(results[first], results[n]) for n in names}
-    table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed)
+    table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels)
     print(table)
     out.mkdir(parents=True, exist_ok=True)
     (out / "evaluation.md").write_text(table)
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
-                  summaries=summaries, comparisons=comparisons,
+                  constant=constant, summaries=summaries, comparisons=comparisons,
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
                                             terminated=e["terminated"], final=e["final"])
                                        for e in eps] for n, eps in results.items()})

@@ -2,13 +2,24 @@
 
     python -m agents.train --env iceenvs/Convergence-v0 --algo ppo [--timesteps N]
         [--seed S] [--n-envs K] [--out DIR] [--force] [--eval-freq F]
-        [--eval-episodes E] [--hyperparams key=value ...]
+        [--eval-episodes E] [--hyperparams key=value ...] [--env-kwargs key=value ...]
 
-``main`` runs named steps: parse and check the arguments → prepare the run
-directory → read the hyperparameters (``agents/hyperparams/<algo>.yaml``,
-the env's entry over ``default``, then ``--hyperparams`` overrides) → save
-the configuration → make the environments → make the model → make the
-callbacks → learn → save the model and the normalisation statistics.
+``main`` runs named steps: parse and check the arguments → read the
+hyperparameters (``agents/hyperparams/<algo>.yaml``, the env's entry over
+``default``, then ``--hyperparams`` overrides, then ``--env-kwargs`` over
+``env_kwargs``) → refuse an existing non-empty run directory without
+``--force`` → check the environment arguments on one environment in
+this process (``gymnasium.make`` and one ``reset``; a bad keyword exits
+with status 2 and the environment's message, before anything is written)
+→ prepare the run directory → save the configuration → make the
+environments → make the model → make the callbacks → learn → save the
+model and the normalisation statistics.
+
+A start that fails before learning begins (making the environments, the
+model or the callbacks) leaves no half-written run directory: a directory
+this call created is removed, and in a directory that existed before
+(``--force``) the artefacts this call wrote are removed; the error is
+raised again.
 
 The run directory (default ``runs/agents/<env-name>_<algo>_<seed>``)
 holds ``model.zip``, ``vecnormalize.pkl`` (when the observations or
@@ -32,7 +43,7 @@ from pathlib import Path
 import yaml
 
 __all__ = ["ALGOS", "HYPERPARAMS_DIR", "SPECIAL_KEYS", "build_parser", "main",
-           "read_hyperparams", "valid_keys", "default_run_dir"]
+           "read_hyperparams", "valid_keys", "default_run_dir", "RUN_FILES"]
 
 #: algorithm names of the command line → stable-baselines3 class names
 ALGOS = {"ppo": "PPO", "sac": "SAC"}
@@ -98,7 +109,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="checkpoint every this many steps, all envs together (0: never)")
     p.add_argument("--hyperparams", nargs="+", default=[], metavar="KEY=VALUE",
                    help="override hyperparameters; VALUE is YAML, KEY may be dotted "
-                        "(env_kwargs.episode_steps=50)")
+                        "(env_kwargs.n_floes=50)")
+    p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
+                   help="gymnasium.make arguments of the environment, set over the YAML's "
+                        "env_kwargs and --hyperparams env_kwargs (VALUE is YAML, e.g. "
+                        "n_floes=40); checked on one environment before the run starts")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p
@@ -121,42 +136,9 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
     return args
 
 
-# -- step 2: the run directory -------------------------------------------------------------
-def prepare_run_dir(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Path:
-    """Create the run directory; an existing non-empty one is refused
-    unless ``--force``, which removes the artefacts of the previous run."""
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        parser.error(f"--out {out} exists and is not a directory")
-    if out.is_dir() and any(out.iterdir()):
-        if not args.force:
-            parser.error(f"run directory {out} exists and is not empty; pass --force to "
-                         f"overwrite it or choose another --out")
-        for name in RUN_FILES:
-            path = out / name
-            if path.is_dir():
-                shutil.rmtree(path)
-            elif path.exists():
-                path.unlink()
-    out.mkdir(parents=True, exist_ok=True)
-    return out
-
-
-# -- step 3: hyperparameters -------------------------------------------------------------
-def _set_dotted(hp: dict, key: str, value) -> None:
-    head, _, rest = key.partition(".")
-    if not rest:
-        hp[head] = value
-        return
-    sub = hp.get(head)
-    if not isinstance(sub, dict):
-        sub = {}
-    hp[head] = sub
-    _set_dotted(sub, rest, value)
-
-
+# -- step 2: hyperparameters and environment arguments ----------------------------------------
 def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | None = None,
-                     n_envs: int | None = None) -> dict:
+                     n_envs: int | None = None, env_kwargs=()) -> dict:
     """The resolved hyperparameters of a run.
 
     Parameters
@@ -171,6 +153,9 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
         entry of a mapping such as ``env_kwargs``).
     timesteps, n_envs : int, optional
         Override ``n_timesteps`` and ``n_envs``.
+    env_kwargs : iterable of str
+        ``key=value`` strings (``--env-kwargs``) set over ``env_kwargs``
+        after ``overrides`` (:func:`agents.envs.parse_key_values`).
 
     Returns
     -------
@@ -180,17 +165,23 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     ------
     ValueError
         For a malformed override or an unknown key (the message lists the
-        valid ones).
+        valid ones). The environment arguments are not checked here
+        (:func:`agents.envs.check_env_kwargs` does).
     """
+    from .envs import parse_key_values
+
     with open(HYPERPARAMS_DIR / f"{algo}.yaml") as fh:
         table = yaml.safe_load(fh)
     hp = copy.deepcopy(table.get("default", {}))
     hp.update(copy.deepcopy(table.get(env_id, {})))
-    for item in overrides:
-        key, sep, text = item.partition("=")
-        if not sep or not key:
-            raise ValueError(f"--hyperparams entries are key=value, got {item!r}")
-        _set_dotted(hp, key.strip(), yaml.safe_load(text))
+    hp = parse_key_values(overrides, into=hp, option="--hyperparams")
+    if hp.get("env_kwargs") is not None and not isinstance(hp["env_kwargs"], dict):
+        raise ValueError(f"hyperparameter env_kwargs must be a mapping, got "
+                         f"{hp['env_kwargs']!r}")
+    env_kwargs = list(env_kwargs)
+    if env_kwargs:
+        hp["env_kwargs"] = parse_key_values(env_kwargs, into=hp.get("env_kwargs") or {},
+                                            option="--env-kwargs")
     if timesteps is not None:
         hp["n_timesteps"] = int(timesteps)
     if n_envs is not None:
@@ -253,6 +244,76 @@ def normalize_kwargs(hp: dict) -> dict | None:
     return kw
 
 
+# -- step 3: the run directory -------------------------------------------------------------
+def _first_missing(path: Path) -> Path | None:
+    """The outermost directory of ``path`` (itself included) that does not
+    exist yet, i.e. the one that creating ``path`` would create; ``None``
+    when ``path`` exists."""
+    missing = None
+    for candidate in (path, *path.parents):
+        if candidate.exists():
+            break
+        missing = candidate
+    return missing
+
+
+def _remove_run_files(run_dir: Path) -> None:
+    for name in RUN_FILES:
+        path = run_dir / name
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        elif path.exists() or path.is_symlink():
+            path.unlink()
+
+
+def discard_run_dir(run_dir: Path, created: Path | None) -> None:
+    """Undo :func:`prepare_run_dir` and what followed after a failed start.
+
+    ``created`` is the outermost directory the preparation created
+    (:func:`_first_missing` before it): the run directory is removed
+    entirely and so are the created parents it leaves empty. When the run
+    directory existed before (``created`` is ``None``), only the
+    artefacts of :data:`RUN_FILES` are removed; other files stay."""
+    run_dir = Path(run_dir)
+    if created is None:
+        if run_dir.is_dir():
+            _remove_run_files(run_dir)
+        return
+    shutil.rmtree(run_dir, ignore_errors=True)
+    parent = run_dir.parent
+    created = Path(created)
+    while parent == created or created in parent.parents:
+        try:
+            parent.rmdir()          # only when empty
+        except OSError:
+            break
+        if parent == created:
+            break
+        parent = parent.parent
+
+
+def check_run_dir(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse (exit status 2) an ``--out`` that is a file, or an existing
+    non-empty directory without ``--force``; touches nothing."""
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        parser.error(f"--out {out} exists and is not a directory")
+    if out.is_dir() and any(out.iterdir()) and not args.force:
+        parser.error(f"run directory {out} exists and is not empty; pass --force to "
+                     f"overwrite it or choose another --out")
+
+
+def prepare_run_dir(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Path:
+    """Create the run directory; an existing non-empty one is refused
+    unless ``--force``, which removes the artefacts of the previous run."""
+    check_run_dir(parser, args)
+    out = Path(args.out)
+    if out.is_dir() and any(out.iterdir()):
+        _remove_run_files(out)
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
 # -- step 4: configuration ---------------------------------------------------------------
 def save_config(run_dir: Path, args: argparse.Namespace, hp: dict, argv: list[str]) -> None:
     """Write ``hyperparams.yaml``, ``args.yaml`` and ``command.txt``."""
@@ -277,8 +338,13 @@ def make_envs(args: argparse.Namespace, hp: dict):
                        env_kwargs=hp["env_kwargs"], normalize=norm)
     eval_env = None
     if args.eval_freq > 0:
-        eval_env = make_vec_env(args.env, n_envs=1, seed=args.seed + EVAL_SEED_OFFSET,
-                                env_kwargs=hp["env_kwargs"], normalize=norm, training=False)
+        try:
+            eval_env = make_vec_env(args.env, n_envs=1, seed=args.seed + EVAL_SEED_OFFSET,
+                                    env_kwargs=hp["env_kwargs"], normalize=norm,
+                                    training=False)
+        except BaseException:
+            env.close()
+            raise
     return env, eval_env
 
 
@@ -341,32 +407,51 @@ def save(model, env, run_dir: Path) -> None:
         env.save(str(run_dir / "vecnormalize.pkl"))
 
 
+def _close(*things) -> None:
+    for thing in things:
+        if thing is not None:
+            thing.close()
+
+
 def main(argv: list[str] | None = None) -> Path:
     """Command-line entry point; returns the run directory."""
+    from .envs import check_env_kwargs
+
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     args = parse_args(parser, argv)
     try:
         hp = read_hyperparams(args.algo, args.env, args.hyperparams, timesteps=args.timesteps,
-                              n_envs=args.n_envs)
+                              n_envs=args.n_envs, env_kwargs=args.env_kwargs)
     except ValueError as err:
         parser.error(str(err))
-    run_dir = prepare_run_dir(parser, args)
-    save_config(run_dir, args, hp, argv)
-
-    import torch
-
-    torch.set_num_threads(1)
-    env, eval_env = make_envs(args, hp)
+    check_run_dir(parser, args)
     try:
+        check_env_kwargs(args.env, hp["env_kwargs"], seed=args.seed)
+    except ValueError as err:
+        parser.error(str(err))
+    created = _first_missing(Path(args.out))
+    run_dir = prepare_run_dir(parser, args)
+
+    env = eval_env = model = None
+    try:
+        save_config(run_dir, args, hp, argv)
+
+        import torch
+
+        torch.set_num_threads(1)
+        env, eval_env = make_envs(args, hp)
         model = make_model(args, hp, env, run_dir)
         callbacks = make_callbacks(args, hp, eval_env, run_dir)
+    except BaseException:
+        _close(env, eval_env, model.logger if model is not None else None)
+        discard_run_dir(run_dir, created)
+        raise
+    try:
         learn(model, hp, callbacks)
         save(model, env, run_dir)
     finally:
-        env.close()
-        if eval_env is not None:
-            eval_env.close()
+        _close(env, eval_env)
     print(f"saved {run_dir / 'model.zip'}")
     return run_dir
 
