@@ -1,60 +1,170 @@
-"""Environment steps per second: ``python -m iceenvs.bench``; the effect of
-the reduced-stiffness option: ``python -m iceenvs.bench --stiffness``.
+"""Sustained environment steps per second: ``python -m iceenvs.bench``; the
+effect of the reduced-stiffness option: ``python -m iceenvs.bench --stiffness``.
 
-Every registered environment in its default configuration, on one core
-(Numba limited to one thread), random actions from a seeded action space,
-after a warm-up episode start and 5 steps that compile everything. Each
-figure is the best of three segments of ``--steps`` steps; an episode end
-inside a segment resets the env (the reset is timed too, as in training).
+Every registered environment (or those of ``--ids``) in its default
+configuration, each in a fresh process with Numba limited to one thread,
+random actions from a seeded action space. After a warm-up (an episode start
+and 5 steps, which compile or load the kernels, then ``--warmup`` seconds of
+untimed steps), ``--runs`` consecutive runs of at least ``--seconds`` wall
+seconds each are timed; an episode that ends (terminated or truncated) is
+reset inside the run and the reset is timed too, as in training. The table
+gives the mean steps/s over the runs, their range and standard deviation,
+the resets and the physics errors (steps with ``info["error"]``); the same
+figures, the command, the machine and the date go to ``--json``
+(default ``docs/benchmarks/environments.json``).
+
+    python -m iceenvs.bench [--ids WindDrift-v0 ...] [--seconds 20] [--runs 3]
+                            [--warmup 2] [--json PATH]
+    python -m iceenvs.bench --stiffness
 """
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
+import math
 import os
 import platform
+import shlex
+import statistics
 import subprocess
 import sys
 import time
+from pathlib import Path
 
-REPEATS = 3
+DEFAULT_JSON = Path("docs/benchmarks/environments.json")
+WARMUP_STEPS = 5
+TARGETS = {"ThicknessDistribution-v0": 5000, "FloeClustering-v0": 200}
 
 
-def _time_env(env_id: str, steps: int, seed: int = 0) -> dict:
+def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0,
+                warmup: float = 2.0) -> dict:
+    """Sustained steps/s of ``env_id`` in this process: ``runs`` consecutive
+    timed runs of at least ``seconds`` each, after the warm-up, with resets
+    at episode ends."""
     import gymnasium as gym
-    import numpy as np
 
     import iceenvs  # noqa: F401
 
     env = gym.make(env_id)
     env.action_space.seed(seed)
     env.reset(seed=seed)
-    for _ in range(5):
-        env.step(env.action_space.sample())
-    best = 0.0
-    errors = 0
-    for r in range(REPEATS):
-        env.reset(seed=seed + r + 1)
+    for _ in range(WARMUP_STEPS):
+        _, _, term, trunc, _ = env.step(env.action_space.sample())
+        if term or trunc:
+            env.reset()
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < warmup:
+        _, _, term, trunc, _ = env.step(env.action_space.sample())
+        if term or trunc:
+            env.reset()
+    env.reset(seed=seed + 1)
+    rates, steps, walls, resets, errors = [], [], [], 0, 0
+    for _ in range(runs):
+        n = 0
         t0 = time.perf_counter()
-        for _ in range(steps):
+        while True:
             _, _, term, trunc, info = env.step(env.action_space.sample())
-            errors += "error" in info
+            n += 1
+            errors += bool(info.get("error"))
             if term or trunc:
                 env.reset()
-        best = max(best, steps / (time.perf_counter() - t0))
+                resets += 1
+            wall = time.perf_counter() - t0
+            if wall >= seconds:
+                break
+        rates.append(n / wall)
+        steps.append(n)
+        walls.append(wall)
     spec = env.unwrapped
+    interval = getattr(spec, "control_interval", getattr(spec, "days_per_step", math.nan))
+    unit = "days" if hasattr(spec, "days_per_step") and not hasattr(spec, "control_interval") \
+        else "s"
     env.close()
-    return dict(id=env_id, rate=best, errors=errors,
-                interval=float(getattr(spec, "control_interval", getattr(spec, "days_per_step",
-                                                                          np.nan))))
+    return dict(id=env_id, rates=rates, mean=statistics.fmean(rates), min=min(rates),
+                max=max(rates), std=statistics.stdev(rates) if len(rates) > 1 else 0.0,
+                steps=steps, seconds=walls, resets=resets, errors=errors,
+                interval=float(interval), unit=unit)
 
 
-def _child(env_id: str, steps: int) -> dict:
+def _child(env_id: str, seconds: float, runs: int, seed: int, warmup: float) -> dict:
+    """:func:`measure_env` in a fresh process limited to one Numba thread."""
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     out = subprocess.run([sys.executable, "-m", "iceenvs.bench", "--child", env_id,
-                          "--steps", str(steps)], capture_output=True, text=True, env=env,
-                         check=True)
+                          "--seconds", repr(seconds), "--runs", str(runs), "--seed", str(seed),
+                          "--warmup", repr(warmup)],
+                         capture_output=True, text=True, env=env)
+    if out.returncode != 0:
+        tail = (out.stderr.strip().splitlines() or ["(no output)"])[-1]
+        return dict(id=env_id, failed=f"exit {out.returncode}: {tail}")
     return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def cpu_model() -> str | None:
+    """The CPU model from /proc/cpuinfo (Linux), else what platform knows."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() in ("model name", "Hardware", "cpu model") and value.strip():
+                    return value.strip()
+    except OSError:
+        pass
+    return platform.processor() or None
+
+
+def machine_info() -> dict:
+    import numba
+
+    return dict(platform=platform.platform(), machine=platform.machine(), cpu=cpu_model(),
+                logical_cpus=os.cpu_count(), python=platform.python_version(),
+                numba=numba.__version__, numba_threads=1)
+
+
+def header(result: dict) -> str:
+    """The title and column heads of the Markdown table."""
+    st, m = result["settings"], result["machine"]
+    return "\n".join([
+        f"Sustained environment steps per second, one core (Numba: 1 thread), {st['runs']} runs "
+        f"of ≥ {st['seconds']:g} s each after a warm-up; {m['cpu'] or m['machine']}, "
+        f"numba {m['numba']}, {result['date'][:10]}", "",
+        "| id | steps/s (mean) | min–max | std | target | model time per step | resets | "
+        "physics errors |",
+        "|---|---|---|---|---|---|---|---|"])
+
+
+def format_row(r: dict) -> str:
+    """One environment's row of the Markdown table."""
+    name = r["id"].split("/")[-1]
+    if "failed" in r:
+        return f"| `{r['id']}` | failed: {r['failed']} | | | | | | |"
+    return (f"| `{r['id']}` | {r['mean']:.0f} | {r['min']:.0f}–{r['max']:.0f} | {r['std']:.0f} | "
+            f"≥ {TARGETS.get(name, 50)} | {r['interval']:g} {r['unit']} | {r['resets']} | "
+            f"{r['errors']} |")
+
+
+def format_table(result: dict) -> str:
+    """The Markdown table of a :func:`run_benchmark` result."""
+    return "\n".join([header(result), *map(format_row, result["environments"])])
+
+
+def run_benchmark(ids, seconds: float = 20.0, runs: int = 3, seed: int = 0, warmup: float = 2.0,
+                  command: str | None = None, on_start=None, on_row=None) -> dict:
+    """Measure every id in its own process. ``on_start(result)`` is called
+    before the first measurement, ``on_row(row)`` after each."""
+    result = dict(command=command, machine=machine_info(),
+                  date=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                  settings=dict(seconds=seconds, runs=runs, seed=seed, warmup=warmup,
+                                warmup_steps=WARMUP_STEPS, threads=1),
+                  environments=[])
+    if on_start is not None:
+        on_start(result)
+    for env_id in ids:
+        row = _child(env_id, seconds, runs, seed, warmup)
+        result["environments"].append(row)
+        if on_row is not None:
+            on_row(row)
+    return result
 
 
 def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) -> list[dict]:
@@ -92,18 +202,38 @@ def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) ->
     return rows
 
 
-TARGETS = {"ThicknessDistribution-v0": 5000, "FloeClustering-v0": 200}
+def _resolve_ids(ids, known) -> list[str]:
+    out = []
+    for i in ids:
+        full = i if "/" in i else f"iceenvs/{i}"
+        if full not in known:
+            raise SystemExit(f"unknown environment {i!r}; known: {', '.join(known)}")
+        out.append(full)
+    return out
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> int:
     from iceenvs import ENV_IDS
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=100, help="steps per timed segment")
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = argparse.ArgumentParser(prog="python -m iceenvs.bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--ids", nargs="+", metavar="ID",
+                        help="environments to time, e.g. WindDrift-v0 (default: all)")
+    parser.add_argument("--seconds", type=float, default=20.0,
+                        help="minimum wall seconds of each timed run (default 20)")
+    parser.add_argument("--runs", type=int, default=3, help="timed runs per environment (default 3)")
+    parser.add_argument("--warmup", type=float, default=2.0,
+                        help="untimed seconds of steps after the compiling steps (default 2)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the episodes and actions")
+    parser.add_argument("--json", type=Path, default=DEFAULT_JSON,
+                        help=f"where to write the results (default {DEFAULT_JSON})")
     parser.add_argument("--stiffness", action="store_true",
                         help="compare stiffness_scale = 1, 0.1, 0.01 instead")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.seconds <= 0 or args.runs < 1 or args.warmup < 0:
+        parser.error("--seconds must be positive, --runs at least 1, --warmup not negative")
     if args.stiffness:
         print("| id | stiffness_scale | Δt [s] | steps/s | A | u_x [m/s] | Z_c | f_nr | "
               "p [N/m] | F_c,1/F_tot |")
@@ -113,24 +243,20 @@ def main(argv=None) -> None:
                   f"{r['concentration']:.3f} | {r['u_x']:.3f} | {r['z_c']:.2f} | "
                   f"{r['f_nr']:.2f} | {r['pressure']:.3g} | {r['largest_cluster']:.2f} |",
                   flush=True)
-        return
+        return 0
     if args.child:
-        print(json.dumps(_time_env(args.child, args.steps)))
-        return
-    import numba
-
-    print(f"Environment steps per second, one core, {platform.machine()}, "
-          f"numba {numba.__version__}\n")
-    print("| id | steps/s | target | model time per step | physics errors |")
-    print("|---|---|---|---|---|")
-    for env_id in ENV_IDS:
-        name = env_id.split("/")[1]
-        steps = args.steps * (20 if name.startswith("Thickness") else 1)
-        r = _child(env_id, steps)
-        unit = "days" if name.startswith("Thickness") else "s"
-        print(f"| `{env_id}` | {r['rate']:.0f} | ≥ {TARGETS.get(name, 50)} | "
-              f"{r['interval']:g} {unit} | {r['errors']} |", flush=True)
-
+        print(json.dumps(measure_env(args.child, args.seconds, args.runs, args.seed,
+                                     args.warmup)))
+        return 0
+    ids = _resolve_ids(args.ids, ENV_IDS) if args.ids else list(ENV_IDS)
+    command = shlex.join(["python", "-m", "iceenvs.bench", *argv])
+    result = run_benchmark(ids, args.seconds, args.runs, args.seed, args.warmup, command,
+                           on_start=lambda r: print(header(r), flush=True),
+                           on_row=lambda row: print(format_row(row), flush=True))
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps(result, indent=2, ensure_ascii=False) + "\n")
+    print(f"\nresults: {args.json}")
+    return 1 if any("failed" in r for r in result["environments"]) else 0
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
