@@ -19,6 +19,10 @@ MAX_EPISODE_STEPS = 200
 _EXTRA = (
     Feature("heading_cos", "cos of the target heading", "-", "none", -1.0, 1.0),
     Feature("heading_sin", "sin of the target heading", "-", "none", -1.0, 1.0),
+    Feature("u_heading", "mean ice velocity along the target heading", "m/s", "/ 1 m/s",
+            -5.0, 5.0),
+    Feature("u_across", "mean ice velocity across the heading (positive to its left)", "m/s",
+            "/ 1 m/s", -5.0, 5.0),
 )
 
 _TASK = (
@@ -68,8 +72,9 @@ class WindDriftEnv(HertzEnv):
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 2} entries: the common floe
-    features, the target heading and the last action (with `horizon=N`,
-    `time_left` before the action):
+    features, the target heading, the ice velocity in the frame of the
+    heading (so that progress is one entry, not a product of two) and the
+    last action (with `horizon=N`, `time_left` before the action):
 
 {feature_table(FLOE_FEATURES + _EXTRA)}
     | {len(FLOE_FEATURES) + len(_EXTRA)}, {len(FLOE_FEATURES) + len(_EXTRA) + 1} | `action` | the last action | - | none | [-1, 1] |
@@ -152,6 +157,7 @@ class WindDriftEnv(HertzEnv):
         now["heading_cos"] = math.cos(h)
         now["heading_sin"] = math.sin(h)
         now["u_heading"] = now["u_x"] * now["heading_cos"] + now["u_y"] * now["heading_sin"]
+        now["u_across"] = now["u_y"] * now["heading_cos"] - now["u_x"] * now["heading_sin"]
         return now
 
     def _frame_text(self):

@@ -8,8 +8,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import iceenvs
-from iceenvs import ENV_IDS
+from iceenvs import ENV_IDS, convergence, floe_clustering, marginal_ice_zone
 from iceenvs.base import REWARD_RANGE
 
 WIND = "iceenvs/WindDrift-v0"
@@ -65,8 +64,8 @@ def test_convergence_top_target_reached_from_lowest_start_without_breaking():
     breaks (the run asserts no termination). Pushing on at full rate
     breaks it soon after (near A = 0.857 for this seed): the top targets
     need a policy that stops in time."""
-    lo, hi = iceenvs.convergence._TASK[3].default
-    top = iceenvs.convergence._TASK[1].default[1]
+    lo, hi = convergence._TASK[3].default
+    top = convergence._TASK[1].default[1]
     steps = gym.spec(CONVERGENCE).max_episode_steps
     a = _run(CONVERGENCE, [1.0], steps, "concentration", concentration=lo, target=top,
              until=lambda value: value >= top)
@@ -74,7 +73,7 @@ def test_convergence_top_target_reached_from_lowest_start_without_breaking():
     assert a.max() >= top, a[-5:]
     assert len(a) - 1 < steps
     # the furthest target below: the lowest, from the highest start, by divergence
-    bottom = iceenvs.convergence._TASK[1].default[0]
+    bottom = convergence._TASK[1].default[0]
     a = _run(CONVERGENCE, [-1.0], steps, "concentration", concentration=hi, target=bottom,
              until=lambda value: value <= bottom)
     assert a.min() <= bottom
@@ -93,14 +92,14 @@ def test_wind_drift_moves_the_ice_along_any_heading():
 
 
 def test_marginal_ice_zone_top_target_speed_reached_with_full_wind():
-    top = iceenvs.marginal_ice_zone._TASK[1].default[1]
+    top = marginal_ice_zone._TASK[1].default[1]
     steps = gym.spec(MIZ).max_episode_steps
     u = _run(MIZ, [1.0, 0.0], steps, "u_x", seed=1)
     assert u.max() >= top, u[-10:]
 
 
 def test_floe_clustering_target_range_covered_under_steady_wind():
-    lo, hi = iceenvs.floe_clustering._TASK[1].default
+    lo, hi = floe_clustering._TASK[1].default
     steps = gym.spec(CLUSTERING).max_episode_steps
     f = _run(CLUSTERING, [1.0, 0.0], steps, "largest_cluster", seed=1)
     assert f[0] < lo, "the start must lie below the whole target range"
