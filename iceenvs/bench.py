@@ -11,7 +11,8 @@ reset inside the run and the reset is timed too, as in training. The table
 gives the mean steps/s over the runs, their range and standard deviation,
 the resets and the physics errors (steps with ``info["error"]``); the same
 figures, the command, the machine and the date go to ``--json``
-(default ``docs/benchmarks/environments.json``).
+(default ``docs/benchmarks/environments.json``) and the table beside it
+(``environments.md``), which the documentation includes.
 
     python -m iceenvs.bench [--ids WindDrift-v0 ...] [--seconds 20] [--runs 3]
                             [--warmup 2] [--json PATH]
@@ -255,7 +256,9 @@ def main(argv=None) -> int:
                            on_row=lambda row: print(format_row(row), flush=True))
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(result, indent=2, ensure_ascii=False) + "\n")
-    print(f"\nresults: {args.json}")
+    markdown = args.json.with_suffix(".md")
+    markdown.write_text(f"`{command}`\n\n" + format_table(result) + "\n")
+    print(f"\nresults: {args.json}, table: {markdown}")
     return 1 if any("failed" in r for r in result["environments"]) else 0
 
 if __name__ == "__main__":

@@ -27,6 +27,9 @@ def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
     assert row["min"] <= row["mean"] <= row["max"] and row["std"] >= 0.0
     assert row["resets"] >= 0 and row["errors"] == 0
     assert row["unit"] == "days" and row["interval"] > 0
+    table = path.with_suffix(".md").read_text()
+    assert table.startswith("`python -m iceenvs.bench --ids ThicknessDistribution-v0")
+    assert f"| `iceenvs/ThicknessDistribution-v0` | {row['mean']:.0f} |" in table
     out = capsys.readouterr().out
     assert "| id | steps/s (mean) | min–max | std |" in out
     assert f"| `iceenvs/ThicknessDistribution-v0` | {row['mean']:.0f} |" in out
