@@ -60,11 +60,13 @@ def plot_learning_curve(run_dir: str | Path, path: str | Path | None = None) -> 
     evaluation = run_dir / "evaluation.json"
     if evaluation.is_file():
         summaries = json.loads(evaluation.read_text())["summaries"]
-        styles = iter([":", "--", "-."] * 3)
+        styles = iter([(":", "0.3"), ("--", "0.3"), ("-.", "0.3"), (":", "C3"), ("--", "C2"),
+                       ("-.", "C4")])
         for name, summary in summaries.items():
             if name.endswith("policy"):
                 continue
-            ax.axhline(summary["return"]["mean"], color="0.3", lw=1, ls=next(styles),
+            ls, colour = next(styles, ("-", "0.5"))
+            ax.axhline(summary["return"]["mean"], color=colour, lw=1, ls=ls,
                        label=f"{name} (mean of the evaluation)")
     ax.set_xlabel("environment steps")
     ax.set_ylabel("episode return")

@@ -24,8 +24,9 @@ from the evaluation episodes. Its row in the table names the action.
 Output (in ``--out``, default the run directory): ``evaluation.md`` (a
 Markdown table of mean ± std and standard error of the return and of the
 final physics metrics, printed as well), ``evaluation.json`` (every
-episode's return and final metrics) and ``evaluation.png`` (reward and the
-task's main physics metric against step, per policy). The policy beats a
+episode's return, final metrics, and rewards and main physics metric per
+step) and ``evaluation.png`` (reward and the task's main physics metric
+against step, per policy). The policy beats a
 baseline when the mean of the paired differences of return exceeds two
 standard errors of that mean.
 """
@@ -120,6 +121,12 @@ def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = 
                 results[name].append(run_episode(env, policy, seed + k, main_metric))
                 bar.update()
     return results
+
+
+def _rounded(values, digits: int = 6) -> list:
+    """Floats to ``digits`` significant digits (the per-step series of the
+    JSON report)."""
+    return [float(f"{v:.{digits}g}") for v in values]
 
 
 def _stats(values) -> dict:
@@ -366,11 +373,14 @@ def main(argv: list[str] | None = None) -> dict:
     (out / "evaluation.md").write_text(table)
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
+                  main_metric=MAIN_METRIC.get(env_name(env_id)),
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
-                                            terminated=e["terminated"], final=e["final"])
+                                            terminated=e["terminated"], final=e["final"],
+                                            rewards=_rounded(e["rewards"]),
+                                            trace=_rounded(e["trace"]))
                                        for e in eps] for n, eps in results.items()})
     with open(out / "evaluation.json", "w") as fh:
-        json.dump(report, fh, indent=2)
+        json.dump(report, fh)
     plot_trajectories(env_id, results, out / "evaluation.png")
     return summaries
 
