@@ -179,7 +179,8 @@ def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) ->
     import iceenvs  # noqa: F401
 
     cases = [("iceenvs/WindDrift-v0", np.array([0.5, 0.0]), {}),
-             ("iceenvs/Convergence-v0", np.array([1.0]), {"concentration": 0.8})]
+             ("iceenvs/Convergence-v0", np.array([1.0]), {"concentration": 0.8,
+                                                          "max_rate": 1.0})]
     keys = ("concentration", "u_x", "z_c", "f_nr", "pressure", "largest_cluster")
     rows = []
     for env_id, action, options in cases:

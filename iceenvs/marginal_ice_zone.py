@@ -108,7 +108,7 @@ class MarginalIceZoneEnv(HertzEnv):
     `n_floes=200`, `preset=HERMAN2013`, `control_interval=5.0` [s],
     `reward_fn`, `reward_params` (`edge_stress_max`, `speed_scale`,
     `stress_weight`), `stiffness_scale`, `cluster_gap`, `horizon=None`,
-    `colour_scale=0.5` [m/s], `render_mode`, and the task parameters.
+    `colour_scale=0.2` [m/s], `render_mode`, and the task parameters.
 
     ## Version History
     * v0: a target transport speed drawn per episode, rewards in [0, 1],
@@ -124,9 +124,9 @@ class MarginalIceZoneEnv(HertzEnv):
     reward_fn = staticmethod(marginal_ice_zone_reward)
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
-                 **kwargs):
+                 colour_scale: float = 0.2, **kwargs):
         super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,
-                         **kwargs)
+                         colour_scale=colour_scale, **kwargs)
 
     def default_reward_params(self) -> dict:
         return dict(edge_stress_max=500.0, speed_scale=0.05, stress_weight=1.0)
