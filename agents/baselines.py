@@ -243,30 +243,36 @@ class ConvergenceController(_FloeController):
 
 
 class MarginalIceZoneController(_FloeController):
-    """Integral control of the wind speed towards the target transport,
-    with the wind turned away from the fast ice as the edge stress rises.
+    """Feed-forward and integral control of the wind speed towards the
+    target transport, with the wind turned away from the fast ice as the
+    edge stress rises.
 
-    The transport grows with the wind speed, so the speed command
-    (action[0]) is integrated from the observed transport error: each
-    step it changes by ``gain`` × (u* − u_x) / 0.05 m/s, within [−1, 1]
-    (starting from −1, no wind). With Coriolis the drift turns to the right
-    of the wind, i.e. towards the fast-ice edge for wind along +x; the wind
-    is therefore turned left (away from the edge) by a base angle of
-    0.1 π (18°), plus up to a further 0.2 π in proportion to the log edge
-    stress between a quarter of the task's ``edge_stress_max`` and
-    ``edge_stress_max``, so that the ice is not pressed onto the edge.
+    The transport grows with the wind speed: 20 m/s of wind along the edge
+    gives about 0.1 m/s. The speed command (action[0]) therefore starts at
+    the wind that would give the target on that estimate, −1 + 2 u* /
+    0.1 m/s, and is then integrated from the observed transport error:
+    each step it changes by ``gain`` × (u* − u_x) / 0.05 m/s, within
+    [−1, 1]. With Coriolis the drift turns to the right of the wind,
+    i.e. towards the fast-ice edge for wind along +x; as the edge stress
+    rises from a quarter of the task's ``edge_stress_max`` to
+    ``edge_stress_max`` (in log stress) the wind is turned left, away from
+    the edge, by up to ``extra`` × π (36°), so that the ice is not pressed
+    onto the edge.
     """
 
-    base = 0.1
+    base = 0.0
     extra = 0.2
-    gain = 0.1
-    _speed = -1.0      # the current speed command
+    gain = 0.4
+    _speed = None      # the current speed command (None: not yet set this episode)
 
     def reset(self, seed=None):
-        self._speed = -1.0
+        self._speed = None
 
     def act(self, obs):
-        error = (self._get(obs, "target_speed") - self._get(obs, "u_x")) / 0.05
+        target = self._get(obs, "target_speed")
+        if self._speed is None:
+            self._speed = float(np.clip(-1.0 + 2.0 * target / 0.1, -1.0, 1.0))
+        error = (target - self._get(obs, "u_x")) / 0.05
         self._speed = float(np.clip(self._speed + self.gain * error, -1.0, 1.0))
         s = self._get(obs, "edge_stress")
         s_max = log_stress(self.reward_params["edge_stress_max"])
