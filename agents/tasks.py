@@ -1,0 +1,152 @@
+"""Does each task need a policy? ``python -m agents.tasks``.
+
+For every environment (or those of ``--ids``) in its default
+configuration: the best constant action of a grid search
+(:func:`agents.constant.search_constant_actions`: ``--grid`` points per
+action dimension, ``--seeds`` episodes each, seeded away from the
+evaluation episodes), then the random, zero-action, best-constant and
+hand-written policies on the same ``--episodes`` seeded episodes
+(episode k seeded ``--seed`` + k), and the paired difference of the
+hand-written controller's return over the best constant action's. A task
+needs a policy when a controller that reacts to the observation beats
+every constant action by more than two standard errors.
+
+Output in ``--out`` (default ``docs/agents/tasks``): ``tasks.md`` (the
+table, with command, machine and date), ``tasks.json`` (every number)
+and ``constant_<env>.json`` per environment (the whole search; reused
+with ``--reuse`` so that a table can be remade without searching again).
+
+    python -m agents.tasks [--ids Convergence-v0 ...] [--episodes 20] [--grid 9]
+        [--seeds 5] [--processes 2] [--out DIR] [--reuse]
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import platform
+import shlex
+import sys
+import time
+from pathlib import Path
+
+__all__ = ["analyse", "task_table", "main"]
+
+EVAL_SEED = 10_000
+DEFAULT_OUT = Path("docs/agents/tasks")
+
+
+def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int,
+            out: Path, reuse: bool = False, progress: bool = True) -> dict:
+    """The constant-action search and the baselines of one environment;
+    returns a dict of the numbers (see :func:`task_table`)."""
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+
+    from .baselines import ConstantPolicy, make_baseline
+    from .constant import load_results, search_constant_actions
+    from .evaluate import compare, evaluate, summarise
+    from .metrics import env_name
+
+    path = out / f"constant_{env_name(env_id)}.json"
+    t0 = time.perf_counter()
+    if reuse and path.exists():
+        results = load_results(path)["results"]
+    else:
+        results = search_constant_actions(env_id, grid=grid, seeds=seeds,
+                                          processes=processes, progress=progress)
+        with open(path, "w") as fh:
+            json.dump(dict(env=env_id, env_kwargs={}, grid=grid, seeds=seeds,
+                           n_actions=len(results), results=results), fh, indent=1)
+    t_search = time.perf_counter() - t0
+    env = gym.make(env_id)
+    try:
+        policies = {name: make_baseline(name, env, EVAL_SEED)
+                    for name in ("random", "zero", "heuristic")}
+        policies["constant"] = ConstantPolicy(env, EVAL_SEED, action=results[0]["action"])
+        runs = evaluate(env, policies, episodes=episodes, seed=EVAL_SEED, progress=progress)
+    finally:
+        env.close()
+    summaries = {name: summarise(eps)["return"] for name, eps in runs.items()}
+    return dict(id=env_id, best_action=list(results[0]["action"]),
+                search_mean=results[0]["mean"], n_actions=len(results),
+                returns=summaries,
+                heuristic_minus_constant=compare(runs["heuristic"], runs["constant"]),
+                steps=int(sum(e["length"] for e in runs["constant"]) / episodes),
+                seconds=time.perf_counter() - t0, search_seconds=t_search)
+
+
+def task_table(rows: list[dict]) -> str:
+    """Markdown: one row per environment."""
+    from .constant import format_action
+
+    lines = ["| id | steps | best constant action (of) | constant | zero | random | "
+             "controller | controller − constant [SE] | needs a policy |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ret = r["returns"]
+        c = r["heuristic_minus_constant"]
+
+        def cell(name):
+            return f"{ret[name]['mean']:.1f} ± {ret[name]['std']:.1f}"
+
+        lines.append(f"| `{r['id']}` | {r['steps']} | {format_action(r['best_action'])} "
+                     f"({r['n_actions']}) | {cell('constant')} | {cell('zero')} | "
+                     f"{cell('random')} | {cell('heuristic')} | {c['diff']:+.1f} "
+                     f"[{c['sem']:.2g}] | {'yes' if c['beats'] else 'not shown'} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> list[dict]:
+    from iceenvs import ENV_IDS
+
+    p = argparse.ArgumentParser(prog="python -m agents.tasks",
+                                description=__doc__.splitlines()[0])
+    names = [e.split("/")[1] for e in ENV_IDS]
+    p.add_argument("--ids", nargs="+", choices=names, default=names, metavar="NAME",
+                   help="environments (default all): " + ", ".join(names))
+    p.add_argument("--episodes", type=int, default=20, help="evaluation episodes (default 20)")
+    p.add_argument("--grid", type=int, default=9, help="constant actions per dimension (9)")
+    p.add_argument("--seeds", type=int, default=5, help="search episodes per action (5)")
+    p.add_argument("--processes", type=int, default=2, help="search processes (2)")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output ({DEFAULT_OUT})")
+    p.add_argument("--reuse", action="store_true",
+                   help="reuse the constant-action searches found in --out")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    raw = sys.argv[1:] if argv is None else argv
+    args = p.parse_args(raw)
+    for name in ("episodes", "seeds", "processes"):
+        if getattr(args, name) < 1:
+            p.error(f"--{name} must be >= 1")
+    if args.grid < 2:
+        p.error("--grid must be >= 2")
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name in args.ids:
+        print(f"{name}: searching {args.grid} points per action dimension, then "
+              f"{args.episodes} episodes per policy ...", flush=True)
+        rows.append(analyse(f"iceenvs/{name}", episodes=args.episodes, grid=args.grid,
+                            seeds=args.seeds, processes=args.processes, out=args.out,
+                            reuse=args.reuse, progress=not args.no_progress))
+        print(task_table(rows[-1:]), flush=True)
+    import numba
+
+    command = shlex.join(["python", "-m", "agents.tasks", *raw])
+    machine = f"{platform.machine()}, {platform.system()}, numba {numba.__version__}"
+    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
+    text = (f"Returns over {args.episodes} episodes (episode k seeded {EVAL_SEED} + k; mean ± "
+            f"std), default configuration of each environment. The best constant action is "
+            f"the best of a grid of {args.grid} points per action dimension, {args.seeds} "
+            f"episodes each (seeds 20000 + k). \"Controller\" is the hand-written controller "
+            f"of `agents.baselines`; its difference from the best constant action is paired "
+            f"by seed.\n\n`{command}` ({machine}, {date})\n\n" + task_table(rows))
+    (args.out / "tasks.md").write_text(text)
+    with open(args.out / "tasks.json", "w") as fh:
+        json.dump(dict(command=command, machine=machine, date=date, rows=rows), fh, indent=1)
+    print(f"wrote {args.out / 'tasks.md'}")
+    return rows
+
+
+if __name__ == "__main__":
+    main()
