@@ -18,6 +18,7 @@ with ``--reuse`` so that a table can be remade without searching again).
 
     python -m agents.tasks [--ids Convergence-v0 ...] [--episodes 20] [--grid 9]
         [--seeds 5] [--processes 2] [--out DIR] [--reuse]
+    python -m agents.tasks --render [--out DIR]     # tasks.md again from tasks.json
 """
 from __future__ import annotations
 
@@ -73,7 +74,7 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
                 search_mean=results[0]["mean"], n_actions=len(results),
                 returns=summaries,
                 heuristic_minus_constant=compare(runs["heuristic"], runs["constant"]),
-                steps=int(sum(e["length"] for e in runs["constant"]) / episodes),
+                steps=int(gym.spec(env_id).max_episode_steps),
                 seconds=time.perf_counter() - t0, search_seconds=t_search)
 
 
@@ -81,7 +82,7 @@ def task_table(rows: list[dict]) -> str:
     """Markdown: one row per environment."""
     from .constant import format_action
 
-    lines = ["| id | steps | best constant action (of) | constant | zero | random | "
+    lines = ["| id | steps per episode | best constant action (of) | constant | zero | random | "
              "controller | controller − constant [SE] | needs a policy |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -96,6 +97,17 @@ def task_table(rows: list[dict]) -> str:
                      f"{cell('random')} | {cell('heuristic')} | {c['diff']:+.1f} "
                      f"[{c['sem']:.2g}] | {'yes' if c['beats'] else 'not shown'} |")
     return "\n".join(lines) + "\n"
+
+
+def _document(saved: dict) -> str:
+    """tasks.md: what was run, then the table."""
+    return (f"Returns over {saved['episodes']} episodes (episode k seeded {EVAL_SEED} + k; mean "
+            f"± std), default configuration of each environment. The best constant action is "
+            f"the best of a grid of {saved['grid']} points per action dimension, "
+            f"{saved['seeds']} episodes each (seeds 20000 + k). \"Controller\" is the "
+            f"hand-written controller of `agents.baselines`; its difference from the best "
+            f"constant action is paired by seed.\n\n`{saved['command']}` ({saved['machine']}, "
+            f"{saved['date']})\n\n" + task_table(saved["rows"]))
 
 
 def main(argv: list[str] | None = None) -> list[dict]:
@@ -114,8 +126,15 @@ def main(argv: list[str] | None = None) -> list[dict]:
     p.add_argument("--reuse", action="store_true",
                    help="reuse the constant-action searches found in --out")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    p.add_argument("--render", action="store_true",
+                   help="only write tasks.md again from the tasks.json in --out")
     raw = sys.argv[1:] if argv is None else argv
     args = p.parse_args(raw)
+    if args.render:
+        saved = json.loads((args.out / "tasks.json").read_text())
+        (args.out / "tasks.md").write_text(_document(saved))
+        print(f"wrote {args.out / 'tasks.md'}")
+        return saved["rows"]
     for name in ("episodes", "seeds", "processes"):
         if getattr(args, name) < 1:
             p.error(f"--{name} must be >= 1")
@@ -132,18 +151,13 @@ def main(argv: list[str] | None = None) -> list[dict]:
         print(task_table(rows[-1:]), flush=True)
     import numba
 
-    command = shlex.join(["python", "-m", "agents.tasks", *raw])
-    machine = f"{platform.machine()}, {platform.system()}, numba {numba.__version__}"
-    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
-    text = (f"Returns over {args.episodes} episodes (episode k seeded {EVAL_SEED} + k; mean ± "
-            f"std), default configuration of each environment. The best constant action is "
-            f"the best of a grid of {args.grid} points per action dimension, {args.seeds} "
-            f"episodes each (seeds 20000 + k). \"Controller\" is the hand-written controller "
-            f"of `agents.baselines`; its difference from the best constant action is paired "
-            f"by seed.\n\n`{command}` ({machine}, {date})\n\n" + task_table(rows))
-    (args.out / "tasks.md").write_text(text)
+    saved = dict(command=shlex.join(["python", "-m", "agents.tasks", *raw]),
+                 machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
+                 date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d"),
+                 episodes=args.episodes, grid=args.grid, seeds=args.seeds, rows=rows)
+    (args.out / "tasks.md").write_text(_document(saved))
     with open(args.out / "tasks.json", "w") as fh:
-        json.dump(dict(command=command, machine=machine, date=date, rows=rows), fh, indent=1)
+        json.dump(saved, fh, indent=1)
     print(f"wrote {args.out / 'tasks.md'}")
     return rows
 

@@ -24,6 +24,9 @@ def test_table_json_and_search_are_written(tmp_path):
     table = (tmp_path / "tasks.md").read_text()
     assert "`python -m agents.tasks --ids ThicknessDistribution-v0" in table
     assert "| `iceenvs/ThicknessDistribution-v0` | 360 |" in table
+    (tmp_path / "tasks.md").unlink()
+    assert tasks.main(["--render", "--out", str(tmp_path)])[0]["id"] == row["id"]
+    assert (tmp_path / "tasks.md").read_text() == table
     saved = json.loads((tmp_path / "tasks.json").read_text())
     assert saved["rows"][0]["best_action"] == row["best_action"]
     assert (tmp_path / "constant_ThicknessDistribution-v0.json").is_file()
