@@ -124,8 +124,11 @@ def interval(low=None, high=None, *, low_open: bool = False,
 
 
 def task_table(params) -> str:
-    """Markdown table of task parameters (for the docstrings)."""
-    lines = ["| name | default | meaning |", "|---|---|---|"]
+    """The "Task parameters" section of an environment's docstring: how to
+    set them, then their Markdown table."""
+    lines = ["Keywords of `gymnasium.make` (kept for every episode) and entries of",
+             "    `reset(options=...)` (this episode only):", "",
+             "| name | default | meaning |", "|---|---|---|"]
     for p in params:
         default = "None" if p.default is None else (
             f"({p.default[0]:g}, {p.default[1]:g})" if isinstance(p.default, tuple)

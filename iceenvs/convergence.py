@@ -91,10 +91,7 @@ class ConvergenceEnv(HertzEnv):
     (seeded), at rest.
 
     ## Task parameters
-    Keywords of `gymnasium.make` (kept for every episode) and entries of
-    `reset(options=...)` (this episode only):
-
-{task_table(_TASK)}
+    {task_table(_TASK)}
 
     ## Episode End
     Terminated when the pressure passes `failure_pressure` or the physics

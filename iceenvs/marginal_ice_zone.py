@@ -95,10 +95,7 @@ class MarginalIceZoneEnv(HertzEnv):
     bottom are frozen. All at rest, no wind.
 
     ## Task parameters
-    Keywords of `gymnasium.make` (kept for every episode) and entries of
-    `reset(options=...)` (this episode only):
-
-{task_table(_TASK)}
+    {task_table(_TASK)}
 
     ## Episode End
     Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS} steps of

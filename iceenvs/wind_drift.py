@@ -97,10 +97,7 @@ class WindDriftEnv(HertzEnv):
     [−π, π) unless `heading` is given.
 
     ## Task parameters
-    Keywords of `gymnasium.make` (kept for every episode) and entries of
-    `reset(options=...)` (this episode only):
-
-{task_table(_TASK)}
+    {task_table(_TASK)}
 
     ## Episode End
     Truncated after `max_episode_steps` (registered: {MAX_EPISODE_STEPS}
