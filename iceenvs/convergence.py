@@ -162,5 +162,6 @@ class ConvergenceEnv(HertzEnv):
 
     def _frame_text(self):
         p = self._prev["pressure"]
+        pressure = f"{p:.3g}" if abs(p) >= 1e-3 else "0"      # no "-0" for a slack pack
         return super()._frame_text() + [f"target A* = {self.episode['target']:.3f}",
-                                        f"p = {p:.3g} N/m"]
+                                        f"p = {pressure} N/m"]
