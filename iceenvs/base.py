@@ -7,8 +7,9 @@ observables of :mod:`iceenvs.observations` and scores them with a reward
 function of :mod:`iceenvs.rewards`. Subclasses say only what differs:
 
 * ``task_parameters`` — the task's :class:`TaskParameter` table;
-* ``_draw_episode(task, rng)`` — the episode's task values (targets and
-  start states drawn from their ranges);
+* ``drawn`` — the task parameters drawn per episode from their
+  ``<name>_range`` when left at ``None`` (or ``_draw_episode`` for another
+  draw);
 * ``_make_sim(rng)`` — a new engine for an episode;
 * ``_apply_action(action)`` — the (clipped) action into forcing;
 * ``_measure()`` — the raw physical observables (dict of SI values);
@@ -161,6 +162,8 @@ class ControlEnv(gym.Env):
     task_parameters: tuple[TaskParameter, ...] = ()
     #: episode task values passed to the reward function with ``reward_params``
     reward_task_keys: tuple[str, ...] = ()
+    #: task parameters drawn uniformly from their ``<name>_range``, in this order
+    drawn: tuple[str, ...] = ()
     _renderer = None
     horizon = None
 
@@ -194,6 +197,20 @@ class ControlEnv(gym.Env):
                              f"{sorted(params)}")
         return {name: params[name].check(name, value) for name, value in values.items()}
 
+    def _init_reward_params(self, defaults: dict, reward_params: dict | None,
+                            custom: bool) -> None:
+        """``self.reward_params``: the task's ``defaults`` updated by
+        ``reward_params``; names the task does not have are refused unless
+        the reward function is a ``custom`` one."""
+        if reward_params is not None and not isinstance(reward_params, dict):
+            raise TypeError(f"reward_params must be a dict, got {type(reward_params).__name__}")
+        unknown = set(reward_params or ()) - set(defaults)
+        if unknown and not custom:
+            raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
+                             f"{sorted(defaults)} (task parameters such as a target are "
+                             f"arguments of their own)")
+        self.reward_params = {**defaults, **(reward_params or {})}
+
     def _init_task(self, given: dict) -> None:
         """Keep the task parameters given to the constructor (``TypeError``
         for a name that is neither an argument nor a task parameter)."""
@@ -220,7 +237,14 @@ class ControlEnv(gym.Env):
         return self._draw_episode(task, self.np_random)
 
     def _draw_episode(self, task: dict, rng: np.random.Generator) -> dict:
-        """Replace the ``None`` entries of ``task`` by values drawn with ``rng``."""
+        """Replace the ``None`` entries of ``task`` by values drawn with ``rng``:
+        each name of ``drawn`` uniformly from its ``<name>_range``. Every one
+        is drawn, given or not and in a fixed order, so that a seed gives
+        the same episode whichever of them is given."""
+        for name in self.drawn:
+            value = float(rng.uniform(*task[f"{name}_range"]))
+            if task[name] is None:
+                task[name] = value
         return task
 
     # -- hooks ------------------------------------------------------------------------------
@@ -389,15 +413,8 @@ class FloeEnv(ControlEnv):
             self.reward_fn = reward_fn
         else:
             self.reward_fn = type(self).reward_fn
-        self.reward_params = self.default_reward_params()
-        if reward_params is not None and not isinstance(reward_params, dict):
-            raise TypeError(f"reward_params must be a dict, got {type(reward_params).__name__}")
-        unknown = set(reward_params or ()) - set(self.reward_params)
-        if unknown and reward_fn is None:
-            raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
-                             f"{sorted(self.reward_params)} (task parameters such as a target "
-                             f"are arguments of their own)")
-        self.reward_params.update(reward_params or {})
+        self._init_reward_params(self.default_reward_params(), reward_params,
+                                 custom=reward_fn is not None)
 
         self.features = FLOE_FEATURES + self.extra_features
         if self.horizon is not None:

@@ -117,6 +117,7 @@ class ConvergenceEnv(HertzEnv):
     extra_features = _EXTRA
     task_parameters = _TASK
     reward_task_keys = ("target",)
+    drawn = ("concentration", "target")
     reward_fn = staticmethod(convergence_reward)
     impact_speed = 0.5
 
@@ -127,17 +128,6 @@ class ConvergenceEnv(HertzEnv):
 
     def default_reward_params(self) -> dict:
         return dict(pressure_max=1e4, concentration_scale=0.1, pressure_weight=1.0)
-
-    def _draw_episode(self, task, rng):
-        # drawn in a fixed order, so that a seed gives the same episode
-        # whichever of the two is given
-        start = float(rng.uniform(*task["concentration_range"]))
-        target = float(rng.uniform(*task["target_range"]))
-        if task["concentration"] is None:
-            task["concentration"] = start
-        if task["target"] is None:
-            task["target"] = target
-        return task
 
     def _make_sim(self, rng):
         p = self.preset

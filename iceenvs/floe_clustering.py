@@ -107,6 +107,7 @@ class FloeClusteringEnv(FloeEnv):
     extra_features = _EXTRA
     task_parameters = _TASK
     reward_task_keys = ("target",)
+    drawn = ("target",)
     reward_fn = staticmethod(floe_clustering_reward)
 
     def __init__(self, n_floes: int = 300, preset=HERMAN2011, control_interval: float = 5.0,
@@ -118,12 +119,6 @@ class FloeClusteringEnv(FloeEnv):
 
     def default_reward_params(self) -> dict:
         return dict(fraction_scale=0.25)
-
-    def _draw_episode(self, task, rng):
-        target = float(rng.uniform(*task["target_range"]))
-        if task["target"] is None:
-            task["target"] = target
-        return task
 
     def _make_sim(self, rng):
         from physics import HardDiskSimulation

@@ -118,6 +118,7 @@ class MarginalIceZoneEnv(HertzEnv):
     extra_features = _EXTRA
     task_parameters = _TASK
     reward_task_keys = ("target_speed",)
+    drawn = ("target_speed",)
     reward_fn = staticmethod(marginal_ice_zone_reward)
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
@@ -127,12 +128,6 @@ class MarginalIceZoneEnv(HertzEnv):
 
     def default_reward_params(self) -> dict:
         return dict(edge_stress_max=500.0, speed_scale=0.05, stress_weight=1.0)
-
-    def _draw_episode(self, task, rng):
-        target = float(rng.uniform(*task["target_speed_range"]))
-        if task["target_speed"] is None:
-            task["target_speed"] = target
-        return task
 
     def _make_sim(self, rng):
         p = self.preset

@@ -101,4 +101,4 @@ def thickness_distribution_reward(prev, action, now, *, target, h,
     """1 − W1(g, g*) / ``distance_scale`` [m], clipped to [0, 1]: the
     thickness distribution ``now["g"]`` kept close to ``target`` on the
     class thicknesses ``h``."""
-    return min(1.0, max(0.0, 1.0 - wasserstein1(now["g"], target, h) / distance_scale))
+    return closeness(wasserstein1(now["g"], target, h), 0.0, distance_scale)

@@ -12,7 +12,7 @@ from physics.itd_figures import KERNELS, R0, RAFT_FACTOR
 from physics.params import check_range
 
 from .base import ControlEnv, TaskParameter
-from .rewards import thickness_distribution_reward, wasserstein1
+from .rewards import closeness, thickness_distribution_reward, wasserstein1
 
 __all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
            "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
@@ -253,14 +253,8 @@ class ThicknessDistributionEnv(ControlEnv):
             raise ValueError(f"bad kernel or kernel_params: {err}") from None
         self.reward_fn = reward_fn if reward_fn is not None else type(self).reward_fn
         self._default_reward = reward_fn is None
-        self.reward_params = {"distance_scale": 1.0}
-        if reward_params is not None and not isinstance(reward_params, dict):
-            raise TypeError(f"reward_params must be a dict, got {type(reward_params).__name__}")
-        unknown = set(reward_params or ()) - set(self.reward_params)
-        if unknown and reward_fn is None:
-            raise ValueError(f"unknown reward parameters {sorted(unknown)}; this task has "
-                             f"{sorted(self.reward_params)}")
-        self.reward_params.update(reward_params or {})
+        self._init_reward_params({"distance_scale": 1.0}, reward_params,
+                                 custom=reward_fn is not None)
         if self._default_reward:
             check_range("distance_scale", self.reward_params["distance_scale"], 0.0, None,
                         low_open=True)
@@ -273,7 +267,6 @@ class ThicknessDistributionEnv(ControlEnv):
             [[0.0], COARSE_WIDTH * (np.arange(N_COARSE) + 0.5)])      # class centres [m]
         self._default_target = default_target(h)
         self._default_target.setflags(write=False)
-        self._target = self._default_target
         self._init_task(task)
 
         n_obs = N_COARSE + 6
@@ -296,8 +289,11 @@ class ThicknessDistributionEnv(ControlEnv):
     # -- helpers ----------------------------------------------------------------------
     @property
     def target(self) -> np.ndarray:
-        """The target distribution on the fine classes (open water first)."""
-        return self._target
+        """The target distribution on the fine classes (open water first): the
+        episode's, or before the first episode the one it will have by
+        default."""
+        target = self.episode["target"]
+        return self._default_target if target is None else target
 
     @property
     def h(self) -> np.ndarray:
@@ -323,7 +319,7 @@ class ThicknessDistributionEnv(ControlEnv):
         return {"g": g.copy(), "h": self._h, "open_water": float(g[0]),
                 "mean_thickness": float(np.dot(g, self._h)), "day": float(m.time),
                 "kernel_scale": float(m.kernel_scale), "rafting_factor": float(m.rafting_factor),
-                "w1": wasserstein1(g, self._target, self._h)}
+                "w1": wasserstein1(g, self.target, self._h)}
 
     def _vector(self, now: dict) -> np.ndarray:
         v = self._vec
@@ -340,7 +336,7 @@ class ThicknessDistributionEnv(ControlEnv):
         physics = dict(now)
         physics["g"] = now["g"].copy()
         physics["h"] = now["h"].copy()
-        return {"physics": physics, "target": self._target.copy(), "steps": self._steps}
+        return {"physics": physics, "target": self.target.copy(), "steps": self._steps}
 
     # -- task --------------------------------------------------------------------------
     def _check_episode_task(self, task: dict) -> None:
@@ -361,13 +357,12 @@ class ThicknessDistributionEnv(ControlEnv):
         return task
 
     def _reward_kwargs(self) -> dict:
-        return {**self.reward_params, "target": self._target, "h": self._h}
+        return {**self.reward_params, "target": self.target, "h": self._h}
 
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
         self.episode = self._episode_task(options)
-        self._target = self.episode["target"]
         self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh,
                                     g0=self.episode["g0"])
         return self._begin_episode()
@@ -380,7 +375,7 @@ class ThicknessDistributionEnv(ControlEnv):
 
     def _reward(self, action: np.ndarray, now: dict) -> float:
         if self._default_reward:           # thickness_distribution_reward, W1 already computed
-            return min(1.0, max(0.0, 1.0 - now["w1"] / self.reward_params["distance_scale"]))
+            return closeness(now["w1"], 0.0, self.reward_params["distance_scale"])
         return super()._reward(action, now)
 
     # -- rendering --------------------------------------------------------------------
@@ -388,4 +383,4 @@ class ThicknessDistributionEnv(ControlEnv):
         from .rendering import draw_itd
 
         return draw_itd(self._h_coarse, self.coarse(self.model.g),
-                        target=self.coarse(self._target), day=self.model.time)
+                        target=self.coarse(self.target), day=self.model.time)
