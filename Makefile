@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml Makefile
 	$(PY) -m pip install --quiet --upgrade pip setuptools wheel
 	$(PY) -m pip install --quiet "$(TORCH_PIN)"
 	$(PY) -m pip install --quiet -e ".[all]"
-	$(PY) -m physics.warmup || echo "warm-up incomplete: the remaining kernels compile on first use"
+	$(PY) -m iceenvs.warmup || echo "warm-up incomplete: the remaining kernels compile on first use"
 	touch $(STAMP)
 
 demo: setup

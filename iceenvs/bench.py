@@ -47,18 +47,15 @@ def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0
 
     import iceenvs  # noqa: F401
 
+    from .warmup import random_steps
+
     env = gym.make(env_id)
     env.action_space.seed(seed)
     env.reset(seed=seed)
-    for _ in range(WARMUP_STEPS):
-        _, _, term, trunc, _ = env.step(env.action_space.sample())
-        if term or trunc:
-            env.reset()
+    random_steps(env, WARMUP_STEPS)
     t0 = time.perf_counter()
     while time.perf_counter() - t0 < warmup:
-        _, _, term, trunc, _ = env.step(env.action_space.sample())
-        if term or trunc:
-            env.reset()
+        random_steps(env, 1)
     env.reset(seed=seed + 1)
     rates, steps, walls, resets, errors = [], [], [], 0, 0
     for _ in range(runs):

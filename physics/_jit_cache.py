@@ -24,7 +24,7 @@ The first time a process compiles a kernel (an empty or outdated cache), one
 line goes to stderr saying that the kernels are being compiled, since that
 takes a minute or two with nothing else printed; kernels loaded from the
 cache print nothing. Set the environment variable ``SEAICE_QUIET=1`` to
-silence it. ``python -m physics.warmup`` compiles everything in advance.
+silence it. ``python -m iceenvs.warmup`` compiles everything in advance.
 
 This module must be imported before any module that compiles kernels.
 """

@@ -132,23 +132,3 @@ def test_first_compilation_prints_one_line_and_a_warm_cache_none(tmp_path):
     assert lines[0] == compile_notice(next(p for p in target.iterdir() if p.is_dir()))
     assert _run_small_kernels(tmp_path) == ""                    # loaded from the cache
     assert _run_small_kernels(tmp_path / "quiet", SEAICE_QUIET="1") == ""
-
-
-def test_warmup_reports_a_failing_item_and_runs_the_others(monkeypatch, capsys):
-    from physics import warmup
-
-    ran = []
-
-    def broken():
-        raise TypeError("unknown argument n_floes")
-
-    monkeypatch.setattr(warmup, "items", lambda steps: [
-        ("first", lambda: ran.append("first")), ("broken", broken),
-        ("last", lambda: ran.append("last") or " (note)")])
-    monkeypatch.setenv("SEAICE_QUIET", "1")
-    assert warmup.main([]) == 1
-    assert ran == ["first", "last"]
-    out, err = capsys.readouterr()
-    assert "[1/3] first:" in out and "[3/3] last:" in out and "(note)" in out
-    assert "[2/3] broken: FAILED: TypeError: unknown argument n_floes" in err
-    assert "1 failed)" in out

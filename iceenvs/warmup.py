@@ -1,4 +1,4 @@
-"""Compile the kernels in advance: ``python -m physics.warmup``.
+"""Compile the kernels in advance: ``python -m iceenvs.warmup``.
 
 Numba compiles the kernels on their first use and keeps them in an on-disk
 cache (see :mod:`physics._jit_cache`); the first run of an environment or
@@ -10,10 +10,11 @@ later runs load everything from the cache. It prints one line per item and
 the total time; an item that fails is reported and the others still run
 (the exit status is then 1).
 
-    python -m physics.warmup [--steps 5] [--quiet] [--traceback]
+    python -m iceenvs.warmup [--steps 5] [--quiet] [--traceback]
 
-(``iceenvs`` and ``gymnasium`` are imported here only, never by the
-``physics`` package itself.)
+It lives beside the environments, not in ``physics``: the physics package
+never imports gymnasium, and every top-level ``physics`` module enters the
+hash that names the kernel cache.
 """
 from __future__ import annotations
 
@@ -43,7 +44,7 @@ class _CompileCounter:
     def __init__(self):
         from numba.core import event
 
-        from . import _jit_cache
+        from physics import _jit_cache
 
         self.count = 0
         depth = [0]
@@ -65,6 +66,15 @@ class _CompileCounter:
         self._event.unregister("numba:compile", self._listener)
 
 
+def random_steps(env, steps: int) -> None:
+    """``steps`` actions sampled from ``env``'s action space, resetting
+    whenever an episode ends (the environment has been reset before)."""
+    for _ in range(steps):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+
+
 def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
     """Make ``env_id`` small, reset it and take ``steps`` random actions
     (resetting when an episode ends). Falls back to the default constructor
@@ -82,10 +92,7 @@ def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
     try:
         env.action_space.seed(seed)
         env.reset(seed=seed)
-        for _ in range(steps):
-            _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-            if terminated or truncated:
-                env.reset()
+        random_steps(env, steps)
     finally:
         env.close()
     return note
@@ -94,7 +101,7 @@ def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
 def warm_demo() -> str:
     """``python -m physics.demo`` on 300 floes for 2 model seconds, its
     output discarded (the kernels are the same as for the full demo)."""
-    from . import demo
+    from physics import demo
 
     with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
         try:
@@ -107,7 +114,7 @@ def warm_demo() -> str:
 def warm_parallel(steps: int = 5) -> str:
     """A few steps of a small Hertz run with ``parallel=True`` (the kernels
     that the engine picks for large fields when Numba has several threads)."""
-    from . import HERMAN2013, Forcing, HertzSimulation, make_floe_field
+    from physics import HERMAN2013, Forcing, HertzSimulation, make_floe_field
 
     field, box = make_floe_field(300, concentration=0.7, alpha=HERMAN2013.fsd_exponent,
                                  mean_diameter=HERMAN2013.mean_diameter, seed=1,
@@ -119,31 +126,18 @@ def warm_parallel(steps: int = 5) -> str:
     return ""
 
 
-def _env_ids() -> tuple[str, ...]:
-    import iceenvs
-
-    return iceenvs.ENV_IDS
-
-
 def items(steps: int = 5) -> list[tuple[str, Callable[[], str | None]]]:
     """The warm-up items, as (label, function) pairs."""
-    out = []
-    try:
-        ids = _env_ids()
-    except ImportError as exc:
-        def missing(exc=exc):
-            raise exc
-        out.append(("environments", missing))
-    else:
-        for env_id in ids:
-            out.append((env_id, lambda env_id=env_id: warm_env(env_id, steps)))
+    from . import ENV_IDS
+
+    out = [(env_id, lambda env_id=env_id: warm_env(env_id, steps)) for env_id in ENV_IDS]
     out.append(("physics.demo", warm_demo))
     out.append(("Hertz engine, parallel kernels", lambda: warm_parallel(steps)))
     return out
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m physics.warmup",
+    p = argparse.ArgumentParser(prog="python -m iceenvs.warmup",
                                 description=__doc__.splitlines()[0])
     p.add_argument("--steps", type=int, default=5, help="random steps per environment (default 5)")
     p.add_argument("--quiet", action="store_true", help="print only failures")
@@ -152,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
     # this module says what it compiles: the one-line notice is redundant
     os.environ.setdefault("SEAICE_QUIET", "1")
 
-    from . import _jit_cache
+    from physics import _jit_cache
 
     def say(text: str) -> None:
         if not args.quiet:
