@@ -48,8 +48,8 @@ class ConvergenceEnv(HertzEnv):
     (experiment 1 of the paper: pure convergence, no wind). The box area
     changes at the rate the agent sets; the floes are remapped affinely.
     Pressure grows slowly with concentration and then sharply as the ice
-    jams: 200 floes compressed at 4 per hour jam at A = 0.85–0.86 and pass
-    the failure pressure (10⁵ N/m) there. Every episode has its own start
+    jams: 200 floes compressed from 0.70 at 4 per hour pass the failure
+    pressure (10⁵ N/m) at A = 0.847–0.867 (seeds 0–3). Every episode has its own start
     concentration and target, both in the observation.
 
     ## Task analysis

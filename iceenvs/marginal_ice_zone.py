@@ -54,11 +54,14 @@ class MarginalIceZoneEnv(HertzEnv):
     transport speed along +x, given in the observation.
 
     ## Task analysis
-    * *Reachable:* targets lie in [0.02, 0.08] m/s. With no wind the ice
-      drifts at about 0.03 m/s with the ocean current of the preset; 20 m/s
-      of wind along +x gives 0.09–0.14 m/s after 500 s (seeds 1 and 2),
-      with edge-stress bursts of several kN/m as the drift turns towards the
-      edge (Coriolis turns it to the right of the wind).
+    * *Reachable:* targets lie in [0.02, 0.08] m/s. Means over the second
+      half of an episode (seeds 1 and 2): with no wind the ice drifts at
+      0.04–0.05 m/s with the ocean current of the preset, 20 m/s of wind
+      along +x gives 0.08–0.10 m/s (up to 0.14 m/s), with edge-stress bursts
+      of several kN/m as the drift turns towards the edge (Coriolis turns it
+      to the right of the wind), and 20 m/s along −x gives −0.04 to
+      −0.07 m/s. The top target is reached at full wind
+      (`tests/iceenvs/test_conventions.py`).
     * *Best constant action:* the transport depends on the wind speed, so a
       constant wind holds one speed and misses the other targets; strong
       constant wind also loads the edge. The best of a grid of constant
