@@ -1,4 +1,4 @@
-"""The Hertz–Mindlin contact law between two floes (Herman 2013; PHYSICS.md §4).
+"""The Hertz–Mindlin contact law between two floes (Herman 2013; :ref:`physics-contact`).
 
 This module holds the physics of one contact, as pointwise Numba functions,
 and the calibration of the normal damping from a target restitution. The

@@ -4,7 +4,7 @@
   (N,), radii, thicknesses, density and a frozen mask, with derived masses
   m = ρ h π r² and moments of inertia I = m r² / 2 (discs).
 * :func:`rank_order_diameters` — the "most probable rank-ordered sample" of a
-  power-law FSD (Herman 2011, appendix A; PHYSICS.md §1).
+  power-law FSD (Herman 2011, appendix A; :ref:`physics-fsd`).
 * :func:`sample_power_law_diameters` — seeded random sample of a truncated
   power law.
 * :func:`domain_size` — side of the square (or a rectangle of given aspect)
@@ -162,7 +162,7 @@ class FloeField:
 
 
 # ---------------------------------------------------------------------------
-# Floe-size distributions (PHYSICS.md §1)
+# Floe-size distributions (:ref:`physics-fsd`)
 # ---------------------------------------------------------------------------
 
 def _check_fsd(n, alpha, mean_diameter):

@@ -1,6 +1,6 @@
 """External forcing of floes: wind and water drag, Coriolis, rotational drag.
 
-Herman (2013), eqs 6–7 (PHYSICS.md §2), for a floe of radius r, thickness h
+Herman (2013), eqs 6–7 (:ref:`physics-drag`), for a floe of radius r, thickness h
 and freeboard h_f = h (ρ_w − ρ) / ρ_w:
 
     m du/dt = −m f k×u + a |u_a| u_a + b (u_w − u) + Σ_j F_ij

@@ -5,7 +5,7 @@ between events; collisions are instantaneous and inelastic (eqs 10–11,
 restitution ε, TC model against inelastic collapse); drag in Stokes form
 relaxes every floe towards its own free-drift velocity u_eq,i with time
 constant τ_i (eqs 5–8), by the linearly implicit update (eqs 13–14) at the
-fixed times k Δt_max (PHYSICS.md §3).
+fixed times k Δt_max (:ref:`physics-harddisk`).
 
 The compiled kernels (prediction, event handlers, main loop) are in
 :mod:`physics.harddisk_kernels`, the event calendar in

@@ -1,6 +1,6 @@
 """Ice thickness distribution: Smoluchowski coagulation, the generalised
 Thorndike model and pure fragmentation (Godlovitch et al., after Thorndike
-2000; PHYSICS.md section 7).
+2000; :ref:`physics-itd`).
 
 Coagulation (ridging and rafting as "stacking")
     :func:`solve_smoluchowski` integrates the discrete coagulation equation

@@ -64,7 +64,7 @@ _NONNEG = (0.0, None, False, False)
 
 @dataclass(frozen=True)
 class ContactParams:
-    """Hertz–Mindlin contact between floes (Herman 2013; PHYSICS.md §4).
+    """Hertz–Mindlin contact between floes (Herman 2013; :ref:`physics-contact`).
 
     Attributes
     ----------
@@ -162,7 +162,7 @@ class ContactParams:
 
     @property
     def damping_alpha(self) -> float:
-        """Dimensionless damping α in η = α √(m* F_n,c / δ) (PHYSICS.md §4)."""
+        """Dimensionless damping α in η = α √(m* F_n,c / δ) (:ref:`physics-contact`)."""
         from .contact import damping_alpha
 
         return damping_alpha(self.restitution, self.damping_model, self.limit_damping)

@@ -1,4 +1,4 @@
-"""Herman (2013) experiments on the Hertz engine (PHYSICS.md §4).
+"""Herman (2013) experiments on the Hertz engine (:ref:`physics-contact`).
 
 * ``herman2013-convergence`` — pure convergence without wind: p(A), Z_c(A),
   f_nr(A), the jamming concentration A_J from the pressure curve (Figs 1a,

@@ -2,7 +2,7 @@
 the Hertzian floe engine.
 
 The analytic quantities here are written out from the contact law
-(Herman 2013; PHYSICS.md section 4) rather than taken from the engine, so
+(Herman 2013; the Physics page: physics-contact) rather than taken from the engine, so
 that the tests compare the engine against the physics and not against itself.
 """
 from __future__ import annotations

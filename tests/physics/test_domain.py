@@ -1,5 +1,5 @@
 """Boxes: prescribed convergence of a deforming periodic box, frozen floes
-and rigid walls (Herman 2013 experiments 1 and 3; PHYSICS.md section 4)."""
+and rigid walls (Herman 2013 experiments 1 and 3; the Physics page: physics-contact)."""
 from __future__ import annotations
 
 import math

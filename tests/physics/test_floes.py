@@ -1,5 +1,5 @@
 """Floe-size distributions, domain size and placement (Herman 2011,
-appendix A; PHYSICS.md section 1)."""
+appendix A; the Physics page: physics-fsd)."""
 from __future__ import annotations
 
 import math

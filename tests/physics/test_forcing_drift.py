@@ -1,6 +1,6 @@
 """External forcing of a lone floe: free drift of Herman (2013) eq 6 with
 Coriolis, rotational drag of eq 7, inertial oscillations, and the drift
-speeds of Herman (2011) (PHYSICS.md section 2)."""
+speeds of Herman (2011) (the Physics page: physics-drag)."""
 from __future__ import annotations
 
 import math
@@ -123,7 +123,7 @@ def test_inertial_oscillation_without_drag():
 def test_herman2011_drift_speeds():
     """Herman (2011) Table I (f = 0, current 0.01 |u_a| along the wind):
     u_eq = u_w + (a/b) |u_a| u_a is about 0.26 m/s for large floes and about
-    0.17 m/s for a 1 m floe (PHYSICS.md section 2), to the two digits quoted."""
+    0.17 m/s for a 1 m floe (the Physics page: physics-drag), to the two digits quoted."""
     params = HERMAN2011.forcing
     forcing = Forcing(params)
     radii = np.array([0.5, 500.0])

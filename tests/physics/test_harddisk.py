@@ -176,7 +176,7 @@ def test_equilibrium_velocity_matches_eqs_6_to_8():
     np.testing.assert_allclose(u_eq, expected, rtol=1e-12)
     np.testing.assert_allclose(1.0 / forcing.time_constant(field.radii, field.thickness,
                                                             field.masses), inv_tau, rtol=1e-12)
-    assert u_eq[0] == pytest.approx(0.17, abs=0.005)       # d = 1 m (PHYSICS.md §2)
+    assert u_eq[0] == pytest.approx(0.17, abs=0.005)       # d = 1 m (the Physics page: physics-drag)
     assert u_eq[-1] == pytest.approx(0.26, abs=0.005)      # large floes
 
 

@@ -1,5 +1,5 @@
 """Conservation laws of the Hertz engine for a gas of elastic, frictionless
-floes in a periodic box (velocity-Verlet; PHYSICS.md section 4)."""
+floes in a periodic box (velocity-Verlet; the Physics page: physics-contact)."""
 from __future__ import annotations
 
 import numpy as np

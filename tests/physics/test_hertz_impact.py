@@ -1,5 +1,5 @@
 """Binary Hertz impacts against the analytic two-body solution (Herman 2013;
-PHYSICS.md section 4): peak overlap, contact time, normal restitution and
+the Physics page: physics-contact): peak overlap, contact time, normal restitution and
 Coulomb sliding in oblique impacts."""
 from __future__ import annotations
 

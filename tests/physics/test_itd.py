@@ -1,4 +1,4 @@
-"""Ice thickness distribution (physics/itd.py, PHYSICS.md section 7).
+"""Ice thickness distribution (physics/itd.py, the Physics page: physics-itd).
 
 Smoluchowski coagulation from a monodisperse start against the closed-form
 solutions for the constant, additive and multiplicative kernels (and their

@@ -1,4 +1,4 @@
-"""Contact fabric and stress (Herman 2013 eqs 10-11; PHYSICS.md section 5)
+"""Contact fabric and stress (Herman 2013 eqs 10-11; the Physics page: physics-observables)
 on lattices with known answers, their invariances, and the hard-disc
 collision virial."""
 from __future__ import annotations

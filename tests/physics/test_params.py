@@ -1,5 +1,5 @@
 """Parameter tables of the papers and the closed-form parts of the contact
-law (Herman 2011 Table I, Herman 2013 Table 1; PHYSICS.md sections 2 and 4)."""
+law (Herman 2011 Table I, Herman 2013 Table 1; the Physics page: physics-drag, physics-contact)."""
 from __future__ import annotations
 
 import math

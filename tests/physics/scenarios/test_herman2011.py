@@ -97,7 +97,7 @@ def test_final_clusters_hold_all_the_floe_area(sweep):
 def test_set_up_matches_the_paper(sweep):
     """Table I of Herman (2011): the sample follows α_r = 1.5 (ML estimate
     within 0.1), the largest floes drift at about 0.25 m/s and the smallest
-    (0.77 m) at about 0.16 m/s in free drift (PHYSICS.md §2, to 0.01 m/s),
+    (0.77 m) at about 0.16 m/s in free drift (the Physics page: physics-drag, to 0.01 m/s),
     τ of 300–1000 s; floes start almost at rest and speed up towards u_eq."""
     _, ds = sweep
     run = ds.isel(case=0, member=0)

@@ -1,0 +1,137 @@
+"""The contract both floe engines keep.
+
+:class:`~physics.hertz.HertzSimulation` (soft Hertzian contacts, fixed time
+step) and :class:`~physics.harddisk.HardDiskSimulation` (hard discs,
+event-driven) model floes differently but are used the same way.
+Environments, scenarios, benchmarks and the demo are written against
+:class:`FloeEngine`, so that code which only reads the state, advances it
+and measures it runs on either engine.
+
+The contract
+------------
+Names
+    The same name always means the same thing: ``n_floes``, ``time``,
+    ``box``, ``positions``, ``velocities``, ``angular_velocities``,
+    ``advance``, ``contacts``, ``fabric``, ``contact_stress``,
+    ``kinetic_energy``, ``momentum`` and ``state``.
+Input
+    The :class:`~physics.floes.FloeField` given to the constructor is
+    copied; the caller's arrays are never modified.
+Arrays exposed
+    ``positions``, ``velocities`` and ``angular_velocities`` are read-only
+    snapshots taken at the call: they do not follow the simulation as it
+    advances, and writing into them raises ``ValueError``. Assign a whole
+    array to ``velocities`` (or ``angular_velocities``) to change the state;
+    the assignment is checked (shape, finiteness, frozen floes at rest).
+Mistakes
+    A wrong type is a ``TypeError``, a wrong value (out of range, wrong
+    shape, not finite, overlapping floes) a ``ValueError``, both raised
+    before anything changes. When the physics itself breaks down during
+    :meth:`~FloeEngine.advance` (a non-finite or unstable state, a deforming
+    box at its concentration limit, an inelastic collapse) the engine raises
+    :class:`SimulationError`, whose :attr:`~SimulationError.reason` says
+    which; the state is then no longer meaningful.
+"""
+from __future__ import annotations
+
+from enum import Enum
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from .domain import Box
+from .floes import FloeField
+from .observables import Contacts, Fabric, Stress
+
+__all__ = ["FailureReason", "FloeEngine", "SimulationError"]
+
+
+class FailureReason(str, Enum):
+    """Why an engine stopped."""
+
+    #: a position, velocity or event time became NaN or infinite
+    NON_FINITE = "non-finite state"
+    #: a floe moved too far in one step for the neighbour list (Hertz engine)
+    UNSTABLE = "unstable integration"
+    #: a deforming box reached its concentration limit (Hertz engine)
+    CONCENTRATION_LIMIT = "concentration limit"
+    #: a floe collided too often in too short a time (hard-disc engine, TC model off)
+    INELASTIC_COLLAPSE = "inelastic collapse"
+
+
+class SimulationError(RuntimeError, FloatingPointError):
+    """The physics broke down during :meth:`FloeEngine.advance`.
+
+    It is both a ``RuntimeError`` and a ``FloatingPointError``, so code
+    written against either keeps catching it.
+
+    Attributes
+    ----------
+    reason : FailureReason
+    time : float
+        Model time [s] at which it happened.
+    """
+
+    def __init__(self, message: str, reason: FailureReason, time: float):
+        super().__init__(message)
+        self.reason = FailureReason(reason)
+        self.time = float(time)
+
+
+@runtime_checkable
+class FloeEngine(Protocol):
+    """What every floe engine offers; see the module docstring for the
+    copy and error semantics."""
+
+    #: model time [s]
+    time: float
+    #: the simulation's box (it owns and updates it; a deforming box changes size)
+    box: Box
+
+    @property
+    def n_floes(self) -> int:
+        """Number of floes N."""
+        ...
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 2) floe centres [m], wrapped into the box; a read-only snapshot."""
+        ...
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(N, 2) floe velocities [m/s]; a read-only snapshot (assign to change)."""
+        ...
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        """(N,) angular velocities [1/s]; a read-only snapshot (zero for hard discs)."""
+        ...
+
+    def advance(self, duration: float, *, progress: bool = False) -> None:
+        """Advance the model time by ``duration`` seconds."""
+        ...
+
+    def contacts(self) -> Contacts:
+        """The floe–floe contacts of the current state."""
+        ...
+
+    def fabric(self) -> Fabric:
+        """The contact fabric tensor of the current state."""
+        ...
+
+    def contact_stress(self, *, per_floe: bool = True) -> Stress:
+        """The contact stress tensor (and, if asked, its per-floe parts)."""
+        ...
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy [J]."""
+        ...
+
+    def momentum(self) -> np.ndarray:
+        """Total linear momentum (2,) [kg m/s]."""
+        ...
+
+    def state(self) -> FloeField:
+        """The current state as a new :class:`~physics.floes.FloeField`."""
+        ...
