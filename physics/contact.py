@@ -42,11 +42,13 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 __all__ = [
+    "ContactLaw",
     "lammps_damping_alpha",
     "damping_alpha",
     "restitution_of_alpha",
@@ -173,9 +175,42 @@ def damping_alpha(restitution: float, model: str = "exact",
 # Pointwise contact force (one contact), compiled
 # ---------------------------------------------------------------------------
 
+class ContactLaw(NamedTuple):
+    """The constants of one kind of contact (floe–floe or floe–wall) as the
+    compiled kernels take them; :meth:`from_params` makes them from a
+    :class:`~physics.params.ContactParams`."""
+
+    #: (4/3) E* [Pa]
+    kn: float
+    #: 8 G* times the tangential stiffness factor [Pa]
+    kt: float
+    #: normal damping coefficient α
+    alpha: float
+    #: tangential damping relative to the normal one
+    gamma_t: float
+    #: Coulomb coefficient μ
+    mu: float
+    #: clip the normal force at zero (no cohesion)
+    limit_damping: bool
+    #: 1.0 if the tangential force acts on translation, else 0.0
+    tangential_translation: float
+
+    @classmethod
+    def from_params(cls, contact, wall: bool = False) -> "ContactLaw":
+        """The floe–floe law of ``contact`` (a
+        :class:`~physics.params.ContactParams`), or with ``wall`` the law
+        of a floe against a rigid wall (its stiffer E* and G*)."""
+        e_eff = contact.wall_effective_modulus if wall else contact.effective_modulus
+        g_eff = (contact.wall_effective_shear_modulus if wall
+                 else contact.effective_shear_modulus)
+        return cls(float(4.0 / 3.0 * e_eff), float(8.0 * g_eff * contact.tangential_stiffness),
+                   float(contact.damping_alpha), float(contact.tangential_damping),
+                   float(contact.friction), bool(contact.limit_damping),
+                   float(contact.tangential_translation))
+
+
 @njit(cache=True, inline="always", error_model="numpy")
-def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, spring, a_last, dt_history,
-                        kn, kt, alpha, gamma_t, mu, limit_damping):
+def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, spring, a_last, dt_history, law):
     """Forces of one Hertz–Mindlin contact.
 
     Parameters
@@ -189,9 +224,8 @@ def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, spring, a_last, d
         contact)
     dt_history : time step to advance the history by (0 for an evaluation
         that must not change it, e.g. at set-up) [s]
-    kn : (4/3) E* [Pa];  kt : 8 G* [Pa]
-    alpha : normal damping coefficient α;  gamma_t : tangential/normal damping
-    mu : Coulomb coefficient;  limit_damping : clip F_n at 0
+    law : ContactLaw
+        Stiffnesses, damping, friction and the clipping of F_n.
 
     Returns
     -------
@@ -200,21 +234,21 @@ def hertz_mindlin_force(delta, r_eff, m_eff, v_normal, v_slip, spring, a_last, d
     spring, a_last : updated history
     """
     a = math.sqrt(r_eff * delta)                 # contact radius scale √(R* δ)
-    stiff = kn * a                               # F_n,c / δ
+    stiff = law.kn * a                           # F_n,c / δ
     f_elastic = stiff * delta                    # (4/3) E* √R* δ^{3/2}
-    eta = alpha * math.sqrt(m_eff * stiff)       # α √(m* F_n,c/δ)
+    eta = law.alpha * math.sqrt(m_eff * stiff)   # α √(m* F_n,c/δ)
     f_normal = f_elastic + eta * v_normal
-    if limit_damping and f_normal < 0.0:
+    if law.limit_damping and f_normal < 0.0:
         f_normal = 0.0
     # incremental Mindlin spring, LAMMPS mindlin/rescale/force order
     if a < a_last:
         spring *= a / a_last                     # unloading: shrink with the contact
     if dt_history > 0.0:
-        spring -= kt * a * v_slip * dt_history
+        spring -= law.kt * a * v_slip * dt_history
         a_last = a
-    eta_t = gamma_t * eta
+    eta_t = law.gamma_t * eta
     f_t = spring - eta_t * v_slip
-    f_crit = mu * abs(f_normal)
+    f_crit = law.mu * abs(f_normal)
     if abs(f_t) > f_crit:
         f_cap = f_crit if f_t > 0.0 else -f_crit
         if spring != 0.0:

@@ -9,12 +9,13 @@ Boxes are ``[0, Lx) × [0, Ly)``. A non-periodic side is a straight rigid wall
 the same Hertz–Mindlin law as floe–floe contacts (the wall is a floe of
 infinite radius and mass).
 
-Boxes are handed to the compiled kernels as a small float array
-(:meth:`Box.kernel_array`), see ``BOX_*`` indices below.
+Boxes are handed to the compiled kernels as a named bundle,
+:class:`KernelBox` (:meth:`Box.kernel_box`).
 """
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -22,12 +23,36 @@ from numba import njit
 from .params import check_range
 
 __all__ = ["Box", "PeriodicBox", "DeformingPeriodicBox", "ChannelBox", "WalledBox",
-           "minimum_image", "wrap_coordinate"]
+           "KernelBox", "minimum_image", "wrap_coordinate"]
 
-# layout of Box.kernel_array()
-BOX_LX, BOX_LY, BOX_PX, BOX_PY = 0, 1, 2, 3
-BOX_DEFORM, BOX_C0, BOX_RATE, BOX_T0, BOX_LX0, BOX_LY0, BOX_AXES = 4, 5, 6, 7, 8, 9, 10
-BOX_SIZE = 11
+
+class KernelBox(NamedTuple):
+    """A box as the compiled kernels see it (:meth:`Box.kernel_box`).
+
+    ``lengths`` is the one mutable part: the kernels that advance a
+    deforming box write its new side lengths there, and
+    :meth:`Box.update_from_kernel` takes them back.
+    """
+
+    #: (2,) current side lengths (lx, ly) [m]
+    lengths: np.ndarray
+    periodic_x: bool
+    periodic_y: bool
+    #: whether the size follows the concentration (:class:`DeformingPeriodicBox`)
+    deforming: bool
+    #: concentration A at ``time0`` [-] (0 for a rigid box)
+    concentration: float
+    #: dA/dt [1/s]
+    rate: float
+    #: model time [s] of the reference state
+    time0: float
+    #: side lengths [m] at ``time0``
+    lx0: float
+    ly0: float
+    #: which sides deform: 0 both ("xy"), 1 x only, 2 y only
+    axes: int
+    #: the concentration at which the kernels stop a deforming box
+    max_concentration: float
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -111,18 +136,14 @@ class Box:
     def bind(self, total_floe_area: float) -> None:
         """Called once by an engine with the total floe area F [m²]."""
 
-    def kernel_array(self, time: float = 0.0) -> np.ndarray:
-        """Box state at model time ``time`` for the compiled kernels (see the
-        ``BOX_*`` indices)."""
-        b = np.zeros(BOX_SIZE)
-        b[BOX_LX], b[BOX_LY] = self.lx, self.ly
-        b[BOX_PX], b[BOX_PY] = float(self.periodic[0]), float(self.periodic[1])
-        b[BOX_LX0], b[BOX_LY0] = self.lx, self.ly
-        return b
+    def kernel_box(self, time: float = 0.0) -> KernelBox:
+        """Box state at model time ``time`` for the compiled kernels."""
+        return KernelBox(np.array([self.lx, self.ly]), self.periodic[0], self.periodic[1],
+                         False, 0.0, 0.0, float(time), self.lx, self.ly, 0, 1.0)
 
-    def update_from_kernel(self, b: np.ndarray) -> None:
+    def update_from_kernel(self, b: KernelBox) -> None:
         """Take back the box size after the kernels advanced it."""
-        self.lx, self.ly = float(b[BOX_LX]), float(b[BOX_LY])
+        self.lx, self.ly = float(b.lengths[0]), float(b.lengths[1])
 
     def __repr__(self):
         return f"{type(self).__name__}(lx={self.lx:g}, ly={self.ly:g}, periodic={self.periodic})"
@@ -175,7 +196,7 @@ class DeformingPeriodicBox(PeriodicBox):
     """
 
     deforming = True
-    _AXES = {"xy": 0.0, "x": 1.0, "y": 2.0}
+    _AXES = {"xy": 0, "x": 1, "y": 2}
 
     def __init__(self, lx, ly=None, *, concentration_rate=0.0, axes="xy",
                  max_concentration=0.999):
@@ -209,15 +230,12 @@ class DeformingPeriodicBox(PeriodicBox):
         check_range("DeformingPeriodicBox.concentration_rate", concentration_rate)
         self.concentration_rate = float(concentration_rate)
 
-    def kernel_array(self, time: float = 0.0) -> np.ndarray:
+    def kernel_box(self, time: float = 0.0) -> KernelBox:
         # A(t) is linear, so the reference state is simply the current one
-        b = super().kernel_array(time)
-        b[BOX_DEFORM] = 1.0
-        b[BOX_C0] = self.concentration
-        b[BOX_RATE] = self.concentration_rate
-        b[BOX_T0] = time
-        b[BOX_AXES] = self._AXES[self.axes]
-        return b
+        return super().kernel_box(time)._replace(
+            deforming=True, concentration=float(self.concentration),
+            rate=self.concentration_rate, axes=self._AXES[self.axes],
+            max_concentration=self.max_concentration)
 
 
 @njit(cache=True, error_model="numpy")
@@ -226,13 +244,13 @@ def box_lengths_at(box, time):
 
     Returns (lx, ly, concentration); the concentration is 0 for a rigid box.
     """
-    if box[BOX_DEFORM] == 0.0:
-        return box[BOX_LX], box[BOX_LY], 0.0
-    c = box[BOX_C0] + box[BOX_RATE] * (time - box[BOX_T0])
-    ratio = box[BOX_C0] / c                       # S(t) / S(t0)
-    if box[BOX_AXES] == 0.0:
+    if not box.deforming:
+        return box.lengths[0], box.lengths[1], 0.0
+    c = box.concentration + box.rate * (time - box.time0)
+    ratio = box.concentration / c                 # S(t) / S(t0)
+    if box.axes == 0:
         s = math.sqrt(ratio)
-        return box[BOX_LX0] * s, box[BOX_LY0] * s, c
-    if box[BOX_AXES] == 1.0:
-        return box[BOX_LX0] * ratio, box[BOX_LY0], c
-    return box[BOX_LX0], box[BOX_LY0] * ratio, c
+        return box.lx0 * s, box.ly0 * s, c
+    if box.axes == 1:
+        return box.lx0 * ratio, box.ly0, c
+    return box.lx0, box.ly0 * ratio, c

@@ -34,6 +34,7 @@ Mistakes
 """
 from __future__ import annotations
 
+import inspect
 from enum import Enum
 from typing import Protocol, runtime_checkable
 
@@ -43,7 +44,8 @@ from .domain import Box
 from .floes import FloeField
 from .observables import Contacts, Fabric, Stress
 
-__all__ = ["FailureReason", "FloeEngine", "SimulationError"]
+__all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
+           "snapshot"]
 
 
 class FailureReason(str, Enum):
@@ -135,3 +137,50 @@ class FloeEngine(Protocol):
     def state(self) -> FloeField:
         """The current state as a new :class:`~physics.floes.FloeField`."""
         ...
+
+
+def engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, kwargs: dict):
+    """The engine ``cls`` set up from a paper preset: the work of the
+    engines' ``from_preset`` class methods.
+
+    The floes come from ``preset.floe_field(n, concentration, seed=seed)``
+    with the keywords of ``kwargs`` that are not parameters of the
+    constructor; the others go to the constructor and replace the
+    preset's values given by ``defaults(preset)`` (a dict of constructor
+    arguments). ``forcing`` True is the preset's
+    (:meth:`~physics.params.PaperPreset.make_forcing`), False or None
+    none, a :class:`~physics.forcing.Forcing` that one.
+    """
+    from .params import PaperPreset
+
+    if not isinstance(preset, PaperPreset):
+        raise TypeError(f"preset must be a PaperPreset, got {type(preset).__name__}")
+    own = set(inspect.signature(cls.__init__).parameters) - {"self", "field", "box", "forcing"}
+    engine = {k: kwargs.pop(k) for k in list(kwargs) if k in own}
+    if forcing is True:
+        forcing = preset.make_forcing()
+    elif forcing is False:
+        forcing = None
+    field, box = preset.floe_field(n, concentration, seed=seed, **kwargs)
+    return cls(field, box, forcing=forcing, **{**defaults(preset), **engine})
+
+
+def snapshot(a: np.ndarray) -> np.ndarray:
+    """A read-only copy of ``a``: what an engine's ``positions``,
+    ``velocities`` and ``angular_velocities`` return."""
+    c = np.array(a, copy=True)
+    c.flags.writeable = False
+    return c
+
+
+def checked_motion(name: str, value, shape: tuple, frozen: np.ndarray, what: str) -> np.ndarray:
+    """``value`` as a float array of ``shape``, finite and zero for the
+    ``frozen`` floes, else ``ValueError``: the check of an assignment to an
+    engine's ``velocities`` or ``angular_velocities``. ``what`` names the
+    quantity in the message about frozen floes."""
+    v = np.asarray(value, dtype=float)
+    if v.shape != shape or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be a finite array of shape {shape}")
+    if np.any(v[frozen] != 0.0):
+        raise ValueError(f"frozen floes must have zero {what}")
+    return v

@@ -5,6 +5,8 @@ Hertz–Mindlin contacts of :mod:`physics.contact`, integrated with
 velocity-Verlet (:mod:`physics.hertz_kernels`) over Verlet lists with a skin
 (:mod:`physics.neighbors`), in a box of :mod:`physics.domain`.
 
+It keeps the engine contract of :mod:`physics.engine`.
+
 Example
 -------
 >>> from physics import make_floe_field, HertzSimulation, ContactParams, Forcing, HERMAN2013
@@ -22,13 +24,17 @@ import numba
 import numpy as np
 
 from . import hertz_kernels as K
-from .contact import contact_time, hertz_stiffness
+from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
+from .engine import FailureReason, SimulationError, engine_from_preset
+from .engine import checked_motion as _checked_motion
+from .engine import snapshot as _snapshot
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
+from .hertz_kernels import HertzStatus
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
-from .params import ContactParams, check_range
+from .params import ContactParams, PaperPreset, check_range
 from .progress import steps_with_bar
 
 __all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
@@ -69,6 +75,13 @@ def hertz_time_step(field: FloeField, box: Box, contact: ContactParams, impact_s
 class HertzSimulation:
     """Soft-contact discrete-element simulation of floes (Herman 2013).
 
+    It keeps the engine contract (:class:`~physics.engine.FloeEngine`):
+    the input field is copied, ``positions``, ``velocities`` and
+    ``angular_velocities`` are read-only snapshots (assign a whole array to
+    ``velocities`` or ``angular_velocities`` to change them), and a
+    breakdown of the physics during :meth:`advance` raises
+    :class:`~physics.engine.SimulationError`.
+
     Parameters
     ----------
     field : FloeField
@@ -101,8 +114,22 @@ class HertzSimulation:
     Attributes
     ----------
     time : float — model time [s]
-    positions, velocities, angular_velocities : arrays of the current state
+    positions, velocities, angular_velocities : read-only snapshots of the current state
     n_steps, n_rebuilds : counters
+
+    Examples
+    --------
+    A simulation set up from a paper's parameters (:meth:`from_preset`):
+    its floe field, contact law, time step and forcing.
+
+    >>> from physics import HERMAN2013, HertzSimulation
+    >>> sim = HertzSimulation.from_preset(HERMAN2013, 300, 0.6, seed=1, velocity_std=0.01)
+    >>> sim.dt, sim.forcing.wind.tolist()
+    (0.002, [10.0, 0.0])
+    >>> sim.advance(1.0)
+    >>> sim.n_steps, sim.positions.shape
+    (500, (300, 2))
+    >>> sim.velocities = 0.5 * sim.velocities       # assign; the snapshot is read-only
     """
 
     def __init__(self, field: FloeField, box: Box, contact: ContactParams | None = None,
@@ -154,20 +181,20 @@ class HertzSimulation:
         self.parallel = bool(parallel)
 
         # positions inside the box; walls must not cut floes deeply
-        self.positions = box.wrap(f.positions)
-        if not np.all(box.contains(self.positions)):
-            bad = int(np.argmin(box.contains(self.positions)))
-            raise ValueError(f"floe {bad} at {self.positions[bad]} is outside the walled box {box}")
+        self._pos = box.wrap(f.positions)
+        if not np.all(box.contains(self._pos)):
+            bad = int(np.argmin(box.contains(self._pos)))
+            raise ValueError(f"floe {bad} at {self._pos[bad]} is outside the walled box {box}")
         if not allow_overlap:
-            worst = max_overlap(self.positions, f.radii, box)
+            worst = max_overlap(self._pos, f.radii, box)
             if worst > 0.01:
                 raise ValueError(
                     f"initial overlap of {worst:.3g} of the smaller radius exceeds 1 %; separate "
                     f"the floes (physics.floes.place_floes) or pass allow_overlap=True")
 
-        # state arrays
-        self.velocities = f.velocities.copy()
-        self.angular_velocities = f.angular_velocities.copy()
+        # state arrays, shared with the kernels through the bundles below
+        self._vel = f.velocities.copy()
+        self._omega = f.angular_velocities.copy()
         mass = f.masses
         mobile = ~f.frozen
         self.inv_mass = np.where(mobile, 1.0 / mass, 0.0)
@@ -176,27 +203,61 @@ class HertzSimulation:
         self.cell_size = choose_cell_size(f.radii, box.lx, box.ly, self.skin)
         box.bind(f.total_area)
         self.max_concentration = getattr(box, "max_concentration", 1.0)
-        self._cp = np.array([
-            4.0 / 3.0 * contact.effective_modulus,
-            8.0 * contact.effective_shear_modulus * contact.tangential_stiffness,
-            contact.damping_alpha, contact.tangential_damping, contact.friction,
-            float(contact.limit_damping),
-            4.0 / 3.0 * contact.wall_effective_modulus,
-            8.0 * contact.wall_effective_shear_modulus * contact.tangential_stiffness,
-            float(contact.tangential_translation),
-        ])
-        self._set_drag()
         self.force = np.zeros((n, 2))
         self.torque = np.zeros(n)
-        self._wall_hist = np.zeros((n, 4, 2))
-        self._centre = np.zeros(2)
-        self._ref_lengths = np.array([box.lx, box.ly])
+        self._floes = K.Floes(self._pos, self._vel, self._omega, self.radius, self.inv_mass,
+                              self.inv_inertia, self.rank, self.force, self.torque,
+                              np.zeros((n, 4, 2)))
+        self._law = ContactLaw.from_params(contact)
+        self._wall_law = ContactLaw.from_params(contact, wall=True)
+        self._set_drag()
         self.time = 0.0
         self.n_steps = 0
         self.n_rebuilds = 0
-        self._build_list(np.zeros(0, dtype=np.int64), np.zeros(n + 1, dtype=np.int64),
-                         np.zeros((0, 2)))
-        self._evaluate_forces(self._drag, self._forcing_vector(), self.force, self.torque)
+        self._build_list()
+        self._evaluate_forces(self._drive(), self.force, self.torque)
+
+    @classmethod
+    def from_preset(cls, preset: PaperPreset, n: int | None = None,
+                    concentration: float | None = None, *, seed: int | None = 0,
+                    forcing: bool | Forcing | None = True, **kwargs) -> "HertzSimulation":
+        """A simulation of a paper preset's floes, contact law and time step.
+
+        The floes come from ``preset.floe_field(n, concentration, seed=seed)``
+        (:meth:`~physics.params.PaperPreset.floe_field`), the contact law
+        from ``preset.contact`` and the time step from ``preset.time_step``.
+
+        Parameters
+        ----------
+        preset : PaperPreset
+            E.g. :data:`~physics.params.HERMAN2013`.
+        n, concentration : optional
+            Number of floes and ice concentration (default: the preset's).
+        seed : int or None
+            Seed of the floe field.
+        forcing : bool, Forcing or None
+            True: the preset's wind, current, drag and Coriolis
+            (:meth:`~physics.params.PaperPreset.make_forcing`); False or
+            None: no external forces; a :class:`~physics.forcing.Forcing`:
+            that one.
+        **kwargs
+            Parameters of the constructor (``contact``, ``dt``,
+            ``impact_speed``, ``skin``, ``parallel``, ``allow_overlap``;
+            ``contact`` and ``dt`` replace the preset's); any other keyword
+            goes to :meth:`~physics.params.PaperPreset.floe_field` (e.g.
+            ``velocity_std``, ``repeat``).
+
+        Raises
+        ------
+        TypeError
+            ``preset`` not a :class:`~physics.params.PaperPreset`, or an
+            unknown keyword.
+        ValueError
+            A bad value (see the constructor).
+        """
+        def defaults(p):
+            return {"contact": p.contact, "dt": p.time_step}
+        return engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, kwargs)
 
     # -- set-up helpers ------------------------------------------------------
     def _set_drag(self):
@@ -209,64 +270,72 @@ class HertzSimulation:
             for col, a in enumerate((k.wind, k.water, k.rotation, k.coriolis_mass)):
                 self._drag[:, col] = np.where(mobile, a, 0.0)
 
-    def _forcing_vector(self) -> np.ndarray:
+    def _drive(self) -> K.Drive:
+        """The forcing bundle of the kernels, with the wind and current now."""
         if self.forcing is None:
-            return np.zeros(4)
-        return self.forcing.kernel_vector()
+            return K.make_drive(self._drag)
+        return K.make_drive(self._drag, self.forcing.wind, self.forcing.current)
 
-    def _build_list(self, old_nbr, old_start, old_hist):
+    def _build_list(self):
         b = self.box
-        self._start, self._nbr, self._hist, self._ref = K.rebuild(
-            self.positions, self.radius, self.rank, b.lx, b.ly, b.periodic[0], b.periodic[1],
-            self.skin, self.cell_size, old_start, old_nbr, old_hist, self.parallel)
-        self._ref_lengths[:] = (b.lx, b.ly)
-        self._centre[:] = 0.0
+        n = self.n_floes
+        empty = K.VerletList(np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                             np.zeros((0, 2)), self._pos.copy(), np.array([b.lx, b.ly]),
+                             np.zeros(2), self.skin, self.cell_size, self.max_cut)
+        self._verlet = K.rebuild(self._floes, empty, b.lx, b.ly, b.periodic[0], b.periodic[1],
+                                 self.parallel)
 
-    def _evaluate_forces(self, drag, forcing_vector, force, torque):
+    def _evaluate_forces(self, drive: K.Drive, force: np.ndarray, torque: np.ndarray):
         """Forces at the current positions and velocities into ``force``,
         ``torque``, leaving the Mindlin history unchanged (as LAMMPS does at
         ``run 0``)."""
-        K.forces_serial(self.positions, self.velocities, self.angular_velocities, self.radius,
-                        self.inv_mass, drag, forcing_vector, self._cp,
-                        self.box.kernel_array(self.time), self._start, self._nbr,
-                        self._hist.copy(), self._wall_hist.copy(), 0.0, force, torque)
+        floes = self._floes._replace(wall_hist=self._floes.wall_hist.copy())
+        verlet = self._verlet._replace(hist=self._verlet.hist.copy())
+        K.forces_serial(floes, self._law, self._wall_law, drive, self.box.kernel_box(self.time),
+                        verlet, 0.0, force, torque)
 
     # -- running -------------------------------------------------------------
     def step(self, n: int = 1) -> None:
-        """Advance by ``n`` time steps."""
+        """Advance by ``n`` time steps.
+
+        Raises
+        ------
+        SimulationError
+            If the state became non-finite, the integration unstable, or a
+            deforming box reached its concentration limit.
+        """
         check_range("n", n, 0, None)
         n = int(n)
         if n == 0:
             return
         if self.forcing is not None:
             self._set_drag_if_changed()
-        box_arr = self.box.kernel_array(self.time)
-        done, status, nreb, self._start, self._nbr, self._hist, self._ref = K.run_steps(
-            n, self.dt, self.time, self.positions, self.velocities, self.angular_velocities,
-            self.force, self.torque, self.radius, self.rank, self.inv_mass, self.inv_inertia,
-            self._drag, self._forcing_vector(), self._cp, box_arr, self.max_concentration,
-            self.skin, self.cell_size, self.max_cut, self._start, self._nbr, self._hist,
-            self._ref, self._ref_lengths, self._centre, self._wall_hist, self.parallel,
-            numba.get_num_threads())
+        box = self.box.kernel_box(self.time)
+        done, status, nreb, self._verlet = K.run_steps(
+            n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(), box,
+            self._verlet, self.parallel, numba.get_num_threads())
         self.time += done * self.dt
         self.n_steps += done
         self.n_rebuilds += nreb
-        self.box.update_from_kernel(box_arr)
-        if status == K.STATUS_CONCENTRATION:
-            raise RuntimeError(
+        self.box.update_from_kernel(box)
+        status = HertzStatus(status)
+        if status is HertzStatus.CONCENTRATION_LIMIT:
+            raise SimulationError(
                 f"the deforming box reached its concentration limit at t = {self.time:.6g} s "
-                f"(A = {self.concentration:.4f})")
-        if status == K.STATUS_UNSTABLE:
-            raise FloatingPointError(
+                f"(A = {self.concentration:.4f})", FailureReason.CONCENTRATION_LIMIT, self.time)
+        if status is HertzStatus.UNSTABLE:
+            raise SimulationError(
                 f"the integration became unstable at t = {self.time:.6g} s (step {self.n_steps}): "
                 f"a floe moved more than half the Verlet skin ({self.skin:.3g} m) in one step. "
                 f"The time step may be too large for the impact speeds, the ice compressed far "
-                f"beyond jamming, or (for fast floes and long steps) the skin too small")
-        if status == K.STATUS_NONFINITE or not (np.all(np.isfinite(self.positions))
-                                                 and np.all(np.isfinite(self.velocities))):
-            raise FloatingPointError(
+                f"beyond jamming, or (for fast floes and long steps) the skin too small",
+                FailureReason.UNSTABLE, self.time)
+        if status is HertzStatus.NON_FINITE or not (np.all(np.isfinite(self._pos))
+                                                   and np.all(np.isfinite(self._vel))):
+            raise SimulationError(
                 f"non-finite floe state at t = {self.time:.6g} s (step {self.n_steps}); "
-                f"the time step is probably too large for the impact speeds")
+                f"the time step is probably too large for the impact speeds",
+                FailureReason.NON_FINITE, self.time)
 
     def _set_drag_if_changed(self):
         # the coefficients depend only on the floes and ForcingParams; the
@@ -280,7 +349,8 @@ class HertzSimulation:
         """Advance by ``duration`` model seconds (rounded to whole steps).
 
         ``progress=True`` shows a progress bar (the run is done in chunks of
-        ``chunk`` model seconds, default 1 % of the duration).
+        ``chunk`` model seconds, default 1 % of the duration). Raises
+        :class:`~physics.engine.SimulationError` as :meth:`step` does.
         """
         check_range("duration", duration, 0.0, None)
         n = int(round(duration / self.dt))
@@ -288,6 +358,32 @@ class HertzSimulation:
             self.step(n)
             return
         steps_with_bar(self.step, n, round((chunk or duration / 100.0) / self.dt), "Hertz")
+
+    # -- state -----------------------------------------------------------------
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 2) floe centres [m], wrapped into the box (a read-only snapshot)."""
+        return _snapshot(self._pos)
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(N, 2) floe velocities [m/s] (a read-only snapshot; assign to change them)."""
+        return _snapshot(self._vel)
+
+    @velocities.setter
+    def velocities(self, value):
+        self._vel[...] = _checked_motion("velocities", value, self._vel.shape, self.field.frozen,
+                                         "velocity")
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        """(N,) angular velocities [1/s] (a read-only snapshot; assign to change them)."""
+        return _snapshot(self._omega)
+
+    @angular_velocities.setter
+    def angular_velocities(self, value):
+        self._omega[...] = _checked_motion("angular_velocities", value, self._omega.shape,
+                                           self.field.frozen, "angular velocity")
 
     # -- observation ---------------------------------------------------------
     @property
@@ -309,18 +405,16 @@ class HertzSimulation:
         velocities, without advancing the contact history."""
         force = np.zeros((self.n_floes, 2))
         torque = np.zeros(self.n_floes)
-        self._evaluate_forces(np.zeros((self.n_floes, 4)), np.zeros(4), force, torque)
+        self._evaluate_forces(K.make_drive(np.zeros((self.n_floes, 4))), force, torque)
         return force, torque
 
     def contacts(self) -> Contacts:
         """Every touching floe pair at the current state (see :class:`Contacts`)."""
-        i, j, d = K.contact_list(self.positions, self.velocities, self.angular_velocities,
-                                 self.radius, self.inv_mass, self._cp,
-                                 self.box.kernel_array(self.time), self._start, self._nbr,
-                                 self._hist)
+        i, j, d = K.contact_list(self._floes, self._law, self.box.kernel_box(self.time),
+                                 self._verlet)
         normal = d[:, 0:2].copy()
         delta = d[:, 2].copy()
-        point, arm_i, arm_j = Contacts.branches(self.positions, self.radius, i, j, normal, delta)
+        point, arm_i, arm_j = Contacts.branches(self._pos, self.radius, i, j, normal, delta)
         return Contacts(i=i, j=j, normal=normal, overlap=delta, normal_force=d[:, 3].copy(),
                         tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
                         contact_point=point, branch_i=arm_i, branch_j=arm_j)
@@ -339,21 +433,20 @@ class HertzSimulation:
         """Translational plus rotational kinetic energy of mobile floes [J]."""
         m = self.field.masses
         mobile = self.inv_mass > 0
-        e_t = 0.5 * np.sum(m[mobile] * np.sum(self.velocities[mobile] ** 2, axis=1))
-        e_r = 0.5 * np.sum(self.field.inertia[mobile] * self.angular_velocities[mobile] ** 2)
+        e_t = 0.5 * np.sum(m[mobile] * np.sum(self._vel[mobile] ** 2, axis=1))
+        e_r = 0.5 * np.sum(self.field.inertia[mobile] * self._omega[mobile] ** 2)
         return float(e_t + e_r)
 
     def momentum(self) -> np.ndarray:
         """Total linear momentum of mobile floes (2,) [kg m/s]."""
         mobile = self.inv_mass > 0
-        return (self.field.masses[mobile, None] * self.velocities[mobile]).sum(axis=0)
+        return (self.field.masses[mobile, None] * self._vel[mobile]).sum(axis=0)
 
     def state(self) -> FloeField:
         """A copy of the current state as a FloeField."""
         f = self.field
-        return FloeField(self.positions.copy(), f.radii.copy(), f.thickness.copy(),
-                         self.velocities.copy(), self.angular_velocities.copy(), f.density,
-                         f.frozen.copy())
+        return FloeField(self._pos.copy(), f.radii.copy(), f.thickness.copy(), self._vel.copy(),
+                         self._omega.copy(), f.density, f.frozen.copy())
 
     def __repr__(self):
         return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "

@@ -33,30 +33,189 @@ Step (LAMMPS ``fix nve/sphere`` order): half kick with F(t) → drift →
 affine remap of a deforming box → drag and wall forces (they need only the
 floe itself) → Verlet-list check (and rebuild) → pair forces at t + Δt with
 the half-step velocities → half kick.
+
+Arguments travel as named bundles (named tuples, which Numba compiles to
+plain structures: reading a field costs nothing): the floes
+(:class:`Floes`), their forcing (:class:`Drive`), the contact law
+(:class:`~physics.contact.ContactLaw`), the box
+(:class:`~physics.domain.KernelBox`), the Verlet list (:class:`VerletList`)
+and, inside a run, the one kick–drift pass (:class:`Kick`), the chunks of
+the parallel pair loop (:class:`PairChunks`), the force buffers
+(:class:`ForceBuffers`) and the thread team (:class:`Team`). The arrays of
+a bundle are shared, not copied: a kernel that writes into them changes the
+caller's state.
 """
 from __future__ import annotations
 
 import math
+from enum import IntEnum
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange, types
 from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
-from .domain import BOX_DEFORM, BOX_LX, BOX_LY, BOX_PX, BOX_PY, box_lengths_at, minimum_image
+from .domain import box_lengths_at, minimum_image
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
                           wait_generation)
 
-# contact parameter vector layout
-CP_KN, CP_KT, CP_ALPHA, CP_GT, CP_MU, CP_LIMIT, CP_KN_WALL, CP_KT_WALL, CP_TT = range(9)
-CP_SIZE = 9
-# forcing vector layout: wind (x, y), current (x, y)
-FV_UAX, FV_UAY, FV_UWX, FV_UWY = range(4)
-# status codes of run_steps
-STATUS_OK, STATUS_NONFINITE, STATUS_CONCENTRATION, STATUS_UNSTABLE = 0, 1, 2, 3
+
+class HertzStatus(IntEnum):
+    """How :func:`run_steps` ended."""
+
+    #: every step done
+    OK = 0
+    #: a position or velocity became NaN or infinite
+    NON_FINITE = 1
+    #: a deforming box reached its concentration limit
+    CONCENTRATION_LIMIT = 2
+    #: a floe moved more than half the Verlet skin in one step
+    UNSTABLE = 3
+
+
+# the statuses as plain integers for the compiled code
+_OK = int(HertzStatus.OK)
+_NON_FINITE = int(HertzStatus.NON_FINITE)
+_CONCENTRATION_LIMIT = int(HertzStatus.CONCENTRATION_LIMIT)
+_UNSTABLE = int(HertzStatus.UNSTABLE)
 # why a team run (team_steps) returned early: the Verlet list must be rebuilt
 TEAM_ALL_DONE, TEAM_REBUILD = 0, 1
+
+
+class Floes(NamedTuple):
+    """The state and constants of N floes. Frozen floes have zero inverse
+    mass and inertia."""
+
+    #: (N, 2) centres [m]
+    pos: np.ndarray
+    #: (N, 2) velocities [m/s]
+    vel: np.ndarray
+    #: (N,) angular velocities [1/s]
+    omega: np.ndarray
+    #: (N,) radii [m]
+    radius: np.ndarray
+    #: (N,) 1/m [1/kg], 0 for frozen floes
+    inv_mass: np.ndarray
+    #: (N,) 1/I [1/(kg m²)], 0 for frozen floes
+    inv_inertia: np.ndarray
+    #: (N,) rank by radius (:func:`physics.neighbors.radius_rank`)
+    rank: np.ndarray
+    #: (N, 2) total force of the last step [N]
+    force: np.ndarray
+    #: (N,) total torque of the last step [N m]
+    torque: np.ndarray
+    #: (N, 4, 2) Mindlin history (spring, a_last) of the contact with each wall
+    wall_hist: np.ndarray
+
+
+class Drive(NamedTuple):
+    """The external forcing (Herman 2013, eqs 6–7)."""
+
+    #: (N, 4) per floe: wind a, water b, rotational drag c, Coriolis m f
+    #: (all zero for frozen floes)
+    coefficients: np.ndarray
+    #: wind (x, y) [m/s]
+    wind_x: float
+    wind_y: float
+    #: ocean current (x, y) [m/s]
+    current_x: float
+    current_y: float
+    #: |wind| [m/s]
+    wind_speed: float
+    #: whether any coefficient is non-zero
+    active: bool
+
+
+def make_drive(coefficients: np.ndarray, wind=(0.0, 0.0), current=(0.0, 0.0)) -> Drive:
+    """A :class:`Drive` with the drag ``coefficients`` (N, 4), the wind and
+    the current (2-vectors [m/s])."""
+    uax, uay = float(wind[0]), float(wind[1])
+    uwx, uwy = float(current[0]), float(current[1])
+    return Drive(coefficients, uax, uay, uwx, uwy, math.sqrt(uax * uax + uay * uay),
+                 bool(np.any(coefficients != 0.0)))
+
+
+class VerletList(NamedTuple):
+    """A Verlet list in CSR form (:mod:`physics.neighbors`) with the
+    contact history of its pairs and what decides when it expires."""
+
+    #: (N + 1,) slice bounds of each owner's partners in ``nbr``
+    start: np.ndarray
+    #: (M,) partners
+    nbr: np.ndarray
+    #: (M, 2) Mindlin history (spring, a_last) of each pair
+    hist: np.ndarray
+    #: (N, 2) positions at the build (remapped with a deforming box)
+    ref: np.ndarray
+    #: (2,) box lengths at the build
+    ref_lengths: np.ndarray
+    #: (2,) mean displacement of the floes since the build [m]
+    centre: np.ndarray
+    #: skin [m]
+    skin: float
+    #: cell width of the build [m]
+    cell_size: float
+    #: longest cut-off 2 r_max + skin [m]
+    max_cut: float
+
+
+class Kick(NamedTuple):
+    """The constants of one kick–drift pass (:func:`first_half`)."""
+
+    #: kick time step (Δt/2 in the first step of a run, else Δt) [s]
+    dt_kick: float
+    #: drift time step Δt [s]
+    dt: float
+    #: box lengths after the step [m]
+    lx: float
+    ly: float
+    periodic_x: bool
+    periodic_y: bool
+    #: affine remap factors of a deforming box (new length / old length)
+    sx: float
+    sy: float
+    #: mean displacement since the build, subtracted before the largest is taken [m]
+    cx: float
+    cy: float
+
+
+class PairChunks(NamedTuple):
+    """The chunks of the parallel pair loop (:func:`pair_chunks`)."""
+
+    #: floes that own pairs
+    owners: np.ndarray
+    #: chunk c is owners[bounds[c]:bounds[c + 1]]
+    bounds: np.ndarray
+    #: the floes the chunks can write to their private buffers (:func:`scatter_floes`)
+    shared: np.ndarray
+
+
+class ForceBuffers(NamedTuple):
+    """Buffer 0 (shared) and one private buffer per chunk of the pair loop
+    (:func:`force_buffers`)."""
+
+    #: (B, N, 2) forces [N]
+    force: np.ndarray
+    #: (B, N) torques [N m]
+    torque: np.ndarray
+
+
+class Team(NamedTuple):
+    """The thread team of :func:`team_steps` (:mod:`physics.thread_team`)."""
+
+    n_threads: int
+    #: tasks of the kick–drift phase
+    n_kick: int
+    #: sync arrays of the two phases
+    sync_kick: np.ndarray
+    sync_pair: np.ndarray
+    #: (n_kick, 4) partial results of the kick pass
+    part: np.ndarray
+    #: (steps done, status, reason, centre x, centre y) of the run
+    out: np.ndarray
+
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
 # tasks per thread of the parallel kick–drift pass: in the thread team
 # (team_steps) a thread that is done with its own tasks takes over the last
@@ -70,16 +229,16 @@ KICK_TASKS_PER_THREAD = 2
 # ---------------------------------------------------------------------------
 
 @njit(cache=True, inline="always", error_model="numpy")
-def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last, dt_history,
-                 kn, kt, alpha, gamma_t, mu, limit_damping, tt):
+def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last, dt_history, law):
     """Force of floe j on floe i, given their minimum-image separation
     (dx, dy) = x_j − x_i and relative velocity (vrx, vry) = u_i − u_j.
 
     Returns (touching, fx, fy, torque_i, torque_j, spring, a_last, f_normal,
     f_tangential, nx, ny, delta): (fx, fy) acts on i and −(fx, fy) on j;
     n = (nx, ny) is the unit vector from i to j; (spring, a_last) is the
-    updated Mindlin history. A pair that does not touch, or of two frozen
-    floes, returns zeros (and a reset history).
+    updated Mindlin history; ``law`` is a
+    :class:`~physics.contact.ContactLaw`. A pair that does not touch, or
+    of two frozen floes, returns zeros (and a reset history).
     """
     rsum = ri + rj
     d2 = dx * dx + dy * dy
@@ -93,7 +252,8 @@ def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last,
     v_slip = -vrx * ny + vry * nx + ri * wi + rj * wj
     fn, ft, spring, a_last = hertz_mindlin_force(delta, ri * rj / rsum, 1.0 / inv_mass_sum,
                                                  v_normal, v_slip, spring, a_last, dt_history,
-                                                 kn, kt, alpha, gamma_t, mu, limit_damping)
+                                                 law)
+    tt = law.tangential_translation
     fx = -fn * nx - tt * ft * ny
     fy = -fn * ny + tt * ft * nx
     return (True, fx, fy, ft * (ri - 0.5 * delta), ft * (rj - 0.5 * delta), spring, a_last,
@@ -101,8 +261,7 @@ def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_history,
-                 kn, kt, alpha, gamma_t, mu, limit_damping, tt):
+def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_history, law):
     """Force of a rigid wall on a floe; ``side`` 0..3 = wall at x=0, x=lx,
     y=0, y=ly. Returns (fx, fy, torque, spring, a_last)."""
     if side == 0:
@@ -118,8 +277,8 @@ def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_
     v_normal = vx * nx + vy * ny
     v_slip = -vx * ny + vy * nx + r * w
     fn, ft, spring, a_last = hertz_mindlin_force(delta, r, 1.0 / inv_mass, v_normal, v_slip,
-                                                 spring, a_last, dt_history, kn, kt, alpha,
-                                                 gamma_t, mu, limit_damping)
+                                                 spring, a_last, dt_history, law)
+    tt = law.tangential_translation
     return -fn * nx - tt * ft * ny, -fn * ny + tt * ft * nx, ft * (r - delta), spring, a_last
 
 
@@ -178,16 +337,14 @@ def min_image_step(d, length, periodic):
 # ---------------------------------------------------------------------------
 
 @njit(cache=True, error_model="numpy")
-def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
-                force, torque):
+def wall_forces(i_lo, i_hi, floes, wall_law, box, dt_history, force, torque):
     """Add the forces of the rigid walls of non-periodic sides to floes
-    i_lo..i_hi−1."""
-    lx, ly = box[BOX_LX], box[BOX_LY]
-    walls_x = box[BOX_PX] == 0.0
-    walls_y = box[BOX_PY] == 0.0
-    kn, kt, alpha, gt, mu = cp[CP_KN_WALL], cp[CP_KT_WALL], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
-    limit = cp[CP_LIMIT] != 0.0
-    tt = cp[CP_TT]
+    i_lo..i_hi−1 (and advance their history ``floes.wall_hist``)."""
+    pos, vel, omega, radius = floes.pos, floes.vel, floes.omega, floes.radius
+    inv_mass, wall_hist = floes.inv_mass, floes.wall_hist
+    lx, ly = box.lengths[0], box.lengths[1]
+    walls_x = not box.periodic_x
+    walls_y = not box.periodic_y
     for i in range(i_lo, i_hi):
         for side in range(4):
             if (side < 2 and not walls_x) or (side >= 2 and not walls_y):
@@ -195,8 +352,7 @@ def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_his
             wfx, wfy, wtq, sp, al = wall_contact(side, pos[i, 0], pos[i, 1], vel[i, 0],
                                                  vel[i, 1], omega[i], radius[i], inv_mass[i],
                                                  lx, ly, wall_hist[i, side, 0],
-                                                 wall_hist[i, side, 1], dt_history, kn, kt,
-                                                 alpha, gt, mu, limit, tt)
+                                                 wall_hist[i, side, 1], dt_history, wall_law)
             wall_hist[i, side, 0] = sp
             wall_hist[i, side, 1] = al
             force[i, 0] += wfx
@@ -205,11 +361,11 @@ def wall_forces(i_lo, i_hi, pos, vel, omega, radius, inv_mass, cp, box, wall_his
 
 
 @njit(cache=True, error_model="numpy")
-def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
-    """Assign the eq 6–7 forcing to floes i_lo..i_hi−1 (``drag`` rows:
-    a, b, c, m f; all zero for frozen floes)."""
-    uax, uay, uwx, uwy = fv[FV_UAX], fv[FV_UAY], fv[FV_UWX], fv[FV_UWY]
-    wind_speed = math.sqrt(uax * uax + uay * uay)
+def drag_forces(i_lo, i_hi, floes, drive, force, torque):
+    """Assign the eq 6–7 forcing of ``drive`` to floes i_lo..i_hi−1."""
+    vel, omega, drag = floes.vel, floes.omega, drive.coefficients
+    uax, uay, uwx, uwy = drive.wind_x, drive.wind_y, drive.current_x, drive.current_y
+    wind_speed = drive.wind_speed
     for i in range(i_lo, i_hi):
         fx, fy, tq = floe_drag(vel[i, 0], vel[i, 1], omega[i], drag[i, 0], drag[i, 1], drag[i, 2],
                                drag[i, 3], uax, uay, uwx, uwy, wind_speed)
@@ -219,8 +375,8 @@ def drag_forces(i_lo, i_hi, vel, omega, drag, fv, force, torque):
 
 
 @njit(cache=True, error_model="numpy")
-def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                dt_history, force, torque, j_lo, j_hi, force_out, torque_out):
+def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, torque, j_lo, j_hi,
+                force_out, torque_out):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
     both floes of its pair at once (a scatter into ``force``, ``torque``;
     for a partner j outside j_lo ≤ j < j_hi into ``force_out``,
@@ -230,11 +386,11 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
     apart, and a write of zero would still claim the cache line for this
     thread, so that the thread doing the kick of that floe would have to
     fetch it back (see :func:`first_half_parallel`)."""
-    lx, ly = box[BOX_LX], box[BOX_LY]
-    px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
-    kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
-    limit = cp[CP_LIMIT] != 0.0
-    tt = cp[CP_TT]
+    pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
+                                         floes.inv_mass)
+    start, nbr, hist = verlet.start, verlet.nbr, verlet.hist
+    lx, ly = box.lengths[0], box.lengths[1]
+    px, py = box.periodic_x, box.periodic_y
     for k in range(k_lo, k_hi):
         i = owners[k]
         xi_, yi_ = pos[i, 0], pos[i, 1]
@@ -247,8 +403,7 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
             res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
                                minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
                                vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p, 0], hist[p, 1], dt_history, kn, kt, alpha, gt, mu, limit,
-                               tt)
+                               hist[p, 0], hist[p, 1], dt_history, law)
             hist[p, 0] = res[5]
             hist[p, 1] = res[6]
             if res[0]:
@@ -270,17 +425,17 @@ def owner_pairs(k_lo, k_hi, owners, pos, vel, omega, radius, inv_mass, cp, box, 
 
 
 @njit(cache=True, error_model="numpy")
-def forces_serial(pos, vel, omega, radius, inv_mass, drag, fv, cp, box, start, nbr, hist,
-                  wall_hist, dt_history, force, torque):
-    """All forces and torques at the current state (serial)."""
-    n = radius.shape[0]
-    drag_forces(0, n, vel, omega, drag, fv, force, torque)
-    if box[BOX_PX] == 0.0 or box[BOX_PY] == 0.0:
-        wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
-                    force, torque)
+def forces_serial(floes, law, wall_law, drive, box, verlet, dt_history, force, torque):
+    """All forces and torques at the current state into ``force``,
+    ``torque`` (serial)."""
+    n = floes.radius.shape[0]
+    drag_forces(0, n, floes, drive, force, torque)
+    if not (box.periodic_x and box.periodic_y):
+        wall_forces(0, n, floes, wall_law, box, dt_history, force, torque)
+    start = verlet.start
     owners = np.nonzero(start[1:] > start[:-1])[0]
-    owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                hist, dt_history, force, torque, 0, n, force, torque)
+    owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt_history, force, torque, 0,
+                n, force, torque)
 
 
 @njit(cache=True, error_model="numpy")
@@ -335,28 +490,39 @@ def scatter_floes(owners, bounds, start, nbr, n):
 
 
 @njit(cache=True, error_model="numpy")
-def pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-              dt_history, fbuf, tbuf):
+def pair_chunks(verlet, n_chunks):
+    """The list's owners cut into ``n_chunks`` chunks of the parallel pair
+    loop (:func:`owner_chunks`) with the floes they can write to their
+    private buffers (:func:`scatter_floes`)."""
+    owners, bounds = owner_chunks(verlet.start, n_chunks)
+    shared = scatter_floes(owners, bounds, verlet.start, verlet.nbr, verlet.start.shape[0] - 1)
+    return PairChunks(owners, bounds, shared)
+
+
+@njit(cache=True, error_model="numpy")
+def pair_task(k, chunks, floes, law, box, verlet, dt_history, buffers):
     """Chunk k of the parallel pair loop (:func:`pair_forces_parallel`, a
     task of :func:`team_member`): :func:`owner_pairs` over the k-th run of
     owners of :func:`owner_chunks`, into the shared buffers fbuf[0],
     tbuf[0] for the floes of its :func:`chunk_range` and into its private
     buffers fbuf[k + 1], tbuf[k + 1] for the others (with one chunk,
     every floe is in its range)."""
+    owners, bounds = chunks.owners, chunks.bounds
+    fbuf, tbuf = buffers.force, buffers.torque
     run = owners[bounds[k]:bounds[k + 1]]
-    lo, hi = chunk_range(k, owners, bounds, pos.shape[0])
+    lo, hi = chunk_range(k, owners, bounds, floes.pos.shape[0])
     b = min(k + 1, fbuf.shape[0] - 1)
-    owner_pairs(0, run.shape[0], run, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                hist, dt_history, fbuf[0], tbuf[0], lo, hi, fbuf[b], tbuf[b])
+    owner_pairs(0, run.shape[0], run, floes, law, box, verlet, dt_history, fbuf[0], tbuf[0], lo,
+                hi, fbuf[b], tbuf[b])
 
 
 @njit(cache=True, error_model="numpy")
 def force_buffers(n_chunks, n):
-    """Zeroed force and torque buffers (fbuf (B, N, 2), tbuf (B, N)) for a
+    """Zeroed :class:`ForceBuffers` (fbuf (B, N, 2), tbuf (B, N)) for a
     pair loop in ``n_chunks`` chunks: the shared buffer 0, then a private
     buffer per chunk if there are two or more (:func:`pair_task`)."""
     n_buf = n_chunks + 1 if n_chunks > 1 else 1
-    return np.zeros((n_buf, n, 2)), np.zeros((n_buf, n))
+    return ForceBuffers(np.zeros((n_buf, n, 2)), np.zeros((n_buf, n)))
 
 
 # Parallel kernels that other compiled kernels call are never cached on disk
@@ -365,33 +531,31 @@ def force_buffers(n_chunks, n):
 # process that loads it (seen with numba 0.68). Compiled in the same process
 # as its caller, the callee is embedded in the caller's (cached) code.
 @njit(cache=False, parallel=True, error_model="numpy")
-def pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr,
-                         hist, dt_history, fbuf, tbuf):
+def pair_forces_parallel(chunks, floes, law, box, verlet, dt_history, buffers):
     """:func:`owner_pairs` over the chunks of :func:`owner_chunks` in
     parallel (:func:`pair_task`): race-free (see the module docstring)."""
-    for c in prange(bounds.shape[0] - 1):
-        pair_task(c, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist,
-                  dt_history, fbuf, tbuf)
+    for c in prange(chunks.bounds.shape[0] - 1):
+        pair_task(c, chunks, floes, law, box, verlet, dt_history, buffers)
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt_history,
-                         force, torque):
+def wall_forces_parallel(floes, wall_law, box, dt_history, force, torque):
     """:func:`wall_forces` over all floes in parallel chunks (each floe only
     touches its own rows: no race)."""
-    n = radius.shape[0]
+    n = floes.radius.shape[0]
     for c in prange(N_CHUNKS):
-        wall_forces(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, pos, vel, omega, radius,
-                    inv_mass, cp, box, wall_hist, dt_history, force, torque)
+        wall_forces(c * n // N_CHUNKS, (c + 1) * n // N_CHUNKS, floes, wall_law, box, dt_history,
+                    force, torque)
 
 
 @njit(cache=True, error_model="numpy")
-def gather_buffers(i_lo, i_hi, fbuf, tbuf, shared):
+def gather_buffers(i_lo, i_hi, buffers, shared):
     """Add the private force buffers b >= 1 of floes i_lo..i_hi-1 into
     buffer 0 and clear them. Only the floes listed in ``shared`` (sorted;
     :func:`scatter_floes`) can hold non-zero entries, and only non-zero
     entries are reset: a line left clean stays in the cache of the pair-loop
     thread that reads it next."""
+    fbuf, tbuf = buffers.force, buffers.torque
     for k in range(np.searchsorted(shared, i_lo), np.searchsorted(shared, i_hi)):
         i = shared[k]
         for b in range(1, fbuf.shape[0]):
@@ -415,48 +579,55 @@ KICK_FASTMATH = {"reassoc"}
 
 
 @njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy")
-def first_half(i_lo, i_hi, dt_kick, dt, pos, vel, omega, force, torque, inv_mass, inv_inertia,
-               lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
-    """Kick–drift of floes i_lo..i_hi−1 with their forces ``force``,
-    ``torque``, their displacement since the list build, and their new drag
-    forces.
+def first_half(floes, ref, drive, kick):
+    """Kick–drift of the floes ``floes`` (all of them, or the views of a
+    run of them) with their forces ``floes.force``, ``floes.torque``, their
+    displacement since the list build, and their new drag forces.
 
-    Kick by ``dt_kick`` with the last forces, drift by Δt, affine remap by
-    (sx, sy) of a deforming box and periodic wrap; frozen floes (inverse
-    mass 0) keep their state. Afterwards ``force``, ``torque`` hold the drag
-    force (it needs only the new half-step velocities; done here to save a
-    pass over memory; zero when ``has_drag`` is false, i.e. without
-    forcing), ready for the pair loop to add to. ``ref`` (the positions at
-    the build) is remapped with the box. Returns (largest squared distance
-    of a displacement from (cx, cy), sum of the displacements along x, along
-    y, largest squared speed); a NaN anywhere in the new positions or
-    velocities makes the sums or the maxima NaN.
+    Kick by ``kick.dt_kick`` with the last forces, drift by Δt, affine remap
+    by (sx, sy) of a deforming box and periodic wrap (:class:`Kick`);
+    frozen floes (inverse mass 0) keep their state. Afterwards the forces
+    hold the drag force of ``drive`` (it needs only the new half-step
+    velocities; done here to save a pass over memory; zero when
+    ``drive.active`` is false, i.e. without forcing), ready for the pair
+    loop to add to. ``ref`` (the floes' positions at the build) is remapped
+    with the box. Returns (largest squared distance of a displacement from
+    (cx, cy), sum of the displacements along x, along y, largest squared
+    speed); a NaN anywhere in the new positions or velocities makes the
+    sums or the maxima NaN.
 
     The loop body has no branch and no call (selects for the frozen floes,
     the wrap and the minimum image; maxima over the bits of non-negative
     floats, :func:`order_key`), and the (N, k) arrays are read as flat
     arrays: so it vectorises (AVX2/AVX-512), about 2.7 times as fast as the
     scalar loop (34 against 94 µs for 20000 floes on one thread,
-    ``python -m physics.bench phases``). Its per-floe arithmetic is the same in the vector body
-    and in the scalar remainder, so the new state does not depend on how the
-    floes are cut into chunks; only the sums are reassociated."""
+    ``python -m benchmarks.hertz_phases``). Its per-floe arithmetic is the
+    same in the vector body and in the scalar remainder, so the new state
+    does not depend on how the floes are cut into chunks; only the sums are
+    reassociated."""
+    omega, torque = floes.omega, floes.torque
+    inv_mass, inv_inertia = floes.inv_mass, floes.inv_inertia
+    dt_kick, dt = kick.dt_kick, kick.dt
+    lx, ly, px, py = kick.lx, kick.ly, kick.periodic_x, kick.periodic_y
+    sx, sy, cx, cy = kick.sx, kick.sy, kick.cx, kick.cy
+    n = inv_mass.shape[0]
     if sx != 1.0 or sy != 1.0:
-        for i in range(i_lo, i_hi):
+        for i in range(n):
             ref[i, 0] *= sx
             ref[i, 1] *= sy
-    uax, uay, uwx, uwy = fv[FV_UAX], fv[FV_UAY], fv[FV_UWX], fv[FV_UWY]
-    wind_speed = math.sqrt(uax * uax + uay * uay)
-    on = 1.0 if has_drag else 0.0
-    p = pos.reshape(-1)
-    v = vel.reshape(-1)
-    f = force.reshape(-1)
+    uax, uay, uwx, uwy = drive.wind_x, drive.wind_y, drive.current_x, drive.current_y
+    wind_speed = drive.wind_speed
+    on = 1.0 if drive.active else 0.0
+    p = floes.pos.reshape(-1)
+    v = floes.vel.reshape(-1)
+    f = floes.force.reshape(-1)
     r = ref.reshape(-1)
-    k = drag.reshape(-1)
+    k = drive.coefficients.reshape(-1)
     vmax2 = np.uint64(0)
     worst = np.uint64(0)
     sdx = 0.0
     sdy = 0.0
-    for i in range(i_lo, i_hi):
+    for i in range(n):
         im = inv_mass[i]
         mobile = im != 0.0
         x0 = p[2 * i]
@@ -526,21 +697,36 @@ def combine_chunks(part):
     return worst, sx, sy, vmax2
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def floe_rows(floes, lo, hi, buffers):
+    """Floes lo..hi−1 of ``floes`` (views) with their rows of the shared
+    force buffer (buffer 0 of ``buffers``) as their forces."""
+    f = floes
+    return Floes(f.pos[lo:hi], f.vel[lo:hi], f.omega[lo:hi], f.radius[lo:hi], f.inv_mass[lo:hi],
+                 f.inv_inertia[lo:hi], f.rank[lo:hi], buffers.force[0, lo:hi],
+                 buffers.torque[0, lo:hi], f.wall_hist[lo:hi])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def drive_rows(drive, lo, hi):
+    """``drive`` with the coefficients of floes lo..hi−1 only (a view)."""
+    d = drive
+    return Drive(d.coefficients[lo:hi], d.wind_x, d.wind_y, d.current_x, d.current_y,
+                 d.wind_speed, d.active)
+
+
 @njit(cache=True, error_model="numpy")
-def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass, inv_inertia,
-              lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part):
+def kick_task(k, n_tasks, floes, buffers, shared, ref, drive, kick, part):
     """Part k of a parallel kick–drift pass (:func:`first_half_parallel`, a
     task of :func:`team_member`): :func:`gather_buffers` and
     :func:`first_half` over the k-th of ``n_tasks`` equal runs of floes,
     its results in part[k]."""
-    n = pos.shape[0]
+    n = floes.pos.shape[0]
     lo = k * n // n_tasks
     hi = (k + 1) * n // n_tasks
-    gather_buffers(lo, hi, fbuf, tbuf, shared)
-    w, sx_, sy_, v2 = first_half(0, hi - lo, dt_kick, dt, pos[lo:hi], vel[lo:hi], omega[lo:hi],
-                                 fbuf[0, lo:hi], tbuf[0, lo:hi], inv_mass[lo:hi],
-                                 inv_inertia[lo:hi], lx, ly, px, py, sx, sy, ref[lo:hi], cx, cy,
-                                 drag[lo:hi], fv, has_drag)
+    gather_buffers(lo, hi, buffers, shared)
+    w, sx_, sy_, v2 = first_half(floe_rows(floes, lo, hi, buffers), ref[lo:hi],
+                                 drive_rows(drive, lo, hi), kick)
     part[k, 0] = w
     part[k, 1] = sx_
     part[k, 2] = sy_
@@ -548,11 +734,13 @@ def kick_task(k, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def first_half_parallel(n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
-                        inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag):
-    """:func:`first_half` over all floes in parallel (no race), each thread
-    first adding up its floes' private pair-force buffers
-    (:func:`gather_buffers`).
+def first_half_parallel(n_tasks, floes, buffers, shared, ref, drive, kick):
+    """:func:`first_half` over all floes in parallel (no race), kicking
+    with the shared force buffer (buffer 0 of ``buffers``; ``floes.force``
+    is not used), each thread first adding up its floes' private pair-force
+    buffers (:func:`gather_buffers`). ``shared`` lists the floes that can
+    have private entries (:func:`scatter_floes`); ``ref`` are the positions
+    at the list build.
 
     The floes are cut into ``n_tasks`` consecutive runs (a few per
     thread, :data:`KICK_TASKS_PER_THREAD`); the runtime gives each thread
@@ -575,8 +763,7 @@ def first_half_parallel(n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, share
     does not vectorise (2.5 times as slow)."""
     part = np.empty((n_tasks, 4))
     for t in prange(n_tasks):
-        kick_task(t, n_tasks, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
-                  inv_inertia, lx, ly, px, py, sx, sy, ref, cx, cy, drag, fv, has_drag, part)
+        kick_task(t, n_tasks, floes, buffers, shared, ref, drive, kick, part)
     return combine_chunks(part)
 
 
@@ -586,42 +773,45 @@ def pass_status(worst, mx, my, vmax2, dt, skin):
     (:func:`first_half`): non-finite state, or a floe that crossed half the
     skin in one step (the dynamics blew up), or OK."""
     if not math.isfinite(worst + mx + my + vmax2):
-        return STATUS_NONFINITE
+        return _NON_FINITE
     if vmax2 * dt * dt > 0.25 * skin * skin:
-        return STATUS_UNSTABLE
-    return STATUS_OK
+        return _UNSTABLE
+    return _OK
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
+def list_expired(worst, lx, ly, verlet):
     """Whether the Verlet list may miss a pair: twice the largest
     displacement since the build, plus what a shrinking box takes off the
     distances (up to the longest cut-off), reaches the skin."""
+    ref_lengths = verlet.ref_lengths
     shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
-    return 2.0 * math.sqrt(worst) + shrink * max_cut >= skin
+    return 2.0 * math.sqrt(worst) + shrink * verlet.max_cut >= verlet.skin
 
 
 @njit(cache=True, error_model="numpy")
-def team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt, time,
-                lx0, ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp,
-                box, max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist,
-                ref, ref_lengths, cx, cy, fbuf, tbuf):
+def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
+                chunks, buffers):
     """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
-    periodic box, each a kick–drift phase of ``n_kick`` tasks and a pair
-    phase of ``n_threads`` tasks (the chunks of :func:`owner_chunks`, each
-    with its private force buffer), with a ``sync`` array each
-    (:mod:`physics.thread_team`).
+    periodic box, each a kick–drift phase of ``team.n_kick`` tasks and a
+    pair phase of ``team.n_threads`` tasks (the chunks of
+    :func:`owner_chunks`, each with its private force buffer), with a
+    ``sync`` array each (:mod:`physics.thread_team`).
 
     Every thread makes the same decisions (stop, rebuild) from the same
-    partial results ``part`` of the kick pass. The thread that takes the
-    token writes (steps done, status, reason, centre x, centre y) to
-    ``out``."""
-    n = pos.shape[0]
-    px = box[BOX_PX] != 0.0
-    py = box[BOX_PY] != 0.0
-    deform = box[BOX_DEFORM] != 0.0
+    partial results ``team.part`` of the kick pass. The thread that takes
+    the token writes (steps done, status, reason, centre x, centre y) to
+    ``team.out``."""
+    n_threads, n_kick = team.n_threads, team.n_kick
+    sync_kick, sync_pair, part, out = team.sync_kick, team.sync_pair, team.part, team.out
+    n = floes.pos.shape[0]
+    px = box.periodic_x
+    py = box.periodic_y
+    deform = box.deforming
     lx_old, ly_old = lx0, ly0
-    status = STATUS_OK
+    cx = verlet.centre[0]
+    cy = verlet.centre[1]
+    status = _OK
     reason = TEAM_ALL_DONE
     done = 0
     gk = 0                                  # generation of the kick phase
@@ -629,43 +819,41 @@ def team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, 
     for s in range(n_steps):
         if deform:
             lx, ly, conc = box_lengths_at(box, time + (step0 + s + 1) * dt)
-            if conc >= max_concentration or conc <= 0.0:
-                status = STATUS_CONCENTRATION
+            if conc >= box.max_concentration or conc <= 0.0:
+                status = _CONCENTRATION_LIMIT
                 break
         else:
             lx, ly = lx_old, ly_old
         dt_kick = 0.5 * dt if step0 + s == 0 else dt
+        kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, cx, cy)
         gk += 1
         for m in range(n_kick):
             k = task_order(t, m, n_threads, n_kick)     # its own tasks first
             if claim(sync_kick, k, gk):
                 if k == 0:
                     # only the pair phase reads the box lengths
-                    box[BOX_LX] = lx
-                    box[BOX_LY] = ly
-                kick_task(k, n_kick, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
-                          inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, cx, cy,
-                          drag, fv, has_drag, part)
+                    box.lengths[0] = lx
+                    box.lengths[1] = ly
+                kick_task(k, n_kick, floes, buffers, chunks.shared, verlet.ref, drive, kick, part)
                 task_done(sync_kick, n_kick)
         wait_generation(sync_kick, n_kick, gk)
         worst, mx, my, vmax2 = combine_chunks(part)
         if overtaken(sync_kick, n_kick, gk):
             return                          # left behind: the others finish the run
         done += 1
-        status = pass_status(worst, mx, my, vmax2, dt, skin)
-        if status != STATUS_OK:
+        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
+        if status != _OK:
             break
         cx = mx / n
         cy = my / n
-        if list_expired(worst, lx, ly, ref_lengths, max_cut, skin):
+        if list_expired(worst, lx, ly, verlet):
             reason = TEAM_REBUILD
             break
         gp += 1
         for m in range(n_threads):
             k = task_order(t, m, n_threads, n_threads)
             if claim(sync_pair, k, gp):
-                pair_task(k, owners, bounds, pos, vel, omega, radius, inv_mass, cp, box, start,
-                          nbr, hist, dt, fbuf, tbuf)
+                pair_task(k, chunks, floes, law, box, verlet, dt, buffers)
                 task_done(sync_pair, n_threads)
         wait_generation(sync_pair, n_threads, gp)
         lx_old, ly_old = lx, ly
@@ -678,26 +866,26 @@ def team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, 
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def team_steps(n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt, time, lx0,
-               ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv, has_drag, cp, box,
-               max_concentration, skin, max_cut, owners, bounds, shared, start, nbr, hist, ref,
-               ref_lengths, cx, cy, fbuf, tbuf):
+def team_steps(team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet, chunks,
+               buffers):
     """Steps of a periodic box by a team of threads that stays in one
     parallel region (:func:`team_member`; :mod:`physics.thread_team`) until
     the run ends or the Verlet list must be rebuilt. Same arithmetic, in
     the same order, as the step of :func:`run_steps` with
     :func:`first_half_parallel` and :func:`pair_forces_parallel`: the new
-    state is the same bit for bit."""
-    for t in prange(n_threads):
-        team_member(t, n_threads, n_kick, sync_kick, sync_pair, part, out, n_steps, step0, dt,
-                    time, lx0, ly0, pos, vel, omega, radius, inv_mass, inv_inertia, drag, fv,
-                    has_drag, cp, box, max_concentration, skin, max_cut, owners, bounds, shared,
-                    start, nbr, hist, ref, ref_lengths, cx, cy, fbuf, tbuf)
+    state is the same bit for bit. (lx0, ly0) are the box lengths before
+    the first step (the team writes the new ones into ``box.lengths``)."""
+    for t in prange(team.n_threads):
+        team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
+                    chunks, buffers)
 
 
 @njit(cache=True, error_model="numpy")
-def half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt):
-    """v += Δt/2 F/m, ω += Δt/2 T/I (the last half kick of a run)."""
+def half_kick(floes, dt):
+    """v += Δt/2 F/m, ω += Δt/2 T/I with the floes' forces (the last half
+    kick of a run)."""
+    vel, omega, force, torque = floes.vel, floes.omega, floes.force, floes.torque
+    inv_mass, inv_inertia = floes.inv_mass, floes.inv_inertia
     h = 0.5 * dt
     for i in range(vel.shape[0]):
         vel[i, 0] += h * force[i, 0] * inv_mass[i]
@@ -706,162 +894,155 @@ def half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt):
 
 
 @njit(cache=True, error_model="numpy")
-def rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size, start, nbr, hist, parallel):
-    """New Verlet list with the contact history carried over.
-
-    Returns (start, nbr, hist, ref) where ``ref`` is a copy of the positions
-    at the build.
-    """
+def rebuild(floes, verlet, lx, ly, px, py, parallel):
+    """A new Verlet list at the floes' positions in a box of lengths
+    (lx, ly), with the contact history of ``verlet`` carried over, the
+    positions at the build copied and the displacement centre reset."""
+    pos, radius, rank = floes.pos, floes.radius, floes.rank
+    skin, cell_size = verlet.skin, verlet.cell_size
+    expected = verlet.nbr.shape[0]
     if parallel:
         new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size,
-                                             nbr.shape[0])
+                                             expected)
     else:
         new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin,
-                                                    cell_size, nbr.shape[0])
-    new_hist = transfer_history(start, nbr, hist, new_start, new_nbr, 2)
-    return new_start, new_nbr, new_hist, pos.copy()
+                                                    cell_size, expected)
+    new_hist = transfer_history(verlet.start, verlet.nbr, verlet.hist, new_start, new_nbr, 2)
+    ref_lengths = np.empty(2)
+    ref_lengths[0] = lx
+    ref_lengths[1] = ly
+    return VerletList(new_start, new_nbr, new_hist, pos.copy(), ref_lengths, np.zeros(2), skin,
+                      cell_size, verlet.max_cut)
 
 
 @njit(cache=True, error_model="numpy")
-def run_steps(n_steps, dt, time, pos, vel, omega, force, torque, radius, rank, inv_mass,
-              inv_inertia, drag, fv, cp, box, max_concentration,
-              skin, cell_size, max_cut, start, nbr, hist, ref, ref_lengths, centre, wall_hist,
-              parallel, n_pair):
+def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
     first half kick of the next are done together (leapfrog form); the state
-    returned is synchronised (velocities at full steps) and ``force``,
-    ``torque`` hold the forces of the last step. ``box`` is updated in place
-    for a deforming box; the Verlet list is rebuilt whenever the
-    displacement criterion of :mod:`physics.neighbors` could be violated.
+    returned is synchronised (velocities at full steps) and
+    ``floes.force``, ``floes.torque`` hold the forces of the last step.
+    ``box.lengths`` is updated in place for a deforming box; the Verlet
+    list is rebuilt whenever the displacement criterion of
+    :mod:`physics.neighbors` could be violated.
 
     ``n_pair`` is the number of chunks of the pair loop of the parallel
     path (the number of threads; 1 for the serial path), each with a
     private force buffer; its kick–drift pass has
     :data:`KICK_TASKS_PER_THREAD` tasks per chunk.
 
-    Returns (steps done, status, n_rebuilds, start, nbr, hist, ref). A
-    non-zero status stops the run early: non-finite state, a blow-up, or a
-    deforming box at its concentration limit.
+    Returns (steps done, status (a :class:`HertzStatus` value), number of
+    list rebuilds, the Verlet list now). A status other than OK stops the
+    run early: non-finite state, a blow-up, or a deforming box at its
+    concentration limit.
     """
-    px = box[BOX_PX] != 0.0
-    py = box[BOX_PY] != 0.0
+    px = box.periodic_x
+    py = box.periodic_y
     walls = not (px and py)
-    n = pos.shape[0]
-    has_drag = np.any(drag != 0.0)
+    lengths = box.lengths
+    n = floes.pos.shape[0]
     n_pair = n_pair if parallel else 1
     n_kick = n_pair * KICK_TASKS_PER_THREAD if parallel else 1
-    fbuf, tbuf = force_buffers(n_pair, n)
-    fbuf[0] = force
-    tbuf[0] = torque
+    buffers = force_buffers(n_pair, n)
+    buffers.force[0] = floes.force
+    buffers.torque[0] = floes.torque
+    # the serial kick–drift pass kicks with buffer 0
+    work = floe_rows(floes, 0, n, buffers)
     n_rebuilds = 0
-    owners, bounds = owner_chunks(start, n_pair)
-    shared = scatter_floes(owners, bounds, start, nbr, n)
+    chunks = pair_chunks(verlet, n_pair)
     done = 0
-    status = STATUS_OK
+    status = _OK
     # parallel path in a periodic box: a team of threads that stays in one
     # parallel region between list rebuilds; the serial path and boxes with
     # walls kick one step at a time. Both end a step whose list expired with
     # the same rebuild and pair loop.
-    team = parallel and not walls
-    sync_kick = np.zeros(sync_size(n_kick), dtype=np.int64)
-    sync_pair = np.zeros(sync_size(n_pair), dtype=np.int64)
-    part = np.empty((n_kick, 4))
-    out = np.empty(5)
+    use_team = parallel and not walls
+    team = Team(n_pair, n_kick, np.zeros(sync_size(n_kick), dtype=np.int64),
+                np.zeros(sync_size(n_pair), dtype=np.int64), np.empty((n_kick, 4)), np.empty(5))
     step = 0
     while step < n_steps:
-        if team:
-            sync_kick[:] = 0
-            sync_pair[:] = 0
-            team_steps(n_pair, n_kick, sync_kick, sync_pair, part, out, n_steps - step, step, dt,
-                       time, box[BOX_LX], box[BOX_LY], pos, vel, omega, radius, inv_mass,
-                       inv_inertia, drag, fv, has_drag, cp, box, max_concentration, skin, max_cut,
-                       owners, bounds, shared, start, nbr, hist, ref, ref_lengths, centre[0],
-                       centre[1], fbuf, tbuf)
+        if use_team:
+            team.sync_kick[:] = 0
+            team.sync_pair[:] = 0
+            team_steps(team, n_steps - step, step, dt, time, lengths[0], lengths[1], floes, law,
+                       drive, box, verlet, chunks, buffers)
+            out = team.out
             k = int(out[0])
             status = int(out[1])
-            centre[0] = out[3]
-            centre[1] = out[4]
+            verlet.centre[0] = out[3]
+            verlet.centre[1] = out[4]
             done += k
             step += k
-            if status != STATUS_OK or int(out[2]) != TEAM_REBUILD:
+            if status != _OK or int(out[2]) != TEAM_REBUILD:
                 break
             # the team stopped after the kick of a step whose list expired:
             # rebuild and finish that step below
-            lx, ly = box[BOX_LX], box[BOX_LY]
+            lx, ly = lengths[0], lengths[1]
             expired = True
         else:
-            lx_old, ly_old = box[BOX_LX], box[BOX_LY]
+            lx_old, ly_old = lengths[0], lengths[1]
             lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
-            if box[BOX_DEFORM] != 0.0 and (conc >= max_concentration or conc <= 0.0):
-                status = STATUS_CONCENTRATION
+            if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
+                status = _CONCENTRATION_LIMIT
                 break
-            box[BOX_LX] = lx
-            box[BOX_LY] = ly
+            lengths[0] = lx
+            lengths[1] = ly
             dt_kick = 0.5 * dt if step == 0 else dt
+            kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, verlet.centre[0],
+                        verlet.centre[1])
             if parallel:
-                worst, mx, my, vmax2 = first_half_parallel(
-                    n_kick, dt_kick, dt, pos, vel, omega, fbuf, tbuf, shared, inv_mass,
-                    inv_inertia, lx, ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0],
-                    centre[1], drag, fv, has_drag)
+                worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
+                                                           verlet.ref, drive, kick)
             else:
-                worst, mx, my, vmax2 = first_half(
-                    0, n, dt_kick, dt, pos, vel, omega, fbuf[0], tbuf[0], inv_mass, inv_inertia,
-                    lx, ly, px, py, lx / lx_old, ly / ly_old, ref, centre[0], centre[1], drag,
-                    fv, has_drag)
+                worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick)
             done += 1
             step += 1
-            status = pass_status(worst, mx, my, vmax2, dt, skin)
-            if status != STATUS_OK:
+            status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
+            if status != _OK:
                 break
             if walls:
                 if parallel:
-                    wall_forces_parallel(pos, vel, omega, radius, inv_mass, cp, box, wall_hist,
-                                         dt, fbuf[0], tbuf[0])
+                    wall_forces_parallel(floes, wall_law, box, dt, buffers.force[0],
+                                         buffers.torque[0])
                 else:
-                    wall_forces(0, n, pos, vel, omega, radius, inv_mass, cp, box, wall_hist, dt,
-                                fbuf[0], tbuf[0])
-            centre[0] = mx / n
-            centre[1] = my / n
-            expired = list_expired(worst, lx, ly, ref_lengths, max_cut, skin)
+                    wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
+                                buffers.torque[0])
+            verlet.centre[0] = mx / n
+            verlet.centre[1] = my / n
+            expired = list_expired(worst, lx, ly, verlet)
         if expired:
-            start, nbr, hist, ref = rebuild(pos, radius, rank, lx, ly, px, py, skin, cell_size,
-                                            start, nbr, hist, parallel)
-            ref_lengths[0] = lx
-            ref_lengths[1] = ly
-            centre[0] = 0.0
-            centre[1] = 0.0
-            owners, bounds = owner_chunks(start, n_pair)
-            shared = scatter_floes(owners, bounds, start, nbr, n)
+            verlet = rebuild(floes, verlet, lx, ly, px, py, parallel)
+            chunks = pair_chunks(verlet, n_pair)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces
         if parallel:
-            pair_forces_parallel(owners, bounds, pos, vel, omega, radius, inv_mass, cp, box,
-                                 start, nbr, hist, dt, fbuf, tbuf)
+            pair_forces_parallel(chunks, floes, law, box, verlet, dt, buffers)
         else:
-            owner_pairs(0, owners.shape[0], owners, pos, vel, omega, radius, inv_mass, cp, box,
-                        start, nbr, hist, dt, fbuf[0], tbuf[0], 0, n, fbuf[0], tbuf[0])
+            owners = chunks.owners
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,
+                        buffers.force[0], buffers.torque[0], 0, n, buffers.force[0],
+                        buffers.torque[0])
     # total force of the last step, and the closing half kick
-    force[:] = fbuf.sum(axis=0)
-    torque[:] = tbuf.sum(axis=0)
+    floes.force[:] = buffers.force.sum(axis=0)
+    floes.torque[:] = buffers.torque.sum(axis=0)
     if done > 0:
-        half_kick(vel, omega, force, torque, inv_mass, inv_inertia, dt)
-    return done, status, n_rebuilds, start, nbr, hist, ref
+        half_kick(floes, dt)
+    return done, status, n_rebuilds, verlet
 
 
 @njit(cache=True, error_model="numpy")
-def contact_list(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist):
+def contact_list(floes, law, box, verlet):
     """All touching pairs at the current state, without changing the history.
 
     Returns arrays: i, j (int), and per contact (nx, ny, delta, f_normal,
     f_tangential, fx, fy, torque_i, torque_j) as a (K, 9) float array.
     """
-    lx, ly = box[BOX_LX], box[BOX_LY]
-    px, py = box[BOX_PX] != 0.0, box[BOX_PY] != 0.0
-    kn, kt, alpha, gt, mu = cp[CP_KN], cp[CP_KT], cp[CP_ALPHA], cp[CP_GT], cp[CP_MU]
-    limit = cp[CP_LIMIT] != 0.0
-    tt = cp[CP_TT]
+    pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
+                                         floes.inv_mass)
+    start, nbr, hist = verlet.start, verlet.nbr, verlet.hist
+    lx, ly = box.lengths[0], box.lengths[1]
+    px, py = box.periodic_x, box.periodic_y
     n = radius.shape[0]
     m = nbr.shape[0]
     ii = np.empty(m, dtype=np.int64)
@@ -874,8 +1055,7 @@ def contact_list(pos, vel, omega, radius, inv_mass, cp, box, start, nbr, hist):
             res = pair_contact(minimum_image(pos[j, 0] - pos[i, 0], lx, px),
                                minimum_image(pos[j, 1] - pos[i, 1], ly, py), radius[i], radius[j],
                                vel[i, 0] - vel[j, 0], vel[i, 1] - vel[j, 1], omega[i], omega[j],
-                               inv_mass[i] + inv_mass[j], hist[p, 0], hist[p, 1], 0.0, kn, kt,
-                               alpha, gt, mu, limit, tt)
+                               inv_mass[i] + inv_mass[j], hist[p, 0], hist[p, 1], 0.0, law)
             if res[0]:
                 ii[k] = i
                 jj[k] = j

@@ -280,6 +280,8 @@ def relax_floes(positions, radii, box: PeriodicBox, *, max_iter: int = 200000,
     force_tol : largest net force on a floe, relative to the mean contact
         force, below which a jammed state is balanced
 
+    Notes
+    -----
     Returns a :class:`RelaxResult`; ``status`` says which criterion ended it.
     """
     pos, r = _check_input(positions, radii, box)

@@ -8,6 +8,15 @@ import pytest
 
 from physics import HERMAN2013, Forcing, HertzSimulation, make_floe_field
 from physics import hertz_kernels as K
+from physics.engine import FailureReason, SimulationError
+
+
+def _floes(pos, vel, omega, force, torque, inv_mass, inv_inertia):
+    """A floe bundle of the kernels around these arrays (radii, ranks and
+    wall history, which the kick–drift pass does not read, are dummies)."""
+    n = pos.shape[0]
+    return K.Floes(pos, vel, omega, np.ones(n), inv_mass, inv_inertia, np.arange(n), force, torque,
+                   np.zeros((n, 4, 2)))
 
 
 def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
@@ -28,27 +37,30 @@ def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
     fbuf = rng.normal(0.0, 1e3, (2, n, 2))
     tbuf = rng.normal(0.0, 1e3, (2, n))
     shared = np.flatnonzero(rng.random(n) < 0.3)
-    fv = np.array([6.0, -3.0, 0.0, 0.0])
+    drive = K.make_drive(sim._drag, (6.0, -3.0))
+    kick = K.Kick(0.002, 0.002, box.lx, box.ly, True, True, 1.0, 1.0, 0.01, -0.02)
     ref = sim.positions + rng.normal(0.0, 0.05, (n, 2))
 
     def fresh_state():
         return [sim.positions.copy(), sim.velocities.copy(), sim.angular_velocities.copy(),
                 fbuf.copy(), tbuf.copy()]
 
-    def run(kernel, *lead):
+    def bundles(state):
+        return (_floes(*state[:3], state[3][0], state[4][0], sim.inv_mass, sim.inv_inertia),
+                K.ForceBuffers(state[3], state[4]))
+
+    def run(kernel, n_tasks):
         state = fresh_state()
-        out = kernel(*lead, 0.002, 0.002, *state, shared, sim.inv_mass, sim.inv_inertia,
-                     box.lx, box.ly, True, True, 1.0, 1.0, ref.copy(), 0.01, -0.02, sim._drag,
-                     fv, True)
+        floes, buffers = bundles(state)
+        out = kernel(n_tasks, floes, buffers, shared, ref.copy(), drive, kick)
         return np.array(out), state
 
     def serial_pass():
         """The serial path: the buffers added up, then the kick of buffer 0."""
         state = fresh_state()
-        K.gather_buffers(0, n, state[3], state[4], shared)
-        out = K.first_half(0, n, 0.002, 0.002, *state[:3], state[3][0], state[4][0],
-                           sim.inv_mass, sim.inv_inertia, box.lx, box.ly, True, True, 1.0, 1.0,
-                           ref.copy(), 0.01, -0.02, sim._drag, fv, True)
+        floes, buffers = bundles(state)
+        K.gather_buffers(0, n, buffers, shared)
+        out = K.first_half(floes, ref.copy(), drive, kick)
         return np.array(out), state
 
     threads = numba.get_num_threads()
@@ -133,8 +145,9 @@ def test_kick_pass_matches_a_plain_numpy_pass_and_reports_nan():
 
     def compiled(v0):
         state = [pos.copy(), v0.copy(), omega.copy(), force.copy(), torque.copy()]
-        out = K.first_half(0, n, dt, dt, *state, inv_mass, inv_inertia, lx, ly, True, True, 1.0,
-                           1.0, ref.copy(), centre[0], centre[1], drag, fv, True)
+        out = K.first_half(_floes(*state, inv_mass, inv_inertia), ref.copy(),
+                           K.make_drive(drag, fv[:2], fv[2:]),
+                           K.Kick(dt, dt, lx, ly, True, True, 1.0, 1.0, centre[0], centre[1]))
         return state, out
 
     state, out = compiled(vel)
@@ -155,15 +168,20 @@ def test_kick_pass_matches_a_plain_numpy_pass_and_reports_nan():
 
 def test_a_blow_up_stops_the_run_at_once_on_both_paths():
     """A NaN velocity (either sign) or a floe flung across the box in one
-    step stops ``step`` with FloatingPointError after the first step, on
-    the serial and the parallel path."""
+    step stops ``step`` with a SimulationError (a FloatingPointError) of
+    the right reason after the first step, on the serial and the parallel
+    path."""
     floes, box = make_floe_field(400, concentration=0.5, alpha=1.8, mean_diameter=8.0, seed=3,
                                  velocity_std=0.05)
     for parallel in (False, True):
-        for value, kind in ((np.nan, "non-finite"), (-np.nan, "non-finite"),
-                            (2.0 * box.lx / 0.002, "unstable")):
+        for value, kind, reason in ((np.nan, "non-finite", FailureReason.NON_FINITE),
+                                    (-np.nan, "non-finite", FailureReason.NON_FINITE),
+                                    (2.0 * box.lx / 0.002, "unstable", FailureReason.UNSTABLE)):
             sim = HertzSimulation(floes, box, HERMAN2013.contact, None, 0.002, parallel=parallel)
-            sim.velocities[7, 0] = value
-            with pytest.raises(FloatingPointError, match=kind):
+            # the velocities setter refuses a NaN: plant it in the engine's own array
+            sim._vel[7, 0] = value
+            with pytest.raises(FloatingPointError, match=kind) as caught:
                 sim.step(50)
+            assert isinstance(caught.value, SimulationError)
+            assert caught.value.reason is reason and caught.value.time == sim.time
             assert sim.n_steps == 1
