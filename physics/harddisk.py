@@ -30,15 +30,22 @@ import numpy as np
 
 from . import harddisk_kernels as K
 from .domain import Box, PeriodicBox
-from .event_calendar import new_heap
+from .engine import FailureReason, SimulationError, checked_motion, engine_from_preset, snapshot
+from .event_calendar import new_calendar
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
+from .harddisk_kernels import HardDiskStatus
 from .observables import Contacts, Fabric, Stress, collision_stress, contacts_within, fabric
-from .params import check_range
+from .params import PaperPreset, check_range
 
-__all__ = ["HardDiskSimulation", "CollisionLog", "choose_cells"]
+__all__ = ["HardDiskSimulation", "HardDiskStatus", "CollisionLog", "choose_cells"]
 
 EVENTS_PER_CALL = 2_000_000     # events per kernel call (progress bar, Ctrl-C)
+
+
+def _new_log(on: bool, size: int) -> K.LogBuffer:
+    return K.LogBuffer(on, np.zeros(1, dtype=np.int64), np.zeros(size),
+                       np.zeros((size, 2), dtype=np.int64), np.zeros((size, 2)))
 
 
 @dataclass
@@ -85,13 +92,21 @@ def choose_cells(radii: np.ndarray, length: float, floes_per_cell: float = 1.5,
 class HardDiskSimulation:
     """Hard-disc floes with instantaneous inelastic collisions (Herman 2011).
 
+    It keeps the :class:`~physics.engine.FloeEngine` contract: the input
+    field is copied, ``positions``, ``velocities`` and
+    ``angular_velocities`` are read-only snapshots, wrong types raise
+    ``TypeError``, wrong values ``ValueError``, and a breakdown of the
+    physics during :meth:`advance` a :class:`~physics.engine.SimulationError`.
+
     Parameters
     ----------
     field : FloeField
         Floes (positions, radii, thickness, velocities, density, frozen
-        mask). Must not overlap. Frozen floes are immovable obstacles.
+        mask); copied, never modified. Must not overlap. Frozen floes are
+        immovable obstacles. Hard discs do not rotate: angular velocities
+        are ignored.
     box : PeriodicBox
-        A square periodic box (the only boundary of this engine).
+        A square, non-deforming periodic box (the only boundary of this engine).
     restitution : float
         ε in (0, 1] (Herman 2011: 0.85).
     forcing : Forcing or None
@@ -113,29 +128,44 @@ class HardDiskSimulation:
     ----------
     time : float
         Model time [s].
-    collision_count : int
-        Floe–floe collisions so far.
+    box : PeriodicBox
+    field : FloeField
+        The simulation's copy of the initial field.
+    radius, mass : (N,) arrays
+    L : float
+        Side of the box [m].
+
+    Raises
+    ------
+    TypeError
+        ``field`` not a :class:`~physics.floes.FloeField`, ``box`` not a
+        :class:`~physics.domain.PeriodicBox`, ``forcing`` neither a
+        :class:`~physics.forcing.Forcing` nor ``None``.
+    ValueError
+        A bad parameter, a deforming or non-square box, overlapping floes,
+        a box too small for the cell list, a non-zero Coriolis parameter.
     """
 
     def __init__(self, field: FloeField, box: Box, restitution: float = 0.85,
                  forcing: Forcing | None = None, max_velocity_step: float = 1.0,
                  collision_duration: float = 0.1, *, log_collisions: bool = False):
         if not isinstance(field, FloeField):
-            raise ValueError(f"field must be a FloeField, got {type(field).__name__}")
-        if not isinstance(box, PeriodicBox) or box.deforming:
-            raise ValueError("the hard-disc engine needs a (non-deforming) PeriodicBox")
+            raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
+        if not isinstance(box, PeriodicBox):
+            raise TypeError(f"the hard-disc engine needs a PeriodicBox, got {type(box).__name__}")
+        if box.deforming:
+            raise ValueError("the hard-disc engine needs a non-deforming PeriodicBox")
         if abs(box.lx - box.ly) > 1e-12 * box.lx:
-            raise ValueError(f"the hard-disc engine needs a square box, got {box.lx:g} x {box.ly:g} m")
+            raise ValueError(f"the hard-disc engine needs a square box, got "
+                             f"{box.lx:g} x {box.ly:g} m")
         check_range("restitution", restitution, 0.0, 1.0, low_open=True)
         check_range("max_velocity_step", max_velocity_step, 0.0, None, low_open=True)
         check_range("collision_duration", collision_duration, 0.0, None)
         if forcing is not None and not isinstance(forcing, Forcing):
-            raise ValueError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
-        f = field
-        n = f.n
+            raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
+        n = field.n
         if n < 2:
             raise ValueError(f"need at least 2 floes, got {n}")
-        self.field = f
         self.box = box
         self.L = float(box.lx)
         self.restitution = float(restitution)
@@ -143,64 +173,109 @@ class HardDiskSimulation:
         self.collision_duration = float(collision_duration)
         self.forcing = forcing
         self._check_coriolis()
-        self.radius = f.radii.copy()
-        self.mass = f.masses.copy()
 
-        pos = box.wrap(f.positions)
-        worst = max_overlap(pos, f.radii, box)
+        pos = box.wrap(field.positions)
+        worst = max_overlap(pos, field.radii, box)
         if worst > 1e-9:
             raise ValueError(f"hard discs must not overlap at the start: the worst overlap is "
                              f"{worst:.3g} of the smaller radius (physics.floes.place_floes "
                              f"places floes without overlap)")
-
-        # cell list
-        nc, cell, bigs = choose_cells(f.radii, self.L)
-        big_r = f.radii[bigs].max() if bigs.size else 0.0
+        nc, cell, bigs = choose_cells(field.radii, self.L)
+        big_r = field.radii[bigs].max() if bigs.size else 0.0
         if nc < 3 or (bigs.size and 2.0 * big_r / cell + 4 > nc):
             raise ValueError(
                 f"the box ({self.L:.4g} m) is too small for the floes: it must hold at least 3 "
-                f"cells of {2 * f.radii.max() if not bigs.size else cell:.4g} m and the largest "
-                f"floe (radius {f.radii.max():.4g} m) with 2 cells to spare")
-        self.n_cells, self.cell = nc, cell
-        self._bigs = bigs
-        self._big_rank = np.full(n, -1, dtype=np.int64)
-        self._big_rank[bigs] = np.arange(bigs.size)
-        self._bbox = np.zeros((max(bigs.size, 1), 4), dtype=np.int64)
-        self._head = np.full(nc * nc, -1, dtype=np.int64)
-        self._nxt = np.full(n, -1, dtype=np.int64)
-        self._prv = np.full(n, -1, dtype=np.int64)
-        self._cell_of = np.full(n, -1, dtype=np.int64)
-        self._cix = np.zeros(n, dtype=np.int64)
-        self._ciy = np.zeros(n, dtype=np.int64)
-        self._cover = np.zeros((nc * nc, 8), dtype=np.int64)
-        self._cover_n = np.zeros(nc * nc, dtype=np.int64)
+                f"cells of {2 * field.radii.max() if not bigs.size else cell:.4g} m and the "
+                f"largest floe (radius {field.radii.max():.4g} m) with 2 cells to spare")
 
-        # state
-        self._pos = pos.copy()
-        self._vel = f.velocities.copy()
-        self._inv_mass = np.where(f.frozen, 0.0, 1.0 / self.mass)
-        self._t_loc = np.zeros(n)
-        self._count = np.zeros(n, dtype=np.int64)
-        self._ev_partner = np.full(n, K.EV_NONE, dtype=np.int64)
-        self._ev_count = np.zeros(n, dtype=np.int64)
-        self._heap, self._where, self._key = new_heap(n)
-        self._last_coll = np.full(n, -np.inf)
-        self._rapid = np.zeros((n, 2))
-        self._rapid[:, 0] = -np.inf
+        self.field = f = field.copy()
+        self.radius = f.radii.copy()
+        self.mass = f.masses.copy()
+        self.n_cells, self.cell = nc, cell
+        rank = np.full(n, -1, dtype=np.int64)
+        rank[bigs] = np.arange(bigs.size)
+        self._cells = K.Cells(
+            side=float(cell), n=int(nc), length=self.L, head=np.full(nc * nc, -1, dtype=np.int64),
+            nxt=np.full(n, -1, dtype=np.int64), prv=np.full(n, -1, dtype=np.int64),
+            cell_of=np.full(n, -1, dtype=np.int64), cix=np.zeros(n, dtype=np.int64),
+            ciy=np.zeros(n, dtype=np.int64))
+        self._cover = K.Cover(
+            rank=rank, floes=bigs, bbox=np.zeros((max(bigs.size, 1), 4), dtype=np.int64),
+            lists=np.zeros((nc * nc, 8), dtype=np.int64), sizes=np.zeros(nc * nc, dtype=np.int64))
+        self._discs = K.Discs(
+            pos=pos.copy(), vel=f.velocities.copy(), t_loc=np.zeros(n),
+            radius=self.radius, inv_mass=np.where(f.frozen, 0.0, 1.0 / self.mass),
+            changes=np.zeros(n, dtype=np.int64), last_collision=np.full(n, -np.inf),
+            rapid_time=np.full(n, -np.inf), rapid_run=np.zeros(n, dtype=np.int64))
+        self._calendar = new_calendar(n, K.EV_NONE)
+        self._law = K.CollisionLaw(self.restitution, self.collision_duration)
         self._counters = np.zeros(K.N_COUNTERS, dtype=np.int64)
         self._acc = np.zeros(K.N_ACC)
         self.time = 0.0
         self._next_sync = self.max_velocity_step
         self._t_drag = 0.0
-        self._log_on = bool(log_collisions)
+        self._log = _new_log(bool(log_collisions), 1024 if log_collisions else 1)
         self._log_t0 = 0.0
-        self._log_alloc(1024 if self._log_on else 1)
 
-        K.build_cells(self._pos, self._big_rank, self.cell, nc, self._head, self._nxt, self._prv,
-                      self._cell_of, self._cix, self._ciy, self._bbox, self.radius)
+        K.build_cells(self._discs, self._cells, self._cover)
         self._build_cover()
-        K.kinetic_tensor(self._vel, self._inv_mass, self._acc)
+        K.kinetic_tensor(self._discs, self._acc)
         self._reschedule()
+
+    @classmethod
+    def from_preset(cls, preset: PaperPreset, n: int | None = None,
+                    concentration: float | None = None, *, seed: int | None = 0,
+                    forcing: bool | Forcing | None = True, **kwargs) -> "HardDiskSimulation":
+        """A simulation of a paper preset's floes, contact and numerics.
+
+        The floes come from ``preset.floe_field(n, concentration, seed=seed)``
+        (:meth:`~physics.params.PaperPreset.floe_field`); the restitution is
+        ``preset.contact.restitution``, and ``max_velocity_step`` and
+        ``collision_duration`` are the preset's.
+
+        Parameters
+        ----------
+        preset : PaperPreset
+            E.g. :data:`~physics.params.HERMAN2011`.
+        n, concentration : optional
+            Number of floes and ice concentration (default: the preset's).
+        seed : int or None
+            Seed of the floe field.
+        forcing : bool, Forcing or None
+            True: the preset's wind and current
+            (:meth:`~physics.params.PaperPreset.make_forcing`); False or
+            None: free flight; a :class:`~physics.forcing.Forcing`: that one.
+        **kwargs
+            Parameters of the constructor (``restitution``,
+            ``max_velocity_step``, ``collision_duration``,
+            ``log_collisions``) replace the preset's; any other keyword goes
+            to :meth:`~physics.params.PaperPreset.floe_field` (e.g.
+            ``velocity_std``, ``repeat``).
+
+        Raises
+        ------
+        TypeError
+            ``preset`` not a :class:`~physics.params.PaperPreset`, or an
+            unknown keyword.
+        ValueError
+            A bad value (see the constructor), e.g. a preset with Coriolis.
+
+        Examples
+        --------
+        >>> from physics import HERMAN2011, HardDiskSimulation
+        >>> sim = HardDiskSimulation.from_preset(HERMAN2011, 300, 0.6, seed=1,
+        ...                                      velocity_std=0.01)
+        >>> sim.n_floes, sim.restitution, sim.collision_duration
+        (300, 0.85, 0.1)
+        >>> sim.advance(10.0)
+        >>> sim.collision_count > 0
+        True
+        """
+        def defaults(p):
+            return {"restitution": p.contact.restitution,
+                    "max_velocity_step": p.max_velocity_step,
+                    "collision_duration": p.collision_duration}
+        return engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, kwargs)
 
     # -- internals -------------------------------------------------------------
     def _check_coriolis(self):
@@ -209,56 +284,66 @@ class HardDiskSimulation:
             raise ValueError(f"the hard-disc engine has no Coriolis force (Herman 2011); "
                              f"got forcing.coriolis = {self.forcing.coriolis:g}, set it to 0")
 
-    def _log_alloc(self, size):
-        self._log_t = np.zeros(size)
-        self._log_ij = np.zeros((size, 2), dtype=np.int64)
-        self._log_j = np.zeros((size, 2))
-        self._log_n = 0
-
     def _grow_log(self):
-        size = 2 * self._log_t.shape[0]
-        for name in ("_log_t", "_log_ij", "_log_j"):
-            old = getattr(self, name)
-            new = np.zeros((size,) + old.shape[1:], dtype=old.dtype)
-            new[:old.shape[0]] = old
-            setattr(self, name, new)
+        old = self._log
+        new = _new_log(True, 2 * old.time.shape[0])
+        for name in ("time", "pair", "impulse"):
+            getattr(new, name)[:old.time.shape[0]] = getattr(old, name)
+        new.used[0] = old.used[0]
+        self._log = new
 
     def _build_cover(self):
         """Cover lists of the big floes, growing them until none is full."""
         while True:
-            self._counters[K.C_COVER_FULL] = 0
-            K.build_cover(self._bbox, self._bigs.size, self.n_cells, self._cover, self._cover_n,
-                          self._counters)
-            if self._counters[K.C_COVER_FULL] == 0:
+            self._counters[K.Counter.COVER_FULL] = 0
+            K.build_cover(self._cover, self.n_cells, self._counters)
+            if self._counters[K.Counter.COVER_FULL] == 0:
                 return
-            self._cover = np.zeros((self._cover.shape[0], 2 * self._cover.shape[1]),
-                                   dtype=np.int64)
+            lists = self._cover.lists
+            self._cover = self._cover._replace(
+                lists=np.zeros((lists.shape[0], 2 * lists.shape[1]), dtype=np.int64))
 
     def _reschedule(self):
-        self._count += 1        # every stored prediction is now stale
-        K.schedule_all(self.time, self._pos, self._vel, self.radius, self._t_loc, self._inv_mass,
-                       self._big_rank, self._bigs, self._bbox, self.cell, self.n_cells, self.L,
-                       self._head, self._nxt, self._cix, self._ciy, self._cover, self._cover_n,
-                       self._count,
-                       self._ev_partner, self._ev_count, self._heap, self._where, self._key,
+        self._discs.changes[:] += 1       # every stored prediction is now stale
+        K.schedule_all(self.time, self._discs, self._cells, self._cover, self._calendar,
                        self._counters)
 
-    def _drag_arrays(self):
+    def _drag(self) -> K.Drag:
         f = self.field
         if self.forcing is None:
-            return np.zeros(f.n), np.zeros((f.n, 2)), False
+            return K.Drag(False, self.max_velocity_step, np.zeros(f.n), np.zeros((f.n, 2)))
         tau = self.forcing.time_constant(f.radii, f.thickness, self.mass)
         u_eq = self.forcing.equilibrium_velocity(f.radii, f.thickness, self.mass)
         inv_tau = np.where(f.frozen, 0.0, 1.0 / tau)
-        return inv_tau, np.ascontiguousarray(u_eq), True
+        return K.Drag(True, self.max_velocity_step, inv_tau, np.ascontiguousarray(u_eq))
+
+    def _failure(self, status: HardDiskStatus, t: float) -> SimulationError:
+        if status is HardDiskStatus.COLLAPSE:
+            return SimulationError(
+                f"inelastic collapse at t = {t:.9g} s: a floe collided "
+                f"{K.COLLAPSE_EVENTS} times in a row, each within {K.COLLAPSE_INTERVAL:g} s "
+                f"of the last (restitution {self.restitution:g}). Use the TC model: "
+                f"collision_duration > 0 (Herman 2011: 0.1 s)",
+                FailureReason.INELASTIC_COLLAPSE, t)
+        return SimulationError(f"non-finite event time at t = {t:.9g} s",
+                               FailureReason.NON_FINITE, t)
 
     # -- running -------------------------------------------------------------
     def advance(self, duration: float, *, progress: bool = False) -> None:
         """Advance by ``duration`` model seconds; afterwards every floe's
-        position is at :attr:`time`. ``progress=True`` shows a progress bar."""
+        position is at :attr:`time`. ``progress=True`` shows a progress bar.
+
+        Raises
+        ------
+        ValueError
+            A negative or non-finite ``duration``, or a forcing with Coriolis.
+        SimulationError
+            Inelastic collapse (TC model off) or a non-finite event time;
+            :attr:`~physics.engine.SimulationError.reason` says which.
+        """
         check_range("duration", duration, 0.0, None)
         self._check_coriolis()
-        inv_tau, u_eq, has_drag = self._drag_arrays()
+        drag = self._drag()
         t_end = self.time + float(duration)
         bar = None
         if progress:
@@ -268,115 +353,115 @@ class HardDiskSimulation:
         t_start = self.time
         try:
             while True:
-                status, t, self._next_sync, self._t_drag, self._log_n = K.run_events(
-                    self.time, t_end, self._next_sync, self.max_velocity_step, EVENTS_PER_CALL,
-                    self._pos, self._vel, self.radius, self._t_loc, self._inv_mass,
-                    self._big_rank, self._bigs, self._bbox, self.cell, self.n_cells, self.L,
-                    self._head, self._nxt, self._prv, self._cell_of, self._cix, self._ciy,
-                    self._cover, self._cover_n, self._count, self._ev_partner, self._ev_count, self._heap, self._where,
-                    self._key, self._last_coll, self._rapid, self.restitution,
-                    self.collision_duration, inv_tau, u_eq, has_drag, self._t_drag, self._acc,
-                    self._counters, self._log_t, self._log_ij, self._log_j, self._log_n,
-                    self._log_on)
+                status, t, self._next_sync, self._t_drag = K.run_events(
+                    self.time, t_end, self._next_sync, self._t_drag, EVENTS_PER_CALL,
+                    self._discs, self._cells, self._cover, self._calendar, self._law, drag,
+                    self._log, self._acc, self._counters)
+                status = HardDiskStatus(status)
                 self.time = t
                 if bar is not None:
                     bar.n = min(t - t_start, float(duration))
                     bar.refresh()
-                if status == K.STATUS_DONE:
+                if status is HardDiskStatus.DONE:
                     self.time = t_end
                     break
-                if status == K.STATUS_LOG_FULL:
+                if status is HardDiskStatus.LOG_FULL:
                     self._grow_log()
-                elif status == K.STATUS_COVER_FULL:
+                elif status is HardDiskStatus.COVER_FULL:
                     self._build_cover()
                     self._reschedule()
-                elif status == K.STATUS_COLLAPSE:
-                    raise RuntimeError(
-                        f"inelastic collapse at t = {t:.9g} s: a floe collided "
-                        f"{K.COLLAPSE_EVENTS} times in a row, each within {K.COLLAPSE_INTERVAL:g} s "
-                        f"of the last (restitution {self.restitution:g}). Use the TC model: "
-                        f"collision_duration > 0 (Herman 2011: 0.1 s)")
-                elif status == K.STATUS_NONFINITE:
-                    raise FloatingPointError(f"non-finite event time at t = {t:.9g} s")
+                elif status in (HardDiskStatus.COLLAPSE, HardDiskStatus.NONFINITE):
+                    raise self._failure(status, t)
         finally:
             if bar is not None:
                 bar.close()
 
     # -- state -----------------------------------------------------------------
     @property
-    def n(self) -> int:
+    def n_floes(self) -> int:
+        """Number of floes N."""
         return self.field.n
 
     @property
     def positions(self) -> np.ndarray:
-        """(N, 2) floe centres at :attr:`time`, wrapped into the box (a copy)."""
-        dt = self.time - self._t_loc
-        return np.mod(self._pos + self._vel * dt[:, None], self.L)
+        """(N, 2) floe centres at :attr:`time`, wrapped into the box; a
+        read-only snapshot."""
+        d = self._discs
+        dt = self.time - d.t_loc
+        return snapshot(np.mod(d.pos + d.vel * dt[:, None], self.L))
 
     @property
     def velocities(self) -> np.ndarray:
-        """(N, 2) floe velocities (a copy; assign to change them)."""
-        return self._vel.copy()
+        """(N, 2) floe velocities [m/s]; a read-only snapshot (assign a
+        whole array to change them)."""
+        return snapshot(self._discs.vel)
 
     @velocities.setter
     def velocities(self, value):
-        v = np.asarray(value, dtype=float)
-        if v.shape != self._vel.shape or not np.all(np.isfinite(v)):
-            raise ValueError(f"velocities must be a finite array of shape {self._vel.shape}")
-        if np.any(self.field.frozen & (np.hypot(*v.T) > 0)):
-            raise ValueError("frozen floes must have zero velocity")
-        K.sync_all(self.time, self._pos, self._vel, self._t_loc)
-        self._vel[:] = v
+        vel = self._discs.vel
+        v = checked_motion("velocities", value, vel.shape, self.field.frozen, "velocity")
+        K.sync_all(self.time, self._discs)
+        vel[:] = v
         K.accumulate(self.time, self._acc)
-        K.kinetic_tensor(self._vel, self._inv_mass, self._acc)
+        K.kinetic_tensor(self._discs, self._acc)
         self._reschedule()
 
     @property
+    def angular_velocities(self) -> np.ndarray:
+        """(N,) zeros: hard discs do not rotate (read-only)."""
+        return snapshot(np.zeros(self.n_floes))
+
+    @property
     def collision_count(self) -> int:
-        return int(self._counters[K.C_COLLISIONS])
+        return int(self._counters[K.Counter.COLLISIONS])
 
     @property
     def diagnostics(self) -> dict:
         """Event counts: collisions, cell crossings, stale predictions, drag
         syncs, TC-model (elastic) collisions and round-off repairs."""
         c = self._counters
-        return dict(collisions=int(c[K.C_COLLISIONS]), crossings=int(c[K.C_CROSSINGS]),
-                    stale=int(c[K.C_STALE]), syncs=int(c[K.C_SYNCS]),
-                    tc_elastic=int(c[K.C_TC]), repairs_overlap=int(c[K.C_REPAIR_OVERLAP]),
-                    repairs_time=int(c[K.C_REPAIR_TIME]),
-                    energy_lost=float(self._acc[K.A_LOST]))
+        C = K.Counter
+        return dict(collisions=int(c[C.COLLISIONS]), crossings=int(c[C.CROSSINGS]),
+                    stale=int(c[C.STALE]), syncs=int(c[C.SYNCS]),
+                    tc_elastic=int(c[C.TC]), repairs_overlap=int(c[C.REPAIR_OVERLAP]),
+                    repairs_time=int(c[C.REPAIR_TIME]),
+                    energy_lost=float(self._acc[K.Acc.LOST]))
 
     @property
     def repairs(self) -> int:
         """Round-off repairs so far (overlapping approach collided at once,
         negative event time clamped)."""
-        return int(self._counters[K.C_REPAIR_OVERLAP] + self._counters[K.C_REPAIR_TIME])
+        return int(self._counters[K.Counter.REPAIR_OVERLAP]
+                   + self._counters[K.Counter.REPAIR_TIME])
 
     def kinetic_energy(self) -> float:
         """Σ m u²/2 of the mobile floes [J] (no rotation in this engine)."""
-        mobile = self._inv_mass > 0
-        return float(0.5 * np.sum(self.mass[mobile] * np.sum(self._vel[mobile] ** 2, axis=1)))
+        d = self._discs
+        mobile = d.inv_mass > 0
+        return float(0.5 * np.sum(self.mass[mobile] * np.sum(d.vel[mobile] ** 2, axis=1)))
 
     def momentum(self) -> np.ndarray:
         """Σ m u of the mobile floes [kg m/s]."""
-        mobile = self._inv_mass > 0
-        return (self.mass[mobile, None] * self._vel[mobile]).sum(axis=0)
+        d = self._discs
+        mobile = d.inv_mass > 0
+        return (self.mass[mobile, None] * d.vel[mobile]).sum(axis=0)
 
     # -- collision log and virial ----------------------------------------------
     @property
     def collision_log(self) -> CollisionLog:
         """The collisions since the start or :meth:`clear_collision_log`
         (needs ``log_collisions=True``)."""
-        if not self._log_on:
+        log = self._log
+        if not log.on:
             raise ValueError("the collision log is off; create the simulation with "
                              "log_collisions=True")
-        k = self._log_n
-        return CollisionLog(self._log_t[:k].copy(), self._log_ij[:k, 0].copy(),
-                            self._log_ij[:k, 1].copy(), self._log_j[:k].copy())
+        k = int(log.used[0])
+        return CollisionLog(log.time[:k].copy(), log.pair[:k, 0].copy(),
+                            log.pair[:k, 1].copy(), log.impulse[:k].copy())
 
     def clear_collision_log(self) -> None:
         """Empty the collision log; it starts a new window for :meth:`contact_stress`."""
-        self._log_n = 0
+        self._log.used[0] = 0
         self._log_t0 = self.time
 
     def contacts(self, gap: float = 0.01) -> Contacts:
@@ -387,7 +472,7 @@ class HardDiskSimulation:
 
     def fabric(self, gap: float = 0.01) -> Fabric:
         """Contact fabric of the pairs closer than ``gap`` [m] (see :meth:`contacts`)."""
-        return fabric(self.contacts(gap), self.n)
+        return fabric(self.contacts(gap), self.n_floes)
 
     def contact_stress(self, *, per_floe: bool = True) -> Stress:
         """Collision-virial stress over the collision log's window (since the
@@ -403,21 +488,23 @@ class HardDiskSimulation:
     def reset_stress(self) -> None:
         """Start a new averaging window for :meth:`stress`."""
         K.accumulate(self.time, self._acc)
-        self._acc[[K.A_IKXX, K.A_IKXY, K.A_IKYY, K.A_WXX, K.A_WXY, K.A_WYX, K.A_WYY]] = 0.0
-        self._acc[K.A_T0] = self.time
+        A = K.Acc
+        self._acc[[A.IKXX, A.IKXY, A.IKYY, A.WXX, A.WXY, A.WYX, A.WYY]] = 0.0
+        self._acc[A.T0] = self.time
 
     def stress(self) -> np.ndarray:
         """Mean stress tensor since the start or :meth:`reset_stress` [N/m],
         compression positive: σ = (⟨Σ m u⊗u⟩ + Σ_collisions r_ij ⊗ J_ij / T) / A,
         with r_ij the centre-to-centre vector at contact, J_ij the impulse on
         j and T the window length (the kinetic part is the time average)."""
-        span = self.time - self._acc[K.A_T0]
+        A = K.Acc
+        span = self.time - self._acc[A.T0]
         if span <= 0:
             raise ValueError("the averaging window is empty: advance the simulation first")
         K.accumulate(self.time, self._acc)
         a = self._acc
-        kin = np.array([[a[K.A_IKXX], a[K.A_IKXY]], [a[K.A_IKXY], a[K.A_IKYY]]]) / span
-        vir = np.array([[a[K.A_WXX], a[K.A_WXY]], [a[K.A_WYX], a[K.A_WYY]]]) / span
+        kin = np.array([[a[A.IKXX], a[A.IKXY]], [a[A.IKXY], a[A.IKYY]]]) / span
+        vir = np.array([[a[A.WXX], a[A.WXY]], [a[A.WYX], a[A.WYY]]]) / span
         return (kin + vir) / (self.L * self.L)
 
     def pressure(self) -> float:
@@ -425,9 +512,9 @@ class HardDiskSimulation:
         return float(0.5 * np.trace(self.stress()))
 
     def state(self) -> FloeField:
-        """A FloeField of the current state (e.g. to save or restart)."""
+        """The current state as a new FloeField (e.g. to save or restart)."""
         f = self.field
-        return FloeField(self.positions, f.radii.copy(), f.thickness.copy(), self._vel.copy(),
+        return FloeField(self.positions, f.radii, f.thickness, self._discs.vel,
                          density=f.density, frozen=f.frozen.copy())
 
     @property
@@ -435,5 +522,5 @@ class HardDiskSimulation:
         return float(np.sum(np.pi * self.radius ** 2) / self.L ** 2)
 
     def __repr__(self):
-        return (f"HardDiskSimulation(n={self.n}, L={self.L:.4g}, restitution={self.restitution:g}, "
-                f"time={self.time:.6g}, collisions={self.collision_count})")
+        return (f"HardDiskSimulation(n_floes={self.n_floes}, L={self.L:.4g}, "
+                f"restitution={self.restitution:g}, time={self.time:.6g}, collisions={self.collision_count})")

@@ -5,9 +5,9 @@ Floes move on straight lines between events. Each floe keeps its position
 an event touches only the floes it involves. Every floe has one pending
 event in the calendar (:mod:`physics.event_calendar`): its earliest
 predicted collision, or the next crossing of a cell boundary (a
-"virtual wall"). A prediction stores the partner's collision counter; when
-the partner has changed course since, the event is stale and is simply
-predicted again (no search over all pairs).
+"virtual wall"). A prediction stores the partner's count of course
+changes; when the partner has changed course since, the event is stale and
+is simply predicted again (no search over all pairs).
 
 Cell list for power-law sizes. The cell side is at least the diameter of
 every "small" floe; the "big" floes (the largest of the field, see
@@ -33,38 +33,250 @@ Round-off repairs (counted): a pair found overlapping while approaching is
 collided at once; a negative predicted time is clamped to zero. A floe that
 collides more than ``COLLAPSE_EVENTS`` times in a row, each within
 ``COLLAPSE_INTERVAL`` of the last, is in inelastic collapse: the run stops
-with a status code instead of hanging.
+with :attr:`HardDiskStatus.COLLAPSE` instead of hanging.
+
+The kernels take their arrays in named bundles (module-level named tuples,
+which Numba compiles as structures): :class:`Discs` (the floes' state),
+:class:`Cells` (the cell list), :class:`Cover` (the big floes and the cover
+lists), :class:`~physics.event_calendar.Calendar` (the pending events),
+:class:`CollisionLaw`, :class:`Drag` and :class:`LogBuffer` (the collision
+log). Event counts and running sums live in two arrays indexed by the
+:class:`Counter` and :class:`Acc` enumerations.
+
+The kernels allocate no arrays, so they are compiled without Numba's
+reference counting (``_nrt=False``): every array taken from a bundle would
+otherwise be counted in and out with atomic operations, which in the event
+loop cost more than the events themselves. A kernel that needs to allocate
+must not be added to this module.
 """
 from __future__ import annotations
 
 import math
+from enum import IntEnum
+from typing import NamedTuple
 
+import numpy as np
 from numba import njit
 
 from .event_calendar import heap_build, heap_update
 
-# event partner codes (ev_partner >= 0: collision with that floe)
+# event partner codes (Calendar.partner >= 0: collision with that floe)
 EV_CELL = -1        # virtual wall: cell crossing (small) or bounding-box change (big)
 EV_NONE = -2        # nothing can happen (floe at rest, alone)
-# status codes of run_events
-STATUS_DONE, STATUS_EVENTS, STATUS_LOG_FULL, STATUS_COLLAPSE, STATUS_NONFINITE, STATUS_COVER_FULL = range(6)
 COLLAPSE_INTERVAL = 1e-9   # [s] collisions of one floe closer than this count as rapid
 COLLAPSE_EVENTS = 20       # rapid collisions of one floe in a row that mean inelastic collapse
-# counters (int64 array) layout
-C_COLLISIONS, C_CROSSINGS, C_STALE, C_REPAIR_OVERLAP, C_REPAIR_TIME, C_SYNCS, C_TC, C_COVER_FULL = range(8)
-N_COUNTERS = 8
-# accumulators (float array): kinetic tensor Σ m v⊗v (xx, xy, yy), its time
-# integral, collision virial Σ r_ij ⊗ J_ij, time of the last accumulation,
-# start of the window, energy lost in collisions
-A_KXX, A_KXY, A_KYY, A_IKXX, A_IKXY, A_IKYY, A_WXX, A_WXY, A_WYX, A_WYY, A_TLAST, A_T0, A_LOST = range(13)
-N_ACC = 13
+
+
+class HardDiskStatus(IntEnum):
+    """Why :func:`run_events` returned."""
+
+    #: the end time was reached; every floe is at it
+    DONE = 0
+    #: the event budget of the call is spent; call again
+    EVENTS = 1
+    #: the collision log is full; grow it and call again
+    LOG_FULL = 2
+    #: inelastic collapse (see the module docstring)
+    COLLAPSE = 3
+    #: an event time is not finite
+    NONFINITE = 4
+    #: a cover list is full; grow the lists, rebuild them and predict again
+    COVER_FULL = 5
+
+
+class Counter(IntEnum):
+    """Slots of the int64 event-count array."""
+
+    COLLISIONS = 0
+    CROSSINGS = 1
+    STALE = 2
+    REPAIR_OVERLAP = 3
+    REPAIR_TIME = 4
+    SYNCS = 5
+    TC = 6
+    #: set (to 1) when a cover list overflows
+    COVER_FULL = 7
+
+
+class Acc(IntEnum):
+    """Slots of the float accumulator array: the kinetic tensor Σ m u⊗u
+    (KXX, KXY, KYY), its time integral (IKXX, IKXY, IKYY), the collision
+    virial Σ r_ij ⊗ J_ij (WXX, WXY, WYX, WYY), the time of the last
+    accumulation, the start of the averaging window and the energy lost in
+    collisions."""
+
+    KXX = 0
+    KXY = 1
+    KYY = 2
+    IKXX = 3
+    IKXY = 4
+    IKYY = 5
+    WXX = 6
+    WXY = 7
+    WYX = 8
+    WYY = 9
+    TLAST = 10
+    T0 = 11
+    LOST = 12
+
+
+N_COUNTERS = len(Counter)
+N_ACC = len(Acc)
+
+
+class Discs(NamedTuple):
+    """The floes' state, in delayed form (each floe at its own time).
+
+    Attributes
+    ----------
+    pos : (N, 2) float
+        Centre at time ``t_loc`` [m] (a big floe's may leave [0, L) while
+        its bounding box is consistent with it).
+    vel : (N, 2) float
+        Velocity [m/s].
+    t_loc : (N,) float
+        Time of the floe's last update [s].
+    radius : (N,) float
+    inv_mass : (N,) float
+        1/m, zero for frozen floes.
+    changes : (N,) int64
+        Course changes so far (collisions, drag updates, new predictions);
+        a prediction naming a partner whose count has changed is stale.
+    last_collision : (N,) float
+        Time of the last collision [s] (TC model).
+    rapid_time : (N,) float
+        Time of the last collision event [s] (collapse detection).
+    rapid_run : (N,) int64
+        Collision events in a row, each within ``COLLAPSE_INTERVAL`` of the last.
+    """
+
+    pos: np.ndarray
+    vel: np.ndarray
+    t_loc: np.ndarray
+    radius: np.ndarray
+    inv_mass: np.ndarray
+    changes: np.ndarray
+    last_collision: np.ndarray
+    rapid_time: np.ndarray
+    rapid_run: np.ndarray
+
+
+class Cells(NamedTuple):
+    """Cell list of the small floes (doubly linked lists per cell).
+
+    Attributes
+    ----------
+    side : float
+        Cell side [m].
+    n : int
+        Cells per side of the box (nc; cell ``cy * nc + cx``).
+    length : float
+        Side L of the periodic square box [m].
+    head : (nc², ) int64
+        First floe of each cell (−1: empty).
+    nxt, prv : (N,) int64
+        Next and previous floe in the same cell (−1: none).
+    cell_of : (N,) int64
+        Cell of each small floe (−1 for big floes).
+    cix, ciy : (N,) int64
+        Cell column and row of each small floe.
+    """
+
+    side: float
+    n: int
+    length: float
+    head: np.ndarray
+    nxt: np.ndarray
+    prv: np.ndarray
+    cell_of: np.ndarray
+    cix: np.ndarray
+    ciy: np.ndarray
+
+
+class Cover(NamedTuple):
+    """The big floes and the cells their bounding boxes cover.
+
+    Attributes
+    ----------
+    rank : (N,) int64
+        Rank b of each big floe among the big ones, −1 for small floes.
+    floes : (B,) int64
+        Index of big floe b.
+    bbox : (max(B, 1), 4) int64
+        Cell range ``ix0, ix1, iy0, iy1`` of the bounding box of big floe b
+        (unwrapped, consistent with its centre).
+    lists : (nc², capacity) int64
+        Cover list of each cell: the ranks b of the big floes whose bounding
+        box grown by one cell holds the cell.
+    sizes : (nc²,) int64
+        Length of each cover list.
+    """
+
+    rank: np.ndarray
+    floes: np.ndarray
+    bbox: np.ndarray
+    lists: np.ndarray
+    sizes: np.ndarray
+
+
+class CollisionLaw(NamedTuple):
+    """Restitution ε in (0, 1] and the TC model's collision duration Δt_c [s]
+    (0: off)."""
+
+    restitution: float
+    duration: float
+
+
+class Drag(NamedTuple):
+    """Stokes drag towards each floe's free-drift velocity.
+
+    Attributes
+    ----------
+    on : bool
+        False: free flight (no velocity updates).
+    step : float
+        Δt_max [s] between velocity updates.
+    inv_tau : (N,) float
+        1/τ_i [1/s], zero for frozen floes.
+    u_eq : (N, 2) float
+        Free-drift velocity u_eq,i [m/s].
+    """
+
+    on: bool
+    step: float
+    inv_tau: np.ndarray
+    u_eq: np.ndarray
+
+
+class LogBuffer(NamedTuple):
+    """The collision log's storage.
+
+    Attributes
+    ----------
+    on : bool
+        Record collisions.
+    used : (1,) int64
+        Entries written.
+    time : (K,) float
+        Time of each collision [s].
+    pair : (K, 2) int64
+        The floes i, j.
+    impulse : (K, 2) float
+        Impulse on j [N s].
+    """
+
+    on: bool
+    used: np.ndarray
+    time: np.ndarray
+    pair: np.ndarray
+    impulse: np.ndarray
 
 
 # ---------------------------------------------------------------------------
 # Pointwise geometry
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def wrap_delta(d, length):
     """Minimum image of a displacement (periodic side of ``length``)."""
     if d > 0.5 * length:
@@ -74,7 +286,7 @@ def wrap_delta(d, length):
     return d
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def collision_time(dx, dy, dvx, dvy, sigma):
     """Time until two discs at separation (dx, dy) = x_j − x_i with relative
     velocity (dvx, dvy) = u_j − u_i touch at centre distance ``sigma``.
@@ -95,7 +307,7 @@ def collision_time(dx, dy, dvx, dvy, sigma):
     return c / (-b + math.sqrt(disc)), 0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def line_crossing(x, v, lo, hi):
     """Time for a coordinate x moving at v to leave [lo, hi]; returns
     (t, +1 or −1 for the side, 0 if never)."""
@@ -106,7 +318,7 @@ def line_crossing(x, v, lo, hi):
     return math.inf, 0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def in_range(c, lo, hi, nc):
     """Is cell index c (0..nc−1) in the periodic range lo..hi (lo may be
     negative or hi ≥ nc; hi − lo < nc)?"""
@@ -117,33 +329,36 @@ def in_range(c, lo, hi, nc):
 # Cell lists (doubly linked, small floes only)
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, inline="always", error_model="numpy")
-def cell_insert(i, c, head, nxt, prv, cell_of):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def cell_insert(i, c, cells):
+    head = cells.head
     h = head[c]
-    nxt[i] = h
-    prv[i] = -1
+    cells.nxt[i] = h
+    cells.prv[i] = -1
     if h >= 0:
-        prv[h] = i
+        cells.prv[h] = i
     head[c] = i
-    cell_of[i] = c
+    cells.cell_of[i] = c
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def cell_remove(i, head, nxt, prv, cell_of):
-    c = cell_of[i]
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def cell_remove(i, cells):
+    nxt = cells.nxt
+    prv = cells.prv
+    c = cells.cell_of[i]
     p = prv[i]
     q = nxt[i]
     if p >= 0:
         nxt[p] = q
     else:
-        head[c] = q
+        cells.head[c] = q
     if q >= 0:
         prv[q] = p
     nxt[i] = -1
     prv[i] = -1
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def wrap_cell(c, nc):
     """Cell index c (at most one box length off) into 0..nc−1."""
     if c >= nc:
@@ -153,60 +368,67 @@ def wrap_cell(c, nc):
     return c
 
 
-@njit(cache=True, error_model="numpy")
-def cover_line(b, kx0, kx1, ky0, ky1, add, nc, cover, cover_n, counters):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def cover_line(b, kx0, kx1, ky0, ky1, add, nc, cover, counters):
     """Add big floe b to (or remove it from) the cover lists of the cells
     kx0..kx1 × ky0..ky1 (unwrapped indices). A full list sets the
-    C_COVER_FULL counter (the caller grows the lists and rebuilds them)."""
-    cap = cover.shape[1]
+    ``Counter.COVER_FULL`` counter (the caller grows the lists and rebuilds them)."""
+    lists = cover.lists
+    sizes = cover.sizes
+    cap = lists.shape[1]
     for ky in range(ky0, ky1 + 1):
         row = (ky % nc) * nc
         for kx in range(kx0, kx1 + 1):
             c = row + kx % nc
-            m = cover_n[c]
+            m = sizes[c]
             if add:
                 if m < cap:
-                    cover[c, m] = b
-                    cover_n[c] = m + 1
+                    lists[c, m] = b
+                    sizes[c] = m + 1
                 else:
-                    counters[C_COVER_FULL] = 1
+                    counters[Counter.COVER_FULL] = 1
             else:
                 for q in range(m):
-                    if cover[c, q] == b:
-                        cover[c, q] = cover[c, m - 1]
-                        cover_n[c] = m - 1
+                    if lists[c, q] == b:
+                        lists[c, q] = lists[c, m - 1]
+                        sizes[c] = m - 1
                         break
 
 
-@njit(cache=True, error_model="numpy")
-def build_cover(bbox, n_big, nc, cover, cover_n, counters):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def build_cover(cover, nc, counters):
     """Cover lists from scratch: every big floe in the cells of its bounding
     box grown by one cell."""
-    cover_n[:] = 0
-    for b in range(n_big):
+    bbox = cover.bbox
+    cover.sizes[:] = 0
+    for b in range(cover.floes.shape[0]):
         cover_line(b, bbox[b, 0] - 1, bbox[b, 1] + 1, bbox[b, 2] - 1, bbox[b, 3] + 1, True, nc,
-                   cover, cover_n, counters)
+                   cover, counters)
 
 
-@njit(cache=True, error_model="numpy")
-def build_cells(pos, big_rank, cell, nc, head, nxt, prv, cell_of, cix, ciy, bbox, radius):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def build_cells(d, cells, cover):
     """Put small floes into cells by their centres and set the bounding-box
     cell ranges of big floes (``bbox[b] = ix0, ix1, iy0, iy1``, unwrapped,
     consistent with pos of the big floe)."""
-    head[:] = -1
-    nxt[:] = -1
-    prv[:] = -1
+    pos = d.pos
+    cell = cells.side
+    nc = cells.n
+    bbox = cover.bbox
+    cells.head[:] = -1
+    cells.nxt[:] = -1
+    cells.prv[:] = -1
     for i in range(pos.shape[0]):
-        b = big_rank[i]
+        b = cover.rank[i]
         if b < 0:
             cx = min(int(pos[i, 0] / cell), nc - 1)
             cy = min(int(pos[i, 1] / cell), nc - 1)
-            cix[i] = cx
-            ciy[i] = cy
-            cell_insert(i, cy * nc + cx, head, nxt, prv, cell_of)
+            cells.cix[i] = cx
+            cells.ciy[i] = cy
+            cell_insert(i, cy * nc + cx, cells)
         else:
-            cell_of[i] = -1
-            r = radius[i]
+            cells.cell_of[i] = -1
+            r = d.radius[i]
             bbox[b, 0] = int(math.floor((pos[i, 0] - r) / cell))
             bbox[b, 1] = int(math.floor((pos[i, 0] + r) / cell))
             bbox[b, 2] = int(math.floor((pos[i, 1] - r) / cell))
@@ -217,39 +439,48 @@ def build_cells(pos, big_rank, cell, nc, head, nxt, prv, cell_of, cix, ciy, bbox
 # Prediction
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel, radius, t_loc, inv_mass, L, best, best_j):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _try_pair(i, j, t, xi, yi, vxi, vyi, ri, d, L, best, best_j):
     """Collision time of i (at (xi, yi) at time t) with j; keeps the earliest."""
+    inv_mass = d.inv_mass
     if inv_mass[i] == 0.0 and inv_mass[j] == 0.0:
         return best, best_j, 0
-    dtj = t - t_loc[j]
+    pos = d.pos
+    vel = d.vel
+    dtj = t - d.t_loc[j]
     dx = wrap_delta(pos[j, 0] + vel[j, 0] * dtj - xi, L)
     dy = wrap_delta(pos[j, 1] + vel[j, 1] * dtj - yi, L)
-    tc, rep = collision_time(dx, dy, vel[j, 0] - vxi, vel[j, 1] - vyi, ri + radius[j])
+    tc, rep = collision_time(dx, dy, vel[j, 0] - vxi, vel[j, 1] - vyi, ri + d.radius[j])
     if tc < best:
         return tc, j, rep
     return best, best_j, rep
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-            nxt, cix, ciy, cover, cover_n):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def predict(i, t, d, cells, cover):
     """Earliest event of floe i from time t: (time offset, partner or EV_CELL /
     EV_NONE, repair flag). ``t`` must not precede t_loc[i]."""
-    dti = t - t_loc[i]
-    vxi = vel[i, 0]
-    vyi = vel[i, 1]
-    xi = pos[i, 0] + vxi * dti
-    yi = pos[i, 1] + vyi * dti
-    ri = radius[i]
+    cell = cells.side
+    nc = cells.n
+    L = cells.length
+    head = cells.head
+    nxt = cells.nxt
+    bigs = cover.floes
+    bbox = cover.bbox
+    dti = t - d.t_loc[i]
+    vxi = d.vel[i, 0]
+    vyi = d.vel[i, 1]
+    xi = d.pos[i, 0] + vxi * dti
+    yi = d.pos[i, 1] + vyi * dti
+    ri = d.radius[i]
     best = math.inf
     best_j = EV_NONE
     repair = 0
     nb = bigs.shape[0]
-    b_i = big_rank[i]
+    b_i = cover.rank[i]
     if b_i < 0:
-        cx = cix[i]
-        cy = ciy[i]
+        cx = cells.cix[i]
+        cy = cells.ciy[i]
         # virtual walls: the boundaries of the floe's cell
         tx, sx = line_crossing(xi, vxi, cx * cell, (cx + 1) * cell)
         ty, sy = line_crossing(yi, vyi, cy * cell, (cy + 1) * cell)
@@ -262,14 +493,14 @@ def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
                 j = head[yy + wrap_cell(cx + ox, nc)]
                 while j >= 0:
                     if j != i:
-                        best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel,
-                                                      radius, t_loc, inv_mass, L, best, best_j)
+                        best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, d, L,
+                                                      best, best_j)
                         repair |= rep
                     j = nxt[j]
         c = cy * nc + cx
-        for q in range(cover_n[c]):
-            best, best_j, rep = _try_pair(i, bigs[cover[c, q]], t, xi, yi, vxi, vyi, ri, pos, vel,
-                                          radius, t_loc, inv_mass, L, best, best_j)
+        for q in range(cover.sizes[c]):
+            best, best_j, rep = _try_pair(i, bigs[cover.lists[c, q]], t, xi, yi, vxi, vyi, ri,
+                                          d, L, best, best_j)
             repair |= rep
     else:
         x0, x1, y0, y1 = bbox[b_i, 0], bbox[b_i, 1], bbox[b_i, 2], bbox[b_i, 3]
@@ -298,87 +529,78 @@ def predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
                     continue      # the whole cell is inside the disc: no centre there
                 j = head[yy * nc + kx % nc]
                 while j >= 0:
-                    best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, pos, vel,
-                                                  radius, t_loc, inv_mass, L, best, best_j)
+                    best, best_j, rep = _try_pair(i, j, t, xi, yi, vxi, vyi, ri, d, L,
+                                                  best, best_j)
                     repair |= rep
                     j = nxt[j]
         for b in range(nb):
             # other big floes whose grown rectangle meets this one's
             if b != b_i and (in_range(x0 % nc, bbox[b, 0] - x1 + x0 - 2, bbox[b, 1] + 2, nc)
                              and in_range(y0 % nc, bbox[b, 2] - y1 + y0 - 2, bbox[b, 3] + 2, nc)):
-                best, best_j, rep = _try_pair(i, bigs[b], t, xi, yi, vxi, vyi, ri, pos, vel,
-                                              radius, t_loc, inv_mass, L, best, best_j)
+                best, best_j, rep = _try_pair(i, bigs[b], t, xi, yi, vxi, vyi, ri, d, L,
+                                              best, best_j)
                 repair |= rep
     return best, best_j, repair
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L,
-                  head, nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, counters):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def predict_event(i, t, d, cells, cover, cal, counters):
     """Predict the next event of floe i from time t, store its partner and
-    the partner's collision counter, and return its time."""
-    dt, j, rep = predict(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc,
-                         L, head, nxt, cix, ciy, cover, cover_n)
+    the partner's count of course changes, and return its time."""
+    dt, j, rep = predict(i, t, d, cells, cover)
     if rep:
-        counters[C_REPAIR_OVERLAP] += 1
-    ev_partner[i] = j
-    ev_count[i] = count[j] if j >= 0 else 0
+        counters[Counter.REPAIR_OVERLAP] += 1
+    cal.partner[i] = j
+    cal.partner_changes[i] = d.changes[j] if j >= 0 else 0
     return t + dt
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def schedule(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-             nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
-             counters):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def schedule(i, t, d, cells, cover, cal, counters):
     """Predict the next event of floe i from time t and put it in the calendar."""
-    heap_update(heap, where, key, i,
-                predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox,
-                              cell, nc, L, head, nxt, cix, ciy, cover, cover_n, count,
-                              ev_partner, ev_count, counters))
+    heap_update(cal, i, predict_event(i, t, d, cells, cover, cal, counters))
 
 
-@njit(cache=True, error_model="numpy")
-def schedule_all(t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L, head,
-                 nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where, key,
-                 counters):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def schedule_all(t, d, cells, cover, cal, counters):
     """Predict every floe's next event from time t and rebuild the calendar."""
-    for i in range(pos.shape[0]):
-        key[i] = predict_event(i, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox,
-                               cell, nc, L, head, nxt, cix, ciy, cover, cover_n, count,
-                               ev_partner, ev_count, counters)
-    heap_build(heap, where, key)
+    for i in range(d.pos.shape[0]):
+        cal.time[i] = predict_event(i, t, d, cells, cover, cal, counters)
+    heap_build(cal)
 
 
 # ---------------------------------------------------------------------------
 # Event handlers
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, inline="always", error_model="numpy")
-def move_to(i, t, pos, vel, t_loc):
-    dt = t - t_loc[i]
-    pos[i, 0] += vel[i, 0] * dt
-    pos[i, 1] += vel[i, 1] * dt
-    t_loc[i] = t
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def move_to(i, t, d):
+    dt = t - d.t_loc[i]
+    d.pos[i, 0] += d.vel[i, 0] * dt
+    d.pos[i, 1] += d.vel[i, 1] * dt
+    d.t_loc[i] = t
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def kinetic_of(m, vx, vy):
     return m * vx * vx, m * vx * vy, m * vy * vy
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def accumulate(t, acc):
     """Advance the time integral of the kinetic tensor to time t."""
-    dt = t - acc[A_TLAST]
-    acc[A_IKXX] += acc[A_KXX] * dt
-    acc[A_IKXY] += acc[A_KXY] * dt
-    acc[A_IKYY] += acc[A_KYY] * dt
-    acc[A_TLAST] = t
+    dt = t - acc[Acc.TLAST]
+    acc[Acc.IKXX] += acc[Acc.KXX] * dt
+    acc[Acc.IKXY] += acc[Acc.KXY] * dt
+    acc[Acc.IKYY] += acc[Acc.KYY] * dt
+    acc[Acc.TLAST] = t
 
 
-@njit(cache=True, error_model="numpy")
-def kinetic_tensor(vel, inv_mass, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def kinetic_tensor(d, acc):
     """Recompute Σ m v⊗v of the mobile floes into acc."""
+    vel = d.vel
+    inv_mass = d.inv_mass
     kxx = 0.0
     kxy = 0.0
     kyy = 0.0
@@ -388,43 +610,47 @@ def kinetic_tensor(vel, inv_mass, acc):
             kxx += a
             kxy += b
             kyy += c
-    acc[A_KXX] = kxx
-    acc[A_KXY] = kxy
-    acc[A_KYY] = kyy
+    acc[Acc.KXX] = kxx
+    acc[Acc.KXY] = kxy
+    acc[Acc.KYY] = kyy
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def collide(i, j, t, pos, vel, inv_mass, L, restitution, last_coll, tc_duration, acc, counters):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def collide(i, j, t, d, L, law, acc, counters):
     """Instantaneous collision of i and j at time t (both moved to t).
     Returns (collided, Jx, Jy) with (Jx, Jy) the impulse on j; a pair that
     is not approaching (round-off) is left alone."""
+    pos = d.pos
+    vel = d.vel
+    inv_mass = d.inv_mass
+    last_coll = d.last_collision
     dx = wrap_delta(pos[j, 0] - pos[i, 0], L)
     dy = wrap_delta(pos[j, 1] - pos[i, 1], L)
-    d = math.sqrt(dx * dx + dy * dy)
-    nx = dx / d
-    ny = dy / d
+    dist = math.sqrt(dx * dx + dy * dy)
+    nx = dx / dist
+    ny = dy / dist
     approach = nx * (vel[i, 0] - vel[j, 0]) + ny * (vel[i, 1] - vel[j, 1])
     if approach <= 0.0:
         return False, 0.0, 0.0
-    eps = restitution
-    if t - last_coll[i] < tc_duration or t - last_coll[j] < tc_duration:
+    eps = law.restitution
+    if t - last_coll[i] < law.duration or t - last_coll[j] < law.duration:
         eps = 1.0
-        counters[C_TC] += 1
+        counters[Counter.TC] += 1
     last_coll[i] = t
     last_coll[j] = t
     imi = inv_mass[i]
     imj = inv_mass[j]
     J = (1.0 + eps) * approach / (imi + imj)
     # energy lost: (1 − ε²)/2 · μ · approach²
-    acc[A_LOST] += 0.5 * (1.0 - eps * eps) * approach * approach / (imi + imj)
+    acc[Acc.LOST] += 0.5 * (1.0 - eps * eps) * approach * approach / (imi + imj)
     # kinetic tensor: remove the old contributions, add the new ones
     for q in range(2):
         k = i if q == 0 else j
         if inv_mass[k] > 0.0:
             a, b, c = kinetic_of(1.0 / inv_mass[k], vel[k, 0], vel[k, 1])
-            acc[A_KXX] -= a
-            acc[A_KXY] -= b
-            acc[A_KYY] -= c
+            acc[Acc.KXX] -= a
+            acc[Acc.KXY] -= b
+            acc[Acc.KYY] -= c
     vel[i, 0] -= J * imi * nx
     vel[i, 1] -= J * imi * ny
     vel[j, 0] += J * imj * nx
@@ -433,18 +659,18 @@ def collide(i, j, t, pos, vel, inv_mass, L, restitution, last_coll, tc_duration,
         k = i if q == 0 else j
         if inv_mass[k] > 0.0:
             a, b, c = kinetic_of(1.0 / inv_mass[k], vel[k, 0], vel[k, 1])
-            acc[A_KXX] += a
-            acc[A_KXY] += b
-            acc[A_KYY] += c
+            acc[Acc.KXX] += a
+            acc[Acc.KXY] += b
+            acc[Acc.KYY] += c
     # collision virial: branch vector i→j (length r_i + r_j) ⊗ impulse on j
-    acc[A_WXX] += dx * J * nx
-    acc[A_WXY] += dx * J * ny
-    acc[A_WYX] += dy * J * nx
-    acc[A_WYY] += dy * J * ny
+    acc[Acc.WXX] += dx * J * nx
+    acc[Acc.WXY] += dx * J * ny
+    acc[Acc.WYX] += dy * J * nx
+    acc[Acc.WYY] += dy * J * ny
     return True, J * nx, J * ny
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def step_cell(c, s, nc, L):
     """Cell index after a step s = ±1 along one axis, and the shift of the
     coordinate that wraps with it at the periodic boundary."""
@@ -456,19 +682,23 @@ def step_cell(c, s, nc, L):
     return c, 0.0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt, prv, cell_of,
-          cix, ciy, cover, cover_n, counters):
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def cross(i, t, d, cells, cover, counters):
     """Virtual-wall event of floe i at time t: move it into the next cell (a
     small floe) or shift its bounding-box range (a big floe), wrapping at
     the periodic boundary."""
-    move_to(i, t, pos, vel, t_loc)
-    b = big_rank[i]
+    cell = cells.side
+    nc = cells.n
+    L = cells.length
+    pos = d.pos
+    vel = d.vel
+    move_to(i, t, d)
+    b = cover.rank[i]
     x = pos[i, 0]
     y = pos[i, 1]
     if b < 0:
-        cx = cix[i]
-        cy = ciy[i]
+        cx = cells.cix[i]
+        cy = cells.ciy[i]
         tx, sx = line_crossing(x, vel[i, 0], cx * cell, (cx + 1) * cell)
         ty, sy = line_crossing(y, vel[i, 1], cy * cell, (cy + 1) * cell)
         if tx <= ty:
@@ -477,12 +707,13 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
         else:
             cy, shift = step_cell(cy, sy, nc, L)
             pos[i, 1] += shift
-        cell_remove(i, head, nxt, prv, cell_of)
-        cix[i] = cx
-        ciy[i] = cy
-        cell_insert(i, cy * nc + cx, head, nxt, prv, cell_of)
+        cell_remove(i, cells)
+        cells.cix[i] = cx
+        cells.ciy[i] = cy
+        cell_insert(i, cy * nc + cx, cells)
     else:
-        r = radius[i]
+        bbox = cover.bbox
+        r = d.radius[i]
         x0, x1, y0, y1 = bbox[b, 0], bbox[b, 1], bbox[b, 2], bbox[b, 3]
         t1, s1 = line_crossing(x - r, vel[i, 0], x0 * cell, (x0 + 1) * cell)
         t2, s2 = line_crossing(x + r, vel[i, 0], x1 * cell, (x1 + 1) * cell)
@@ -494,19 +725,19 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
         if t1 == tm:
             bbox[b, 0] += s1
             kx = x0 - 1 if s1 > 0 else x0 - 2
-            cover_line(b, kx, kx, y0 - 1, y1 + 1, s1 < 0, nc, cover, cover_n, counters)
+            cover_line(b, kx, kx, y0 - 1, y1 + 1, s1 < 0, nc, cover, counters)
         elif t2 == tm:
             bbox[b, 1] += s2
             kx = x1 + 2 if s2 > 0 else x1 + 1
-            cover_line(b, kx, kx, y0 - 1, y1 + 1, s2 > 0, nc, cover, cover_n, counters)
+            cover_line(b, kx, kx, y0 - 1, y1 + 1, s2 > 0, nc, cover, counters)
         elif t3 == tm:
             bbox[b, 2] += s3
             ky = y0 - 1 if s3 > 0 else y0 - 2
-            cover_line(b, x0 - 1, x1 + 1, ky, ky, s3 < 0, nc, cover, cover_n, counters)
+            cover_line(b, x0 - 1, x1 + 1, ky, ky, s3 < 0, nc, cover, counters)
         else:
             bbox[b, 3] += s4
             ky = y1 + 2 if s4 > 0 else y1 + 1
-            cover_line(b, x0 - 1, x1 + 1, ky, ky, s4 > 0, nc, cover, cover_n, counters)
+            cover_line(b, x0 - 1, x1 + 1, ky, ky, s4 > 0, nc, cover, counters)
         # keep the centre in [0, L) and the ranges consistent with it
         for ax in range(2):
             shift = -1 if pos[i, ax] >= L else (1 if pos[i, ax] < 0.0 else 0)
@@ -516,19 +747,22 @@ def cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt,
                 bbox[b, 2 * ax + 1] += shift * nc
 
 
-@njit(cache=True, error_model="numpy")
-def sync_all(t, pos, vel, t_loc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def sync_all(t, d):
     """Move every floe to time t (positions stay in their cells: every
     crossing before t has been processed)."""
-    for i in range(pos.shape[0]):
-        move_to(i, t, pos, vel, t_loc)
+    for i in range(d.pos.shape[0]):
+        move_to(i, t, d)
 
 
-@njit(cache=True, error_model="numpy")
-def drag_update(dt, vel, inv_tau, u_eq):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def drag_update(dt, d, drag):
     """Linearly implicit Stokes relaxation over dt (eqs 13–14):
     u ← (u + (dt/τ) u_eq) / (1 + dt/τ). Frozen floes have inv_tau = 0 and
     stay at rest."""
+    vel = d.vel
+    inv_tau = drag.inv_tau
+    u_eq = drag.u_eq
     for i in range(vel.shape[0]):
         h = dt * inv_tau[i]
         if h > 0.0:
@@ -540,101 +774,96 @@ def drag_update(dt, vel, inv_tau, u_eq):
 # Main loop
 # ---------------------------------------------------------------------------
 
-@njit(cache=True, error_model="numpy")
-def run_events(t_now, t_end, next_sync, dt_max, max_events, pos, vel, radius, t_loc, inv_mass,
-               big_rank, bigs, bbox, cell, nc, L, head, nxt, prv, cell_of, cix, ciy, cover,
-               cover_n, count, ev_partner, ev_count, heap, where, key, last_coll, rapid, restitution,
-               tc_duration, inv_tau, u_eq, has_drag, t_drag, acc, counters, log_t, log_ij,
-               log_j, log_n, log_on):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def run_events(t_now, t_end, next_sync, t_drag, max_events, d, cells, cover, cal, law, drag,
+               log, acc, counters):
     """Process events from t_now until t_end (then every floe is moved to
     t_end), or until ``max_events`` events, or until the collision log is
     full. With drag, velocities are relaxed at every multiple of Δt_max
-    (``next_sync``) and all events predicted again.
+    (``next_sync``; ``t_drag`` is the time of the last relaxation) and all
+    events predicted again.
 
-    Returns (status, time reached, next_sync, t_drag, log_n). On
-    STATUS_EVENTS / STATUS_LOG_FULL the call can simply be repeated.
+    Returns (status, time reached, next_sync, t_drag), status a
+    :class:`HardDiskStatus`. On ``EVENTS`` / ``LOG_FULL`` the call can
+    simply be repeated.
     """
     t = t_now
     n_events = 0
-    status = STATUS_DONE
+    status = HardDiskStatus.DONE
+    changes = d.changes
     while True:
-        i = heap[0]
-        te = key[i]
-        stop = min(t_end, next_sync) if has_drag else t_end
+        i = cal.heap[0]
+        te = cal.time[i]
+        stop = min(t_end, next_sync) if drag.on else t_end
         if te >= stop:
-            if has_drag and next_sync <= t_end:
+            if drag.on and next_sync <= t_end:
                 # velocity update of every floe at the sync time
                 t = next_sync
                 accumulate(t, acc)
-                sync_all(t, pos, vel, t_loc)
-                drag_update(t - t_drag, vel, inv_tau, u_eq)
+                sync_all(t, d)
+                drag_update(t - t_drag, d, drag)
                 t_drag = t
-                for k in range(count.shape[0]):
-                    count[k] += 1
-                kinetic_tensor(vel, inv_mass, acc)
-                next_sync += dt_max
-                counters[C_SYNCS] += 1
-                schedule_all(t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell,
-                             nc, L, head, nxt, cix, ciy, cover, cover_n, count, ev_partner,
-                             ev_count, heap, where, key, counters)
+                for k in range(changes.shape[0]):
+                    changes[k] += 1
+                kinetic_tensor(d, acc)
+                next_sync += drag.step
+                counters[Counter.SYNCS] += 1
+                schedule_all(t, d, cells, cover, cal, counters)
                 continue
             t = t_end
             accumulate(t, acc)
-            sync_all(t, pos, vel, t_loc)
-            return STATUS_DONE, t, next_sync, t_drag, log_n
+            sync_all(t, d)
+            return HardDiskStatus.DONE, t, next_sync, t_drag
         if n_events >= max_events:
-            return STATUS_EVENTS, t, next_sync, t_drag, log_n
-        if log_on and log_n >= log_t.shape[0]:
-            return STATUS_LOG_FULL, t, next_sync, t_drag, log_n
+            return HardDiskStatus.EVENTS, t, next_sync, t_drag
+        if log.on and log.used[0] >= log.time.shape[0]:
+            return HardDiskStatus.LOG_FULL, t, next_sync, t_drag
         if not math.isfinite(te):
-            return STATUS_NONFINITE, t, next_sync, t_drag, log_n
+            return HardDiskStatus.NONFINITE, t, next_sync, t_drag
         if te < t:
-            counters[C_REPAIR_TIME] += 1
+            counters[Counter.REPAIR_TIME] += 1
             te = t
         t = te
         n_events += 1
-        j = ev_partner[i]
+        j = cal.partner[i]
         n_sched = 1
         if j >= 0:
-            if count[j] != ev_count[i]:
+            if changes[j] != cal.partner_changes[i]:
                 # stale: the partner changed course since the prediction
-                counters[C_STALE] += 1
+                counters[Counter.STALE] += 1
             else:
                 accumulate(t, acc)
-                move_to(i, t, pos, vel, t_loc)
-                move_to(j, t, pos, vel, t_loc)
-                hit, jx, jy = collide(i, j, t, pos, vel, inv_mass, L, restitution, last_coll,
-                                      tc_duration, acc, counters)
-                counters[C_COLLISIONS] += hit
-                count[i] += 1
-                count[j] += 1
+                move_to(i, t, d)
+                move_to(j, t, d)
+                hit, jx, jy = collide(i, j, t, d, cells.length, law, acc, counters)
+                counters[Counter.COLLISIONS] += hit
+                changes[i] += 1
+                changes[j] += 1
                 n_sched = 2
                 for k in range(2):
                     q = i if k == 0 else j
-                    if t - rapid[q, 0] < COLLAPSE_INTERVAL:
-                        rapid[q, 1] += 1
+                    if t - d.rapid_time[q] < COLLAPSE_INTERVAL:
+                        d.rapid_run[q] += 1
                     else:
-                        rapid[q, 1] = 0
-                    rapid[q, 0] = t
-                    if rapid[q, 1] >= COLLAPSE_EVENTS:
-                        status = STATUS_COLLAPSE
-                if log_on and hit:
-                    log_t[log_n] = t
-                    log_ij[log_n, 0] = i
-                    log_ij[log_n, 1] = j
-                    log_j[log_n, 0] = jx
-                    log_j[log_n, 1] = jy
-                    log_n += 1
+                        d.rapid_run[q] = 0
+                    d.rapid_time[q] = t
+                    if d.rapid_run[q] >= COLLAPSE_EVENTS:
+                        status = HardDiskStatus.COLLAPSE
+                if log.on and hit:
+                    slot = log.used[0]
+                    log.time[slot] = t
+                    log.pair[slot, 0] = i
+                    log.pair[slot, 1] = j
+                    log.impulse[slot, 0] = jx
+                    log.impulse[slot, 1] = jy
+                    log.used[0] = slot + 1
         elif j == EV_CELL:
-            cross(i, t, pos, vel, radius, t_loc, big_rank, bbox, cell, nc, L, head, nxt, prv,
-                  cell_of, cix, ciy, cover, cover_n, counters)
-            counters[C_CROSSINGS] += 1
-            if counters[C_COVER_FULL] != 0:
-                status = STATUS_COVER_FULL
+            cross(i, t, d, cells, cover, counters)
+            counters[Counter.CROSSINGS] += 1
+            if counters[Counter.COVER_FULL] != 0:
+                status = HardDiskStatus.COVER_FULL
         for k in range(n_sched):
             q = i if k == 0 else j
-            schedule(q, t, pos, vel, radius, t_loc, inv_mass, big_rank, bigs, bbox, cell, nc, L,
-                     head, nxt, cix, ciy, cover, cover_n, count, ev_partner, ev_count, heap, where,
-                     key, counters)
-        if status != STATUS_DONE:
-            return status, t, next_sync, t_drag, log_n
+            schedule(q, t, d, cells, cover, cal, counters)
+        if status != HardDiskStatus.DONE:
+            return status, t, next_sync, t_drag

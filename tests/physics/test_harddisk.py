@@ -11,10 +11,11 @@ import math
 import numpy as np
 import pytest
 
-from physics import (HERMAN2011, FloeField, Forcing, HardDiskSimulation, PeriodicBox,
-                     make_floe_field)
+from physics import (HERMAN2011, HERMAN2013, ChannelBox, DeformingPeriodicBox, FloeField,
+                     Forcing, HardDiskSimulation, PeriodicBox, make_floe_field)
 from physics import harddisk_kernels as K
-from physics.event_calendar import heap_build, heap_check, heap_update, new_heap
+from physics.engine import FailureReason, SimulationError
+from physics.event_calendar import heap_build, heap_check, heap_update, new_calendar
 from physics.floes import max_overlap
 
 
@@ -31,15 +32,15 @@ def two_discs(r1=0.5, r2=1.0, gap=1.0, v1=(1.0, 0.0), v2=(0.0, 0.0), offset=0.0,
 def test_calendar_orders_events_under_updates():
     rng = np.random.default_rng(0)
     n = 200
-    heap, where, key = new_heap(n)
-    key[:] = rng.random(n)
-    heap_build(heap, where, key)
-    assert heap_check(heap, where, key)
+    cal = new_calendar(n)
+    cal.time[:] = rng.random(n)
+    heap_build(cal)
+    assert heap_check(cal)
     for _ in range(2000):
         i = int(rng.integers(n))
-        heap_update(heap, where, key, i, float(rng.random()) * (1.0 if rng.random() < 0.5 else 10.0))
-        assert key[heap[0]] == key.min()
-    assert heap_check(heap, where, key)
+        heap_update(cal, i, float(rng.random()) * (1.0 if rng.random() < 0.5 else 10.0))
+        assert cal.time[cal.heap[0]] == cal.time.min()
+    assert heap_check(cal)
 
 
 # -- single collisions -------------------------------------------------------------
@@ -134,11 +135,11 @@ def test_every_coming_contact_is_in_the_calendar(seed):
     field, box = make_floe_field(400, concentration=0.65, alpha=1.5, mean_diameter=2.0,
                                  seed=seed, velocity_std=0.3)
     sim = HardDiskSimulation(field, box, restitution=0.85, collision_duration=0.0)
-    assert sim._bigs.size > 0
+    assert sim._cover.floes.size > 0
     for _ in range(5):
         sim.advance(3.0)
         t_pair = _pair_times(sim) + sim.time
-        ev = sim._key
+        ev = sim._calendar.time
         first = np.minimum(ev[:, None], ev[None, :])
         finite = np.isfinite(t_pair)
         assert finite.sum() > 100
@@ -247,8 +248,10 @@ def test_tc_model_keeps_three_disc_collapse_bounded():
 
 def test_collapse_without_tc_model_stops_with_a_clear_error():
     sim = _three_in_a_row(0.0)
-    with pytest.raises(RuntimeError, match="inelastic collapse.*collision_duration"):
+    with pytest.raises(SimulationError, match="inelastic collapse.*collision_duration") as err:
         sim.advance(5.0)
+    assert err.value.reason is FailureReason.INELASTIC_COLLAPSE
+    assert 0.0 < err.value.time < 5.0
     assert sim.collision_count >= K.COLLAPSE_EVENTS
 
 
@@ -304,6 +307,8 @@ def test_bad_set_ups_raise():
         HardDiskSimulation(bad, box)
     with pytest.raises(ValueError, match="square"):
         HardDiskSimulation(field, PeriodicBox(box.lx, 1.5 * box.lx))
+    with pytest.raises(ValueError, match="non-deforming"):
+        HardDiskSimulation(field, DeformingPeriodicBox(box.lx, concentration_rate=1e-5))
     with pytest.raises(ValueError, match="Coriolis"):
         HardDiskSimulation(field, box, forcing=Forcing(HERMAN2011.forcing, coriolis=1e-4))
     small_box = FloeField(np.array([[2.0, 2.0], [6.0, 6.0], [6.0, 2.0]]),
@@ -317,3 +322,61 @@ def test_bad_set_ups_raise():
         sim.advance(-1.0)
     with pytest.raises(ValueError, match="velocities"):
         sim.velocities = np.full((field.n, 2), np.nan)
+
+
+def test_wrong_types_raise_type_error():
+    field, box = _field()
+    with pytest.raises(TypeError, match="FloeField"):
+        HardDiskSimulation(field.positions, box)
+    with pytest.raises(TypeError, match="PeriodicBox"):
+        HardDiskSimulation(field, ChannelBox(box.lx, box.ly))
+    with pytest.raises(TypeError, match="PeriodicBox"):
+        HardDiskSimulation(field, box.lx)
+    with pytest.raises(TypeError, match="forcing"):
+        HardDiskSimulation(field, box, forcing=HERMAN2011.forcing)
+
+
+def test_non_finite_event_time_raises_simulation_error():
+    field, box = _field()
+    sim = HardDiskSimulation(field, box)
+    sim.advance(1.0)
+    cal = sim._calendar
+    cal.time[cal.heap[0]] = np.nan           # what a corrupted prediction would give
+    with pytest.raises(SimulationError, match="non-finite") as err:
+        sim.advance(1.0)
+    assert err.value.reason is FailureReason.NON_FINITE
+    assert err.value.time == pytest.approx(1.0)
+
+
+# -- set-up from a preset -----------------------------------------------------------------
+
+def test_from_preset_builds_the_preset_set_up():
+    """The same floes, parameters and forcing as the set-up written out by hand,
+    hence the same trajectory."""
+    P = HERMAN2011
+    sim = HardDiskSimulation.from_preset(P, 300, 0.6, seed=2, velocity_std=0.01,
+                                         log_collisions=True)
+    field, box = make_floe_field(300, concentration=0.6, alpha=P.fsd_exponent,
+                                 mean_diameter=P.mean_diameter, thickness=P.thickness,
+                                 density=P.forcing.ice_density, seed=2, velocity_std=0.01)
+    ref = HardDiskSimulation(field, box, restitution=P.contact.restitution,
+                             forcing=Forcing(P.forcing), max_velocity_step=P.max_velocity_step,
+                             collision_duration=P.collision_duration)
+    assert (sim.n_floes, sim.restitution, sim.max_velocity_step, sim.collision_duration) == (
+        300, 0.85, 1.0, 0.1)
+    assert sim.box.lx == box.lx and sim.forcing.wind.tolist() == [10.0, 0.0]
+    for s in (sim, ref):
+        s.advance(30.0)
+    assert sim.collision_count == ref.collision_count > 0
+    np.testing.assert_array_equal(sim.positions, ref.positions)
+    assert len(sim.collision_log) == sim.collision_count
+
+
+def test_from_preset_keywords_replace_the_presets_numerics():
+    """(The options both engines share are in test_engine_protocol.py.)"""
+    free = HardDiskSimulation.from_preset(HERMAN2011, 200, 0.5, forcing=False, restitution=1.0,
+                                          collision_duration=0.0, max_velocity_step=2.0)
+    assert free.forcing is None
+    assert (free.restitution, free.collision_duration, free.max_velocity_step) == (1.0, 0.0, 2.0)
+    with pytest.raises(ValueError, match="Coriolis"):
+        HardDiskSimulation.from_preset(HERMAN2013, 200, 0.5)

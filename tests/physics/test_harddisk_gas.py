@@ -71,12 +71,12 @@ def free_sim(field: FloeField, box: PeriodicBox, restitution: float = 1.0,
 
 def temperature(sim: HardDiskSimulation) -> float:
     """kT = KE / N [J] (2D, translation only)."""
-    return sim.kinetic_energy() / sim.n
+    return sim.kinetic_energy() / sim.n_floes
 
 
 def enskog_rate(sim: HardDiskSimulation, eta: float) -> float:
     """Enskog collision frequency per floe at the current temperature [1/s]."""
-    number_density = sim.n / sim.L ** 2
+    number_density = sim.n_floes / sim.L ** 2
     return (2.0 * number_density * SIGMA * henderson_g(eta)
             * np.sqrt(np.pi * temperature(sim) / sim.mass[0]))
 
@@ -194,7 +194,7 @@ def test_henderson_equation_of_state(equilibrium):
 def test_elastic_conservation_no_overlap():
     eta, target = 0.4, 120_000
     sim = free_sim(*monodisperse_field(500, eta, seed=77))
-    duration = 2.0 * target / (sim.n * enskog_rate(sim, eta))
+    duration = 2.0 * target / (sim.n_floes * enskog_rate(sim, eta))
     worst = conservation_run(sim, duration, chunks=200)
     assert sim.collision_count >= 100_000, f"only {sim.collision_count} collisions, expected >= 1e5"
     assert_conserved(worst, sim)
@@ -252,7 +252,7 @@ def test_haff_law():
 def test_same_seed_same_trajectory():
     runs = [equilibrated_gas(500, 0.4, seed) for seed in (5, 5, 6)]
     a, b, other = runs
-    expected = EQUILIBRATION * a.n // 2
+    expected = EQUILIBRATION * a.n_floes // 2
     assert a.collision_count > 0.8 * expected, (
         f"only {a.collision_count} collisions, expected about {expected}")
     assert np.array_equal(a.positions, b.positions), (
@@ -270,7 +270,7 @@ def test_power_law_sizes_big_floes():
     field, box = make_floe_field(800, concentration=0.6, alpha=1.5, mean_diameter=2.0, seed=3,
                                  velocity_std=0.05)
     sim = free_sim(field, box, log_collisions=True)
-    bigs = sim._bigs
+    bigs = sim._cover.floes
     assert bigs.size > 0, "no big floes: the big-floe path of the cell list is not exercised"
     worst = conservation_run(sim, 1000.0, chunks=100)
     log = sim.collision_log

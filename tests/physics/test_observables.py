@@ -221,7 +221,8 @@ def test_collision_stress_equals_the_engine_virial():
     s = sim.contact_stress()
     a = sim._acc
     HK.accumulate(sim.time, a)
-    virial = np.array([[a[HK.A_WXX], a[HK.A_WXY]], [a[HK.A_WYX], a[HK.A_WYY]]])
+    A = HK.Acc
+    virial = np.array([[a[A.WXX], a[A.WXY]], [a[A.WYX], a[A.WYY]]])
     virial /= sim.time * sim.L ** 2
     np.testing.assert_allclose(s.tensor, virial, rtol=1e-10)
     np.testing.assert_allclose(s.per_floe.sum(axis=0), s.tensor, rtol=1e-10,
