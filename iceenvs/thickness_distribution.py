@@ -8,8 +8,7 @@ import gymnasium as gym
 import numpy as np
 
 from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
-from physics.itd_figures import KERNELS, R0, RAFT_FACTOR
-from physics.params import check_range
+from physics.params import GODLOVITCH, check_range
 
 from .base import ControlEnv, TaskParameter
 from .rewards import closeness, thickness_distribution_reward, wasserstein1
@@ -17,7 +16,7 @@ from .rewards import closeness, thickness_distribution_reward, wasserstein1
 __all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
            "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
 
-RAFT_MAX = 2.0 * RAFT_FACTOR     # rafting factor at action[1] = +1 (1 at action[1] = −1)
+RAFT_MAX = 2.0 * GODLOVITCH.raft_factor   # rafting factor at action[1] = +1 (1 at −1)
 RAFT_CUTOFF = 0.5                # m: rafting acts where both floes are thinner than this
 COARSE_WIDTH = 0.5               # m: width of the coarse observation classes
 N_COARSE = 20                    # coarse ice classes; the last gathers h >= 9.5 m
@@ -25,8 +24,8 @@ MEAN_SCALE = 10.0                # m: the mean thickness is observed in these un
 TARGET_OPEN_WATER = 0.05         # open-water fraction of the default target
 TARGET_EFOLDING = 1.0            # m: λ of the default target g ∝ h exp(−h/λ)
 START_NOISE = 0.1                # log-normal perturbation of the default start
-# default kernel parameters: the calibrated rates, r0 for the constant kernel
-DEFAULT_KERNEL_PARAMS = {**KERNELS, "constant": dict(r=R0)}
+# default kernel parameters: the calibrated rates (r0 for the constant kernel)
+DEFAULT_KERNEL_PARAMS = GODLOVITCH.kernels
 
 MAX_EPISODE_STEPS = 360         # one year of daily steps
 
@@ -101,7 +100,8 @@ class ThicknessDistributionEnv(ControlEnv):
     The generalised Thorndike model of Godlovitch et al. (the ice thickness
     distribution as a coagulation process, after Thorndike 2000), in
     :class:`physics.itd.ThorndikeModel`: area fractions g_0 (open water) and
-    g_1 … g_n of ice of thickness kΔh (200 classes of 0.1 m by default).
+    g_1 … g_n of ice of thickness kΔh ({GODLOVITCH.n_classes} classes of
+    {GODLOVITCH.class_width:g} m by default).
     Mechanical redistribution stacks two floes of thicknesses h1 and h2 into
     one of h1 + h2 and frees one cell of open water (a Smoluchowski
     coagulation kernel K(h1, h2)); thermodynamics grows thin ice in winter
@@ -113,10 +113,10 @@ class ThicknessDistributionEnv(ControlEnv):
     away from any fixed target.
 
     The default kernel is the constant kernel K = r0 with the rate
-    r0 = {R0:g}/day of Godlovitch's Fig. 4 as calibrated in
-    :mod:`physics.itd_figures` (`R0`); the other named kernels
-    ("exponential", "multiplicative", "additive") default to their
-    calibrated rates there (`KERNELS`). One step costs about the time of
+    r0 = {GODLOVITCH.r0:g}/day of Godlovitch's Fig. 4 as calibrated in the
+    :data:`physics.params.GODLOVITCH` preset (`r_constant`); the other named
+    kernels ("exponential", "multiplicative", "additive") default to their
+    calibrated rates there (:meth:`~physics.params.ItdPreset.kernel_params`). One step costs about the time of
     `days_per_step` model days of the Thorndike model (a few forward-Euler
     substeps of O(n²) each).
 
@@ -127,7 +127,7 @@ class ThicknessDistributionEnv(ControlEnv):
     | Index | Action | Mapping |
     |---|---|---|
     | 0 | redistribution intensity | kernel scale = 10**action[0]: 0.1× … 10× the kernel's rate (1× at 0) |
-    | 1 | rafting strength | rafting factor = 1 + (RAFT_MAX − 1)(action[1] + 1)/2, RAFT_MAX = 2 × {RAFT_FACTOR:g} = {RAFT_MAX:g}: 1 (no rafting) … {RAFT_MAX:g}, the kernel multiplied by it where both floes are thinner than {RAFT_CUTOFF:g} m |
+    | 1 | rafting strength | rafting factor = 1 + (RAFT_MAX − 1)(action[1] + 1)/2, RAFT_MAX = 2 × {GODLOVITCH.raft_factor:g} = {RAFT_MAX:g}: 1 (no rafting) … {RAFT_MAX:g}, the kernel multiplied by it where both floes are thinner than {RAFT_CUTOFF:g} m |
 
     ## Observation Space
     `Box(float32)` of {N_COARSE + 6} entries, every entry clipped into its
@@ -202,7 +202,8 @@ class ThicknessDistributionEnv(ControlEnv):
     thicknesses [m]; or an n × n matrix), `kernel_params=None` (e.g.
     `dict(r=...)`, replacing the defaults; default: the calibrated rates of
     the named kernels),
-    `n_classes=200`, `dh=0.1` [m] (the fine classes), `days_per_step=1.0`,
+    `n_classes={GODLOVITCH.n_classes}`, `dh={GODLOVITCH.class_width:g}` [m] (the fine classes),
+    `days_per_step={GODLOVITCH.time_step:g}`,
     `reward_fn=None`, `reward_params=None` (`distance_scale`),
     `render_mode=None` ("rgb_array" or "human"), and the task parameters.
 
@@ -217,7 +218,8 @@ class ThicknessDistributionEnv(ControlEnv):
     task_parameters = _TASK
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
-                 n_classes: int = 200, dh: float = 0.1, days_per_step: float = 1.0,
+                 n_classes: int = GODLOVITCH.n_classes, dh: float = GODLOVITCH.class_width,
+                 days_per_step: float = GODLOVITCH.time_step,
                  reward_fn=None, reward_params: dict | None = None,
                  render_mode: str | None = None, **task):
         if isinstance(n_classes, bool) or not isinstance(n_classes, (int, np.integer)) \

@@ -5,7 +5,8 @@ Engines
     :class:`HardDiskSimulation` — event-driven hard discs (Herman 2011).
 State and set-up
     :class:`FloeField`, :func:`make_floe_field`, boxes of :mod:`physics.domain`,
-    :class:`Forcing`, parameter tables :data:`HERMAN2011`, :data:`HERMAN2013`.
+    :class:`Forcing`, parameter tables :data:`HERMAN2011`, :data:`HERMAN2013`,
+    :data:`GODLOVITCH`.
 Observables
     :mod:`physics.observables` — contact fabric and stress (both engines).
     :mod:`physics.clusters` — clusters, power-law exponents, g_rdf, g_ffd.
@@ -28,7 +29,8 @@ from .hertz import HertzSimulation
 from .itd import ThorndikeModel, make_kernel, solve_fragmentation, solve_smoluchowski
 from .observables import (Contacts, Fabric, Stress, collision_stress, contacts_within, fabric,
                           stress)
-from .params import HERMAN2011, HERMAN2013, ContactParams, ForcingParams, PaperPreset
+from .params import (GODLOVITCH, HERMAN2011, HERMAN2013, ContactParams, ForcingParams,
+                     ItdPreset, PaperPreset)
 
 __version__ = "0.1.0"
 
@@ -43,5 +45,6 @@ __all__ = [
     "fsd_exponent", "g_rdf", "g_ffd",
     "ThorndikeModel", "make_kernel", "solve_smoluchowski", "solve_fragmentation",
     "HERMAN2011", "HERMAN2013", "ContactParams", "ForcingParams", "PaperPreset",
+    "GODLOVITCH", "ItdPreset",
     "damping_alpha",
 ]

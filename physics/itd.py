@@ -67,14 +67,15 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from .params import check_range
+from .params import GODLOVITCH, check_range
 
 __all__ = ["constant_kernel", "exponential_kernel", "multiplicative_kernel", "additive_kernel",
            "rafting_kernel", "kernel_from_function", "make_kernel", "check_kernel",
            "solve_smoluchowski", "smoluchowski_rhs", "ThorndikeModel", "growth_rates",
            "season", "tail_fit", "TailFit", "solve_fragmentation", "YEAR_DAYS"]
 
-YEAR_DAYS = 360.0
+#: length of the model year [days] (:data:`physics.params.GODLOVITCH`)
+YEAR_DAYS = GODLOVITCH.year_days
 
 
 # -- kernels ---------------------------------------------------------------------
@@ -383,8 +384,8 @@ class ThorndikeModel:
     kernel : str, callable or (n, n) matrix — "constant", "exponential",
         "multiplicative", "additive", "rafting", a callable K(x, y) of the
         thicknesses [m], or a matrix on the ice classes
-    n_classes : int — ice classes (default 200)
-    dh : float — class width [m] (default 0.1)
+    n_classes : int — ice classes (default ``GODLOVITCH.n_classes``, 200)
+    dh : float — class width [m] (default ``GODLOVITCH.class_width``, 0.1)
     g0 : (n_classes + 1,) array, optional — initial fractions (open water
         first); default all open water
     thermodynamics : bool — the seasonal growth and melt (default on)
@@ -399,7 +400,8 @@ class ThorndikeModel:
     thicknesses [m] (h[0] = 0, open water)
     """
 
-    def __init__(self, kernel="constant", *, n_classes: int = 200, dh: float = 0.1,
+    def __init__(self, kernel="constant", *, n_classes: int = GODLOVITCH.n_classes,
+                 dh: float = GODLOVITCH.class_width,
                  g0=None, thermodynamics: bool = True, thermo_strength: float = 1.0,
                  scale: float = 1.0, start_day: float = 0.0, **kernel_params):
         self.h = _class_values(n_classes, dh)
@@ -466,7 +468,7 @@ class ThorndikeModel:
             return np.zeros(self.n + 1)
         return self.thermo_strength * growth_rates(self.h, t) / self.dh
 
-    def step(self, dt: float = 1.0) -> None:
+    def step(self, dt: float = GODLOVITCH.time_step) -> None:
         """Advance by ``dt`` days in forward-Euler substeps, each short enough
         that no class loses more than 90 % of itself (the limit is taken
         again before every substep); ``substeps`` counts them."""
@@ -486,7 +488,7 @@ class ThorndikeModel:
             self.time = end - left if left > 0.0 else end
             self.substeps += 1
 
-    def run(self, days: float, dt: float = 1.0, *, every: float | None = None,
+    def run(self, days: float, dt: float = GODLOVITCH.time_step, *, every: float | None = None,
             progress: bool = False):
         """Step for ``days`` days with steps of ``dt``; with ``every`` (days),
         return (times, g snapshots) taken every that many days (and at the

@@ -19,15 +19,42 @@ process, Figs 4–7, as scenarios.
 * ``scm-analytic`` (Fig. 7) — pure Smoluchowski coagulation with K = 1 from
   u_1(0) = 1 against the exact u_k(t) = (1 + t/2)^(−2) (t/(2 + t))^(k−1).
 
-The kernel rates default to those of :mod:`physics.itd_figures` (tuned so
-that every kernel gives a tail with λ = 1.0 m after 2000 days), whose helpers
-(daily diagnostics, tail-formation and seasonal-cycle statistics, the g(h)
-and Fig. 7 panels) these scenarios share. The Thorndike-model runs record
+The constants (kernel rates, rafting factor and cut-offs, relative
+strengths, the Fig. 7 settings) are those of the :data:`physics.params.GODLOVITCH`
+preset, and the configuration files' defaults equal them. The kernel rates
+are tuned so that every kernel gives a tail with λ = 1.0 m after 2000 days
+(:func:`tune_rate` repeats the tuning). The Thorndike-model runs record
 time in days (day 0 is mid-winter) every ``output_every`` days: g(h) over the
 ``thickness`` coordinate (the ice classes; open water is ``open_water``),
 mean thickness, ice volume above 2 m and 5 m, λ and R² of the tail fit.
 Each run checkpoints its model and the daily diagnostics, so an interrupted
 run continues exactly where it stopped.
+
+Parameter choices
+-----------------
+The paper tunes the rate r of each kernel "so that the results are similar
+in the extent and slope of the exponential tail". Here each r was found by
+bisection in log r (:func:`tune_rate`) so that the tail above 2 m has an
+e-folding thickness of 1.0 m after 2000 days; the kernels take thickness in
+metres and time in days, so r is in 1/day for the constant kernel, 1/(m day)
+for the additive and 1/(m² day) for the multiplicative kernel. With such
+rates the 20 m class, which collects all stacking that would exceed it, holds
+less than 1e-9 of the area. Faster rates spread the tail up to the
+truncation, where ice accumulates and the tail is no longer exponential (for
+the constant kernel R² = 0.89 at r = 0.008/day and 0.63 at 0.01/day). The
+exponential kernel uses β = 0.2 per metre: with β = 0.5 thick ice hardly
+stacks at all (K(10 m, 10 m) = e^(−10) r) and the tail bends strongly.
+
+Figs 5 and 6 use the constant-kernel rate of Fig. 4 as their base,
+r0 = 0.00341/day, so that the rafting runs are "K = 4 against K = 1" in
+units of that rate and R_T = 1 is the run of Fig. 4. The paper's K = 1/R_T
+is in its own units; what matters here is r0 against this model's
+thermodynamics, in which 0.1 m ice grows by up to 0.07 m/day in mid-winter
+and ice thicker than about 1.35 m thins by about 0.01 m/day all year.
+
+The tail is not yet stationary after 2000 days for the constant kernel (λ
+still creeps up by about 1 % per 200 days), so λ at the last day depends on
+``days``; the rates above were tuned for 2000 days.
 """
 from __future__ import annotations
 
@@ -36,13 +63,222 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import itd_figures as figs
 from ..itd import ThorndikeModel, constant_kernel, solve_smoluchowski, tail_fit
+from ..params import GODLOVITCH
 from . import plots
 from .experiment import Experiment, register
 
 #: the kernels of Table 1, in the order of the paper
-KERNEL_NAMES = tuple(figs.KERNELS)
+KERNEL_NAMES = GODLOVITCH.KERNEL_NAMES
+#: the kernels as formulas, and the units of their rates r
+KERNEL_TEXT = {"constant": "K = r", "exponential": "K = r exp(−β(x+y))",
+               "multiplicative": "K = r x y", "additive": "K = r (x+y)"}
+R_UNITS = {"constant": "1/day", "exponential": "1/day", "multiplicative": "1/(m² day)",
+           "additive": "1/(m day)"}
+# brackets for the bisection in tune_rate (the tail e-folding grows with r)
+_BRACKETS = {"constant": (0.001, 0.008), "exponential": (0.003, 0.05),
+             "multiplicative": (1e-4, 1e-3), "additive": (1e-4, 1e-3)}
+DPI = 120
+GREEN, RED, BLUE = (0.0, 0.65, 0.0), (0.85, 0.0, 0.0), (0.0, 0.2, 0.9)
+
+
+# ---------------------------------------------------------------------------
+# Daily diagnostics and their statistics
+# ---------------------------------------------------------------------------
+
+def snapshot_every(days):
+    """Days between the g(h) snapshots of a run of ``days`` days (ten per run)."""
+    return max(1, int(round(days / 10)))
+
+
+def ice_volume_above(model, h_min):
+    """Ice volume per unit area in the classes thicker than ``h_min`` [m]."""
+    use = model.h > h_min
+    return float(np.dot(model.h[use], model.g[use]))
+
+
+#: daily series kept by :func:`advance_day`: model time [days], mean thickness
+#: [m], open water, ice volume above 2 m and above 5 m [m], tail e-folding λ [m]
+SERIES = ("t", "mean", "open", "v2", "v5", "lam")
+
+
+def new_series(days) -> dict:
+    """Empty (NaN) daily series of :data:`SERIES` for a run of ``days`` days."""
+    return {k: np.full(int(days), np.nan) for k in SERIES}
+
+
+def advance_day(model, series: dict, d: int, fit_every: int = 5) -> None:
+    """Step ``model`` by one day and store the diagnostics of day ``d``
+    (0-based) in ``series`` (from :func:`new_series`); the tail e-folding
+    thickness is fitted every ``fit_every`` days and on the last day (NaN
+    between, and while the tail is too short to fit)."""
+    n = len(series["t"])
+    model.step(1.0)
+    series["t"][d] = model.time
+    series["mean"][d] = model.mean_thickness
+    series["open"][d] = model.open_water
+    series["v2"][d] = ice_volume_above(model, 2.0)
+    series["v5"][d] = ice_volume_above(model, 5.0)
+    if (d + 1) % fit_every == 0 or d == n - 1:
+        lam = model.tail_fit(GODLOVITCH.tail_min).efolding
+        series["lam"][d] = lam if math.isfinite(lam) else np.nan
+
+
+def first_day(t, series, level):
+    """First time at which ``series`` >= ``level`` (NaN entries skipped)."""
+    ok = np.isfinite(series) & (series >= level)
+    return float(t[np.argmax(ok)]) if ok.any() else math.nan
+
+
+def last_year(x):
+    """The last 360 entries (one model year of daily values) of ``x``."""
+    return x[-min(len(x), int(GODLOVITCH.year_days)):]
+
+
+def tail_formation(s: dict) -> dict:
+    """How fast the thick ice forms, from daily series ``s``: the day the ice
+    volume above 2 m (and 5 m) first reaches 90 % of its mean over the last
+    year, and those means [m]."""
+    v2, v5 = last_year(s["v2"]).mean(), last_year(s["v5"]).mean()
+    return dict(t90_volume_above_2m=first_day(s["t"], s["v2"], 0.9 * v2),
+                t90_volume_above_5m=first_day(s["t"], s["v5"], 0.9 * v5),
+                volume_above_2m=float(v2), volume_above_5m=float(v5))
+
+
+def seasonal_cycle(s: dict) -> dict:
+    """The seasonal cycle over the last year of daily series ``s``: mean
+    thickness, its amplitude (half the range) absolute and relative, the
+    range of the tail e-folding thickness λ and its range relative to its
+    mean, and the range of the open-water fraction."""
+    mean_y, lam_y = last_year(s["mean"]), last_year(s["lam"])
+    lam_y = lam_y[np.isfinite(lam_y)]
+    if lam_y.size == 0:
+        lam_y = np.array([math.nan])
+    open_y = last_year(s["open"])
+    return dict(mean_thickness=float(mean_y.mean()),
+                mean_thickness_amplitude=float((mean_y.max() - mean_y.min()) / 2),
+                relative_amplitude=float((mean_y.max() - mean_y.min()) / 2 / mean_y.mean()),
+                efolding_range=(float(lam_y.min()), float(lam_y.max())),
+                efolding_relative_range=float((lam_y.max() - lam_y.min()) / lam_y.mean()),
+                open_water_range=(float(open_y.min()), float(open_y.max())))
+
+
+def scm_exact(k, t):
+    """Exact solution of the coagulation equation with K = 1 from u_1(0) = 1:
+    u_k(t) = (1 + t/2)^(−2) (t/(2 + t))^(k−1), broadcast over ``k`` and ``t``."""
+    k = np.asarray(k, dtype=float)
+    t = np.asarray(t, dtype=float)
+    return (1.0 + t / 2.0) ** -2 * (t / (2.0 + t)) ** (k - 1)
+
+
+def tune_rate(kind: str, target: float = GODLOVITCH.tail_target,
+              days: int = GODLOVITCH.days, *, iterations: int = 12, bracket=None,
+              **params) -> tuple[float, float]:
+    """The rate r of kernel ``kind`` for which the tail above 2 m has an
+    e-folding thickness ``target`` [m] after ``days`` days (bisection in
+    log r; the e-folding grows with r). ``params`` are further kernel
+    parameters (``beta`` of the exponential kernel). Returns (r, λ of the
+    last trial).
+
+    This is how the rates of :data:`physics.params.GODLOVITCH` were found
+    (rounded to three significant digits), e.g. for the exponential kernel
+    ``tune_rate("exponential", beta=GODLOVITCH.exponential_beta)`` (about 10 s).
+    """
+    lo, hi = bracket or _BRACKETS[kind]
+    r = lam = math.nan
+    for _ in range(iterations):
+        r = math.sqrt(lo * hi)
+        m = ThorndikeModel(kind, r=r, **params)
+        m.run(days)
+        lam = m.tail_fit(GODLOVITCH.tail_min).efolding
+        if math.isfinite(lam) and lam >= target:
+            hi = r
+        else:
+            lo = r
+    return r, lam
+
+
+# ---------------------------------------------------------------------------
+# Panels
+# ---------------------------------------------------------------------------
+
+def colours(n, start, end):
+    """n colours interpolated linearly from ``start`` to ``end`` (RGB)."""
+    a, b = np.asarray(start, float), np.asarray(end, float)
+    return [tuple(a + (b - a) * (i / max(n - 1, 1))) for i in range(n)]
+
+
+def time_colourbar(fig, axes, plt, start, end, t_max, label="model time [days]"):
+    """A colour bar from ``start`` (t = 0) to ``end`` (t = ``t_max``) beside ``axes``."""
+    from matplotlib.colors import LinearSegmentedColormap, Normalize
+
+    cmap = LinearSegmentedColormap.from_list("time", [start, end])
+    sm = plt.cm.ScalarMappable(norm=Normalize(0, t_max), cmap=cmap)
+    fig.colorbar(sm, ax=axes, label=label, shrink=0.8, pad=0.02)
+
+
+def plot_g(ax, h, snaps, line_colours, fit=None, title=None):
+    """g(h) of the ice classes on a log axis, one line per snapshot.
+
+    Parameters
+    ----------
+    ax : matplotlib axes
+    h : (n,) array — thicknesses of the ice classes [m] (open water left out)
+    snaps : (k, n) array — area fractions of the ice classes, oldest first
+    line_colours : k colours
+    fit : TailFit, optional — drawn as a dashed line through the last snapshot
+    title : str, optional
+    """
+    tail_min = GODLOVITCH.tail_min
+    h = np.asarray(h, dtype=float)
+    snaps = np.atleast_2d(np.asarray(snaps, dtype=float))
+    for g, c in zip(snaps, line_colours):
+        ax.semilogy(h, np.where(g > 0, g, np.nan), color=c, lw=1.1)
+    if fit is not None and math.isfinite(fit.efolding):
+        hh = np.linspace(tail_min, h[-2], 50)
+        use = (h > tail_min) & (snaps[-1] > 1e-12)
+        use[-1] = False
+        icpt = np.mean(np.log(snaps[-1][use]) - fit.slope * h[use])
+        ax.semilogy(hh, np.exp(icpt + fit.slope * hh), "k--", lw=1.0,
+                    label=f"fit > {tail_min:g} m: λ = {fit.efolding:.2f} m, R² = {fit.r2:.3f}")
+        ax.legend(loc="upper right", fontsize=7.5, frameon=False)
+    ax.set_xlim(0, h[-1])
+    ax.set_ylim(1e-12, 1.5)
+    ax.set_xlabel("h [m]")
+    ax.set_ylabel(f"g(h) per {h[1] - h[0]:.3g} m class")
+    ax.grid(True, which="major", alpha=0.3)
+    if title:
+        ax.set_title(title, fontsize=9.5)
+
+
+def plot_scm(ax, ax2, k, times, u, exact, n_classes, rtol):
+    """Fig. 7 panels: numerical u_k (dots) against the exact solution (lines)
+    on ``ax`` and their relative error on ``ax2``, one colour per time
+    (blue → red); ``u`` and ``exact`` have shape (len(times), len(k))."""
+    u, exact = np.asarray(u, float), np.asarray(exact, float)
+    shown = exact > 1e-12
+    rel = np.abs(u - exact) / np.where(shown, exact, 1.0)
+    for q, (tq, c) in enumerate(zip(times, colours(len(times), BLUE, RED))):
+        ax.semilogy(k, exact[q], color=c, lw=1.0)
+        ax.semilogy(k, u[q], "o", color=c, ms=3, label=f"t = {tq:g}")
+        ok = shown[q]
+        ax2.semilogy(k[ok], np.maximum(rel[q][ok], 1e-16), color=c, lw=1.0)
+    ax.set_ylim(1e-12, 1.5)
+    ax.set_xlabel("mass k")
+    ax.set_ylabel("number density u_k")
+    ax.set_title(r"$u_k(t)$: numerical (dots), exact $(1 + t/2)^{-2}\,(t/(2 + t))^{k-1}$ "
+                 "(lines)", fontsize=9.5)
+    ax.legend(fontsize=7.5, frameon=False, ncol=2)
+    ax.grid(True, alpha=0.3)
+    ax2.set_xlabel("mass k")
+    ax2.set_ylabel("|u_k − exact| / exact (where exact u_k > 1e-12)")
+    ax2.set_title(f"relative error ({n_classes} classes, DOP853, rtol {rtol:g})", fontsize=9.5)
+    ax2.grid(True, alpha=0.3)
+
+
+# ---------------------------------------------------------------------------
+# The scenarios
+# ---------------------------------------------------------------------------
 
 _ITD_VARIABLES = {
     "time": ("d", "model time of the output (day 0 is mid-winter, 360-day years)"),
@@ -86,7 +322,7 @@ def _series(run, name: str):
 def _snapshot_rows(t, days: int) -> list[int]:
     """Rows of the outputs nearest to every ``days``/10 days (the paper's
     snapshot times), oldest first, without repeats."""
-    every = figs.snapshot_every(days)
+    every = snapshot_every(days)
     targets = np.arange(every, int(days) + 1, every, dtype=float)
     if len(t) == 0:
         return []
@@ -99,7 +335,7 @@ def _fit_of(run, row: int):
     :meth:`ThorndikeModel.tail_fit` does (for the dashed line of the panels)."""
     h = np.asarray(run["thickness"].values, dtype=float)
     g = np.asarray(run["g"].values[row], dtype=float)
-    return tail_fit(h[:-1], g[:-1], figs.TAIL_MIN)
+    return tail_fit(h[:-1], g[:-1], GODLOVITCH.tail_min)
 
 
 def _g_panel(ax, run, days: int, start, end, title: str) -> None:
@@ -108,7 +344,7 @@ def _g_panel(ax, run, days: int, start, end, title: str) -> None:
     t = np.asarray(run["time"].values, dtype=float)
     rows = _snapshot_rows(np.where(np.isfinite(t), t, -np.inf), days)
     snaps = np.asarray(run["g"].values, dtype=float)[rows]
-    figs.plot_g(ax, run["thickness"].values, snaps, figs.colours(len(rows), start, end),
+    plot_g(ax, run["thickness"].values, snaps, colours(len(rows), start, end),
                 _fit_of(run, rows[-1]) if rows else None, title)
 
 
@@ -116,7 +352,7 @@ def _save(fig, out_dir, name: str) -> Path:
     """Save a figure with a constrained layout (no tight_layout) and close it."""
     plt = plots.pyplot()
     path = Path(out_dir) / name
-    fig.savefig(path, dpi=figs.DPI)
+    fig.savefig(path, dpi=DPI)
     plt.close(fig)
     return path
 
@@ -150,20 +386,20 @@ class _ThorndikeExperiment(Experiment):
         if st is None:
             m = self.model(p, case)
             rec.coord("thickness", m.h[1:], "m", "ice thickness of the class")
-            st = {"model": m, "day": 0, "series": figs.new_series(days)}
+            st = {"model": m, "day": 0, "series": new_series(days)}
         m, s = st["model"], st["series"]
         for d in range(st["day"], days):
-            figs.advance_day(m, s, d, fit_every=1)
+            advance_day(m, s, d, fit_every=1)
             st["day"] = d + 1
             if (d + 1) % every == 0 or d + 1 == days:
-                fit = m.tail_fit(figs.TAIL_MIN)
+                fit = m.tail_fit(GODLOVITCH.tail_min)
                 rec.record(m.time, g=("thickness", m.g[1:]), open_water=m.open_water,
                            mean_thickness=m.mean_thickness,
                            volume_above_2m=s["v2"][d], volume_above_5m=s["v5"][d],
                            tail_lambda=fit.efolding, tail_r2=fit.r2, top_class=m.g[-1])
                 rec.progress((d + 1) / days)
                 rec.checkpoint(st)
-        fit = m.tail_fit(figs.TAIL_MIN)
+        fit = m.tail_fit(GODLOVITCH.tail_min)
         rec.result(lambda_final=fit.efolding, r2_final=fit.r2, open_water_final=m.open_water,
                    mean_thickness_final=m.mean_thickness, top_class_final=m.g[-1],
                    **self.results(m, s, p, case))
@@ -196,7 +432,7 @@ class Kernels(_ThorndikeExperiment):
                          _fmt(run["r2_final"], ".4f"),
                          "exponential (semilog-linear) tail for every kernel, R² ≥ 0.95"))
             rows.append((f"e-folding thickness λ of the tail at day {p['days']}, {kind} kernel "
-                         f"(r = {p[f'r_{kind}']:.3g} {figs.R_UNITS[kind]})",
+                         f"(r = {p[f'r_{kind}']:.3g} {R_UNITS[kind]})",
                          f"{_fmt(run['lambda_final'])} m",
                          "r adjusted per kernel for a similar tail "
                          "(tuned here: λ = 1.0 m at day 2000)"))
@@ -228,15 +464,15 @@ class Kernels(_ThorndikeExperiment):
                                  layout="constrained")
         for c, (ax, kind) in enumerate(zip(axes.flat, kinds)):
             extra = f", β = {p['beta']:g}/m" if kind == "exponential" else ""
-            _g_panel(ax, _member0(ds, c), days, figs.GREEN, figs.RED,
-                     f"{kind}: {figs.KERNEL_TEXT[kind]}, r = {p[f'r_{kind}']:.3g} "
-                     f"{figs.R_UNITS[kind]}{extra}")
+            _g_panel(ax, _member0(ds, c), days, GREEN, RED,
+                     f"{kind}: {KERNEL_TEXT[kind]}, r = {p[f'r_{kind}']:.3g} "
+                     f"{R_UNITS[kind]}{extra}")
         for ax in axes.flat[len(kinds):]:
             ax.set_visible(False)
         fig.suptitle(f"Godlovitch et al. Fig. 4: Table 1 kernels, g(h) every "
-                     f"{figs.snapshot_every(days)} days for {days} days (green → red)",
+                     f"{snapshot_every(days)} days for {days} days (green → red)",
                      fontsize=11)
-        figs.time_colourbar(fig, axes, plt, figs.GREEN, figs.RED, days)
+        time_colourbar(fig, axes, plt, GREEN, RED, days)
         out = [_save(fig, out_dir, "godlovitch_fig4_kernels.png")]
 
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -248,7 +484,7 @@ class Kernels(_ThorndikeExperiment):
             t, r2 = _series(run, "tail_r2")
             ok = np.isfinite(r2)
             ax2.plot(t[ok], r2[ok], lw=1.2, label=kind)
-        ax1.set_ylabel(f"tail e-folding thickness λ (h > {figs.TAIL_MIN:g} m) [m]")
+        ax1.set_ylabel(f"tail e-folding thickness λ (h > {GODLOVITCH.tail_min:g} m) [m]")
         ax2.set_ylabel("R² of the log-linear tail fit")
         ax2.axhline(0.95, color="k", ls=":", lw=0.8)
         for ax in (ax1, ax2):
@@ -295,8 +531,8 @@ class Rafting(_ThorndikeExperiment):
         return ThorndikeModel("rafting", r=p["r0"], h_raft=h, factor=p["raft_factor"])
 
     def results(self, model, series, p, case):
-        tf = figs.tail_formation(series)
-        return dict(t_lambda_target=figs.first_day(series["t"], series["lam"],
+        tf = tail_formation(series)
+        return dict(t_lambda_target=first_day(series["t"], series["lam"],
                                                    p["lambda_target"]),
                     t90_volume_above_2m=tf["t90_volume_above_2m"],
                     t90_volume_above_5m=tf["t90_volume_above_5m"],
@@ -348,7 +584,7 @@ class Rafting(_ThorndikeExperiment):
         for c, h in enumerate(hs):
             title = "no rafting (K = r0 everywhere)" if h <= 0 else \
                 f"h_R = {h:g} m: K = {p['raft_factor']:g} r0 below, r0 above"
-            _g_panel(flat[c], _member0(ds, c), days, figs.GREEN, figs.RED, title)
+            _g_panel(flat[c], _member0(ds, c), days, GREEN, RED, title)
         ax_lam, ax_vol = flat[len(hs)], flat[len(hs) + 1]
         line_colours = ["k"] + list(plt.cm.viridis(np.linspace(0.0, 0.9, max(len(hs) - 1, 1))))
         for c in list(range(1, len(hs))) + [0]:         # no rafting drawn on top
@@ -362,7 +598,7 @@ class Rafting(_ThorndikeExperiment):
             ax_vol.semilogy(t, np.where(v2 > 0, v2, np.nan), color=colour, lw=1.1)
             ax_vol.semilogy(t, np.where(v5 > 0, v5, np.nan), color=colour, lw=1.1, ls="--")
         ax_lam.axhline(p["lambda_target"], color="0.5", ls=":", lw=0.8)
-        ax_lam.set_ylabel(f"tail e-folding thickness λ (h > {figs.TAIL_MIN:g} m) [m]")
+        ax_lam.set_ylabel(f"tail e-folding thickness λ (h > {GODLOVITCH.tail_min:g} m) [m]")
         ax_lam.set_title("tail e-folding thickness (dotted: lambda_target)", fontsize=9.5)
         ax_lam.legend(fontsize=7.5, frameon=False)
         ax_vol.set_ylabel("ice volume per unit area [m]")
@@ -375,7 +611,7 @@ class Rafting(_ThorndikeExperiment):
             ax.set_visible(False)
         fig.suptitle(f"Godlovitch et al. Fig. 5: constant kernel r0 = {p['r0']:g}/day with "
                      f"rafting (K = {p['raft_factor']:g} r0 where both floes are thinner than "
-                     f"h_R), g(h) every {figs.snapshot_every(days)} days (green → red)",
+                     f"h_R), g(h) every {snapshot_every(days)} days (green → red)",
                      fontsize=10.5)
         return [plots.savefig(fig, Path(out_dir) / "godlovitch_fig5_rafting.png")]
 
@@ -411,7 +647,7 @@ class Thermo(_ThorndikeExperiment):
         return ThorndikeModel("constant", r=p["r0"], scale=1.0 / case["relative_strength"])
 
     def results(self, model, series, p, case):
-        sc = figs.seasonal_cycle(series)
+        sc = seasonal_cycle(series)
         return dict(mean_thickness_last_year=sc["mean_thickness"],
                     mean_thickness_amplitude=sc["mean_thickness_amplitude"],
                     mean_thickness_relative_amplitude=sc["relative_amplitude"],
@@ -460,12 +696,12 @@ class Thermo(_ThorndikeExperiment):
         fig, axes = plt.subplots(nrow, ncol, figsize=(4.3 * ncol, 3.8 * nrow), squeeze=False)
         flat = list(axes.flat)
         for c, rt in enumerate(rts):
-            _g_panel(flat[c], _member0(ds, c), days, figs.BLUE, figs.RED,
+            _g_panel(flat[c], _member0(ds, c), days, BLUE, RED,
                      f"R_T = {rt:g}: K = r0/R_T = {p['r0'] / rt:.3g}/day")
-        strength_colours = figs.colours(len(rts), figs.BLUE, figs.RED)
+        strength_colours = colours(len(rts), BLUE, RED)
         panels = [("mean_thickness", "mean thickness (open water as 0) [m]", "mean thickness"),
                   ("tail_lambda", "λ / its mean over the last year",
-                   f"tail e-folding thickness λ (h > {figs.TAIL_MIN:g} m), relative"),
+                   f"tail e-folding thickness λ (h > {GODLOVITCH.tail_min:g} m), relative"),
                   ("open_water", "open-water fraction g_0", "open water")]
         years = min(3.0, days / 360.0)                  # the last (up to) three years
         for ax, (key, ylabel, title) in zip(flat[len(rts):], panels):
@@ -490,7 +726,7 @@ class Thermo(_ThorndikeExperiment):
             ax.set_visible(False)
         fig.suptitle(f"Godlovitch et al. Fig. 6: relative strength R_T of thermodynamics and "
                      f"stacking, K = r0/R_T with r0 = {p['r0']:g}/day, g(h) every "
-                     f"{figs.snapshot_every(days)} days (blue → red)", fontsize=11)
+                     f"{snapshot_every(days)} days (blue → red)", fontsize=11)
         return [plots.savefig(fig, Path(out_dir) / "godlovitch_fig6_relative_strength.png")]
 
 
@@ -543,7 +779,7 @@ class ScmAnalytic(Experiment):
         while st["next"] < len(times):
             tq = times[st["next"]]
             u = solve_smoluchowski(kernel, st["u"], [0.0, tq - st["t"]], rtol=p["rtol"])[-1]
-            exact = figs.scm_exact(k, tq)
+            exact = scm_exact(k, tq)
             rel = np.abs(u - exact) / np.where(exact > 0, exact, 1.0)
             shown = exact[:kmax] > 1e-12
             err10 = float(rel[:10].max())
@@ -582,7 +818,7 @@ class ScmAnalytic(Experiment):
         t = np.asarray(run["time"].values, dtype=float)
         ok = np.isfinite(t)
         fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11.5, 4.8))
-        figs.plot_scm(ax, ax2, np.asarray(run["k"].values), t[ok],
+        plot_scm(ax, ax2, np.asarray(run["k"].values), t[ok],
                       np.asarray(run["u"].values)[ok], np.asarray(run["u_exact"].values)[ok],
                       int(p["classes"]), float(p["rtol"]))
         fig.suptitle("Godlovitch et al. Fig. 7: Smoluchowski coagulation with K(j, k) = 1, "

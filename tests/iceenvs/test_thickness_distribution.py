@@ -8,7 +8,7 @@ import pytest
 from iceenvs.rewards import thickness_distribution_reward, wasserstein1
 from iceenvs.thickness_distribution import (RAFT_MAX, ThicknessDistributionEnv,
                                             default_target)
-from physics.itd_figures import R0, RAFT_FACTOR
+from physics.params import GODLOVITCH
 
 N_OBS = 26
 
@@ -60,13 +60,13 @@ def test_spaces_and_defaults(env):
     assert space.low[23] == 0 and space.high[23] == 2
     assert np.all(space.low[24:] == -1) and np.all(space.high[24:] == 1)
     # constant kernel with the calibrated rate r0 of the Godlovitch figures
-    assert env.kernel == "constant" and env.kernel_params == {"r": R0}
-    assert np.all(env._K == R0)
+    assert env.kernel == "constant" and env.kernel_params == {"r": GODLOVITCH.r0}
+    assert np.all(env._K == GODLOVITCH.r0)
     import gymnasium as gym
 
     import iceenvs  # noqa: F401
     assert gym.spec("iceenvs/ThicknessDistribution-v0").max_episode_steps == 360
-    assert RAFT_MAX == 2 * RAFT_FACTOR
+    assert RAFT_MAX == 2 * GODLOVITCH.raft_factor
 
 
 # -- determinism -------------------------------------------------------------------------

@@ -12,7 +12,7 @@ from physics.contact import (contact_time, damping_alpha, hertz_stiffness, lammp
                              peak_overlap, restitution_of_alpha)
 from physics.hertz import minimum_contact_time
 
-from dem_reference import HERTZ_TIME_CONSTANT, disc_mass, hertz_contact_time, hertz_peak_overlap
+from reference.dem import HERTZ_TIME_CONSTANT, disc_mass, hertz_contact_time, hertz_peak_overlap
 
 
 def test_herman2013_table1():
@@ -160,3 +160,147 @@ def test_closed_form_contact_helpers():
     m = disc_mass(0.7, 1.2)
     want = hertz_contact_time(0.5 * m, hertz_stiffness(c.effective_modulus, 0.35), 0.1)
     assert minimum_contact_time(radii, 1.2, 910.0, c, 0.1) == pytest.approx(want, rel=1e-4)
+
+
+# -- set-up written once: a preset builds its floe field and its forcing -------
+
+@pytest.mark.parametrize("preset", [HERMAN2011, HERMAN2013], ids=lambda p: p.name)
+def test_preset_floe_field_follows_preset(preset):
+    from physics import make_floe_field
+
+    field, box = preset.floe_field(150, 0.6, seed=4)
+    assert field.n == 150
+    assert field.concentration(box) == pytest.approx(0.6, rel=1e-9)
+    assert np.all(field.thickness == preset.thickness)
+    assert field.density == preset.forcing.ice_density
+    # exactly the call written out by hand
+    ref, ref_box = make_floe_field(150, concentration=0.6, alpha=preset.fsd_exponent,
+                                   mean_diameter=preset.mean_diameter,
+                                   thickness=preset.thickness,
+                                   density=preset.forcing.ice_density, seed=4)
+    assert (box.lx, box.ly) == (ref_box.lx, ref_box.ly)
+    np.testing.assert_array_equal(field.positions, ref.positions)
+    np.testing.assert_array_equal(field.radii, ref.radii)
+
+
+def test_preset_floe_field_defaults_and_seed():
+    small = HERMAN2011.replace(n_floes=120, concentration=0.5)
+    a, box_a = small.floe_field(seed=7)
+    b, box_b = small.floe_field(seed=7)
+    c, _ = small.floe_field(seed=8)
+    assert a.n == 120 and a.concentration(box_a) == pytest.approx(0.5, rel=1e-9)
+    assert (box_a.lx, box_a.ly) == (box_b.lx, box_b.ly)
+    np.testing.assert_array_equal(a.positions, b.positions)
+    np.testing.assert_array_equal(a.radii, b.radii)
+    assert not np.array_equal(a.positions, c.positions)
+
+
+def test_preset_floe_field_overrides():
+    from physics import ChannelBox
+
+    field, box = HERMAN2013.floe_field(100, 0.5, seed=2, aspect=0.5, box_type=ChannelBox,
+                                       velocity_std=0.01, repeat=4, thickness=2.0)
+    assert isinstance(box, ChannelBox)
+    assert box.ly == pytest.approx(0.5 * box.lx)
+    assert field.n == 400
+    assert np.all(field.thickness == 2.0)
+    assert np.std(field.velocities) > 0
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"n": 0}, {"n": -5}, {"n": 10.5}, {"concentration": 0.0}, {"concentration": 1.0},
+    {"concentration": float("nan")}, {"n": 10, "repeat": 0}, {"n": 10, "aspect": -1.0},
+])
+def test_preset_floe_field_rejects_bad_values(kwargs):
+    with pytest.raises(ValueError):
+        HERMAN2013.floe_field(**{"n": 10, "concentration": 0.5, **kwargs})
+
+
+def test_preset_floe_field_rejects_unknown_keyword():
+    with pytest.raises(TypeError):
+        HERMAN2013.floe_field(10, 0.5, colour="white")
+
+
+def test_preset_make_forcing():
+    from physics import Forcing
+
+    f = HERMAN2013.make_forcing()
+    ref = Forcing(HERMAN2013.forcing)
+    assert f.params is HERMAN2013.forcing
+    np.testing.assert_array_equal(f.wind, ref.wind)
+    np.testing.assert_array_equal(f.current, ref.current)
+    assert f.coriolis == ref.coriolis
+
+    calm = HERMAN2011.make_forcing(wind_speed=0.0, coriolis=0.0)
+    assert calm.wind.tolist() == [0.0, 0.0] and calm.coriolis == 0.0
+    assert calm.current.tolist() == list(HERMAN2011.forcing.current_vector())
+    assert calm.params.water_skin_drag == HERMAN2011.forcing.water_skin_drag
+
+    turned = HERMAN2013.make_forcing(wind=(0.0, -3.0), current=(0.1, 0.0))
+    assert turned.wind.tolist() == [0.0, -3.0] and turned.current.tolist() == [0.1, 0.0]
+    # a new object every call: changing one does not change another
+    assert HERMAN2013.make_forcing() is not f
+
+
+@pytest.mark.parametrize("kwargs, error", [
+    ({"wind_speed": -1.0}, ValueError), ({"ice_density": 2000.0}, ValueError),
+    ({"wind": (1.0, 2.0, 3.0)}, ValueError), ({"wind_vector": 3.0}, TypeError),
+])
+def test_preset_make_forcing_rejects_bad_values(kwargs, error):
+    with pytest.raises(error):
+        HERMAN2013.make_forcing(**kwargs)
+
+
+# -- the Godlovitch et al. ITD preset ------------------------------------------
+
+def test_godlovitch_preset_values():
+    """The constants of the Godlovitch figures, environment and benchmark."""
+    from physics import GODLOVITCH, ItdPreset
+
+    g = GODLOVITCH
+    assert isinstance(g, ItdPreset) and g.name == "godlovitch"
+    assert (g.n_classes, g.class_width, g.year_days, g.time_step) == (200, 0.1, 360.0, 1.0)
+    assert (g.days, g.tail_min, g.tail_target) == (2000, 2.0, 1.0)
+    assert g.kernels == {"constant": {"r": 0.00341},
+                         "exponential": {"r": 0.0141, "beta": 0.2},
+                         "multiplicative": {"r": 0.000498},
+                         "additive": {"r": 0.000477}}
+    assert list(g.kernels) == ["constant", "exponential", "multiplicative", "additive"]
+    assert g.r0 == 0.00341 and g.raft_factor == 4.0
+    assert g.raft_cutoffs == (0.2, 0.5, 1.0, 2.0) and g.raft_lambda_target == 0.9
+    assert g.relative_strengths == (0.5, 1.0, 2.0, 5.0, 10.0)
+    assert g.scm_times == (0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
+    assert (g.scm_kmax, g.scm_classes) == (50, 400)
+    assert g.rafting_params(1.0) == {"r": 0.00341, "h_raft": 1.0, "factor": 4.0}
+    with pytest.raises(AttributeError):
+        g.r_constant = 1.0                         # frozen
+    # the model's defaults are the preset's
+    from physics.itd import YEAR_DAYS, ThorndikeModel
+    m = ThorndikeModel("constant", **g.kernel_params("constant"))
+    assert (m.n, m.dh, YEAR_DAYS) == (g.n_classes, g.class_width, g.year_days)
+
+
+@pytest.mark.parametrize("changes", [
+    {"n_classes": 1}, {"n_classes": 20.5}, {"class_width": 0.0}, {"r_constant": -1.0},
+    {"r_additive": float("nan")}, {"raft_factor": 0.5}, {"raft_cutoffs": ()},
+    {"raft_cutoffs": (0.5, -1.0)}, {"relative_strengths": [1.0]}, {"scm_kmax": 500},
+    {"days": 0},
+])
+def test_godlovitch_preset_validates(changes):
+    from physics import GODLOVITCH
+
+    with pytest.raises(ValueError):
+        GODLOVITCH.replace(**changes)
+
+
+def test_godlovitch_kernel_params_rejects_unknown():
+    from physics import GODLOVITCH
+
+    with pytest.raises(ValueError, match="unknown kernel"):
+        GODLOVITCH.kernel_params("rafting")
+    with pytest.raises(ValueError):
+        GODLOVITCH.rafting_params(-1.0)
+    # a fresh dict every call: changing it does not change the preset
+    k = GODLOVITCH.kernels
+    k["constant"]["r"] = 1.0
+    assert GODLOVITCH.kernels["constant"]["r"] == 0.00341

@@ -11,7 +11,7 @@ pytest.importorskip("yaml")
 
 import xarray as xr  # noqa: E402
 
-from physics import itd_figures as figs  # noqa: E402
+from physics.params import GODLOVITCH  # noqa: E402
 from physics.scenarios import find_config, get_experiment, resume_run, run_scenario  # noqa: E402
 from physics.scenarios.recorder import Recorder  # noqa: E402
 
@@ -40,19 +40,24 @@ def _check_required(name, ds):
 
 
 def test_scenario_files_use_the_tuned_constants():
-    """The scenario defaults are the rates and settings of physics.itd_figures."""
+    """The scenario defaults are the rates and settings of the GODLOVITCH preset."""
     k = find_config("godlovitch-kernels").defaults()
-    for kind, params in figs.KERNELS.items():
+    for kind, params in GODLOVITCH.kernels.items():
         assert k[f"r_{kind}"] == params["r"]
-    assert k["beta"] == figs.KERNELS["exponential"]["beta"]
+    assert k["beta"] == GODLOVITCH.kernels["exponential"]["beta"]
+    assert k["days"] == GODLOVITCH.days
     r = find_config("godlovitch-rafting").defaults()
-    assert r["r0"] == figs.R0 and r["raft_factor"] == figs.RAFT_FACTOR
-    assert r["raft_cutoffs"] == [h for h in figs.RAFT_CUTOFFS if h is not None]
+    assert r["r0"] == GODLOVITCH.r0 and r["raft_factor"] == GODLOVITCH.raft_factor
+    assert r["raft_cutoffs"] == list(GODLOVITCH.raft_cutoffs)
+    assert r["lambda_target"] == GODLOVITCH.raft_lambda_target
+    assert r["days"] == GODLOVITCH.days
     t = find_config("godlovitch-thermo").defaults()
-    assert t["r0"] == figs.R0 and t["relative_strengths"] == list(figs.RELATIVE_STRENGTHS)
+    assert t["r0"] == GODLOVITCH.r0
+    assert t["relative_strengths"] == list(GODLOVITCH.relative_strengths)
+    assert t["days"] == GODLOVITCH.days
     s = find_config("scm-analytic").defaults()
-    assert s["times"] == list(figs.SCM_TIMES)
-    assert (s["kmax"], s["classes"]) == (figs.SCM_KMAX, figs.SCM_CLASSES)
+    assert s["times"] == list(GODLOVITCH.scm_times)
+    assert (s["kmax"], s["classes"]) == (GODLOVITCH.scm_kmax, GODLOVITCH.scm_classes)
     for name in NAMES:                        # the --quick forms are valid
         find_config(name).resolve(quick=True)
 
@@ -82,7 +87,7 @@ def test_every_kernel_gives_an_exponential_tail(tmp_path):
     NetCDF file."""
     res, ds = _run("godlovitch-kernels", tmp_path, quick=True)
     _check_required("godlovitch-kernels", ds)
-    assert list(ds["kernel"].values.astype(str)) == list(figs.KERNELS)
+    assert list(ds["kernel"].values.astype(str)) == list(GODLOVITCH.kernels)
     assert ds["time"].attrs["units"] == "d"
     r2 = ds["r2_final"].isel(member=0).values
     lam = ds["lambda_final"].isel(member=0).values
@@ -167,3 +172,33 @@ def test_figures_are_written(tmp_path):
         assert res.figures, name
         for path in res.figures:
             assert path.suffix == ".png" and path.stat().st_size > 10_000, path
+
+
+def test_tune_rate_reaches_its_target():
+    """The bisection behind the preset's kernel rates: the e-folding thickness
+    of the last trial is close to the target and grows with the rate."""
+    from physics.itd import ThorndikeModel
+    from physics.scenarios.godlovitch import tune_rate
+
+    r, lam = tune_rate("constant", target=0.6, days=360, iterations=10)
+    assert 0.001 < r < 0.008
+    assert lam == pytest.approx(0.6, abs=0.02)
+    lams = []
+    for rate in (0.5 * r, r, 2 * r):
+        m = ThorndikeModel("constant", r=rate)
+        m.run(360)
+        lams.append(m.tail_fit(GODLOVITCH.tail_min).efolding)
+    assert lams[0] < lams[1] < lams[2]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", GODLOVITCH.KERNEL_NAMES)
+def test_tune_rate_gives_the_preset_rates(kind):
+    """Tuned for λ = 1 m after 2000 days, the rates are those of GODLOVITCH
+    (to their three significant digits)."""
+    from physics.scenarios.godlovitch import tune_rate
+
+    params = GODLOVITCH.kernel_params(kind)
+    r, lam = tune_rate(kind, **{k: v for k, v in params.items() if k != "r"})
+    assert float(f"{r:.3g}") == params["r"]
+    assert lam == pytest.approx(GODLOVITCH.tail_target, abs=0.01)
