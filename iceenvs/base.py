@@ -56,10 +56,13 @@ from .observations import FLOE_FEATURES, Feature, normalise
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
-           "TIME_FEATURE", "task_table"]
+           "TIME_FEATURE", "task_table", "MAX_WIND"]
 
 #: every per-step reward of the built-in tasks lies in this range
 REWARD_RANGE = (0.0, 1.0)
+#: default wind speed [m/s] of a full action of the wind-driven tasks (the
+#: ``max_wind`` task parameter)
+MAX_WIND = 20.0
 
 #: the observation entry that ``horizon=N`` appends
 TIME_FEATURE = Feature("time_left", "remaining fraction of the episode, 1 − t/N", "-", "none",

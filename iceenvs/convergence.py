@@ -4,7 +4,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from physics import DeformingPeriodicBox, HERMAN2013, make_floe_field
+from physics import DeformingPeriodicBox, HERMAN2013
 
 from .base import HertzEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
@@ -131,10 +131,8 @@ class ConvergenceEnv(HertzEnv):
 
     def _make_sim(self, rng):
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
-                                     alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
-                                     thickness=p.thickness, density=p.forcing.ice_density,
-                                     seed=int(rng.integers(2 ** 63)))
+        field, box = p.floe_field(self.n_floes, self.episode["concentration"],
+                                  seed=int(rng.integers(2 ** 63)))
         self.box = DeformingPeriodicBox(box.lx, box.ly, concentration_rate=0.0)
         return self._hertz_sim(field, self.box, None)
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from physics import Forcing, HERMAN2011, find_clusters, make_floe_field
+from physics import HERMAN2011, find_clusters
 
-from .base import FloeEnv, TaskParameter, interval, number, task_table
+from .base import MAX_WIND, FloeEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table, floe_physics
 from .rewards import floe_clustering_reward
 
@@ -27,7 +27,7 @@ _TASK = (
     TaskParameter("target_range", (0.3, 0.8), "range of the drawn targets", interval(0.0, 1.0)),
     TaskParameter("concentration", 0.7, "ice concentration of the start state",
                   number(0.0, 0.85, low_open=True)),
-    TaskParameter("max_wind", 20.0, "wind speed [m/s] per component at |action| = 1",
+    TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] per component at |action| = 1",
                   number(0.0, 100.0, low_open=True)),
 )
 
@@ -63,7 +63,7 @@ class FloeClusteringEnv(FloeEnv):
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: the wind vector in units of `max_wind`
-    (default 20 m/s).
+    (default {MAX_WIND:g} m/s).
 
     ## Observation Space
     `Box(float32)` of {len(FLOE_FEATURES) + len(_EXTRA) + 2} entries. Contacts are pairs
@@ -125,11 +125,9 @@ class FloeClusteringEnv(FloeEnv):
         from physics import HardDiskSimulation
 
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
-                                     alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
-                                     thickness=p.thickness, density=p.forcing.ice_density,
-                                     seed=int(rng.integers(2 ** 63)), velocity_std=0.01)
-        self.forcing = Forcing(p.forcing, wind=(0.0, 0.0), coriolis=0.0)
+        field, box = p.floe_field(self.n_floes, self.episode["concentration"],
+                                  seed=int(rng.integers(2 ** 63)), velocity_std=0.01)
+        self.forcing = p.make_forcing(wind=(0.0, 0.0), coriolis=0.0)
         sim = HardDiskSimulation(field, box, restitution=p.contact.restitution,
                                  forcing=self.forcing, max_velocity_step=p.max_velocity_step,
                                  collision_duration=p.collision_duration)
@@ -155,7 +153,7 @@ class FloeClusteringEnv(FloeEnv):
                            self._contacts, tensor, sim.box.area, mobile,
                            cluster_gap=self.cluster_gap)
         now["target"] = self.episode["target"]
-        now["collision_rate"] = (sim.collision_count - c0) / sim.n / span if span > 0 else 0.0
+        now["collision_rate"] = (sim.collision_count - c0) / sim.n_floes / span if span > 0 else 0.0
         return now
 
     def _frame(self) -> np.ndarray:

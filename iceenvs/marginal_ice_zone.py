@@ -7,9 +7,9 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics import ChannelBox, FloeField, Forcing, HERMAN2013, make_floe_field
+from physics import ChannelBox, FloeField, HERMAN2013
 
-from .base import HertzEnv, TaskParameter, interval, number, task_table
+from .base import MAX_WIND, HertzEnv, TaskParameter, interval, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
 from .rewards import marginal_ice_zone_reward
 
@@ -35,7 +35,7 @@ _TASK = (
                   number(0.0, 0.85, low_open=True)),
     TaskParameter("edge_width", 10.0, "floes whose centres lie within this distance [m] of "
                   "the bottom are frozen (the fast ice)", number(0.0, None, low_open=True)),
-    TaskParameter("max_wind", 20.0, "wind speed [m/s] at action[0] = +1",
+    TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] at action[0] = +1",
                   number(0.0, 100.0, low_open=True)),
 )
 
@@ -73,7 +73,7 @@ class MarginalIceZoneEnv(HertzEnv):
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: action[0] → wind speed `max_wind` (a + 1)/2
-    (0 to 20 m/s by default), action[1] → wind direction π a [rad] from +x
+    (0 to {MAX_WIND:g} m/s by default), action[1] → wind direction π a [rad] from +x
     (±π: along −x; −π/2: towards the edge).
 
     ## Observation Space
@@ -134,11 +134,9 @@ class MarginalIceZoneEnv(HertzEnv):
 
     def _make_sim(self, rng):
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
-                                     alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
-                                     thickness=p.thickness, density=p.forcing.ice_density,
-                                     seed=int(rng.integers(2 ** 63)), aspect=0.5,
-                                     box_type=ChannelBox)
+        field, box = p.floe_field(self.n_floes, self.episode["concentration"],
+                                  seed=int(rng.integers(2 ** 63)), aspect=0.5,
+                                  box_type=ChannelBox)
         edge_width = self.episode["edge_width"]
         frozen = field.positions[:, 1] < edge_width
         if frozen.all() or not frozen.any():
@@ -147,7 +145,7 @@ class MarginalIceZoneEnv(HertzEnv):
                              f"but not all floes are frozen")
         field = FloeField(field.positions, field.radii, field.thickness, field.velocities,
                           density=field.density, frozen=frozen)
-        self.forcing = Forcing(p.forcing, wind=(0.0, 0.0))
+        self.forcing = p.make_forcing(wind=(0.0, 0.0))
         return self._hertz_sim(field, box, self.forcing)
 
     def _apply_action(self, action):

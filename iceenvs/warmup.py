@@ -114,12 +114,10 @@ def warm_demo() -> str:
 def warm_parallel(steps: int = 5) -> str:
     """A few steps of a small Hertz run with ``parallel=True`` (the kernels
     that the engine picks for large fields when Numba has several threads)."""
-    from physics import HERMAN2013, Forcing, HertzSimulation, make_floe_field
+    from physics import HERMAN2013, HertzSimulation
 
-    field, box = make_floe_field(300, concentration=0.7, alpha=HERMAN2013.fsd_exponent,
-                                 mean_diameter=HERMAN2013.mean_diameter, seed=1,
-                                 velocity_std=0.01)
-    sim = HertzSimulation(field, box, HERMAN2013.contact, Forcing(HERMAN2013.forcing),
+    field, box = HERMAN2013.floe_field(300, 0.7, seed=1, velocity_std=0.01)
+    sim = HertzSimulation(field, box, HERMAN2013.contact, HERMAN2013.make_forcing(),
                           dt=HERMAN2013.time_step, parallel=True)
     sim.step(steps)
     sim.contacts()

@@ -6,9 +6,9 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics import Forcing, HERMAN2013, make_floe_field
+from physics import HERMAN2013
 
-from .base import HertzEnv, TaskParameter, number, task_table
+from .base import MAX_WIND, HertzEnv, TaskParameter, number, task_table
 from .observations import FLOE_FEATURES, Feature, feature_table
 from .rewards import wind_drift_reward
 
@@ -31,7 +31,7 @@ _TASK = (
                   number(optional=True)),
     TaskParameter("concentration", 0.8, "ice concentration of the start state",
                   number(0.0, 0.85, low_open=True)),
-    TaskParameter("max_wind", 20.0, "wind speed [m/s] per component at |action| = 1",
+    TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] per component at |action| = 1",
                   number(0.0, 100.0, low_open=True)),
 )
 
@@ -68,7 +68,7 @@ class WindDriftEnv(HertzEnv):
 
     ## Action Space
     `Box(-1, 1, (2,), float32)`: the wind vector (u_a,x, u_a,y) in units of
-    `max_wind` (default 20 m/s). NaN/inf entries are set to 0 and entries
+    `max_wind` (default {MAX_WIND:g} m/s). NaN/inf entries are set to 0 and entries
     clipped.
 
     ## Observation Space
@@ -138,12 +138,9 @@ class WindDriftEnv(HertzEnv):
 
     def _make_sim(self, rng):
         p = self.preset
-        field, box = make_floe_field(self.n_floes, concentration=self.episode["concentration"],
-                                     alpha=p.fsd_exponent, mean_diameter=p.mean_diameter,
-                                     thickness=p.thickness,
-                                     density=p.forcing.ice_density,
-                                     seed=int(rng.integers(2 ** 63)))
-        self.forcing = Forcing(p.forcing, wind=(0.0, 0.0))
+        field, box = p.floe_field(self.n_floes, self.episode["concentration"],
+                                  seed=int(rng.integers(2 ** 63)))
+        self.forcing = p.make_forcing(wind=(0.0, 0.0))
         return self._hertz_sim(field, box, self.forcing)
 
     def _apply_action(self, action):

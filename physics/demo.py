@@ -16,8 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .forcing import Forcing, steady_drift
-from .floes import make_floe_field
+from .forcing import steady_drift
 from .hertz import HertzSimulation
 from .params import HERMAN2013
 
@@ -59,8 +58,8 @@ def draw(sim: HertzSimulation, path: Path, title: str) -> None:
     plt.close(fig)
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m physics.demo", description=__doc__,
+def main(argv=None, prog: str = "python -m physics.demo") -> int:
+    p = argparse.ArgumentParser(prog=prog, description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--floes", type=int, default=2000)
     p.add_argument("--concentration", type=float, default=0.8)
@@ -77,13 +76,12 @@ def main(argv=None) -> int:
     preset = HERMAN2013
     print(f"Hertz engine demo: Herman (2013) set-up, {args.floes} floes, Ā = {args.concentration}")
     t0 = time.perf_counter()
-    field, box = make_floe_field(args.floes, concentration=args.concentration,
-                                 alpha=preset.fsd_exponent, mean_diameter=preset.mean_diameter,
-                                 thickness=preset.thickness, seed=args.seed, velocity_std=0.01)
+    field, box = preset.floe_field(args.floes, args.concentration, seed=args.seed,
+                                   velocity_std=0.01)
     t_place = time.perf_counter() - t0
     print(f"  floe field: box {box.lx:.0f} m × {box.ly:.0f} m, radii {field.radii.min():.2f}–"
           f"{field.radii.max():.1f} m, placed without overlap in {t_place:.2f} s")
-    forcing = Forcing(preset.forcing)
+    forcing = preset.make_forcing()
     sim = HertzSimulation(field, box, preset.contact, forcing, dt=preset.time_step)
     sim.step(1)                                         # compile (or load the cache)
     t0 = time.perf_counter()

@@ -53,6 +53,8 @@ class Forcing:
     coriolis : float, optional
         Override f [1/s].
 
+    Notes
+    -----
     The wind and current vectors may be changed between calls to an engine
     (``forcing.wind = (ux, uy)``); the environments do so every control step.
 

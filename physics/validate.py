@@ -22,11 +22,12 @@ import numpy as np
 from .contact import contact_time, hertz_stiffness, peak_overlap
 from .domain import PeriodicBox
 from .floes import FloeField, make_floe_field
-from .forcing import Forcing, steady_drift
+from .forcing import steady_drift
 from .hertz import HertzSimulation
 from .params import HERMAN2013, ContactParams
 
-RADIUS, THICKNESS, DENSITY = 2.0, 1.5, 910.0
+RADIUS = 2.0
+THICKNESS, DENSITY = HERMAN2013.thickness, HERMAN2013.forcing.ice_density
 
 
 def binary_impact(contact: ContactParams, speed: float, angle_deg: float = 0.0,
@@ -120,7 +121,7 @@ def report() -> list[tuple[str, str, str]]:
     rows.append(("elastic gas, energy drift (Δt = t_c/20, 2e4 steps)", "< 1e-3",
                  f"{np.max(np.abs(np.array(energies) / e0 - 1)):.1e}"))
     # 5. lone floe drift
-    forcing = Forcing(HERMAN2013.forcing, current=(0.05, 0.02))
+    forcing = HERMAN2013.make_forcing(current=(0.05, 0.02))
     one = FloeField(np.array([[50.0, 50.0]]), [5.0], 1.5, density=HERMAN2013.forcing.ice_density)
     sim = HertzSimulation(one, PeriodicBox(100.0), HERMAN2013.contact, forcing, dt=0.003)
     sim.advance(20000.0)                    # about 20 relaxation times m/b

@@ -35,8 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..domain import DeformingPeriodicBox, PeriodicBox
-from ..floes import FloeField, make_floe_field
-from ..forcing import Forcing
+from ..floes import FloeField
 from ..hertz import HertzSimulation
 from ..params import HERMAN2013, ContactParams
 from .lammps_runner import LammpsSimulation
@@ -44,9 +43,6 @@ from .results import Check, save_figure
 
 __all__ = ["zero_step_forces", "trajectories", "convergence", "speed", "run",
            "compressed_field", "jammed_field"]
-
-ALPHA = 1.8            # FSD exponent of Herman (2013)
-MEAN_DIAMETER = 8.0    # [m]
 
 
 def _periodic_error(a: np.ndarray, b: np.ndarray, lengths) -> np.ndarray:
@@ -62,8 +58,7 @@ def compressed_field(n: int, seed: int, squeeze: float = 0.997, speed: float = 0
     standard deviation ``speed`` [m/s] and contact-point spin speeds r ω of
     standard deviation ``spin`` [m/s]. Returns (field, box)."""
     rng = np.random.default_rng(seed)
-    field, box = make_floe_field(n, concentration=0.85, alpha=ALPHA,
-                                 mean_diameter=MEAN_DIAMETER, seed=seed)
+    field, box = HERMAN2013.floe_field(n, 0.85, seed=seed)
     vel = rng.normal(0.0, speed, (n, 2)) if speed > 0 else np.zeros((n, 2))
     omega = rng.normal(0.0, spin, n) / field.radii if spin > 0 else np.zeros(n)
     f = FloeField(field.positions * squeeze, field.radii, 1.0 + rng.random(n), vel, omega)
@@ -180,9 +175,8 @@ def jammed_field(n: int, seed: int, concentration: float, rate_per_hour: float =
     """A packing at ``concentration`` made by our engine: convergence with
     water drag from Ā = 0.80, one minute at rest, velocities set to zero.
     Returns (field, box)."""
-    field, box = make_floe_field(n, concentration=0.80, alpha=ALPHA,
-                                 mean_diameter=MEAN_DIAMETER, seed=seed)
-    forcing = Forcing(HERMAN2013.forcing, wind=(0.0, 0.0), current=(0.0, 0.0))
+    field, box = HERMAN2013.floe_field(n, 0.80, seed=seed)
+    forcing = HERMAN2013.make_forcing(wind=(0.0, 0.0), current=(0.0, 0.0))
     pre = HertzSimulation(field, DeformingPeriodicBox(box.lx, box.ly,
                                                       concentration_rate=rate_per_hour / 3600),
                           ContactParams(), forcing, dt=1e-3)
@@ -316,8 +310,7 @@ def speed(n: int = 20000, steps: int = 1000, seed: int = 1,
     excluded (both engines run 20 steps first)."""
     import numba
 
-    field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA, mean_diameter=MEAN_DIAMETER,
-                                 seed=seed, velocity_std=0.03)
+    field, box = HERMAN2013.floe_field(n, 0.7, seed=seed, velocity_std=0.03)
     dt = HERMAN2013.time_step
     contact = HERMAN2013.contact
     threads = numba.get_num_threads()

@@ -88,7 +88,7 @@ __all__ = ["binary_frictionless", "binary_friction", "gas_cooling", "drag_relaxa
            "pymunk_pair_impact", "pymunk_oblique_impact", "harddisk_pair_impact",
            "enskog_rate", "henderson_g", "drag_forcing"]
 
-DENSITY = 910.0            # ice density [kg/m³] (FloeField default)
+DENSITY = HERMAN2011.forcing.ice_density   # ice density [kg/m³]
 LEAD = 1e-10               # pymunk steps end this fraction of the approach time after touching
 
 
@@ -699,7 +699,7 @@ def drag_forcing() -> Forcing:
     """Herman (2011) drag coefficients with a constant 3 m/s wind at 30° and
     no current (a drift of ~1 cm/s, so that the gas stays clear of pymunk's
     walls over five relaxation times)."""
-    return Forcing(HERMAN2011.forcing, wind=DRAG_WIND, current=(0.0, 0.0))
+    return HERMAN2011.make_forcing(wind=DRAG_WIND, current=(0.0, 0.0))
 
 
 def drag_relaxation(out_dir: Path | None = None, quick: bool = False, seed: int = 0,

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -64,11 +63,9 @@ def _preset():
 def _forcing(p: dict):
     """The Herman (2011) forcing with the scenario's wind and current
     (both along +x), without Coriolis."""
-    from .. import Forcing
-
-    params = replace(_preset().forcing, wind_speed=float(p["wind_speed"]), wind_direction=0.0,
-                     current_speed=float(p["current_speed"]), current_angle=0.0, coriolis=0.0)
-    return Forcing(params, coriolis=0.0)
+    return _preset().make_forcing(wind_speed=float(p["wind_speed"]), wind_direction=0.0,
+                                  current_speed=float(p["current_speed"]), current_angle=0.0,
+                                  coriolis=0.0)
 
 
 def _equilibrium(p: dict, diameters):
@@ -258,7 +255,7 @@ class Herman2011Clustering(Experiment):
                 * (1.0 + a / (1.0 - a) / 9.0))
 
     def simulate(self, p: dict, case: dict, seed: int, rec) -> None:
-        from .. import HardDiskSimulation, make_floe_field
+        from .. import HardDiskSimulation
 
         pre = _preset()
         n_out = max(1, int(round(float(p["duration"]) / float(p["output_interval"]))))
@@ -279,11 +276,9 @@ class Herman2011Clustering(Experiment):
         st = rec.restore()
         if st is None:
             a = float(case["concentration"])
-            field, box = make_floe_field(
-                int(p["floes"]), repeat=int(p["repeat"]), concentration=a,
-                alpha=float(p["fsd_exponent"]),
-                mean_diameter=pre.mean_diameter, thickness=pre.thickness,
-                density=pre.forcing.ice_density, seed=int(seed), fsd=str(p["fsd"]),
+            field, box = pre.floe_field(
+                int(p["floes"]), a, seed=int(seed), repeat=int(p["repeat"]),
+                alpha=float(p["fsd_exponent"]), fsd=str(p["fsd"]),
                 velocity_std=float(p["initial_velocity_std"]))
             reach = 2.0 * float(field.radii.max()) + _widest_gap(p)
             if reach >= 0.5 * box.lx:
@@ -344,7 +339,7 @@ class Herman2011Clustering(Experiment):
         mass = sim.mass
         slip = np.hypot(vel[:, 0] - ueq, vel[:, 1])
         count = sim.collision_count
-        rate = (count - st["count"]) / (sim.n * interval) if st["step"] > 0 else math.nan
+        rate = (count - st["count"]) / (sim.n_floes * interval) if st["step"] > 0 else math.nan
         st["count"] = count
         values = dict(
             largest_fraction=cs.largest_fraction, n_clusters=cs.n_clusters, alpha=alpha,
@@ -362,7 +357,7 @@ class Herman2011Clustering(Experiment):
                 cluster_statistics(find_clusters(pos, r, sim.box, float(g)), r).largest_fraction
                 for g in p["gap_sweep"]]))
         if st["step"] == n_out:
-            ranked = np.full(sim.n, np.nan)
+            ranked = np.full(sim.n_floes, np.nan)
             ranked[:cs.n_clusters] = cs.effective_radius
             values["cluster_radius"] = ("rank", ranked)
         rec.record(sim.time, **values)

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..domain import ChannelBox, DeformingPeriodicBox, PeriodicBox
-from ..floes import FloeField, make_floe_field
+from ..floes import FloeField
 from ..forcing import Forcing, steady_drift
 from ..hertz import HertzSimulation, hertz_time_step, scaled_contact
 from ..hertz_kernels import floe_drag
@@ -82,11 +82,7 @@ def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_
     which works up to about 0.88 (beyond, placement fails with a
     :class:`physics.floes.PlacementError` saying so)."""
     place = min(concentration, 0.85) if box_type is PeriodicBox else concentration
-    field, box = make_floe_field(n, concentration=place, alpha=HERMAN2013.fsd_exponent,
-                                 mean_diameter=HERMAN2013.mean_diameter,
-                                 thickness=HERMAN2013.thickness,
-                                 density=HERMAN2013.forcing.ice_density, seed=seed,
-                                 aspect=aspect, box_type=box_type)
+    field, box = HERMAN2013.floe_field(n, place, seed=seed, aspect=aspect, box_type=box_type)
     if concentration > place:
         from ..jamming import compress_floes
         # above the field's jamming point the result is a jammed packing in force
@@ -258,7 +254,7 @@ class Convergence(Experiment):
             box = DeformingPeriodicBox(box.lx, box.ly, concentration_rate=rate,
                                        max_concentration=min(0.999, p["end_concentration"] + 0.02))
             # no wind and no current, but water drag and Coriolis act on moving floes
-            forcing = Forcing(HERMAN2013.forcing, wind=(0.0, 0.0), current=(0.0, 0.0))
+            forcing = HERMAN2013.make_forcing(wind=(0.0, 0.0), current=(0.0, 0.0))
             sim = _simulation(field, box, p, forcing)
             st = dict(sim=sim, next_snap=p["start_concentration"] + p["snapshot_step"],
                       error=None)
@@ -397,7 +393,7 @@ class Wind(Experiment):
         st = rec.restore()
         if st is None:
             field, box = _field(p["floes"], case["concentration"], seed)
-            forcing = Forcing(HERMAN2013.forcing, wind=(p["wind_speed"], 0.0))
+            forcing = HERMAN2013.make_forcing(wind=(p["wind_speed"], 0.0))
             # every floe starts at its own free drift: the spin-up of the whole sheet
             # (water-drag time of ~20 min) is skipped
             drift = steady_drift(forcing, field.radii, field.thickness, field.masses)
@@ -522,7 +518,7 @@ class MarginalIceZone(Experiment):
                                  f"of {field.n} floes; choose it so that some but not all are")
             field = FloeField(field.positions, field.radii, field.thickness, field.velocities,
                               density=field.density, frozen=frozen)
-            forcing = Forcing(HERMAN2013.forcing, wind=(math.sqrt(speed ** 2 - uy ** 2), uy))
+            forcing = HERMAN2013.make_forcing(wind=(math.sqrt(speed ** 2 - uy ** 2), uy))
             sim = _simulation(field, box, p, forcing)
             st = dict(sim=sim, error=None, next_snap=0)
         sim = st["sim"]
