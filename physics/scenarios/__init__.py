@@ -11,7 +11,8 @@ Layout: ``configs/*.yaml`` the scenario files (parameters, ranges, the
 ``--quick`` form); ``config.py`` their parsing and checks; ``experiment.py``
 the interface and registry of experiments; ``herman2013.py``,
 ``herman2011.py``, ``godlovitch.py`` the experiments; ``recorder.py`` time
-series, snapshots and checkpoints; ``runner.py`` ensembles, run directories,
+series, snapshots and checkpoints; ``checkpoint.py`` the checkpoint file
+format (NumPy arrays and YAML, no pickle); ``runner.py`` ensembles, run directories,
 NetCDF; ``plots.py`` shared figure helpers; ``cli.py`` the command line.
 
 Needs the ``plots`` extra (matplotlib, xarray, h5netcdf, PyYAML).

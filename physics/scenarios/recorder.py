@@ -11,11 +11,17 @@ An experiment's ``simulate`` gets a :class:`Recorder` and calls
 * ``rec.result(a_j=...)`` for per-run results;
 * ``rec.progress(fraction)`` for the progress bar;
 * ``rec.checkpoint(state)`` after each output: every ``checkpoint_every``
-  wall seconds the state (anything picklable: the simulation object, loop
-  counters, generators) and everything recorded so far are written together,
-  atomically, so an interrupted run resumes exactly where its last
-  checkpoint left it (``rec.restore()`` returns that state, or ``None`` on a
-  fresh start).
+  wall seconds the state (the simulation object, loop counters, generators:
+  whatever :mod:`physics.scenarios.checkpoint` writes) and everything
+  recorded so far are written together, atomically, so an interrupted run
+  resumes exactly where its last checkpoint left it (``rec.restore()``
+  returns that state, or ``None`` on a fresh start).
+
+A checkpoint holds NumPy arrays and a YAML description of them, never a
+pickle: reading one cannot run code. The previous checkpoint is kept beside
+the newest (``NAME.previous.EXT`` next to ``NAME.EXT``); a checkpoint that
+cannot be read is reported (on standard error and in the run's notes) and
+the run continues from the previous one, or from the start.
 
 :meth:`Recorder.dataset` turns it all into an ``xarray.Dataset`` with
 dimensions ``sample`` (output times), ``snapshot``, ``floe`` and
@@ -27,26 +33,56 @@ dimensions ``sample`` (output times), ``snapshot``, ``floe`` and
 from __future__ import annotations
 
 import os
-import pickle
+import sys
 import time as _time
 from pathlib import Path
 
 import numpy as np
 
-CHECKPOINT_VERSION = 1
+from . import checkpoint as _checkpoint
 
 
-def atomic_write(path: Path, write) -> None:
+def atomic_write(path: Path, write, previous: Path | None = None) -> None:
     """Call ``write(tmp_path)`` and move the result onto ``path`` in one
-    step: an interruption leaves either the old file or the new one."""
+    step: an interruption leaves either the old file or the new one. With
+    ``previous``, the old ``path`` is first moved there (an interruption in
+    between leaves ``previous`` and no ``path``)."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         write(tmp)
+        if previous is not None and path.exists():
+            os.replace(path, previous)
         os.replace(tmp, path)
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def checkpoint_files(path) -> tuple[Path, Path]:
+    """(newest, previous): the two checkpoint files kept for the checkpoint
+    path ``path`` (``NAME.EXT`` and ``NAME.previous.EXT``)."""
+    path = Path(path)
+    return path, path.with_name(f"{path.stem}.previous{path.suffix}")
+
+
+def checkpoint_fraction(path) -> float:
+    """The progress saved with the newest readable checkpoint of ``path``
+    (0 if there is none), read without its arrays."""
+    for file in checkpoint_files(path):
+        if file.exists():
+            try:
+                return float(_checkpoint.read_meta(file).get("fraction", 0.0))
+            except (_checkpoint.CheckpointError, TypeError, ValueError):
+                continue
+    return 0.0
+
+
+def _to_stderr(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+_PAYLOAD = ("state", "rows", "coords", "snapshots", "results", "notes", "fraction")
 
 
 class Recorder:
@@ -65,10 +101,14 @@ class Recorder:
         attributes.
     keep_snapshots : bool
         Write the snapshot variables even when there are no snapshots.
+    log : callable(str) or None
+        Receives the report on a checkpoint that cannot be read (default:
+        standard error).
     """
 
     def __init__(self, checkpoint_path: Path | None = None, checkpoint_every: float = 60.0,
-                 on_progress=None, variables: dict | None = None, keep_snapshots: bool = True):
+                 on_progress=None, variables: dict | None = None, keep_snapshots: bool = True,
+                 log=None):
         self.checkpoint_path = Path(checkpoint_path) if checkpoint_path else None
         self.checkpoint_every = float(checkpoint_every)
         self.on_progress = on_progress
@@ -83,8 +123,9 @@ class Recorder:
         self._state = None
         self._last = _time.monotonic()
         self._fraction = 0.0
-        if self.checkpoint_path is not None and self.checkpoint_path.exists():
-            self._load()
+        self._newest_ok = False        # whether the newest checkpoint file is a good one
+        if self.checkpoint_path is not None:
+            self._load(log or _to_stderr)
 
     # -- writing -----------------------------------------------------------
     def coord(self, name: str, values, units: str = "", description: str = "") -> None:
@@ -141,37 +182,54 @@ class Recorder:
 
     def checkpoint(self, state, *, force: bool = False) -> bool:
         """Save ``state`` and the output so far if ``checkpoint_every`` wall
-        seconds have passed (or ``force``). Returns whether it wrote."""
+        seconds have passed (or ``force``). Returns whether it wrote. Raises
+        :class:`TypeError` naming the part of ``state`` that a checkpoint
+        cannot hold (see :mod:`physics.scenarios.checkpoint`)."""
         if self.checkpoint_path is None:
             return False
         now = _time.monotonic()
         if not force and now - self._last < self.checkpoint_every:
             return False
-        payload = dict(version=CHECKPOINT_VERSION, state=state, rows=self.rows,
-                       coords=self.coords, snapshots=self.snapshots, results=self.results,
-                       notes=self.notes, fraction=self._fraction)
-
-        def write(tmp):
-            with open(tmp, "wb") as fh:
-                pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        atomic_write(self.checkpoint_path, write)
+        payload = dict(state=state, rows=self.rows, coords=self.coords,
+                       snapshots=self.snapshots, results=self.results, notes=self.notes,
+                       fraction=self._fraction)
+        newest, previous = checkpoint_files(self.checkpoint_path)
+        # the newest file becomes the previous one only if it is a good checkpoint
+        atomic_write(newest, lambda tmp: _checkpoint.save(tmp, payload,
+                                                          meta={"fraction": self._fraction}),
+                     previous=previous if self._newest_ok else None)
+        self._newest_ok = True
         self._last = now
         self.n_checkpoints += 1
         return True
 
-    def _load(self) -> None:
-        with open(self.checkpoint_path, "rb") as fh:
-            payload = pickle.load(fh)
-        if payload.get("version") != CHECKPOINT_VERSION:
-            raise ValueError(f"checkpoint {self.checkpoint_path} was written by another version "
-                             f"of the runner; start the run again with --force")
-        self._state = payload["state"]
-        self.rows = payload["rows"]
-        self.coords = payload["coords"]
-        self.snapshots = payload["snapshots"]
-        self.results = payload["results"]
-        self.notes = payload["notes"]
-        self._fraction = payload["fraction"]
+    def _load(self, log) -> None:
+        """Restore the newest checkpoint that can be read; report those that
+        cannot (the run then continues from the previous one, or starts)."""
+        problems = []
+        for file in checkpoint_files(self.checkpoint_path):
+            if not file.exists():
+                continue
+            try:
+                payload = _checkpoint.load(file)
+                if not (isinstance(payload, dict) and set(payload) == set(_PAYLOAD)):
+                    raise _checkpoint.CheckpointError("it holds no recorder state")
+            except _checkpoint.CheckpointError as exc:
+                problems.append(f"checkpoint {file} cannot be read: {exc}")
+                continue
+            self._state = payload["state"]
+            self.rows, self.coords = payload["rows"], payload["coords"]
+            self.snapshots, self.results = payload["snapshots"], payload["results"]
+            self.notes, self._fraction = payload["notes"], float(payload["fraction"])
+            self._newest_ok = file == self.checkpoint_path
+            outcome = f"the run continues from {file}"
+            break
+        else:
+            outcome = "the run starts again from the beginning"
+        if problems:
+            message = "; ".join(problems) + "; " + outcome
+            log(message)
+            self.note(message)
 
     # -- output ------------------------------------------------------------
     def _snapshot_variables(self, ds) -> None:

@@ -34,7 +34,7 @@ import numpy as np
 
 from .config import ScenarioConfig, bundled_configs, dump_yaml, load_config, parse_config
 from .experiment import get_experiment
-from .recorder import Recorder, atomic_write
+from .recorder import Recorder, atomic_write, checkpoint_files, checkpoint_fraction
 
 RUN_FILE = "run.yaml"
 RESULTS_FILE = "results.nc"
@@ -128,8 +128,8 @@ def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: 
     ds = rec.dataset()
     ds.attrs.update(case=c, member=m, seed=str(seed))
     atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
-    if ckpt.exists():
-        ckpt.unlink()
+    for file in checkpoint_files(ckpt):
+        file.unlink(missing_ok=True)
     return str(out)
 
 
@@ -241,11 +241,8 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
     """Run the unfinished jobs, ``workers`` at a time, with one progress bar."""
     from tqdm.auto import tqdm
 
-    fractions = {k: 0.0 for k in range(len(todo))}
-    for k, job in enumerate(todo):
-        _, ckpt = _job_paths(out, job["c"], job["m"])
-        if ckpt.exists():
-            fractions[k] = Recorder(ckpt)._fraction
+    fractions = {k: checkpoint_fraction(_job_paths(out, j["c"], j["m"])[1])
+                 for k, j in enumerate(todo)}
     bar = tqdm(total=len(todo), unit="run", desc=info["scenario"], disable=not progress,
                dynamic_ncols=True, bar_format="{l_bar}{bar}| {n:.2f}/{total} runs "
                                                "[{elapsed}<{remaining}]")

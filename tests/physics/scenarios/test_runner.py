@@ -2,6 +2,9 @@
 end to end, checkpoints and resume, reproducible ensembles."""
 from __future__ import annotations
 
+import pathlib
+import pickle
+import shutil
 import subprocess
 import sys
 
@@ -14,6 +17,7 @@ pytest.importorskip("yaml")
 from physics.scenarios import get_experiment, load_config, resume_run, run_scenario  # noqa: E402
 from physics.scenarios import recorder as recorder_module  # noqa: E402
 from physics.scenarios.config import bundled_configs, parse_set  # noqa: E402
+from physics.scenarios.recorder import checkpoint_files  # noqa: E402
 from physics.scenarios.runner import find_config, member_seeds  # noqa: E402
 
 ALL = ["godlovitch-kernels", "godlovitch-rafting", "godlovitch-thermo", "herman2013-convergence",
@@ -23,10 +27,50 @@ TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.
             output_step=0.004)
 
 
-def _run(out, **kw):
+# one small run of each kind of engine: Hertz contacts, hard discs, an ITD
+KINDS = {
+    "hertz": ("herman2013-convergence", TINY),
+    "hard-disc": ("herman2011-clustering", dict(floes=300, concentrations=[0.7], duration=200.0,
+                                                output_interval=50.0, snapshots=2)),
+    "itd": ("godlovitch-kernels", dict(kernel="constant", days=120, output_every=30)),
+}
+
+
+def _run(out, name="herman2013-convergence", **kw):
     kw.setdefault("overrides", TINY)
-    return run_scenario("herman2013-convergence", out=out, workers=1, progress=False,
+    return run_scenario(name, out=out, workers=1, progress=False,
                         plots=False, log=lambda *a: None, **kw)
+
+
+def _resume(out):
+    return resume_run(out, workers=1, progress=False, plots=False, log=lambda *a: None)
+
+
+def _interrupted(out, monkeypatch, after: int, **kw):
+    """A run stopped (as by Ctrl-C) right after its checkpoint number
+    ``after``, with checkpoints at every output."""
+    real = recorder_module.Recorder.checkpoint
+    calls = {"n": 0}
+
+    def checkpoint_then_crash(self, state, *, force=False):
+        wrote = real(self, state, force=True)
+        calls["n"] += 1
+        if calls["n"] == after:
+            raise KeyboardInterrupt
+        return wrote
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", checkpoint_then_crash)
+    with pytest.raises(KeyboardInterrupt):
+        _run(out, checkpoint_every=0, **kw)
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", real)
+    assert list((out / "jobs").glob("*.ckpt")) and not (out / "results.nc").exists()
+
+
+def _assert_same_numbers(res, whole):
+    with xr.open_dataset(res.dataset) as ds:
+        ds = ds.load()
+    assert set(ds.data_vars) == set(whole.data_vars)
+    for name in whole.data_vars:
+        np.testing.assert_array_equal(ds[name].values, whole[name].values, err_msg=name)
 
 
 def test_every_shipped_file_parses_and_names_an_experiment():
@@ -110,26 +154,72 @@ def test_same_seed_same_trajectory_other_seed_another(tmp_path):
 
 def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path, monkeypatch):
     whole = xr.open_dataset(_run(tmp_path / "whole", seed=2).dataset).load()
-    real = recorder_module.Recorder.checkpoint
-    calls = {"n": 0}
-
-    def checkpoint_then_crash(self, state, *, force=False):
-        wrote = real(self, state, force=True)
-        calls["n"] += 1
-        if calls["n"] == 4:
-            raise KeyboardInterrupt          # as Ctrl-C right after the 4th checkpoint
-        return wrote
-    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", checkpoint_then_crash)
     out = tmp_path / "cut"
-    with pytest.raises(KeyboardInterrupt):
-        _run(out, seed=2, checkpoint_every=0)
-    assert list((out / "jobs").glob("*.ckpt")) and not (out / "results.nc").exists()
-    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", real)
-    res = resume_run(out, workers=1, progress=False, plots=False, log=lambda *a: None)
-    resumed = xr.open_dataset(res.dataset).load()
+    _interrupted(out, monkeypatch, 4, seed=2)      # as Ctrl-C right after the 4th checkpoint
+    resumed = xr.open_dataset(_resume(out).dataset).load()
     for name in ("time", "p", "z_c", "f_nr", "floe_x", "contact_force", "a_j"):
         np.testing.assert_array_equal(resumed[name].values, whole[name].values, err_msg=name)
     assert not list((out / "jobs").glob("*.ckpt"))
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_resume_from_the_newest_checkpoint_or_after_damage_the_previous(tmp_path, monkeypatch,
+                                                                         capsys, kind):
+    """Every kind of engine resumes bit-for-bit; when its newest checkpoint
+    is damaged the run says so and resumes, still bit-for-bit, from the
+    previous one."""
+    name, overrides = KINDS[kind]
+    with xr.open_dataset(_run(tmp_path / "whole", name, overrides=overrides, seed=4).dataset) as ds:
+        whole = ds.load()
+    out = tmp_path / "cut"
+    _interrupted(out, monkeypatch, 3, name=name, overrides=overrides, seed=4)
+    newest, previous = checkpoint_files(out / "jobs" / "case00_member00.ckpt")
+    assert newest.exists() and previous.exists()
+    damaged = tmp_path / "damaged"
+    shutil.copytree(out, damaged)
+    bad = damaged / "jobs" / newest.name
+    bad.write_bytes(bad.read_bytes()[:-100])
+    capsys.readouterr()
+    _assert_same_numbers(_resume(out), whole)
+    assert "cannot be read" not in capsys.readouterr().err
+    res = _resume(damaged)
+    err = capsys.readouterr().err
+    assert f"checkpoint {bad} cannot be read: it is damaged or truncated" in err, err
+    assert f"the run continues from {damaged / 'jobs' / previous.name}" in err, err
+    _assert_same_numbers(res, whole)
+    assert not list((out / "jobs").glob("*.ckpt")) and not list((damaged / "jobs").glob("*.ckpt"))
+    with xr.open_dataset(res.dataset) as ds:
+        assert "cannot be read" in ds.attrs["notes"]
+
+
+class _TouchWhenUnpickled:
+    """A pickle that creates a file when it is loaded: stands for the code
+    an old-style checkpoint received from someone else could run."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def __reduce__(self):
+        return pathlib.Path.touch, (self.path,)
+
+
+def test_old_pickle_checkpoint_is_reported_and_never_loaded(tmp_path, monkeypatch, capsys):
+    with xr.open_dataset(_run(tmp_path / "whole", seed=1).dataset) as ds:
+        whole = ds.load()
+    out = tmp_path / "old"
+    _interrupted(out, monkeypatch, 2, seed=1)
+    newest, previous = checkpoint_files(out / "jobs" / "case00_member00.ckpt")
+    previous.unlink()
+    marker = tmp_path / "unpickled"
+    newest.write_bytes(pickle.dumps({"version": 1, "state": _TouchWhenUnpickled(marker)}))
+    capsys.readouterr()
+    res = _resume(out)
+    err = capsys.readouterr().err
+    assert f"checkpoint {newest} cannot be read: it is a pickle file" in err, err
+    assert "the run starts again from the beginning" in err, err
+    assert not marker.exists()
+    _assert_same_numbers(res, whole)
+    assert not newest.exists()
 
 
 def test_sigterm_during_a_kernel_stops_cleanly_and_resumes(tmp_path):
