@@ -10,7 +10,7 @@ import pytest
 from physics import (HERMAN2013, ChannelBox, ContactParams, DeformingPeriodicBox, FloeField,
                      Forcing, HertzSimulation, PeriodicBox, WalledBox, make_floe_field)
 
-from dem_reference import disc_mass, hertz_contact_time, hertz_k, hertz_peak_overlap
+from reference.dem import disc_mass, hertz_contact_time, hertz_k, hertz_peak_overlap
 
 
 # ---------------------------------------------------------------------------

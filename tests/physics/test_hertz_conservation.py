@@ -7,7 +7,7 @@ import pytest
 
 from physics import ContactParams, FloeField, HertzSimulation, PeriodicBox, place_floes
 
-from dem_reference import disc_mass, hertz_contact_time, hertz_k
+from reference.dem import disc_mass, hertz_contact_time, hertz_k
 
 N_FLOES = 100
 CONCENTRATION = 0.45

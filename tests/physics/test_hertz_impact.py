@@ -8,7 +8,7 @@ import pytest
 
 from physics import ContactParams
 
-from dem_reference import hertz_contact_time, hertz_peak_overlap, run_impact
+from reference.dem import hertz_contact_time, hertz_peak_overlap, run_impact
 
 ELASTIC = ContactParams(restitution=1.0, friction=0.0)
 

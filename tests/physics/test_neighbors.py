@@ -13,7 +13,7 @@ from physics import (HERMAN2013, ChannelBox, ContactParams, DeformingPeriodicBox
                      sample_power_law_diameters)
 from physics.neighbors import brute_force_pairs, build_pair_list, choose_cell_size, radius_rank
 
-from dem_reference import effective_modulus
+from reference.dem import effective_modulus
 
 
 def all_pairs_within(pos, radius, box, skin):

@@ -8,7 +8,7 @@ import pytest
 from physics import (ContactParams, DeformingPeriodicBox, FloeField, Forcing, ForcingParams,
                      HertzSimulation, PeriodicBox, WalledBox, make_floe_field)
 
-from dem_reference import disc_mass, hertz_contact_time, hertz_k
+from reference.dem import disc_mass, hertz_contact_time, hertz_k
 
 POS = np.array([[10.0, 10.0], [20.0, 10.0], [10.0, 25.0]])
 RADII = np.array([2.0, 3.0, 1.5])
