@@ -1,0 +1,60 @@
+"""Benchmarks of the engines, the observables, the ITD models and the
+environments, apart from the library.
+
+One module per suite, each with a ``main(argv)`` and a ``python -m`` entry
+point (``seaice bench <suite>`` runs the same), all sharing
+:mod:`benchmarks.harness`:
+
+=================  ==============================================================
+suite              what is timed
+=================  ==============================================================
+``hertz``          floe-steps/s of the Hertz engine at Ā = 0.7 and jammed, on
+                   the serial and parallel kernels (:mod:`benchmarks.hertz`)
+``hertz_phases``   each phase of a Hertz step on its own
+                   (:mod:`benchmarks.hertz_phases`)
+``harddisk``       collisions/s of the hard-disc engine (:mod:`benchmarks.harddisk`)
+``observables``    clusters, g_ffd, g_rdf, fabric and stress on 10⁵ floes
+                   (:mod:`benchmarks.observables`)
+``itd``            the ice-thickness-distribution models (:mod:`benchmarks.itd`)
+``environments``   sustained steps/s of every environment
+                   (:mod:`benchmarks.environments`)
+``compare``        this tree against another revision, side by side
+                   (:mod:`benchmarks.compare`)
+=================  ==============================================================
+
+Every suite writes one JSON record to ``docs/benchmarks/<suite>.json``
+(:func:`benchmarks.harness.write_record`), which the documentation renders
+(:func:`benchmarks.harness.render_markdown`);
+``python -m benchmarks.headline`` puts the headline figures into the README.
+Every suite takes ``--quick``, a run small enough for the tests.
+
+This package imports neither :mod:`physics` nor :mod:`iceenvs` on import:
+:mod:`benchmarks.compare` runs the same workloads on another revision's
+packages in fresh processes.
+"""
+from __future__ import annotations
+
+import importlib
+
+#: the suites, in the order the documentation shows them
+SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "compare")
+
+__all__ = ["SUITES", "main"]
+
+
+def main(suite: str, argv: list[str] | None = None) -> int:
+    """Run ``suite`` (one of :data:`SUITES`) with the command-line arguments
+    ``argv``; returns its exit status.
+
+    Raises
+    ------
+    TypeError
+        If ``suite`` is not a string.
+    ValueError
+        If ``suite`` is not one of :data:`SUITES`.
+    """
+    if not isinstance(suite, str):
+        raise TypeError(f"suite must be a string, got {type(suite).__name__}")
+    if suite not in SUITES:
+        raise ValueError(f"unknown benchmark suite {suite!r}; known: {', '.join(SUITES)}")
+    return importlib.import_module(f"{__name__}.{suite}").main(argv)

@@ -1,0 +1,115 @@
+"""The headline figures in the README, from the benchmarks' records:
+``python -m benchmarks.headline [--readme README.md] [--records docs/benchmarks]``.
+
+Rewrites the block between ``<!-- headline:start -->`` and
+``<!-- headline:end -->`` with one small table: the Hertz engine's
+floe-steps/s at Ā = 0.7 and jammed, the hard-disc engine's collisions/s and
+each environment's sustained steps/s, as far as records of full runs
+(not ``--quick``) exist, each with its date.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import harness
+
+START = "<!-- headline:start -->"
+END = "<!-- headline:end -->"
+#: the documentation page with every table, relative to the README
+BENCHMARKS_PAGE = "docs/benchmarks.md"
+
+
+def _hertz_rows(record: dict) -> list[list[str]]:
+    rows = record["data"]["rows"]
+    out = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        if not case.startswith(("Ā =", "jammed")):
+            continue
+        timed = [r for r in rows if r["case"] == case]
+        serial = [r for r in timed if r["kernel"] == "serial"]
+        most = max(timed, key=lambda r: (r["kernel"] == "parallel", r["threads"]))
+        figure = f"{most['rate']:.3g} floe-steps/s on {most['threads']} thread" \
+                 f"{'s' * (most['threads'] > 1)}"
+        if serial and most is not serial[0]:
+            figure += f" ({serial[0]['rate']:.3g} on one, serial kernels)"
+        out.append([f"Hertz engine, N = {record['data']['n']}, {case}", figure])
+    return out
+
+
+def _harddisk_rows(record: dict) -> list[list[str]]:
+    return [[f"Hard-disc engine, {r['case']}", f"{r['rate']:.3g} collisions/s, one core"]
+            for r in record["data"]["rows"]]
+
+
+def _environment_rows(record: dict) -> list[list[str]]:
+    return [[f"`{r['id']}`", f"{r['mean']:.0f} steps/s, one core"]
+            for r in record["data"]["environments"] if "failed" not in r]
+
+
+_ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _environment_rows}
+
+
+def headline_table(records: list[dict]) -> str:
+    """The Markdown of the headline block (without the markers)."""
+    rows, machines = [], []
+    for record in records:
+        if record.get("suite") not in _ROWS or record.get("data", {}).get("quick"):
+            continue
+        if record["suite"] == "environments" and "environments" not in record["data"]:
+            continue                                   # the stiffness table
+        rows += [[what, figure, record["date"][:10]]
+                 for what, figure in _ROWS[record["suite"]](record)]
+        machines.append(record["machine"].get("cpu") or "?")
+    if not rows:
+        return "No benchmark records yet: `make bench` measures them."
+    lines = ["| benchmark | figure | measured |", "|---|---|---|"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    lines += ["", f"Measured on {', '.join(dict.fromkeys(machines))} with `make bench`; "
+                  f"commands, machines and every table are on the "
+                  f"[Benchmarks]({BENCHMARKS_PAGE}) page."]
+    return "\n".join(lines)
+
+
+def rewrite(text: str, records: list[dict]) -> str:
+    """``text`` with the block between the markers replaced by
+    :func:`headline_table`.
+
+    Raises
+    ------
+    ValueError
+        If the markers are missing, repeated or out of order.
+    """
+    start, end = text.count(START), text.count(END)
+    if start != 1 or end != 1 or text.index(START) > text.index(END):
+        raise ValueError(f"the README needs one line {START} and, after it, one line {END} "
+                         f"around the headline figures (found {start} and {end})")
+    head, rest = text.split(START)
+    _, tail = rest.split(END)
+    return f"{head}{START}\n{headline_table(records)}\n{END}{tail}"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m benchmarks.headline",
+                                description=__doc__.split("\n\n")[1],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--readme", type=Path, default=Path("README.md"),
+                   help="the file to rewrite (default README.md)")
+    p.add_argument("--records", type=Path, default=harness.DEFAULT_DIR,
+                   help=f"where the records are (default {harness.DEFAULT_DIR})")
+    args = p.parse_args(argv)
+    try:
+        text = args.readme.read_text(encoding="utf-8")
+        new = rewrite(text, harness.load_records(args.records))
+    except (OSError, ValueError) as exc:
+        print(f"python -m benchmarks.headline: {args.readme}: {exc}", file=sys.stderr)
+        return 1
+    if new != text:
+        args.readme.write_text(new, encoding="utf-8")
+    print(f"headline figures written to {args.readme}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,70 @@
+"""``python -m benchmarks.environments`` (and ``python -m iceenvs.bench``,
+which forwards to it) on one fast environment with short runs (a smoke
+test; the figures themselves come from the full benchmark)."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from benchmarks import environments, harness
+from iceenvs import bench
+
+
+def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
+    path = tmp_path / "bench" / "environments.json"
+    argv = ["--ids", "ThicknessDistribution-v0", "--seconds", "0.5", "--runs", "2",
+            "--warmup", "0", "--json", str(path)]
+    assert bench.main(argv) == 0
+    record = json.loads(path.read_text())
+    harness.validate_record(record)
+    assert set(record) >= {"command", "machine", "date", "data"}
+    result = record["data"]
+    assert set(result) >= {"settings", "environments"}
+    assert record["command"].startswith("seaice bench environments --ids "
+                                        "ThicknessDistribution-v0")
+    assert set(record["machine"]) >= {"platform", "cpu", "numba"}
+    assert record["machine"]["numba_threads"] == 1
+    assert result["settings"]["runs"] == 2 and result["settings"]["seconds"] == 0.5
+    (row,) = result["environments"]
+    assert row["id"] == "iceenvs/ThicknessDistribution-v0"
+    assert len(row["rates"]) == len(row["steps"]) == len(row["seconds"]) == 2
+    for rate, steps, wall in zip(row["rates"], row["steps"], row["seconds"]):
+        assert wall >= 0.5 and rate == pytest.approx(steps / wall)
+    assert row["min"] <= row["mean"] <= row["max"] and row["std"] >= 0.0
+    assert row["resets"] >= 0 and row["errors"] == 0
+    assert row["unit"] == "days" and row["interval"] > 0
+    table = harness.render_markdown(record)
+    assert "`seaice bench environments --ids ThicknessDistribution-v0" in table
+    assert f"| `iceenvs/ThicknessDistribution-v0` | {row['mean']:.0f} |" in table
+    out = capsys.readouterr().out
+    assert "| id | steps/s (mean) | min–max | std |" in out
+    assert f"| `iceenvs/ThicknessDistribution-v0` | {row['mean']:.0f} |" in out
+
+
+def test_unknown_ids_are_refused(tmp_path):
+    with pytest.raises(SystemExit):
+        bench.main(["--ids", "NoSuchEnv-v0", "--json", str(tmp_path / "x.json")])
+
+
+def test_quick_option_shortens_the_runs(tmp_path):
+    path = tmp_path / "environments.json"
+    assert environments.main(["--quick", "--quiet", "--ids", "ThicknessDistribution-v0",
+                              "--json", str(path)]) == 0
+    record = json.loads(path.read_text())
+    assert record["data"]["quick"] is True
+    assert record["data"]["settings"] == dict(environments.QUICK, seed=0,
+                                              warmup_steps=environments.WARMUP_STEPS, threads=1)
+    t = record["tables"][0]
+    assert len(t["rows"]) == 1 and len(t["rows"][0]) == len(t["columns"])
+
+
+def test_a_failing_environment_is_reported_not_raised(monkeypatch):
+    def failing(*args, **kwargs):
+        raise harness.ChildError("measure_env failed in its process:\nValueError: broken")
+
+    monkeypatch.setattr(harness, "spawn_call", failing)
+    row = environments._child("iceenvs/WindDrift-v0", 1.0, 1, 0, 0.0)
+    assert row == dict(id="iceenvs/WindDrift-v0", failed="ValueError: broken")
+    cells = environments.env_row(row)
+    assert len(cells) == len(environments.COLUMNS) and "failed" in cells[1]
