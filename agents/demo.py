@@ -23,9 +23,9 @@ __all__ = ["main"]
 ENV_ID = "iceenvs/ThicknessDistribution-v0"
 
 
-def main(argv: list[str] | None = None) -> dict:
+def main(argv: list[str] | None = None, prog: str = "python -m agents.demo") -> dict:
     """Train, evaluate, print; returns the evaluation summaries."""
-    p = argparse.ArgumentParser(prog="python -m agents.demo", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n")[0])
     p.add_argument("--timesteps", type=int, default=20_000,
                    help="training budget in environment steps (default 20000)")
     p.add_argument("--episodes", type=int, default=10,

@@ -210,10 +210,10 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
     plots.savefig(fig, path, dpi=100)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentParser:
     from .baselines import BASELINES
 
-    p = argparse.ArgumentParser(prog="python -m agents.evaluate",
+    p = argparse.ArgumentParser(prog=prog,
                                 description="Compare a trained policy with baselines.")
     p.add_argument("run_dir", nargs="?", type=Path, help="run directory of agents.train")
     p.add_argument("--episodes", type=int, default=20, help="episodes per policy (default 20)")
@@ -289,15 +289,16 @@ def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, e
     return action, source
 
 
-def main(argv: list[str] | None = None) -> dict:
-    """Command-line entry point; returns the summaries per policy."""
+def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate") -> dict:
+    """Command-line entry point (``prog``: the command's name in the help);
+    returns the summaries per policy."""
     from iceenvs import ENV_IDS
 
     from .baselines import BASELINES, make_baseline
     from .constant import ConstantPolicy, format_action
     from .envs import make_checked_env, parse_key_values
 
-    parser = build_parser()
+    parser = build_parser(prog)
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error("--episodes must be >= 1")

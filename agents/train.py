@@ -81,11 +81,11 @@ def default_run_dir(env_id: str, algo: str, seed: int) -> Path:
 
 
 # -- step 1: arguments -------------------------------------------------------------------
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParser:
     """The command-line parser (env ids and algorithms as choices)."""
     from iceenvs import ENV_IDS
 
-    p = argparse.ArgumentParser(prog="python -m agents.train",
+    p = argparse.ArgumentParser(prog=prog,
                                 description="Train a stable-baselines3 agent on an iceenvs "
                                             "environment.")
     p.add_argument("--env", required=True, choices=ENV_IDS, metavar="ID",
@@ -413,12 +413,13 @@ def _close(*things) -> None:
             thing.close()
 
 
-def main(argv: list[str] | None = None) -> Path:
-    """Command-line entry point; returns the run directory."""
+def main(argv: list[str] | None = None, prog: str = "python -m agents.train") -> Path:
+    """Command-line entry point (``prog``: the command's name in the help);
+    returns the run directory."""
     from .envs import check_env_kwargs
 
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
+    parser = build_parser(prog)
     args = parse_args(parser, argv)
     try:
         hp = read_hyperparams(args.algo, args.env, args.hyperparams, timesteps=args.timesteps,

@@ -139,9 +139,9 @@ def write_report(rows, skipped, seconds, out_dir: Path, command: str, quick: boo
     return path
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str = "python -m physics.crosscheck") -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m physics.crosscheck",
+        prog=prog,
         description="Cross-check the floe engines against pymunk and LAMMPS.")
     parser.add_argument("command", choices=["all", *GROUPS, "list"],
                         help="which comparisons to run ('list' describes them)")
@@ -171,8 +171,7 @@ def main(argv=None) -> int:
     names = list(GROUPS) if args.command == "all" else [args.command]
     rows, skipped, seconds = run_groups(names, args.out, args.quick, args.seed,
                                         not args.no_progress)
-    command = "python -m physics.crosscheck " + " ".join(argv if argv is not None
-                                                          else sys.argv[1:])
+    command = f"{prog} " + " ".join(argv if argv is not None else sys.argv[1:])
     path = write_report(rows, skipped, seconds, args.out, command, args.quick)
     print(format_table(rows))
     for name, why in skipped.items():

@@ -47,8 +47,9 @@ def _show(name: str) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="ice-scenarios", description=__doc__.split("\n\n")[0],
+def build_parser(prog: str = "ice-scenarios") -> argparse.ArgumentParser:
+    """The command-line parser; ``prog`` is the command's name in the help."""
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=textwrap.dedent(__doc__.split("::", 1)[1]))
     sub = ap.add_subparsers(dest="command", required=True)
@@ -79,9 +80,12 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str = "ice-scenarios") -> int:
+    """Run the command line ``argv`` (default: this process's); ``prog`` is
+    the command's name in the help and the messages (``seaice scenarios``
+    runs this one). Returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser().parse_args(argv)
+    args = build_parser(prog).parse_args(argv)
     try:
         if args.command == "list":
             return _list()
@@ -106,15 +110,15 @@ def main(argv=None) -> int:
             raise ValueError("run needs a scenario name (ice-scenarios list) or --resume RUN_DIR")
         run_scenario(args.name, overrides=parse_set(args.set), floes=args.floes, seed=args.seed,
                      ensemble=args.ensemble, quick=args.quick, out=args.out, force=args.force,
-                     command="ice-scenarios " + shlex.join(argv), **common)
+                     command=f"{prog} {shlex.join(argv)}", **common)
         return 0
     except (ValueError, FileExistsError, FileNotFoundError) as exc:
-        print(f"ice-scenarios: error: {exc}", file=sys.stderr)
+        print(f"{prog}: error: {exc}", file=sys.stderr)
         return 2
     except (RuntimeError, FloatingPointError) as exc:
         # the physics stopped a run (a blow-up, inelastic collapse, a box at
         # its concentration limit): say why, without a traceback
-        print(f"ice-scenarios: the run stopped: {exc}\n"
+        print(f"{prog}: the run stopped: {exc}\n"
               "The outputs and checkpoints written before are kept in the run directory.",
               file=sys.stderr)
         return 1

@@ -1,0 +1,154 @@
+"""``seaice`` (also ``python -m seaice_gym``): the project's tools under one
+command.
+
+::
+
+    seaice train --env iceenvs/ThicknessDistribution-v0 --algo ppo
+    seaice evaluate runs/ppo-thickness
+    seaice scenarios run herman2013-convergence --quick
+    seaice crosscheck all --quick
+    seaice bench hertz --quick
+    seaice validate
+    seaice demo
+
+Each sub-command hands the rest of the command line to a tool's own entry
+point, which also runs on its own (``python -m agents.train``,
+``ice-scenarios``, ...); ``seaice SUB --help`` shows its options.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import inspect
+import sys
+
+from . import __version__
+
+#: sub-command → (entry point "module:function", or None for the groups below, one-line
+#: description)
+COMMANDS = {
+    "train": ("agents.train:main", "train a stable-baselines3 agent on an environment"),
+    "evaluate": ("agents.evaluate:main", "compare a trained policy with the baselines"),
+    "scenarios": ("physics.scenarios.cli:main", "run the papers' experiments (ice-scenarios)"),
+    "crosscheck": ("physics.crosscheck.report:main",
+                   "cross-check the engines against pymunk and LAMMPS"),
+    "bench": (None, "run a benchmark suite (seaice bench --help lists them)"),
+    "validate": ("physics.validate:main", "check the Hertz engine against theory"),
+    "demo": (None, "an engine run, then a training run (as make demo)"),
+}
+
+#: benchmark suite → one-line description; ``seaice bench SUITE`` runs benchmarks.SUITE
+BENCH_SUITES = {
+    "hertz": "floe-steps/s of the Hertz engine at A = 0.7 and jammed",
+    "hertz_phases": "each phase of a Hertz step on its own",
+    "harddisk": "collisions/s of the hard-disc engine",
+    "observables": "clusters, g_ffd, g_rdf, fabric and stress on many floes",
+    "itd": "the ice-thickness-distribution models",
+    "environments": "sustained steps/s of every environment",
+    "compare": "this tree against another revision, side by side",
+    "headline": "put the headline figures of the records into the README",
+}
+
+#: the parts of ``seaice demo``, run in this order when none is named
+DEMOS = {
+    "physics": ("physics.demo:main", "a short Hertz-engine run, with a figure"),
+    "agents": ("agents.demo:main", "a short PPO training and its evaluation"),
+}
+
+
+def _parser(prog: str, description: str, entries: dict, what: str, required: bool = True,
+            epilog: str | None = None) -> argparse.ArgumentParser:
+    """A parser that reads only the first argument, the name of an entry
+    (``what`` it is called in the messages)."""
+    parser = argparse.ArgumentParser(prog=prog, description=description, epilog=epilog,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest=what, required=required)
+    for name, (_, text) in entries.items():
+        sub.add_parser(name, help=text, add_help=False)
+    return parser
+
+
+def _pick(parser: argparse.ArgumentParser, argv: list[str], what: str) -> str | None:
+    """The entry named by ``argv[0]``; help, usage errors (an unknown name
+    lists the valid ones) and ``--version`` exit as argparse does."""
+    return getattr(parser.parse_args(argv[:1]), what)
+
+
+def _call(target: str, argv: list[str], prog: str) -> int:
+    """Run the entry point ``module:function`` with ``argv``; its return
+    value becomes an exit status (0 unless it returns an int)."""
+    module_name, func_name = target.split(":")
+    module = importlib.import_module(module_name)
+    func = getattr(module, func_name)
+    params = inspect.signature(func).parameters
+    if not params:
+        # an entry point without options: its help is its module's docstring
+        argparse.ArgumentParser(prog=prog, description=module.__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter
+                                ).parse_args(argv)
+        result = func()
+    else:
+        result = func(list(argv), **({"prog": prog} if "prog" in params else {}))
+    return result if isinstance(result, int) and not isinstance(result, bool) else 0
+
+
+def _bench(argv: list[str], prog: str) -> int:
+    entries = {name: (f"benchmarks.{name}:main", text) for name, text in BENCH_SUITES.items()}
+    parser = _parser(prog, "Run one benchmark suite (python -m benchmarks.SUITE).", entries,
+                     "suite", epilog=f"{prog} SUITE --help shows the options of a suite.")
+    suite = _pick(parser, argv, "suite")
+    try:
+        importlib.import_module(f"benchmarks.{suite}")
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("benchmarks", f"benchmarks.{suite}"):
+            raise
+        parser.error(f"the benchmark suite {suite!r} is not available here ({exc}); the "
+                     f"benchmarks package comes with the source tree")
+    return _call(entries[suite][0], argv[1:], f"{prog} {suite}")
+
+
+def _demo(argv: list[str], prog: str) -> int:
+    parser = _parser(prog, f"{prog}: the engine demo, then the training demo, as make demo runs\n"
+                           f"them. {prog} physics, {prog} agents: that demo alone, with its\n"
+                           f"own options ({prog} physics --help).", DEMOS, "part",
+                     required=False)
+    part = _pick(parser, argv, "part")
+    if part is not None:
+        return _call(DEMOS[part][0], argv[1:], f"{prog} {part}")
+    for name, (target, _) in DEMOS.items():
+        status = _call(target, [], f"{prog} {name}")
+        if status:
+            return status
+    return 0
+
+
+#: the sub-commands that choose among several entry points
+_GROUPS = {"bench": _bench, "demo": _demo}
+
+
+def build_parser(prog: str = "seaice") -> argparse.ArgumentParser:
+    """The parser of the first argument (the sub-command), for the help and
+    the usage errors."""
+    examples = __doc__.split("::", 1)[1].split("\n\n")[1]
+    parser = _parser(prog, "The tools of seaice-gym (environments, engines, scenarios, agents) "
+                           "under one command.", COMMANDS, "command",
+                     epilog=f"examples:\n{examples}\n\n{prog} COMMAND --help shows the options "
+                            f"of a command.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``seaice`` with ``argv`` (default: the command line); returns the
+    exit status of the sub-command."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    command = _pick(parser, argv, "command")
+    prog = f"{parser.prog} {command}"
+    if command in _GROUPS:
+        return _GROUPS[command](argv[1:], prog)
+    return _call(COMMANDS[command][0], argv[1:], prog)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,149 @@
+"""The ``seaice`` command: its help, the forwarding of each sub-command to
+its tool's entry point, and its usage errors."""
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from seaice_gym import __version__
+from seaice_gym import cli
+
+SUBCOMMANDS = ["train", "evaluate", "scenarios", "crosscheck", "bench", "validate", "demo"]
+
+
+def _exit(argv, capsys) -> tuple[int, str, str]:
+    """(exit status, stdout, stderr) of ``seaice argv`` that exits through
+    argparse (help or a usage error)."""
+    with pytest.raises(SystemExit) as stop:
+        cli.main(argv)
+    out, err = capsys.readouterr()
+    return stop.value.code, out, err
+
+
+def test_help_lists_every_subcommand_with_its_description(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "100")
+    assert list(cli.COMMANDS) == SUBCOMMANDS
+    code, out, _ = _exit(["--help"], capsys)
+    assert code == 0 and out.startswith("usage: seaice ")
+    for name, (_, text) in cli.COMMANDS.items():
+        assert name in out and text in out, name
+    assert _exit(["--version"], capsys)[1].strip() == f"seaice {__version__}"
+
+
+@pytest.mark.parametrize("sub", SUBCOMMANDS)
+def test_each_subcommand_shows_its_entry_points_help(capsys, sub):
+    code, out, _ = _exit([sub, "--help"], capsys)
+    assert code == 0
+    assert out.startswith(f"usage: seaice {sub} "), out[:200]
+
+
+@pytest.mark.parametrize("argv, shown", [
+    (["scenarios", "run", "--help"], "--resume RUN_DIR"),
+    (["train", "--help"], "--algo"),
+    (["evaluate", "--help"], "--episodes"),
+    (["crosscheck", "--help"], "pymunk"),
+    (["validate", "--help"], "Validation report of the Hertz engine"),
+    (["demo", "physics", "--help"], "--floes"),
+    (["demo", "agents", "--help"], "--timesteps"),
+])
+def test_the_help_is_the_entry_points_own(capsys, argv, shown):
+    code, out, _ = _exit(argv, capsys)
+    assert code == 0 and shown in out
+    assert out.startswith("usage: seaice " + " ".join(argv[:-1]))
+
+
+def test_unknown_subcommand_lists_the_valid_ones(capsys):
+    code, _, err = _exit(["nope"], capsys)
+    assert code == 2 and "invalid choice: 'nope'" in err
+    for name in SUBCOMMANDS:
+        assert repr(name) in err, name
+    code, _, err = _exit([], capsys)
+    assert code == 2 and "required: command" in err
+    code, _, err = _exit(["bench", "nope"], capsys)
+    assert code == 2 and "'hertz'" in err and "'environments'" in err
+
+
+def test_arguments_are_forwarded_and_the_status_returned(monkeypatch):
+    calls = []
+
+    def fake_scenarios(argv, prog="ice-scenarios"):
+        calls.append(("scenarios", argv, prog))
+        return 3
+
+    def fake_validate():                     # an entry point without options
+        calls.append(("validate",))
+        return 0
+
+    def fake_train(argv, prog="python -m agents.train"):
+        calls.append(("train", argv, prog))
+        return "runs/x"                      # not an exit status: success
+
+    monkeypatch.setattr(importlib.import_module("physics.scenarios.cli"), "main", fake_scenarios)
+    monkeypatch.setattr(importlib.import_module("physics.validate"), "main", fake_validate)
+    monkeypatch.setattr(importlib.import_module("agents.train"), "main", fake_train)
+    assert cli.main(["scenarios", "run", "herman2013-convergence", "--quick"]) == 3
+    assert cli.main(["validate"]) == 0
+    assert cli.main(["train", "--env", "E", "--help-me"]) == 0
+    assert calls == [("scenarios", ["run", "herman2013-convergence", "--quick"],
+                      "seaice scenarios"),
+                     ("validate",),
+                     ("train", ["--env", "E", "--help-me"], "seaice train")]
+
+
+def test_demo_runs_the_engine_demo_then_the_training_demo(monkeypatch):
+    calls = []
+    physics_demo = importlib.import_module("physics.demo")
+    agents_demo = importlib.import_module("agents.demo")
+    monkeypatch.setattr(physics_demo, "main",
+                        lambda argv, prog="": calls.append(("physics", argv, prog)) or 0)
+    monkeypatch.setattr(agents_demo, "main",
+                        lambda argv, prog="": calls.append(("agents", argv, prog)) or {})
+    assert cli.main(["demo"]) == 0
+    assert calls == [("physics", [], "seaice demo physics"), ("agents", [], "seaice demo agents")]
+    calls.clear()
+    assert cli.main(["demo", "agents", "--timesteps", "10"]) == 0
+    assert calls == [("agents", ["--timesteps", "10"], "seaice demo agents")]
+    monkeypatch.setattr(physics_demo, "main", lambda argv, prog="": 1)
+    calls.clear()
+    assert cli.main(["demo"]) == 1 and calls == []     # a failed engine demo stops there
+
+
+def test_bench_forwards_to_the_suite(monkeypatch, capsys):
+    benchmarks = pytest.importorskip("benchmarks")
+    for suite in cli.BENCH_SUITES:
+        importlib.import_module(f"benchmarks.{suite}")     # every listed suite exists
+    assert set(cli.BENCH_SUITES) >= set(getattr(benchmarks, "SUITES", ()))
+    seen = []
+    monkeypatch.setattr(importlib.import_module("benchmarks.itd"), "main",
+                        lambda argv: seen.append(argv) or 0)
+    assert cli.main(["bench", "itd", "--quick"]) == 0 and seen == [["--quick"]]
+    code, out, _ = _exit(["bench", "--help"], capsys)
+    assert code == 0 and all(s in out for s in cli.BENCH_SUITES)
+
+
+def test_without_the_benchmarks_package_bench_says_so_and_the_rest_works(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "benchmarks", None)       # as if it were not installed
+    monkeypatch.delitem(sys.modules, "benchmarks.hertz", raising=False)
+    code, _, err = _exit(["bench", "hertz"], capsys)
+    assert code == 2 and "not available" in err and "Traceback" not in err
+    assert _exit(["bench", "--help"], capsys)[0] == 0
+    assert _exit(["scenarios", "--help"], capsys)[0] == 0
+
+
+def test_console_script_and_module_entry_points():
+    tomllib = pytest.importorskip("tomllib")
+    root = Path(__file__).resolve().parents[1]
+    project = tomllib.loads((root / "pyproject.toml").read_text())["project"]
+    assert project["scripts"]["seaice"] == "seaice_gym.cli:main"
+    assert project["scripts"]["ice-scenarios"] == "physics.scenarios.cli:main"
+    script = Path(sys.executable).with_name("seaice")
+    assert script.exists(), "the seaice script is missing: install the project again (make setup)"
+    for command in ([str(script)], [sys.executable, "-m", "seaice_gym"]):
+        done = subprocess.run(command + ["--help"], capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0 and all(s in done.stdout for s in SUBCOMMANDS)
+        wrong = subprocess.run(command + ["nope"], capture_output=True, text=True, timeout=120)
+        assert wrong.returncode == 2 and "invalid choice" in wrong.stderr
