@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 # so that the RL extra never pulls the CUDA wheels.
 TORCH_PIN := torch==2.13.0
 
-.PHONY: setup demo test test-slow bench validate crosscheck clean
+.PHONY: setup demo test test-slow bench validate crosscheck docs clean
 
 setup: $(STAMP)
 
@@ -31,12 +31,16 @@ test-slow: setup
 	$(PY) -m pytest -q -m slow
 
 bench: setup
-	$(PY) -m physics.bench hertz
-	$(PY) -m physics.bench phases
-	$(PY) -m physics.bench harddisk
-	$(PY) -m physics.bench observables
-	$(PY) -m physics.bench itd
-	$(PY) -m iceenvs.bench
+	$(PY) -m benchmarks.hertz
+	$(PY) -m benchmarks.hertz_phases
+	$(PY) -m benchmarks.harddisk
+	$(PY) -m benchmarks.observables
+	$(PY) -m benchmarks.itd
+	$(PY) -m benchmarks.environments
+	$(PY) -m benchmarks.headline
+
+docs: setup
+	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
 
 validate: setup
 	$(PY) -m physics.validate

@@ -14,7 +14,7 @@ every constant action by more than two standard errors.
 Output in ``--out`` (default ``docs/agents/tasks``): ``tasks.md`` (the
 table, with command, machine and date), ``tasks.json`` (every number)
 and ``constant_<env>.json`` per environment (the whole search; reused
-with ``--reuse`` so that a table can be remade without searching again).
+with ``--reuse`` so that a table can be remade without searching again)::
 
     python -m agents.tasks [--ids Convergence-v0 ...] [--episodes 20] [--grid 9]
         [--seeds 5] [--processes 2] [--out DIR] [--reuse]

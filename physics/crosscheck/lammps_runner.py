@@ -190,6 +190,8 @@ class LammpsSimulation:
     allow_overlap : bool
         Accept initial overlaps above 1 % of the smaller radius.
 
+    Notes
+    -----
     The state is read back in the order of ``field`` (LAMMPS atom i + 1 is
     floe i), positions wrapped into ``[0, L)``.
     """

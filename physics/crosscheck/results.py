@@ -12,6 +12,8 @@ __all__ = ["Check", "format_table", "save_figure"]
 class Check:
     """The outcome of one comparison.
 
+    Attributes
+    ----------
     name : short identifier, e.g. ``"binary/frictionless/harddisk-vs-law"``
     description : one sentence saying what was compared
     measured : the number compared with ``tolerance`` (an error, usually

@@ -1,0 +1,438 @@
+"""Pages of the documentation that are generated at build time.
+
+Everything here is written under ``docs/_generated/`` (not kept in the
+repository) when the builder starts:
+
+* ``environments/<name>.md`` — one page per registered environment id, made
+  from the class docstring (its specification), with a frame rendered by
+  ``env.render()`` after a seeded reset and a few seeded steps
+  (``frames/<name>.png``, reused if present);
+* ``api/<module>.md`` — one autodoc page per public module;
+* ``include/`` — parts of hand-written pages: the lists of those pages in
+  registry order (``environments_toc.md``, ``api_toc.md``), the tables of the
+  benchmark records of ``docs/benchmarks/*.json`` (``benchmarks.md``), the
+  ``--help`` of the console commands (``cli.md``), the parameters of every
+  bundled scenario file (``scenario_parameters.md``), the cross-check
+  report of ``docs/crosscheck/`` (``crosscheck_report.md``) and the common
+  observation entries of the floe environments (``observations.md``).
+
+A file is rewritten only when its text changes, so incremental builds stay
+incremental.
+"""
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import inspect
+import json
+import os
+import pkgutil
+import re
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from sphinx.util import logging
+
+log = logging.getLogger(__name__)
+
+#: packages whose public modules get an API page
+API_PACKAGES = ("physics", "iceenvs", "agents", "seaice_gym")
+#: modules left out of the API reference: command shims kept for old entry points
+API_SKIP = {"physics.bench", "iceenvs.bench"}
+#: seed, number of steps and action seed of the rendered frames
+FRAME_SEED = 0
+FRAME_STEPS = 5
+
+_ROLE = re.compile(r":(\w+(?::\w+)?):`")
+
+
+def write_if_changed(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        path.write_text(text, encoding="utf-8")
+
+
+def myst_roles(text: str) -> str:
+    """Docstring roles (``:func:`x```) in MyST syntax (``{func}`x```)."""
+    return _ROLE.sub(r"{\1}`", text)
+
+
+# ---------------------------------------------------------------------------
+# Environments
+
+
+def registered_environments() -> list[tuple[str, object]]:
+    """(id, EnvSpec) of every environment ``iceenvs`` registers, in its order."""
+    import gymnasium as gym
+    import iceenvs
+
+    return [(env_id, gym.spec(env_id)) for env_id in iceenvs.ENV_IDS]
+
+
+def environment_class(spec):
+    module, _, name = spec.entry_point.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def render_frame(env_id: str, path: Path) -> None:
+    """A frame of ``env_id`` after ``reset(seed=FRAME_SEED)`` and a few seeded steps."""
+    import gymnasium as gym
+    from matplotlib.image import imsave
+
+    env = gym.make(env_id, render_mode="rgb_array")
+    try:
+        env.reset(seed=FRAME_SEED)
+        env.action_space.seed(FRAME_SEED)
+        for _ in range(FRAME_STEPS):
+            env.step(env.action_space.sample())
+        frame = env.render()
+    finally:
+        env.close()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    imsave(path, frame)
+
+
+def docstring_markdown(doc: str) -> str:
+    """A Markdown docstring without its indentation. Lines that start at the
+    margin (tables pasted into an f-string docstring) do not count towards
+    the common indentation."""
+    lines = doc.expandtabs().splitlines()
+    indents = [len(l) - len(l.lstrip()) for l in lines[1:] if l.strip()]
+    margin = min((i for i in indents if i > 0), default=0)
+    body = [l[margin:] if l[:margin].isspace() else l for l in lines[1:]]
+    return "\n".join([lines[0].strip()] + body).strip()
+
+
+def environment_page(env_id: str, spec, frame: str) -> str:
+    cls = environment_class(spec)
+    summary, _, body = docstring_markdown(cls.__doc__ or "").partition("\n\n")
+    summary = " ".join(summary.split())
+    module = cls.__module__
+    source = module.replace(".", "/") + ".py"
+    reward = getattr(cls, "reward_fn", None)
+    reward = getattr(reward, "__func__", reward)
+    lines = [
+        f"# {env_id}", "",
+        summary.replace("\n", " "), "",
+        f"```{{image}} {frame}", f":alt: a frame of {env_id}", ":width: 480px", "```", "",
+        f"*A frame from `env.render()` after `reset(seed={FRAME_SEED})` and {FRAME_STEPS} "
+        "random steps.*", "",
+        "| | |", "|---|---|",
+        f"| id | `{env_id}` |",
+        f"| class | {{class}}`{module}.{cls.__name__}` |",
+        f"| source | `{source}` |",
+        f"| episode length | {spec.max_episode_steps} steps (`max_episode_steps`) |",
+    ]
+    if reward is not None and getattr(reward, "__module__", None):
+        lines.append(f"| reward | {{func}}`{reward.__module__}.{reward.__name__}` "
+                     f"(`{reward.__module__.replace('.', '/')}.py`) |")
+    lines += ["", "```python", "import gymnasium as gym",
+              "import iceenvs  # noqa: F401  (registers the ids)", "",
+              f'env = gym.make("{env_id}", render_mode="rgb_array")',
+              "obs, info = env.reset(seed=0)", "```", "",
+              myst_roles(body), ""]
+    return "\n".join(lines)
+
+
+def generate_environments(out: Path) -> None:
+    envs = registered_environments()
+    toc = ["```{toctree}", ":maxdepth: 1", ""]
+    for env_id, spec in envs:
+        name = env_id.split("/")[-1]
+        frame = out / "frames" / f"{name}.png"
+        if not frame.is_file():
+            log.info(f"rendering a frame of {env_id}")
+            render_frame(env_id, frame)
+        write_if_changed(out / "environments" / f"{name}.md",
+                         environment_page(env_id, spec, f"../frames/{name}.png"))
+        toc.append(f"/_generated/environments/{name}")
+    write_if_changed(out / "include" / "environments_toc.md", "\n".join(toc + ["```", ""]))
+
+
+def environment_classes() -> set:
+    return {environment_class(spec) for _, spec in registered_environments()}
+
+
+def observation_table() -> str:
+    from iceenvs.observations import FLOE_FEATURES, feature_table
+
+    return feature_table(FLOE_FEATURES)
+
+
+# ---------------------------------------------------------------------------
+# Benchmarks
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown_record(record: dict) -> str:
+    """A benchmark record as Markdown (used until ``benchmarks.harness`` exists)."""
+    machine = record.get("machine", {})
+    if isinstance(machine, dict):
+        machine = ", ".join(f"{k} {v}" for k, v in machine.items())
+    lines = [f"## {record.get('title', record.get('suite', 'benchmark'))}", ""]
+    if record.get("description"):
+        lines += [record["description"], ""]
+    wall = record.get("wall_seconds")
+    lines += [f"Command: `{record.get('command', '')}`  ", f"Machine: {machine}  ",
+              f"Date: {record.get('date', '')}  ",
+              f"Wall time: {wall:.0f} s" if isinstance(wall, (int, float)) else "", ""]
+    for table in record.get("tables", []):
+        lines += [f"### {table['title']}", "",
+                  "| " + " | ".join(map(_cell, table["columns"])) + " |",
+                  "|" + "---|" * len(table["columns"])]
+        lines += ["| " + " | ".join(map(_cell, row)) + " |" for row in table["rows"]]
+        lines.append("")
+        notes = table.get("notes")
+        if notes:
+            lines += ([notes] if isinstance(notes, str) else list(notes)) + [""]
+    return "\n".join(lines)
+
+
+def _is_record(data) -> bool:
+    return isinstance(data, dict) and "suite" in data and "tables" in data
+
+
+def benchmark_records(directory: Path) -> list[dict]:
+    """The records of ``directory``: ``benchmarks.harness.load_records`` if
+    the package is there, else every JSON file that has the record keys."""
+    try:
+        from benchmarks.harness import load_records
+    except ImportError:
+        load_records = None
+    if load_records is not None:
+        return list(load_records(directory))
+    records = []
+    for path in sorted(directory.glob("*.json")):
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if _is_record(data):
+            records.append(data)
+        else:
+            log.info(f"benchmarks: {path.name} is not a benchmark record, left out")
+    return records
+
+
+def generate_benchmarks(out: Path, directory: Path) -> None:
+    try:
+        from benchmarks.harness import render_markdown
+    except ImportError:
+        render_markdown = markdown_record
+    records = benchmark_records(directory) if directory.is_dir() else []
+    parts = [render_markdown(r).strip() + "\n" for r in records]
+    if not parts:
+        parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
+    write_if_changed(out / "include" / "benchmarks.md", "\n".join(parts))
+
+
+# ---------------------------------------------------------------------------
+# Cross-check report
+
+
+def table_safe(text: str) -> str:
+    """Markdown tables whose last cells hold ``|`` (an absolute value), with
+    those bars escaped: a row keeps the header's number of columns."""
+    out, columns = [], None
+    for line in text.splitlines():
+        if line.startswith("|"):
+            cells = line.strip().strip("|").split("|")
+            if columns is None:
+                columns = len(cells)
+            elif len(cells) > columns:
+                cells = cells[:columns - 1] + ["\\|".join(cells[columns - 1:])]
+            line = "|" + "|".join(cells) + "|"
+        else:
+            columns = None
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def generate_crosscheck(out: Path, directory: Path) -> None:
+    """The cross-check report, with its figures addressed from the site's root."""
+    report = directory / "report.md"
+    text = report.read_text(encoding="utf-8") if report.is_file() else (
+        "No report yet: `make crosscheck` writes it.\n")
+    text = re.sub(r"\]\((?!https?:|/)([^)]+\.png)\)", rf"](/{directory.name}/\1)", text)
+    write_if_changed(out / "include" / "crosscheck_report.md", table_safe(text))
+
+
+# ---------------------------------------------------------------------------
+# Command line
+
+
+def _has_module(name: str) -> bool:
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def cli_commands() -> list[tuple[str, list[str]]]:
+    """(command as a user types it, argv of ``python -m``) of every command."""
+    if _has_module("seaice_gym.__main__"):
+        top = _help(["seaice_gym"])
+        found = re.search(r"\{([\w,-]+)\}", top)
+        subs = found.group(1).split(",") if found else [
+            "train", "evaluate", "scenarios", "crosscheck", "bench", "validate", "demo"]
+        return [("seaice", ["seaice_gym"])] + [(f"seaice {s}", ["seaice_gym", s]) for s in subs]
+    return [
+        ("python -m agents.train", ["agents.train"]),
+        ("python -m agents.evaluate", ["agents.evaluate"]),
+        ("ice-scenarios", ["physics.scenarios"]),
+        ("python -m physics.crosscheck", ["physics.crosscheck"]),
+        ("python -m physics.demo", ["physics.demo"]),
+        ("python -m agents.demo", ["agents.demo"]),
+    ]
+
+
+def _help(argv: list[str]) -> str:
+    env = dict(os.environ, COLUMNS="88", SEAICE_QUIET="1", PYTHONWARNINGS="ignore")
+    done = subprocess.run([sys.executable, "-m", *argv, "--help"], capture_output=True,
+                          text=True, env=env, timeout=300)
+    if done.returncode != 0:
+        raise RuntimeError(f"python -m {' '.join(argv)} --help failed:\n{done.stderr}")
+    return done.stdout
+
+
+def generate_cli(out: Path) -> None:
+    commands = cli_commands()
+    with ThreadPoolExecutor(2) as pool:
+        helps = list(pool.map(_help, [argv for _, argv in commands]))
+    lines = []
+    for (command, argv), text in zip(commands, helps):
+        lines += [f"## `{command}`", "",
+                  f"(also `python -m {' '.join(argv)}`)" if command.startswith("seaice") else "",
+                  "", "```text", text.rstrip(), "```", ""]
+    write_if_changed(out / "include" / "cli.md", "\n".join(lines))
+
+
+def generate_scenario_parameters(out: Path) -> None:
+    from physics.scenarios.config import bundled_configs, load_config
+
+    lines = []
+    for name, path in bundled_configs().items():
+        cfg = load_config(path)
+        lines += [f"### `{name}`", "", f"**{cfg.title}.** Reproduces {cfg.reproduces}.", "",
+                  cfg.description, "",
+                  f"File: `physics/scenarios/configs/{path.name}`", "",
+                  "| parameter | default | `--quick` | units | allowed | meaning |",
+                  "|---|---|---|---|---|---|"]
+        for key, p in cfg.params.items():
+            quick = cfg.quick.get(key, "")
+            lines.append(f"| `{key}` | `{p.default}` | {f'`{quick}`' if quick != '' else ''} | "
+                         f"{p.units} | {_cell(p.allowed())} | {_cell(p.help)} |")
+        lines.append("")
+    write_if_changed(out / "include" / "scenario_parameters.md", "\n".join(lines))
+
+
+# ---------------------------------------------------------------------------
+# API reference
+
+
+def public_modules() -> list[str]:
+    """Every public module of :data:`API_PACKAGES` that is installed, walked
+    from the packages (no private module, no ``__main__``, no shim)."""
+    found = []
+    for package in API_PACKAGES:
+        if not _has_module(package):
+            continue
+        pkg = importlib.import_module(package)
+        found.append(package)
+        for info in pkgutil.walk_packages(pkg.__path__, prefix=package + "."):
+            parts = info.name.split(".")
+            if any(p.startswith("_") for p in parts) or info.name in API_SKIP:
+                continue
+            found.append(info.name)
+    return found
+
+
+def generate_api(out: Path) -> None:
+    modules = public_modules()
+    api = out / "api"
+    for name in modules:
+        source = name.replace(".", "/")
+        source += "/__init__.py" if _is_package(name) else ".py"
+        write_if_changed(api / f"{name}.md", "\n".join([
+            f"# {name}", "", f"Source: `{source}`", "",
+            "```{eval-rst}", f".. automodule:: {name}", "```", ""]))
+    for stale in api.glob("*.md"):
+        if stale.stem not in modules:
+            stale.unlink()
+    toc = ["```{toctree}", ":maxdepth: 1", ""] + [f"/_generated/api/{m}" for m in modules]
+    write_if_changed(out / "include" / "api_toc.md", "\n".join(toc + ["```", ""]))
+
+
+def _is_package(name: str) -> bool:
+    spec = importlib.util.find_spec(name)
+    return spec is not None and spec.submodule_search_locations is not None
+
+
+# ---------------------------------------------------------------------------
+# Sphinx hooks
+
+
+def on_builder_inited(app) -> None:
+    os.environ.setdefault("SEAICE_QUIET", "1")
+    src = Path(app.srcdir)
+    out = src / "_generated"
+    generate_environments(out)
+    generate_benchmarks(out, src / "benchmarks")
+    generate_crosscheck(out, src / "crosscheck")
+    generate_cli(out)
+    generate_scenario_parameters(out)
+    generate_api(out)
+    write_if_changed(out / "include" / "observations.md", observation_table() + "\n")
+    app.env_classes = environment_classes()
+
+
+_LITERAL = re.compile(r"(``.+?``|:\w+(?::\w+)?:`[^`]*`|`[^`]*`_?)")
+
+
+def escape_bars(lines: list[str]) -> list[str]:
+    """``|x|`` (an absolute value) outside literals, as plain text: reST would
+    read it as a substitution. Literal blocks and doctests are left alone."""
+    out, literal_indent = [], None
+    for line in lines:
+        stripped = line.lstrip()
+        indent = len(line) - len(stripped)
+        if literal_indent is not None and stripped and indent <= literal_indent:
+            literal_indent = None
+        if literal_indent is None and stripped and not stripped.startswith(">>>"):
+            parts = _LITERAL.split(line)
+            line = "".join(p if k % 2 else p.replace("|", "\\|") for k, p in enumerate(parts))
+        if stripped.endswith("::"):
+            literal_indent = indent
+        out.append(line)
+    return out
+
+
+def on_process_docstring(app, what, name, obj, options, lines) -> None:
+    """An environment's class docstring is Markdown: its page renders it, the
+    API page points there. Absolute-value bars are escaped."""
+    if what == "class" and obj in getattr(app, "env_classes", ()):
+        env_id = next(i for i, s in registered_environments() if environment_class(s) is obj)
+        page = "/_generated/environments/" + env_id.split("/")[-1]
+        lines[:] = [f"The environment ``{env_id}``; its specification (description, "
+                    f"spaces, rewards, task parameters) is on its page, :doc:`{page}`."]
+        return
+    lines[:] = escape_bars(lines)
+
+
+def on_skip_member(app, what, name, obj, skip, options):
+    """Leave out the generated field accessors of named tuples (their fields
+    are listed in the class docstring)."""
+    if (getattr(obj, "__doc__", None) or "").startswith("Alias for field number"):
+        return True
+    return None
+
+
+def setup(app):
+    app.connect("builder-inited", on_builder_inited)
+    app.connect("autodoc-process-docstring", on_process_docstring)
+    app.connect("autodoc-skip-member", on_skip_member)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

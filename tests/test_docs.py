@@ -1,0 +1,124 @@
+"""The documentation site builds without warnings, its generated pages are
+there, and the README stays short with working links."""
+from __future__ import annotations
+
+import html
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("sphinx")
+pytest.importorskip("myst_parser")
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+README_LIMIT = 12 * 1024
+# spelled in two parts so that this file does not name it
+OUTSIDE_BRIEF = "PHYSICS" + ".md"
+# never part of the project: version control, environments, build output
+SKIP_DIRS = {".git", ".venv", "_build", "_generated", "__pycache__", ".pytest_cache",
+             ".hypothesis", "runs", ".bench_cache", "build", "dist"}
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    """The site built from a copy of docs/ (so that the frames are rendered
+    afresh and nothing is written into the work tree), warnings as errors."""
+    work = tmp_path_factory.mktemp("docs")
+    src = work / "docs"
+    shutil.copytree(DOCS, src, ignore=shutil.ignore_patterns("_build", "_generated"))
+    out = work / "html"
+    env = dict(os.environ, SEAICE_QUIET="1", SEAICE_DOCS_OFFLINE="1")
+    done = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
+         str(src), str(out)],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, f"the site does not build cleanly:\n{done.stderr[-6000:]}"
+    return out
+
+
+def test_every_environment_has_a_generated_page_with_a_frame(site):
+    import iceenvs
+
+    for env_id in iceenvs.ENV_IDS:
+        name = env_id.split("/")[-1]
+        page = site / "_generated" / "environments" / f"{name}.html"
+        assert page.is_file(), f"no page for {env_id}"
+        text = page.read_text(encoding="utf-8")
+        assert env_id in text
+        images = re.findall(r'<img[^>]*src="([^"]+)"', text)
+        assert images, f"the page of {env_id} has no image"
+        assert any((page.parent / src).is_file() and (page.parent / src).stat().st_size > 1000
+                   for src in images), f"the frame of {env_id} is missing or empty"
+        # the specification comes from the class docstring, not from a copy
+        assert "Rewards" in text and "Task parameters" in text
+
+
+def _benchmark_records() -> list[dict]:
+    try:
+        from benchmarks.harness import load_records
+    except ImportError:
+        records = [json.loads(p.read_text(encoding="utf-8"))
+                   for p in sorted((DOCS / "benchmarks").glob("*.json"))]
+        return [r for r in records if isinstance(r, dict) and "tables" in r]
+    return list(load_records(DOCS / "benchmarks"))
+
+
+def test_benchmarks_page_shows_the_tables_of_the_records(site):
+    records = _benchmark_records()
+    assert records, "no benchmark record in docs/benchmarks"
+    text = html.unescape((site / "benchmarks.html").read_text(encoding="utf-8"))
+    n_tables = 0
+    for record in records:
+        assert record["title"] in text
+        for table in record["tables"]:
+            n_tables += 1
+            assert table["title"] in text, table["title"]
+            for column in table["columns"]:
+                assert str(column).strip("`") in text, column
+    assert text.count("<table") >= n_tables
+
+
+def test_docstring_labels_resolve_to_the_physics_page(site):
+    text = (site / "physics.html").read_text(encoding="utf-8")
+    for label in ("physics-fsd", "physics-drag", "physics-harddisk", "physics-contact",
+                  "physics-observables", "physics-itd"):
+        assert f'id="{label}"' in text, label
+
+
+def _project_files() -> list[Path]:
+    try:
+        listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"],
+                                cwd=ROOT, capture_output=True, text=True, check=True).stdout
+        files = [ROOT / line for line in listed.splitlines() if line]
+    except (OSError, subprocess.CalledProcessError):
+        files = [p for p in ROOT.rglob("*") if p.is_file()]
+    return [p for p in files if p.is_file()
+            and not SKIP_DIRS.intersection(p.relative_to(ROOT).parts)
+            and not any(part.endswith(".egg-info") for part in p.relative_to(ROOT).parts)]
+
+
+def test_no_file_refers_to_a_document_outside_the_project():
+    needle = OUTSIDE_BRIEF.encode()
+    offenders = [str(p.relative_to(ROOT)) for p in _project_files() if needle in p.read_bytes()]
+    assert not offenders, f"{OUTSIDE_BRIEF} is named in {offenders}"
+
+
+def test_readme_is_short():
+    size = (ROOT / "README.md").stat().st_size
+    assert size <= README_LIMIT, f"README.md is {size} bytes, more than {README_LIMIT}"
+
+
+def test_readme_links_resolve():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    targets = re.findall(r"\]\(([^)\s]+)\)", text) + re.findall(r'src="([^"]+)"', text)
+    local = [t for t in targets if not re.match(r"[a-z]+:", t) and not t.startswith("#")]
+    assert local, "the README links into the documentation"
+    missing = [t for t in local if not (ROOT / t.split("#")[0]).exists()]
+    assert not missing, f"README links to missing files: {missing}"
