@@ -316,8 +316,8 @@ def _describe_new() -> str:
     return f"{head} with uncommitted changes" if dirty else head
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, __doc__.split("\n\n")[0] + "\n\n" + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, __doc__.split("\n\n")[0] + "\n\n" + DESCRIPTION, prog)
     p.add_argument("--against", required=True, metavar="REV",
                    help="the revision to compare against (a commit, tag or branch)")
     p.add_argument("--suites", default=",".join(SUITE_NAMES),

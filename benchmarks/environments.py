@@ -198,10 +198,10 @@ def _resolve_ids(ids, known) -> list[str]:
     return out
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str | None = None) -> int:
     from iceenvs import ENV_IDS
 
-    parser = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+    parser = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     parser.add_argument("--ids", nargs="+", metavar="ID",
                         help="environments to time, e.g. WindDrift-v0 (default: all)")
     parser.add_argument("--seconds", type=float, default=None,

@@ -147,8 +147,8 @@ def format_harddisk_table(rows: list[dict]) -> str:
     return harness.render_table(harddisk_table(rows), heading=None)
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--seed", type=int, default=1)
     args, argv = harness.parse(p, argv)
     sizes = QUICK if args.quick else FULL

@@ -404,10 +404,12 @@ class Progress:
 # records
 # ---------------------------------------------------------------------------
 
-def suite_parser(suite: str, description: str) -> argparse.ArgumentParser:
-    """The command-line parser of ``python -m benchmarks.<suite>``, with
-    ``--quiet`` and the options of :func:`add_common_options`."""
-    parser = argparse.ArgumentParser(prog=f"python -m benchmarks.{suite}",
+def suite_parser(suite: str, description: str,
+                 prog: str | None = None) -> argparse.ArgumentParser:
+    """The command-line parser of ``python -m benchmarks.<suite>`` (shown as
+    ``prog`` when given, e.g. ``seaice bench <suite>``), with ``--quiet`` and
+    the options of :func:`add_common_options`."""
+    parser = argparse.ArgumentParser(prog=prog or f"python -m benchmarks.{suite}",
                                      description=description,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quiet", action="store_true", help="print only the result")

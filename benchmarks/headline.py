@@ -90,8 +90,8 @@ def rewrite(text: str, records: list[dict]) -> str:
     return f"{head}{START}\n{headline_table(records)}\n{END}{tail}"
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m benchmarks.headline",
+def main(argv=None, prog: str | None = None) -> int:
+    p = argparse.ArgumentParser(prog=prog or "python -m benchmarks.headline",
                                 description=__doc__.split("\n\n")[1],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--readme", type=Path, default=Path("README.md"),

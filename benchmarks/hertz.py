@@ -367,8 +367,8 @@ def format_table(rows: list[dict], n: int) -> str:
     return harness.render_table(hertz_table(rows, n), heading=None)
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--floes", type=int, default=None, help="floes of both cases (default 20000)")
     p.add_argument("--steps", type=int, default=None, help="timed steps per segment (default 2000)")
     p.add_argument("--seed", type=int, default=1)

@@ -165,8 +165,8 @@ def format_phases_table(result: dict) -> str:
     return harness.render_table(phases_table(result), heading=None)
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--floes", type=int, default=None, help="floes of the field (default 20000)")
     p.add_argument("--passes", type=int, default=None,
                    help="timed passes per phase and round (default 2000)")

@@ -79,8 +79,8 @@ def itd_table(rows: list[dict]) -> dict:
                          body)
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     args, argv = harness.parse(p, argv)
     sizes = QUICK if args.quick else FULL
     t0 = time.perf_counter()

@@ -93,8 +93,8 @@ def observables_table(rows: list[dict]) -> dict:
                          "\n\n".join(notes))
 
 
-def main(argv=None) -> int:
-    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION)
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--seed", type=int, default=1)
     args, argv = harness.parse(p, argv)
     floes = QUICK_FLOES if args.quick else 100008

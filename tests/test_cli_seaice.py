@@ -49,6 +49,8 @@ def test_each_subcommand_shows_its_entry_points_help(capsys, sub):
     (["validate", "--help"], "Validation report of the Hertz engine"),
     (["demo", "physics", "--help"], "--floes"),
     (["demo", "agents", "--help"], "--timesteps"),
+    (["bench", "hertz", "--help"], "--memory-floes"),
+    (["bench", "headline", "--help"], "--readme"),
 ])
 def test_the_help_is_the_entry_points_own(capsys, argv, shown):
     code, out, _ = _exit(argv, capsys)
