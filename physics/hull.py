@@ -75,20 +75,22 @@ class Hull:
         if not np.all(np.isfinite(v)):
             raise ValueError("hull vertices must be finite")
         edges = np.roll(v, -1, axis=0) - v
-        area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+        x0, y0, x1, y1, cross = _shoelace(v)
+        area2 = float(np.sum(cross))
         if area2 < 0.0:
             raise ValueError("hull vertices run clockwise; give them counter-clockwise "
                              "(x forward, y to port), e.g. reversed")
         if area2 == 0.0:
             raise ValueError("hull vertices enclose no area")
         turn = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
-        scale = np.hypot(edges[:, 0], edges[:, 1]) * np.roll(np.hypot(edges[:, 0], edges[:, 1]), -1)
+        side = np.hypot(edges[:, 0], edges[:, 1])
+        scale = side * np.roll(side, -1)
         bad = np.nonzero(turn <= 1e-12 * scale)[0]
         if bad.size:
             j = int((bad[0] + 1) % k)
             raise ValueError(f"the hull is not strictly convex at vertex {j} {tuple(v[j])}: "
                              f"give a convex polygon without repeated or collinear corners")
-        centroid = _centroid(v, 0.5 * area2)
+        centroid = np.array([np.sum((x0 + x1) * cross), np.sum((y0 + y1) * cross)]) / (3.0 * area2)
         self.vertices = v - centroid
         self.vertices.flags.writeable = False
         self.name = str(name)
@@ -133,8 +135,7 @@ class Hull:
     @property
     def area(self) -> float:
         """Plan area [m²]."""
-        v = self.vertices
-        return 0.5 * float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+        return 0.5 * float(np.sum(_shoelace(self.vertices)[4]))
 
     @property
     def length(self) -> float:
@@ -157,10 +158,7 @@ class Hull:
         [kg m²] of a uniform plate of this plan form and ``mass`` [kg]."""
         if not (math.isfinite(mass) and mass > 0.0):
             raise ValueError(f"mass must be a positive number, got {mass!r}")
-        v = self.vertices
-        x0, y0 = v[:, 0], v[:, 1]
-        x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
-        cross = x0 * y1 - x1 * y0
+        x0, y0, x1, y1, cross = _shoelace(self.vertices)
         polar = float(np.sum(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))) / 12.0
         return mass * polar / self.area
 
@@ -182,11 +180,12 @@ def _check_dimensions(length, beam):
             raise ValueError(f"{name} must be a positive number, got {value!r}")
 
 
-def _centroid(v, area):
+def _shoelace(v):
+    """Each corner (x0, y0), the next one (x1, y1), and x0 y1 − x1 y0: the
+    terms of the polygon's area, centroid and second moment."""
     x0, y0 = v[:, 0], v[:, 1]
     x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
-    cross = x0 * y1 - x1 * y0
-    return np.array([np.sum((x0 + x1) * cross), np.sum((y0 + y1) * cross)]) / (6.0 * area)
+    return x0, y0, x1, y1, x0 * y1 - x1 * y0
 
 
 @njit(cache=True, error_model="numpy")
