@@ -3,7 +3,6 @@ there, and the README stays short with working links."""
 from __future__ import annotations
 
 import html
-import json
 import os
 import re
 import shutil
@@ -12,6 +11,8 @@ import sys
 from pathlib import Path
 
 import pytest
+
+from benchmarks.harness import load_records
 
 pytest.importorskip("sphinx")
 pytest.importorskip("myst_parser")
@@ -60,18 +61,8 @@ def test_every_environment_has_a_generated_page_with_a_frame(site):
         assert "Rewards" in text and "Task parameters" in text
 
 
-def _benchmark_records() -> list[dict]:
-    try:
-        from benchmarks.harness import load_records
-    except ImportError:
-        records = [json.loads(p.read_text(encoding="utf-8"))
-                   for p in sorted((DOCS / "benchmarks").glob("*.json"))]
-        return [r for r in records if isinstance(r, dict) and "tables" in r]
-    return list(load_records(DOCS / "benchmarks"))
-
-
 def test_benchmarks_page_shows_the_tables_of_the_records(site):
-    records = _benchmark_records()
+    records = load_records(DOCS / "benchmarks")
     assert records, "no benchmark record in docs/benchmarks"
     text = html.unescape((site / "benchmarks.html").read_text(encoding="utf-8"))
     n_tables = 0

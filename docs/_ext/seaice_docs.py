@@ -22,9 +22,6 @@ incremental.
 from __future__ import annotations
 
 import importlib
-import importlib.util
-import inspect
-import json
 import os
 import pkgutil
 import re
@@ -151,10 +148,6 @@ def generate_environments(out: Path) -> None:
     write_if_changed(out / "include" / "environments_toc.md", "\n".join(toc + ["```", ""]))
 
 
-def environment_classes() -> set:
-    return {environment_class(spec) for _, spec in registered_environments()}
-
-
 def observation_table() -> str:
     from iceenvs.observations import FLOE_FEATURES, feature_table
 
@@ -171,59 +164,10 @@ def _cell(value) -> str:
     return str(value).replace("|", "\\|").replace("\n", " ")
 
 
-def markdown_record(record: dict) -> str:
-    """A benchmark record as Markdown (used until ``benchmarks.harness`` exists)."""
-    machine = record.get("machine", {})
-    if isinstance(machine, dict):
-        machine = ", ".join(f"{k} {v}" for k, v in machine.items())
-    lines = [f"## {record.get('title', record.get('suite', 'benchmark'))}", ""]
-    if record.get("description"):
-        lines += [record["description"], ""]
-    wall = record.get("wall_seconds")
-    lines += [f"Command: `{record.get('command', '')}`  ", f"Machine: {machine}  ",
-              f"Date: {record.get('date', '')}  ",
-              f"Wall time: {wall:.0f} s" if isinstance(wall, (int, float)) else "", ""]
-    for table in record.get("tables", []):
-        lines += [f"### {table['title']}", "",
-                  "| " + " | ".join(map(_cell, table["columns"])) + " |",
-                  "|" + "---|" * len(table["columns"])]
-        lines += ["| " + " | ".join(map(_cell, row)) + " |" for row in table["rows"]]
-        lines.append("")
-        notes = table.get("notes")
-        if notes:
-            lines += ([notes] if isinstance(notes, str) else list(notes)) + [""]
-    return "\n".join(lines)
-
-
-def _is_record(data) -> bool:
-    return isinstance(data, dict) and "suite" in data and "tables" in data
-
-
-def benchmark_records(directory: Path) -> list[dict]:
-    """The records of ``directory``: ``benchmarks.harness.load_records`` if
-    the package is there, else every JSON file that has the record keys."""
-    try:
-        from benchmarks.harness import load_records
-    except ImportError:
-        load_records = None
-    if load_records is not None:
-        return list(load_records(directory))
-    records = []
-    for path in sorted(directory.glob("*.json")):
-        data = json.loads(path.read_text(encoding="utf-8"))
-        if _is_record(data):
-            records.append(data)
-        else:
-            log.info(f"benchmarks: {path.name} is not a benchmark record, left out")
-    return records
-
-
 def generate_benchmarks(out: Path, directory: Path) -> None:
-    try:
-        from benchmarks.harness import render_markdown
-    except ImportError:
-        render_markdown = markdown_record
-    records = benchmark_records(directory) if directory.is_dir() else []
+    from benchmarks.harness import load_records, render_markdown
+
+    records = load_records(directory)
     parts = [render_markdown(r).strip() + "\n" for r in records]
     if not parts:
         parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
@@ -265,29 +209,12 @@ def generate_crosscheck(out: Path, directory: Path) -> None:
 # Command line
 
 
-def _has_module(name: str) -> bool:
-    try:
-        return importlib.util.find_spec(name) is not None
-    except (ImportError, ValueError):
-        return False
-
-
 def cli_commands() -> list[tuple[str, list[str]]]:
-    """(command as a user types it, argv of ``python -m``) of every command."""
-    if _has_module("seaice_gym.__main__"):
-        top = _help(["seaice_gym"])
-        found = re.search(r"\{([\w,-]+)\}", top)
-        subs = found.group(1).split(",") if found else [
-            "train", "evaluate", "scenarios", "crosscheck", "bench", "validate", "demo"]
-        return [("seaice", ["seaice_gym"])] + [(f"seaice {s}", ["seaice_gym", s]) for s in subs]
-    return [
-        ("python -m agents.train", ["agents.train"]),
-        ("python -m agents.evaluate", ["agents.evaluate"]),
-        ("ice-scenarios", ["physics.scenarios"]),
-        ("python -m physics.crosscheck", ["physics.crosscheck"]),
-        ("python -m physics.demo", ["physics.demo"]),
-        ("python -m agents.demo", ["agents.demo"]),
-    ]
+    """(command as a user types it, argv of ``python -m``) of ``seaice`` and
+    each of its sub-commands."""
+    from seaice_gym.cli import COMMANDS
+
+    return [("seaice", ["seaice_gym"])] + [(f"seaice {s}", ["seaice_gym", s]) for s in COMMANDS]
 
 
 def _help(argv: list[str]) -> str:
@@ -334,29 +261,27 @@ def generate_scenario_parameters(out: Path) -> None:
 # API reference
 
 
-def public_modules() -> list[str]:
-    """Every public module of :data:`API_PACKAGES` that is installed, walked
-    from the packages (no private module, no ``__main__``, no shim)."""
+def public_modules() -> list[tuple[str, bool]]:
+    """(name, is a package) of every public module of :data:`API_PACKAGES`,
+    walked from the packages (no private module, no ``__main__``, no shim)."""
     found = []
     for package in API_PACKAGES:
-        if not _has_module(package):
-            continue
         pkg = importlib.import_module(package)
-        found.append(package)
+        found.append((package, True))
         for info in pkgutil.walk_packages(pkg.__path__, prefix=package + "."):
             parts = info.name.split(".")
             if any(p.startswith("_") for p in parts) or info.name in API_SKIP:
                 continue
-            found.append(info.name)
+            found.append((info.name, info.ispkg))
     return found
 
 
 def generate_api(out: Path) -> None:
-    modules = public_modules()
+    found = public_modules()
+    modules = [name for name, _ in found]
     api = out / "api"
-    for name in modules:
-        source = name.replace(".", "/")
-        source += "/__init__.py" if _is_package(name) else ".py"
+    for name, package in found:
+        source = name.replace(".", "/") + ("/__init__.py" if package else ".py")
         write_if_changed(api / f"{name}.md", "\n".join([
             f"# {name}", "", f"Source: `{source}`", "",
             "```{eval-rst}", f".. automodule:: {name}", "```", ""]))
@@ -365,11 +290,6 @@ def generate_api(out: Path) -> None:
             stale.unlink()
     toc = ["```{toctree}", ":maxdepth: 1", ""] + [f"/_generated/api/{m}" for m in modules]
     write_if_changed(out / "include" / "api_toc.md", "\n".join(toc + ["```", ""]))
-
-
-def _is_package(name: str) -> bool:
-    spec = importlib.util.find_spec(name)
-    return spec is not None and spec.submodule_search_locations is not None
 
 
 # ---------------------------------------------------------------------------
@@ -387,7 +307,8 @@ def on_builder_inited(app) -> None:
     generate_scenario_parameters(out)
     generate_api(out)
     write_if_changed(out / "include" / "observations.md", observation_table() + "\n")
-    app.env_classes = environment_classes()
+    app.env_pages = {environment_class(spec): env_id
+                     for env_id, spec in registered_environments()}
 
 
 _LITERAL = re.compile(r"(``.+?``|:\w+(?::\w+)?:`[^`]*`|`[^`]*`_?)")
@@ -414,8 +335,8 @@ def escape_bars(lines: list[str]) -> list[str]:
 def on_process_docstring(app, what, name, obj, options, lines) -> None:
     """An environment's class docstring is Markdown: its page renders it, the
     API page points there. Absolute-value bars are escaped."""
-    if what == "class" and obj in getattr(app, "env_classes", ()):
-        env_id = next(i for i, s in registered_environments() if environment_class(s) is obj)
+    env_id = getattr(app, "env_pages", {}).get(obj) if what == "class" else None
+    if env_id is not None:
         page = "/_generated/environments/" + env_id.split("/")[-1]
         lines[:] = [f"The environment ``{env_id}``; its specification (description, "
                     f"spaces, rewards, task parameters) is on its page, :doc:`{page}`."]
