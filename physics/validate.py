@@ -13,6 +13,7 @@ Prints, for small systems, the measured errors that the test suite bounds:
 """
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 import time
@@ -131,7 +132,9 @@ def report() -> list[tuple[str, str, str]]:
     return rows
 
 
-def main() -> int:
+def main(argv=None, prog: str = "python -m physics.validate") -> int:
+    argparse.ArgumentParser(prog=prog, description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
     t0 = time.perf_counter()
     rows = report()
     print("| check | tolerance | measured |")

@@ -81,14 +81,7 @@ def _call(target: str, argv: list[str], prog: str) -> int:
     module = importlib.import_module(module_name)
     func = getattr(module, func_name)
     params = inspect.signature(func).parameters
-    if not params:
-        # an entry point without options: its help is its module's docstring
-        argparse.ArgumentParser(prog=prog, description=module.__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter
-                                ).parse_args(argv)
-        result = func()
-    else:
-        result = func(list(argv), **({"prog": prog} if "prog" in params else {}))
+    result = func(list(argv), **({"prog": prog} if "prog" in params else {}))
     return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 

@@ -76,8 +76,8 @@ def test_arguments_are_forwarded_and_the_status_returned(monkeypatch):
         calls.append(("scenarios", argv, prog))
         return 3
 
-    def fake_validate():                     # an entry point without options
-        calls.append(("validate",))
+    def fake_validate(argv, prog="python -m physics.validate"):
+        calls.append(("validate", argv, prog))
         return 0
 
     def fake_train(argv, prog="python -m agents.train"):
@@ -92,7 +92,7 @@ def test_arguments_are_forwarded_and_the_status_returned(monkeypatch):
     assert cli.main(["train", "--env", "E", "--help-me"]) == 0
     assert calls == [("scenarios", ["run", "herman2013-convergence", "--quick"],
                       "seaice scenarios"),
-                     ("validate",),
+                     ("validate", [], "seaice validate"),
                      ("train", ["--env", "E", "--help-me"], "seaice train")]
 
 
