@@ -107,21 +107,18 @@ def new_series(days) -> dict:
     return {k: np.full(int(days), np.nan) for k in SERIES}
 
 
-def advance_day(model, series: dict, d: int, fit_every: int = 5) -> None:
+def advance_day(model, series: dict, d: int) -> None:
     """Step ``model`` by one day and store the diagnostics of day ``d``
-    (0-based) in ``series`` (from :func:`new_series`); the tail e-folding
-    thickness is fitted every ``fit_every`` days and on the last day (NaN
-    between, and while the tail is too short to fit)."""
-    n = len(series["t"])
+    (0-based) in ``series`` (from :func:`new_series`), among them the tail
+    e-folding thickness (NaN while the tail is too short to fit)."""
     model.step(1.0)
     series["t"][d] = model.time
     series["mean"][d] = model.mean_thickness
     series["open"][d] = model.open_water
     series["v2"][d] = ice_volume_above(model, 2.0)
     series["v5"][d] = ice_volume_above(model, 5.0)
-    if (d + 1) % fit_every == 0 or d == n - 1:
-        lam = model.tail_fit(GODLOVITCH.tail_min).efolding
-        series["lam"][d] = lam if math.isfinite(lam) else np.nan
+    lam = model.tail_fit(GODLOVITCH.tail_min).efolding
+    series["lam"][d] = lam if math.isfinite(lam) else np.nan
 
 
 def first_day(t, series, level):
@@ -389,7 +386,7 @@ class _ThorndikeExperiment(Experiment):
             st = {"model": m, "day": 0, "series": new_series(days)}
         m, s = st["model"], st["series"]
         for d in range(st["day"], days):
-            advance_day(m, s, d, fit_every=1)
+            advance_day(m, s, d)
             st["day"] = d + 1
             if (d + 1) % every == 0 or d + 1 == days:
                 fit = m.tail_fit(GODLOVITCH.tail_min)
