@@ -2,7 +2,8 @@
 
 A checkpoint is one ZIP archive in the layout of NumPy's ``.npz`` files: the
 arrays of the saved state as ``.npy`` members, read back with
-``numpy.load(..., allow_pickle=False)``, and a member ``structure.yaml``,
+``numpy.lib.format.read_array(..., allow_pickle=False)`` (and readable with
+``numpy.load(..., allow_pickle=False)``), and a member ``structure.yaml``,
 read with PyYAML's safe loader, that describes how they fit together. Both can
 be inspected with ordinary tools (``unzip -p FILE structure.yaml``).
 
@@ -266,8 +267,8 @@ _TAGS = ("list", "dict", "pairs", "tuple", "array", "view", "scalar", "generator
 
 
 class _Decoder:
-    def __init__(self, arrays):
-        self.arrays = arrays
+    def __init__(self, archive: zipfile.ZipFile):
+        self.archive = archive
         self._memo: dict[int, object] = {}
 
     def _remember(self, node: dict, value):
@@ -278,7 +279,8 @@ class _Decoder:
     def _stored(self, key):
         if not isinstance(key, str):
             raise CheckpointError(f"bad array name {key!r}")
-        return self.arrays[key]
+        with self.archive.open(key + ".npy") as fh:
+            return np.lib.format.read_array(fh, allow_pickle=False)
 
     def decode(self, node):
         if type(node) in _PLAIN:
@@ -401,18 +403,19 @@ def _open(path) -> tuple[zipfile.ZipFile, dict]:
     except (zipfile.BadZipFile, EOFError, OSError) as exc:
         raise CheckpointError(f"it is damaged or truncated ({exc})") from None
     try:
-        doc = yaml.load(zf.read(STRUCTURE).decode("utf-8"), Loader=loader)
-    except (zipfile.BadZipFile, KeyError, EOFError, OSError, UnicodeDecodeError,
-            yaml.YAMLError) as exc:
+        try:
+            doc = yaml.load(zf.read(STRUCTURE).decode("utf-8"), Loader=loader)
+        except (zipfile.BadZipFile, KeyError, EOFError, OSError, UnicodeDecodeError,
+                yaml.YAMLError) as exc:
+            raise CheckpointError(f"it is damaged or truncated ({exc})") from None
+        if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+            raise CheckpointError("it is not a checkpoint archive (damaged or of another kind)")
+        if doc.get("version") != VERSION:
+            raise CheckpointError(f"it was written in checkpoint format version "
+                                  f"{doc.get('version')!r}; this version reads {VERSION}")
+    except CheckpointError:
         zf.close()
-        raise CheckpointError(f"it is damaged or truncated ({exc})") from None
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        zf.close()
-        raise CheckpointError("it is not a checkpoint archive (damaged or of another kind)")
-    if doc.get("version") != VERSION:
-        zf.close()
-        raise CheckpointError(f"it was written in checkpoint format version "
-                              f"{doc.get('version')!r}; this version reads {VERSION}")
+        raise
     return zf, doc
 
 
@@ -429,8 +432,8 @@ def load(path):
     :class:`CheckpointError` (naming the reason) if it cannot be read."""
     zf, doc = _open(path)
     try:
-        with zf, np.load(path, allow_pickle=False) as npz:
-            return _Decoder(npz).decode(doc.get("data"))
+        with zf:
+            return _Decoder(zf).decode(doc.get("data"))
     except CheckpointError:
         raise
     except Exception as exc:            # anything a damaged file can raise
