@@ -101,10 +101,12 @@ def task_table(rows: list[dict]) -> str:
 
 def _document(saved: dict) -> str:
     """tasks.md: what was run, then the table."""
+    from .constant import SEARCH_SEED
+
     return (f"Returns over {saved['episodes']} episodes (episode k seeded {EVAL_SEED} + k; mean "
             f"± std), default configuration of each environment. The best constant action is "
             f"the best of a grid of {saved['grid']} points per action dimension, "
-            f"{saved['seeds']} episodes each (seeds 20000 + k). \"Controller\" is the "
+            f"{saved['seeds']} episodes each (seeds {SEARCH_SEED} + k). \"Controller\" is the "
             f"hand-written controller of `agents.baselines`; its difference from the best "
             f"constant action is paired by seed.\n\n`{saved['command']}` ({saved['machine']}, "
             f"{saved['date']})\n\n" + task_table(saved["rows"]))

@@ -362,7 +362,6 @@ class PaperPreset:
         check_range("n", n, 1, None)
         if int(n) != n:
             raise ValueError(f"n must be a whole number of floes, got {n!r}")
-        check_range("concentration", concentration, 0.0, 1.0, low_open=True, high_open=True)
         kwargs = {"alpha": self.fsd_exponent, "mean_diameter": self.mean_diameter,
                   "thickness": self.thickness, "density": self.forcing.ice_density}
         kwargs.update(overrides)
