@@ -207,11 +207,11 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
         field, box = H.gas_field(sizes["gas_floes"], 0.5, seed)
         sim = H.elastic_sim(field, box)
         sim.advance(1.0)                          # about 5 collisions per disc
-        gas = _save_field(work / "gas.npz", _snapshot(field, sim), box)
+        gas = _save_field(work / "gas.npz", sim.state(), box)
         field, box = H.herman_field(sizes["herman_floes"], seed)
         sim = H.herman_sim(field, box)
         sim.advance(sizes["spin_up"], progress=not quiet)
-        herman = _save_field(work / "herman2011.npz", _snapshot(field, sim), box)
+        herman = _save_field(work / "herman2011.npz", sim.state(), box)
         out.append(dict(name=f"hard discs, elastic, N = {sizes['gas_floes']}, η = 0.5",
                         labels=["one core"], unit="collisions/s", fn=_harddisk_child,
                         args=(gas, "elastic", sizes["gas_collisions"], 1.0, sizes["segments"]),
@@ -233,14 +233,6 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
                             threads=1))
     return out
 
-
-def _snapshot(field, sim):
-    """``field`` with the positions and velocities of ``sim`` now."""
-    from physics.floes import FloeField
-
-    return FloeField(positions=np.array(sim.positions), radii=np.asarray(field.radii),
-                     thickness=np.asarray(field.thickness), velocities=np.array(sim.velocities),
-                     angular_velocities=np.zeros(len(field.radii)), density=field.density)
 
 
 # ---------------------------------------------------------------------------

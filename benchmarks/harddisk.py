@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 from physics.domain import PeriodicBox
-from physics.floes import FloeField, make_floe_field
+from physics.floes import FloeField
 from physics.forcing import Forcing
 from physics.harddisk import HardDiskSimulation
 from physics.params import HERMAN2011
@@ -57,10 +57,7 @@ def gas_field(n: int, eta: float, seed: int):
 
 def herman_field(n: int, seed: int):
     """The floe field of the Herman (2011) set-up."""
-    P = HERMAN2011
-    return make_floe_field(n, concentration=0.75, alpha=P.fsd_exponent,
-                           mean_diameter=P.mean_diameter, thickness=P.thickness, seed=seed,
-                           velocity_std=0.01)
+    return HERMAN2011.floe_field(n, 0.75, seed=seed, velocity_std=0.01)
 
 
 def elastic_sim(field, box) -> HardDiskSimulation:
@@ -140,11 +137,6 @@ def harddisk_table(rows: list[dict]) -> dict:
     return harness.table("Hard-disc engine, one core",
                          ["case", "collisions/s", "collisions timed", "model time [s]",
                           "cell crossings per collision", "repairs"], body, "\n\n".join(notes))
-
-
-def format_harddisk_table(rows: list[dict]) -> str:
-    """The table of :func:`harddisk_table` as Markdown."""
-    return harness.render_table(harddisk_table(rows), heading=None)
 
 
 def main(argv=None, prog: str | None = None) -> int:

@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from physics.domain import PeriodicBox
-from physics.floes import FloeField, make_floe_field
+from physics.floes import FloeField
 from physics.hertz import HertzSimulation
 from physics.params import HERMAN2013
 
@@ -55,9 +55,7 @@ pinned to each core at once. The peak memory of a run with N = 100000 floes is
 measured in a fresh process.
 """
 
-ALPHA = HERMAN2013.fsd_exponent
 JAMMED = 0.95          # concentration of the jammed case (above A_J = 0.94 of the field)
-MEAN_DIAMETER = HERMAN2013.mean_diameter
 #: sizes of ``--quick`` (no host or machine ceilings)
 QUICK = dict(floes=400, steps=20, memory_floes=0, processes=1, ceilings=False)
 
@@ -82,8 +80,7 @@ def _loose_state(n: int, seed: int, cache_dir: Path) -> Path:
     path = Path(cache_dir) / f"hertz_a070_n{n}_seed{seed}_v2.npz"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA,
-                                     mean_diameter=MEAN_DIAMETER, seed=seed, velocity_std=0.03)
+        field, box = HERMAN2013.floe_field(n, 0.7, seed=seed, velocity_std=0.03)
         _save_state(path, field, box)
     return path
 
@@ -106,8 +103,7 @@ def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float
     if path.exists():
         return path, 0.0
     t0 = time.perf_counter()
-    field, box = make_floe_field(n, concentration=0.85, alpha=ALPHA, mean_diameter=MEAN_DIAMETER,
-                                 seed=seed)
+    field, box = HERMAN2013.floe_field(n, 0.85, seed=seed)
     field, box, _ = compress_floes(field, box, 0.925, increment=0.005, force_tol=1e-3,
                                    progress=not quiet)
     field, box, res = compress_floes(field, box, target, increment=1.0, force_tol=1e-3,
@@ -203,10 +199,8 @@ def _timed_steps(path: Path, dt: float, steps: int, threads: int) -> dict:
 
 
 def _memory_child(n: int) -> int:
-    field, box = make_floe_field(n, concentration=0.7, alpha=ALPHA, mean_diameter=MEAN_DIAMETER,
-                                 seed=1, velocity_std=0.03)
-    sim = HertzSimulation(field, box, contact=HERMAN2013.contact, forcing=None,
-                          dt=HERMAN2013.time_step)
+    sim = HertzSimulation.from_preset(HERMAN2013, n, 0.7, seed=1, velocity_std=0.03,
+                                      forcing=False)
     sim.step(200)
     return harness.peak_rss()
 
@@ -360,11 +354,6 @@ def _notes(rows: list[dict]) -> list[str]:
                          f"{np.median(paired):.2f}, best {max(paired):.2f}; "
                          f"all threads / serial kernels = {allt[0]['rate'] / ser['rate']:.2f}")
     return lines
-
-
-def format_table(rows: list[dict], n: int) -> str:
-    """The table of :func:`hertz_table` and its notes as Markdown."""
-    return harness.render_table(hertz_table(rows, n), heading=None)
 
 
 def main(argv=None, prog: str | None = None) -> int:

@@ -160,11 +160,6 @@ def phases_table(result: dict) -> dict:
                           "serial / this (same round: median, best)"], body)
 
 
-def format_phases_table(result: dict) -> str:
-    """The table of :func:`phases_table` as Markdown."""
-    return harness.render_table(phases_table(result), heading=None)
-
-
 def main(argv=None, prog: str | None = None) -> int:
     p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--floes", type=int, default=None, help="floes of the field (default 20000)")

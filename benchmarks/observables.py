@@ -13,7 +13,6 @@ import numpy as np
 
 from physics.clusters import cluster_statistics, find_clusters, g_ffd, g_rdf
 from physics.domain import PeriodicBox
-from physics.floes import make_floe_field
 from physics.observables import Contacts, contacts_within, fabric, stress
 from physics.params import HERMAN2011
 
@@ -36,10 +35,7 @@ QUICK_FLOES = 2000
 def bench_observables(seed: int = 1, tiles: int = 6, quiet: bool = False,
                       floes: int = 100008) -> list[dict]:
     """Wall times of the observables on ``floes`` floes (see :data:`DESCRIPTION`)."""
-    P = HERMAN2011
-    tile, tile_box = make_floe_field(floes // tiles ** 2, concentration=0.75,
-                                     alpha=P.fsd_exponent, mean_diameter=P.mean_diameter,
-                                     thickness=P.thickness, seed=seed)
+    tile, tile_box = HERMAN2011.floe_field(floes // tiles ** 2, 0.75, seed=seed)
     shift = np.array([(a * tile_box.lx, b * tile_box.ly) for a in range(tiles)
                       for b in range(tiles)])
     pos = (tile.positions[None, :, :] + shift[:, None, :]).reshape(-1, 2)

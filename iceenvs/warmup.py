@@ -116,9 +116,8 @@ def warm_parallel(steps: int = 5) -> str:
     that the engine picks for large fields when Numba has several threads)."""
     from physics import HERMAN2013, HertzSimulation
 
-    field, box = HERMAN2013.floe_field(300, 0.7, seed=1, velocity_std=0.01)
-    sim = HertzSimulation(field, box, HERMAN2013.contact, HERMAN2013.make_forcing(),
-                          dt=HERMAN2013.time_step, parallel=True)
+    sim = HertzSimulation.from_preset(HERMAN2013, 300, 0.7, seed=1, velocity_std=0.01,
+                                      parallel=True)
     sim.step(steps)
     sim.contacts()
     return ""

@@ -14,14 +14,11 @@ import pytest
 from benchmarks import harness
 from benchmarks import hertz as bench
 from benchmarks import hertz_phases as phases
-from physics import make_floe_field
+from benchmarks.harness import render_table
 
 
 def test_timing_child_times_every_configuration_in_every_round(tmp_path):
-    field, box = make_floe_field(400, concentration=0.7, alpha=1.8, mean_diameter=8.0, seed=1,
-                                 velocity_std=0.03)
-    path = tmp_path / "state.npz"
-    bench._save_state(path, field, box)
+    path = bench._loose_state(400, 1, tmp_path)
     out = bench._timed_steps(path, 0.002, 20, threads=2)
     configs = bench._kernel_configs(2)
     assert [label for label, _, _ in configs] == ["serial", "parallel", "parallel"]
@@ -43,7 +40,7 @@ def test_table_reports_rows_ratios_and_ceilings():
                  together=[8e7, 7e7], contacts_per_floe=math.nan, dt=0.002, rebuilds=0),
             dict(case="control", kernel="scalar", threads=2, rate=1.4, paired=[1.3, 1.4, 2.0],
                  contacts_per_floe=math.nan, dt=0.0, rebuilds=0)]
-    text = bench.format_table(rows, 20000)
+    text = render_table(bench.hertz_table(rows, 20000), heading=None)
     assert "| Ā = 0.70 | parallel | 2 | 1.2e+08 | 1e+08–1.2e+08 |" in text
     assert "best / best = 1.50, same round: median 1.60, best 1.90" in text
     assert "all threads / serial kernels = 1.20" in text
@@ -65,7 +62,7 @@ def test_phase_benchmark_times_every_phase_and_configuration(tmp_path):
         if r["kernel"] == "serial":
             assert r["speedup"] == r["speedup_best"] == 1.0
     assert result["n"] == 400 and result["n_pairs"] >= 0
-    text = phases.format_phases_table(result)
+    text = render_table(phases.phases_table(result), heading=None)
     assert "| list rebuild | serial | 1 |" in text and "Ā = 0.70" in text
 
 
