@@ -24,6 +24,7 @@ import numba
 import numpy as np
 
 from . import hertz_kernels as K
+from . import hull_contact as HC
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
 from .engine import FailureReason, SimulationError, engine_from_preset
@@ -36,6 +37,7 @@ from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, PaperPreset, check_range
 from .progress import steps_with_bar
+from .ship import Ship, ShipLoads, ShipState
 
 __all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
 
@@ -52,6 +54,16 @@ def minimum_contact_time(radius, thickness, density, contact: ContactParams, spe
     if walls:
         t = np.minimum(t, contact_time(m, hertz_stiffness(contact.wall_effective_modulus, r), speed))
     return float(np.min(t))
+
+
+def hull_contact_time(radius, thickness, density, contact: ContactParams, speed: float) -> float:
+    """Shortest undamped contact time of a floe hitting a rigid hull at
+    ``speed`` [s] (m* = m, R* = r, the wall moduli;
+    :mod:`physics.hull_contact`)."""
+    r = np.asarray(radius, dtype=float)
+    m = density * np.asarray(thickness, dtype=float) * math.pi * r ** 2
+    return float(np.min(contact_time(m, hertz_stiffness(contact.wall_effective_modulus, r),
+                                     speed)))
 
 
 def scaled_contact(contact: ContactParams, stiffness_scale: float) -> ContactParams:
@@ -110,6 +122,12 @@ class HertzSimulation:
     allow_overlap : bool
         Accept initial overlaps above 1 % of the smaller radius (e.g. when
         restoring a saved, compressed state).
+    ship : Ship, optional
+        A ship among the floes (:mod:`physics.ship`); it must not overlap a
+        floe at the start. Then ``sim.ship`` is its
+        :class:`~physics.ship.ShipState` and :meth:`ship_loads` gives the
+        statistics of its ice loads. The time-step check then also covers a
+        floe hitting the hull at the ship's speed.
 
     Attributes
     ----------
@@ -135,7 +153,8 @@ class HertzSimulation:
     def __init__(self, field: FloeField, box: Box, contact: ContactParams | None = None,
                  forcing: Forcing | None = None, dt: float = 0.002, *,
                  impact_speed: float = 0.1, skin: float | None = None,
-                 parallel: bool | None = None, allow_overlap: bool = False):
+                 parallel: bool | None = None, allow_overlap: bool = False,
+                 ship: Ship | None = None):
         if not isinstance(field, FloeField):
             raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
         if not isinstance(box, Box):
@@ -147,6 +166,8 @@ class HertzSimulation:
             raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
         check_range("dt", dt, 0.0, None, low_open=True)
         check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
+        if ship is not None and not isinstance(ship, Ship):
+            raise TypeError(f"ship must be a physics.ship.Ship or None, got {type(ship).__name__}")
         self.field = field.copy()
         self.box = box
         self.contact = contact
@@ -159,10 +180,17 @@ class HertzSimulation:
         # time step against the shortest contact time
         t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed,
                                    walls=not all(box.periodic))
+        what = f"the smallest floes at impact speed {impact_speed:g} m/s"
+        if ship is not None:
+            speed = max(impact_speed, abs(ship.speed))
+            t_hull = hull_contact_time(f.radii, f.thickness, f.density, contact, speed)
+            if t_hull < t_c:
+                t_c = t_hull
+                what = f"the smallest floes hitting the hull at {speed:g} m/s"
         if self.dt > 0.1 * t_c:
             raise ValueError(
                 f"dt={self.dt:g} s is above a tenth of the shortest contact time "
-                f"({t_c:.4g} s for the smallest floes at impact speed {impact_speed:g} m/s); "
+                f"({t_c:.4g} s for {what}); "
                 f"use dt <= {0.1 * t_c:.3g} s")
         self.min_contact_time = t_c
 
@@ -215,6 +243,8 @@ class HertzSimulation:
         self.n_steps = 0
         self.n_rebuilds = 0
         self._build_list()
+        self._no_ship = HC.inactive_bundle(self._wall_law)
+        self.ship = None if ship is None else self._place_ship(ship)
         self._evaluate_forces(self._drive(), self.force, self.torque)
 
     @classmethod
@@ -260,6 +290,30 @@ class HertzSimulation:
         return engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, kwargs)
 
     # -- set-up helpers ------------------------------------------------------
+    def _place_ship(self, ship: Ship) -> ShipState:
+        box = self.box
+        state = ShipState(ship, self.n_floes, self._wall_law)
+        # the hull's list skin: a quarter of the beam, at least the floes' skin
+        state.set_skin(max(self.skin, 0.25 * ship.hull.beam))
+        reach = state.reach + float(self.radius.max()) + state.skin
+        for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
+            if per and 2.0 * reach >= length:
+                raise ValueError(
+                    f"the box is too small along {axis} ({length:.4g} m) for the ship: periodic "
+                    f"sides must exceed 2 (hull reach + r_max + hull skin) = {2 * reach:.4g} m")
+        if ship.current_drag and self.forcing is not None:
+            state.set_current(self.forcing.current)
+        bundle = state.bundle(0)
+        b = box.kernel_box(self.time)
+        HC.build_hull_list(bundle, self._pos, self.radius, b.lengths[0], b.lengths[1],
+                           b.periodic_x, b.periodic_y)
+        idx, data = HC.hull_contact_list(bundle, self._floes, b)
+        if idx.size:
+            raise ValueError(
+                f"the ship overlaps {idx.size} floe(s) at the start (floe {int(idx[0])}, "
+                f"overlap {data[0, 8]:.3g} m); start it in open water")
+        return state
+
     def _set_drag(self):
         f = self.field
         n = f.n
@@ -310,15 +364,37 @@ class HertzSimulation:
             return
         if self.forcing is not None:
             self._set_drag_if_changed()
+        if self.ship is None:
+            status, _ = self._run(n, self._no_ship)
+        else:
+            # in pieces that bound the record buffer; the collision log is
+            # emptied whenever it fills
+            self.ship.set_current(self.forcing.current if self.forcing is not None else (0, 0))
+            self.ship.refresh()
+            left = n
+            while left > 0:
+                status, done = self._run(min(left, self._SHIP_CHUNK), self.ship.bundle(
+                    min(left, self._SHIP_CHUNK)))
+                left -= done
+                self.ship.drain()
+                if status not in (HertzStatus.OK, HertzStatus.SHIP_LOG_FULL):
+                    break
+        self._check_status(status)
+
+    _SHIP_CHUNK = 50_000
+
+    def _run(self, n: int, ship_bundle) -> tuple:
         box = self.box.kernel_box(self.time)
         done, status, nreb, self._verlet = K.run_steps(
             n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(), box,
-            self._verlet, self.parallel, numba.get_num_threads())
+            self._verlet, self.parallel, numba.get_num_threads(), ship_bundle)
         self.time += done * self.dt
         self.n_steps += done
         self.n_rebuilds += nreb
         self.box.update_from_kernel(box)
-        status = HertzStatus(status)
+        return HertzStatus(status), done
+
+    def _check_status(self, status: HertzStatus):
         if status is HertzStatus.CONCENTRATION_LIMIT:
             raise SimulationError(
                 f"the deforming box reached its concentration limit at t = {self.time:.6g} s "
@@ -330,6 +406,8 @@ class HertzSimulation:
                 f"The time step may be too large for the impact speeds, the ice compressed far "
                 f"beyond jamming, or (for fast floes and long steps) the skin too small",
                 FailureReason.UNSTABLE, self.time)
+        if self.ship is not None and not np.all(np.isfinite(self.ship._bundle.state)):
+            status = HertzStatus.NON_FINITE
         if status is HertzStatus.NON_FINITE or not (np.all(np.isfinite(self._pos))
                                                    and np.all(np.isfinite(self._vel))):
             raise SimulationError(
@@ -406,7 +484,30 @@ class HertzSimulation:
         force = np.zeros((self.n_floes, 2))
         torque = np.zeros(self.n_floes)
         self._evaluate_forces(K.make_drive(np.zeros((self.n_floes, 4))), force, torque)
+        if self.ship is not None:
+            idx, data = self.hull_contacts()
+            np.add.at(force, idx, data[:, 0:2])
+            np.add.at(torque, idx, data[:, 2])
         return force, torque
+
+    def hull_contacts(self):
+        """The floes touching the hull now: (floes (K,), data (K, 9)) with
+        per contact the force on the floe (x, y) [N], the torque on the floe
+        and the moment on the hull [N m], the normal and tangential forces
+        [N], the contact point relative to the ship's centroid (x, y; world
+        frame) [m] and the overlap [m]. Empty without a ship."""
+        if self.ship is None:
+            return np.zeros(0, dtype=np.int64), np.zeros((0, 9))
+        return HC.hull_contact_list(self.ship._bundle, self._floes,
+                                    self.box.kernel_box(self.time))
+
+    def ship_loads(self, start: float | None = None, end: float | None = None) -> ShipLoads:
+        """Statistics of the ship's ice loads over the steps with
+        start < t ≤ end (default: all recorded; see
+        :meth:`physics.ship.ShipState.statistics`)."""
+        if self.ship is None:
+            raise ValueError("this simulation has no ship (pass ship= to HertzSimulation)")
+        return self.ship.statistics(start, end)
 
     def contacts(self) -> Contacts:
         """Every touching floe pair at the current state (see :class:`Contacts`)."""
@@ -430,7 +531,8 @@ class HertzSimulation:
         return stress(self.contacts(), self.box.area, n_floes=self.n_floes, per_floe=per_floe)
 
     def kinetic_energy(self) -> float:
-        """Translational plus rotational kinetic energy of mobile floes [J]."""
+        """Translational plus rotational kinetic energy of mobile floes [J]
+        (the ship's is ``sim.ship.kinetic_energy``)."""
         m = self.field.masses
         mobile = self.inv_mass > 0
         e_t = 0.5 * np.sum(m[mobile] * np.sum(self._vel[mobile] ** 2, axis=1))

@@ -64,6 +64,7 @@ from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
 from .domain import box_lengths_at, minimum_image
+from .hull_contact import hull_forces, ship_closing_kick, ship_kick_drift
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
                           wait_generation)
@@ -80,6 +81,8 @@ class HertzStatus(IntEnum):
     CONCENTRATION_LIMIT = 2
     #: a floe moved more than half the Verlet skin in one step
     UNSTABLE = 3
+    #: the ship's collision log is full (the caller empties it and goes on)
+    SHIP_LOG_FULL = 4
 
 
 # the statuses as plain integers for the compiled code
@@ -87,6 +90,7 @@ _OK = int(HertzStatus.OK)
 _NON_FINITE = int(HertzStatus.NON_FINITE)
 _CONCENTRATION_LIMIT = int(HertzStatus.CONCENTRATION_LIMIT)
 _UNSTABLE = int(HertzStatus.UNSTABLE)
+_SHIP_LOG_FULL = int(HertzStatus.SHIP_LOG_FULL)
 # why a team run (team_steps) returned early: the Verlet list must be rebuilt
 TEAM_ALL_DONE, TEAM_REBUILD = 0, 1
 
@@ -923,7 +927,8 @@ def rebuild(floes, verlet, lx, ly, px, py, parallel):
 
 
 @njit(cache=True, error_model="numpy")
-def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair):
+def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair,
+              ship):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
@@ -939,10 +944,15 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     private force buffer; its kick–drift pass has
     :data:`KICK_TASKS_PER_THREAD` tasks per chunk.
 
+    ``ship`` is a :class:`~physics.hull_contact.ShipBundle` (inactive
+    without a ship). With a ship every step also moves the ship before the
+    floes' kick–drift pass and adds the hull contacts after it
+    (:mod:`physics.hull_contact`); the thread team is not used then.
+
     Returns (steps done, status (a :class:`HertzStatus` value), number of
     list rebuilds, the Verlet list now). A status other than OK stops the
-    run early: non-finite state, a blow-up, or a deforming box at its
-    concentration limit.
+    run early: non-finite state, a blow-up, a deforming box at its
+    concentration limit, or a full collision log of the ship.
     """
     px = box.periodic_x
     py = box.periodic_y
@@ -964,7 +974,8 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     # parallel region between list rebuilds; the serial path and boxes with
     # walls kick one step at a time. Both end a step whose list expired with
     # the same rebuild and pair loop.
-    use_team = parallel and not walls
+    use_team = parallel and not walls and not ship.active
+    log_full = False
     team = Team(n_pair, n_kick, np.zeros(sync_size(n_kick), dtype=np.int64),
                 np.zeros(sync_size(n_pair), dtype=np.int64), np.empty((n_kick, 4)), np.empty(5))
     step = 0
@@ -998,6 +1009,8 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             dt_kick = 0.5 * dt if step == 0 else dt
             kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, verlet.centre[0],
                         verlet.centre[1])
+            if ship.active:
+                ship_kick_drift(ship, dt_kick, dt)
             if parallel:
                 worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
                                                            verlet.ref, drive, kick)
@@ -1015,6 +1028,9 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
                 else:
                     wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
                                 buffers.torque[0])
+            if ship.active:
+                log_full = not hull_forces(ship, floes, box, time + step * dt, dt,
+                                           math.sqrt(vmax2), buffers.force[0], buffers.torque[0])
             verlet.centre[0] = mx / n
             verlet.centre[1] = my / n
             expired = list_expired(worst, lx, ly, verlet)
@@ -1030,11 +1046,16 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,
                         buffers.force[0], buffers.torque[0], 0, n, buffers.force[0],
                         buffers.torque[0])
+        if log_full:
+            status = _SHIP_LOG_FULL
+            break
     # total force of the last step, and the closing half kick
     floes.force[:] = buffers.force.sum(axis=0)
     floes.torque[:] = buffers.torque.sum(axis=0)
     if done > 0:
         half_kick(floes, dt)
+        if ship.active:
+            ship_closing_kick(ship, dt)
     return done, status, n_rebuilds, verlet
 
 

@@ -1,0 +1,296 @@
+"""The ship in the Hertz engine (the Physics page: physics-ship): single
+impacts on an edge and a corner of the hull against the restitution and
+Coulomb's law, exact momentum conservation with a free ship, energy
+conservation of elastic contacts, the momentum-flux resistance of a flat bow
+in dilute ice, the motion modes and the API's errors."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from physics import ContactParams, HertzSimulation
+from physics.domain import ChannelBox, PeriodicBox
+from physics.floes import FloeField
+from physics.hertz import hull_contact_time
+from physics.hull import Hull
+from physics.ship import Ship, ShipHydrodynamics, model_ship, psv_ship
+
+E_MOD = 1.0e8          # a soft contact keeps the impacts a few hundred steps long
+
+
+def contact(restitution, friction=0.0):
+    return ContactParams(elastic_modulus=E_MOD, restitution=restitution, friction=friction)
+
+
+def single_floe_run(hull, floe_pos, floe_vel, *, restitution=0.5, friction=0.0,
+                    ship_friction=0.0, mode="prescribed", ship_speed=0.0, ship_mass=None,
+                    radius=1.0, steps_per_contact=1000, box=60.0, omega=0.0):
+    """One floe of radius ``radius`` (thickness 1 m) and a hull at the
+    centre of a periodic box; dt a thousandth of the impact's contact time.
+    Returns the simulation (advanced until the floe has left the hull)."""
+    field = FloeField(np.array([floe_pos], dtype=float), np.array([radius]), 1.0,
+                      np.array([floe_vel], dtype=float), np.array([omega], dtype=float))
+    params = contact(restitution, friction)
+    speed = float(np.hypot(*floe_vel)) + abs(ship_speed)
+    t_c = hull_contact_time(field.radii, 1.0, field.density, params, speed)
+    dt = t_c / steps_per_contact
+    mass = ship_mass or 50.0 * field.masses[0]
+    ship = Ship(hull, mass, mode=mode, friction=ship_friction, position=(0.5 * box, 0.5 * box),
+                speed=ship_speed)
+    sim = HertzSimulation(field, PeriodicBox(box), params, None, dt, impact_speed=speed,
+                          ship=ship)
+    return sim, t_c
+
+
+def run_until_apart(sim, t_c, gap=3.0):
+    """Step until a contact has started and ended, then ``gap`` contact
+    times more."""
+    touched = False
+    for _ in range(4000):
+        sim.advance(0.25 * t_c)
+        n = sim.hull_contacts()[0].size
+        touched = touched or n > 0
+        if touched and n == 0:
+            break
+    sim.advance(gap * t_c)
+    assert touched, "the floe never touched the hull"
+    assert sim.hull_contacts()[0].size == 0
+
+
+@pytest.mark.parametrize("restitution", [0.3, 0.5, 0.9])
+@pytest.mark.parametrize("feature", ["edge", "vertex"])
+def test_head_on_restitution_on_edge_and_vertex(restitution, feature):
+    """A floe hits a fixed hull head-on, on the middle of the flat bow (edge)
+    or on the stem of a pointed bow (vertex): it leaves with e times its
+    approach speed, within 1e-3 (dt = t_c/1000), and the log holds one
+    collision whose impulse is (1 + e) m v."""
+    hull = Hull.box(10.0, 4.0) if feature == "edge" else Hull.pointed(10.0, 4.0)
+    bow = hull.vertices[:, 0].max()
+    v = 0.5
+    sim, t_c = single_floe_run(hull, (30.0 + bow + 1.05, 30.0), (-v, 0.0),
+                               restitution=restitution)
+    run_until_apart(sim, t_c)
+    vx, vy = sim.velocities[0]
+    assert vx / v == pytest.approx(restitution, abs=1e-3)
+    assert abs(vy) < 1e-12
+    log = sim.ship.collisions()
+    assert log["floe"].tolist() == [0]
+    m = sim.field.masses[0]
+    assert -log["impulse_surge"][0] == pytest.approx((1 + restitution) * m * v, rel=1e-3)
+    assert log["point_x"][0] == pytest.approx(bow, abs=0.01)
+
+
+@pytest.mark.parametrize("feature", ["edge", "vertex"])
+def test_free_ship_conserves_momentum(feature):
+    """A dynamic ship in vacuum (no added mass or damping) hit off-centre
+    and obliquely by a spinning floe, with friction: total linear and angular
+    momentum (about the origin) of floe and ship are conserved to 1e-10 of
+    their scale."""
+    hull = Hull.box(10.0, 4.0) if feature == "edge" else Hull.pointed(10.0, 4.0)
+    bow = hull.vertices[:, 0].max()
+    y = 31.2 if feature == "edge" else 30.4
+    sim, t_c = single_floe_run(hull, (30.0 + bow + 2.0, y), (-0.6, -0.15), restitution=0.5,
+                               ship_friction=0.3, mode="dynamic", omega=0.2,
+                               ship_mass=None)
+    ship_mass = sim.ship.ship.mass
+    inertia = sim.ship.ship.yaw_inertia
+
+    def totals():
+        m = sim.field.masses[0]
+        x, u = sim.positions[0], sim.velocities[0]
+        xs, us = sim.ship.position, sim.ship.velocity
+        p = m * u + ship_mass * us
+        lz = (m * (x[0] * u[1] - x[1] * u[0]) + sim.field.inertia[0] * sim.angular_velocities[0]
+              + ship_mass * (xs[0] * us[1] - xs[1] * us[0]) + inertia * sim.ship.yaw_rate)
+        return p, lz
+
+    p0, l0 = totals()
+    run_until_apart(sim, t_c)
+    p1, l1 = totals()
+    scale_p = sim.field.masses[0] * 0.6
+    scale_l = scale_p * 30.0
+    assert sim.ship.yaw_rate != 0.0 and np.hypot(*sim.ship.velocity) > 0.0
+    assert np.max(np.abs(p1 - p0)) < 1e-10 * scale_p
+    assert abs(l1 - l0) < 1e-10 * scale_l
+
+
+@pytest.mark.parametrize("feature", ["edge", "vertex"])
+def test_gross_sliding_follows_coulomb(feature):
+    """A floe hits the hull in gross sliding: on the side (an edge) while
+    the ship sails past at 80 times the approach speed, and head-on on the
+    stem (a vertex) while the floe spins with a rim speed 200 times its
+    approach speed (so the normal stays along the centre line). The slip is
+    so fast that the Mindlin spring reaches the Coulomb limit within the
+    first steps of the contact: the tangential impulse is μ times the
+    normal one (1e-3 relative)."""
+    mu = 0.2
+    if feature == "edge":
+        hull = Hull.box(30.0, 4.0)
+        pos, vel = (30.0, 30.0 + 2.0 + 1.01), (0.0, -0.05)     # onto the port side
+    else:
+        hull = Hull.pointed(10.0, 4.0)
+        bow = hull.vertices[:, 0].max()
+        pos, vel = (30.0 + bow + 1.001, 30.0), (-0.005, 0.0)
+    sim, t_c = single_floe_run(hull, pos, vel, restitution=0.5, ship_friction=mu,
+                               ship_speed=4.0 if feature == "edge" else 0.0,
+                               omega=0.0 if feature == "edge" else 1.0)
+    run_until_apart(sim, t_c)
+    log = sim.ship.collisions()
+    assert log["floe"].size == 1
+    rec = sim.ship.records()
+    # normal and tangential parts of the impulse on the floe, from the
+    # records of the force on the hull in the ship frame
+    jx, jy = log["impulse_surge"][0], log["impulse_sway"][0]
+    if feature == "edge":
+        normal, tangential = abs(jy), abs(jx)
+    else:
+        normal, tangential = abs(jx), abs(jy)
+    assert rec["contacts"].max() == 1
+    assert tangential / normal == pytest.approx(mu, rel=1e-3)
+
+
+def test_elastic_free_ship_conserves_energy():
+    """Elastic, frictionless contacts, no drag, a free ship among 12 floes
+    for 10⁴ steps with many impacts: kinetic energy of floes plus ship at
+    the end equals the start to 1e-4 (velocity-Verlet, dt = t_c/100; the
+    error is of the integrator's order, (dt/t_c)² ≈ 1e-4, not a drift)."""
+    rng = np.random.default_rng(3)
+    n = 12
+    ang = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    pos = np.column_stack([30.0 + 7.0 * np.cos(ang), 30.0 + 7.0 * np.sin(ang)])
+    vel = -2.0 * (pos - 30.0) / 7.0 + rng.normal(0.0, 0.2, (n, 2))
+    field = FloeField(pos, np.full(n, 1.0), 1.0, vel)
+    params = contact(1.0, 0.0)
+    t_c = hull_contact_time(field.radii, 1.0, field.density, params, 3.0)
+    ship = Ship(Hull.pointed(8.0, 3.0), 20.0 * field.masses[0], mode="dynamic",
+                friction=0.0, position=(30.0, 30.0))
+    sim = HertzSimulation(field, PeriodicBox(60.0), params, None, t_c / 100, impact_speed=3.0,
+                          ship=ship)
+
+    def energy():
+        return sim.kinetic_energy() + sim.ship.kinetic_energy
+
+    e0 = energy()
+    sim.step(10_000)
+    assert sim.ship.collisions()["floe"].size >= 8
+    assert sim.hull_contacts()[0].size == 0
+    assert energy() == pytest.approx(e0, rel=1e-4)
+
+
+def lane_field(concentration, width, x0, rng):
+    """Floes of radii 1–3 m at rest, each in a lane of its own across the
+    channel (no two overlap in y, so a floe the bow pushes ahead never meets
+    another), at random places along a band starting at x0 whose length
+    gives the concentration. Returns (field, band length)."""
+    radii, lanes, y = [], [], 0.0
+    while True:
+        r = rng.uniform(1.0, 3.0)
+        gap = rng.uniform(0.0, 0.5)
+        if y + gap + 2 * r > width:
+            break
+        radii.append(r)
+        lanes.append(y + gap + r)
+        y += gap + 2 * r
+    radii = np.array(radii)
+    band = math.pi * np.sum(radii ** 2) / (concentration * width)
+    xs = x0 + radii + rng.uniform(0.0, 1.0, radii.size) * (band - 2 * radii)
+    return FloeField(np.column_stack([xs, lanes]), radii, 1.0, np.zeros((radii.size, 2))), band
+
+
+@pytest.mark.parametrize("concentration", [0.02, 0.05])
+def test_flat_bow_resistance_is_momentum_flux(concentration):
+    """A flat bow of width W = 50 m at constant speed v = 2 m/s through floes
+    at rest (radii 1–3 m, no drag, e = 0.5, μ = 0.05): the mean resistance
+    while the bow crosses the ice equals the momentum it gives the floes it
+    meets, (1 + e) ρ h A W v², within 5 %. The channel is as wide as the
+    hull (walls at its sides), so the flat bow meets every floe and no
+    corner does. The formula assumes every floe is met at rest: here each
+    floe has a lane of its own, so floes pushed ahead at (1 + e) v never
+    meet others before the bow (in a random field they do, and share their
+    momentum with floes that then escape the bow; the ``ship-transit``
+    scenario measures that)."""
+    w, v, e = 50.0, 2.0, 0.5
+    x0 = 60.0
+    field, band = lane_field(concentration, w, x0, np.random.default_rng(11))
+    x1 = x0 + band
+    params = ContactParams(elastic_modulus=E_MOD, restitution=e, friction=0.7)
+    ship = Ship(Hull.box(20.0, w), 1e9, position=(30.0, 0.5 * w), speed=v)
+    t_c = hull_contact_time(field.radii, 1.0, field.density, params, 2 * v)
+    sim = HertzSimulation(field, ChannelBox(x1 + 200.0, w), params, None, t_c / 20,
+                          impact_speed=2 * v, ship=ship)
+    bow = 30.0 + 10.0
+    t_in, t_out = (x0 - bow) / v, (x1 - bow) / v
+    sim.advance(t_out + 2.0)
+    loads = sim.ship_loads(start=t_in, end=t_out)
+    a_true = math.pi * np.sum(field.radii ** 2) / (band * w)
+    expected = (1 + e) * field.density * 1.0 * a_true * w * v ** 2
+    assert a_true == pytest.approx(concentration, rel=1e-9)
+    assert loads.collided_floes == field.n
+    assert loads.resistance == pytest.approx(expected, rel=0.05)
+
+
+def test_prescribed_ship_follows_commands_and_dynamic_ship_answers_thrust():
+    """A prescribed ship in open water sails the commanded arc (radius u/r)
+    to rounding; a dynamic ship under constant thrust T with linear damping
+    X_u reaches the terminal speed T/X_u (1e-3) and starts with the
+    acceleration T/(m + added mass)."""
+    field = FloeField(np.array([[5.0, 5.0]]), np.array([1.0]), 1.0, np.zeros((1, 2)))
+    params = contact(0.5)
+    ship = Ship(Hull.box(10.0, 3.0), 1e4, position=(100.0, 100.0), speed=1.0, yaw_rate=0.05)
+    sim = HertzSimulation(field, PeriodicBox(400.0), params, None, math.pi / 1000, ship=ship)
+    sim.advance(10.0 * math.pi)          # a quarter turn of radius 20 m
+    assert sim.ship.heading == pytest.approx(0.5 * math.pi, abs=1e-9)
+    assert sim.ship.position == pytest.approx([120.0, 120.0], abs=1e-6)
+
+    hydro = ShipHydrodynamics(added_mass=(1e3, 5e3, 0.0), linear_damping=(2e3, 1e4, 1e5))
+    ship = Ship(Hull.box(10.0, 3.0), 1e4, hydrodynamics=hydro, mode="dynamic",
+                position=(100.0, 100.0), max_thrust=1e4)
+    sim = HertzSimulation(field, PeriodicBox(400.0), params, None, 0.004, ship=ship)
+    sim.ship.command(thrust=5e4)          # clipped to the bound
+    assert sim.ship.commands["thrust"] == 1e4
+    sim.step(1)
+    assert sim.ship.surge / 0.004 == pytest.approx(1e4 / 1.1e4, rel=1e-2)
+    sim.advance(200.0)
+    assert sim.ship.surge == pytest.approx(1e4 / 2e3, rel=1e-3)
+    assert abs(sim.ship.sway) < 1e-12
+
+
+def test_presets():
+    """The full-scale and model-scale ships of the issue's presets."""
+    psv = psv_ship("dynamic")
+    assert (psv.hull.length, psv.hull.beam, psv.mass) == pytest.approx((76.2, 18.0, 6e6))
+    m_x, m_y, i_z = psv.total_mass
+    assert m_x == pytest.approx(1.1274 * 6e6) and m_y == pytest.approx(1.8902 * 6e6)
+    assert i_z == pytest.approx(0.1278 * 6e6 * 76.2 ** 2)
+    model = model_ship()
+    assert (model.hull.length, model.hull.beam, model.mass) == pytest.approx((1.84, 0.38, 90.0))
+
+
+def test_bad_input_is_a_clear_error():
+    field = FloeField(np.array([[30.0, 30.0]]), np.array([1.0]), 1.0, np.zeros((1, 2)))
+    params = contact(0.5)
+    with pytest.raises(ValueError, match="overlaps 1 floe"):
+        HertzSimulation(field, PeriodicBox(60.0), params, None, 0.004,
+                        ship=Ship(Hull.box(10.0, 3.0), 1e4, position=(31.0, 30.0)))
+    sim = HertzSimulation(field, PeriodicBox(60.0), params, None, 0.004,
+                          ship=Ship(Hull.box(10.0, 3.0), 1e4, position=(10.0, 10.0)))
+    with pytest.raises(ValueError, match="finite"):
+        sim.ship.command(surge=float("nan"))
+    with pytest.raises(ValueError, match="takes the commands"):
+        sim.ship.command(thrust=1.0)
+    with pytest.raises(ValueError, match="counter-clockwise"):
+        Hull([(0, 0), (0, 1), (1, 0)])
+    with pytest.raises(ValueError, match="at least 3"):
+        Hull([(0, 0), (1, 0)])
+    with pytest.raises(ValueError, match="convex"):
+        Hull([(0, 0), (2, 0), (1, 0.2), (2, 2), (0, 2)])
+    with pytest.raises(ValueError, match="mode"):
+        Ship(Hull.box(10.0, 3.0), 1e4, mode="sail")
+    with pytest.raises(ValueError, match="too small along"):
+        HertzSimulation(field, PeriodicBox(60.0), params, None, 0.004,
+                        ship=Ship(Hull.box(58.0, 3.0), 1e4, position=(10.0, 10.0)))
+    with pytest.raises(ValueError, match="hitting the hull"):
+        HertzSimulation(field, PeriodicBox(60.0), params, None, 0.5,
+                        ship=Ship(Hull.box(10.0, 3.0), 1e4, position=(10.0, 10.0), speed=5.0))
