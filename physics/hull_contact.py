@@ -4,9 +4,7 @@ A ship is one rigid convex polygon (:class:`~physics.hull.Hull`) among the
 floe discs. :func:`physics.hull.disc_hull_contact` finds where a disc
 touches it; this module turns that into forces and moves the ship.
 
-Contact law
------------
-The floe–hull contact uses the Hertz–Mindlin law of the floe–floe contacts
+**Contact law.** The floe–hull contact uses the Hertz–Mindlin law of the floe–floe contacts
 (:func:`physics.contact.hertz_mindlin_force`) with
 
 * the effective moduli of a floe against a rigid body (those of the walls),
@@ -30,9 +28,7 @@ relative to the hull's (floe lever r − δ/2), so that friction only ever
 removes energy. Forces on the floe and on the hull are equal and opposite
 and act at p: the step conserves linear and angular momentum exactly.
 
-Neighbour search
-----------------
-The hull is 10–40 floe diameters long, so it does not go into the cell
+**Neighbour search.** The hull is 10–40 floe diameters long, so it does not go into the cell
 lists of the floes. It keeps a list of its own: the floes whose discs come
 within a skin s of the polygon, found by one linear pass (bounding circle,
 then the polygon distance). The list is valid while the hull's points and
@@ -100,7 +96,7 @@ class ShipBundle(NamedTuple):
     mass_x: float
     mass_y: float
     inertia: float
-    #: linear damping X_u, Y_v, N_r and quadratic X_|u|u, Y_|v|v, N_|r|r
+    #: (6,) linear damping ``X_u, Y_v, N_r`` and quadratic ``X_uu, Y_vv, N_rr``
     damping: np.ndarray
     #: (3,) commands: prescribed (surge speed, sway speed, yaw rate),
     #: dynamic (thrust, side force, yaw moment)
@@ -172,8 +168,8 @@ def ship_accelerations(ship, fx, fy, moment):
     damping, at its current (half-step) velocities, into ``state``.
 
     Surge, sway and yaw of a body with added mass (Kirchhoff's equations in
-    the ship frame): M_x u̇ − M_y v r = X, M_y v̇ + M_x u r = Y,
-    I ṙ + (M_y − M_x) u v = N."""
+    the ship frame): ``M_x u̇ − M_y v r = X``, ``M_y v̇ + M_x u r = Y``,
+    ``I ṙ + (M_y − M_x) u v = N``."""
     s = ship.state
     c = math.cos(s[S_PSI])
     sn = math.sin(s[S_PSI])

@@ -31,7 +31,7 @@ Example
 >>> field, box = transit_field(HERMAN2013, concentration=0.3, band=(150.0, 350.0),
 ...                            length=500.0, width=150.0, seed=1)
 >>> ship = psv_ship(position=(50.0, 75.0), speed=2.0)
->>> sim = HertzSimulation(field, box, HERMAN2013.contact, dt=0.002, ship=ship)
+>>> sim = HertzSimulation(field, box, HERMAN2013.contact, dt=0.001, ship=ship)
 >>> sim.advance(1.0)
 >>> sim.ship.position.round(3).tolist()
 [52.0, 75.0]
@@ -67,17 +67,19 @@ _WATER_DENSITY = 1025.0
 class ShipHydrodynamics:
     """Added mass and hydrodynamic damping in surge, sway and yaw (ship frame).
 
+    The default is no added mass and no damping (a ship in vacuum, for
+    verification). :meth:`fossen_supply` gives documented values.
+
     Parameters
     ----------
     added_mass : (3,) floats
-        −X_u̇ [kg], −Y_v̇ [kg], −N_ṙ [kg m²] (non-negative).
+        ``-X_udot`` [kg], ``-Y_vdot`` [kg], ``-N_rdot`` [kg m²] (non-negative).
     linear_damping : (3,) floats
-        X_u [N s/m], Y_v [N s/m], N_r [N m s]: the force −X_u u and so on.
+        ``X_u`` [N s/m], ``Y_v`` [N s/m], ``N_r`` [N m s], so that the
+        force is ``-X_u u`` and so on.
     quadratic_damping : (3,) floats
-        X_|u|u [N s²/m²], Y_|v|v, N_|r|r [N m s²]: the force −X_|u|u |u| u.
-
-    The default is no added mass and no damping (a ship in vacuum, for
-    verification). :meth:`fossen_supply` gives documented values.
+        ``X_uu`` [N s²/m²], ``Y_vv`` [N s²/m²], ``N_rr`` [N m s²], so that
+        the force is ``-X_uu |u| u`` and so on.
     """
 
     added_mass: tuple = (0.0, 0.0, 0.0)
@@ -104,10 +106,10 @@ class ShipHydrodynamics:
 
         The model is linear (a dynamic-positioning model). Quadratic terms
         are added for higher speeds: in surge the frictional resistance
-        ½ ρ S C_F u² of a wetted surface S = L (B + 2T) ≈ L (L/4 + 2T) with
-        C_F = 0.0015, and in sway and yaw the cross-flow drag of a flat
-        plate of length L and draft T (C_D = 1): ½ ρ T L v² and
-        ½ ρ T L⁴/32 r².
+        ``½ ρ S C_F u²`` of a wetted surface ``S = L (L/4 + 2T)`` with
+        ``C_F = 0.0015``, and in sway and yaw the cross-flow drag of a
+        flat plate of length L and draft T (``C_D = 1``): ``½ ρ T L v²``
+        and ``½ ρ T L⁴/32 r²``.
         """
         m_bis, d_bis = FOSSEN_SUPPLY["mass"], FOSSEN_SUPPLY["damping"]
         root = math.sqrt(_GRAVITY / length)

@@ -294,3 +294,13 @@ def test_bad_input_is_a_clear_error():
     with pytest.raises(ValueError, match="hitting the hull"):
         HertzSimulation(field, PeriodicBox(60.0), params, None, 0.5,
                         ship=Ship(Hull.box(10.0, 3.0), 1e4, position=(10.0, 10.0), speed=5.0))
+
+
+def test_module_example_runs():
+    """The example at the top of physics.ship runs as written."""
+    import doctest
+
+    import physics.ship
+
+    result = doctest.testmod(physics.ship, optionflags=doctest.ELLIPSIS)
+    assert result.attempted >= 5 and result.failed == 0
