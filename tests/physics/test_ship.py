@@ -304,3 +304,77 @@ def test_module_example_runs():
 
     result = doctest.testmod(physics.ship, optionflags=doctest.ELLIPSIS)
     assert result.attempted >= 5 and result.failed == 0
+
+
+def test_dynamic_ship_bounces_off_fast_ice():
+    """A dynamic ship (no added mass or damping) sails head-on into a frozen
+    floe (fast ice, infinite mass): it leaves astern at e times its speed
+    (1e-3), the floe does not move, and a prescribed ship passes a frozen
+    floe without force (both have infinite mass)."""
+    hull = Hull.box(10.0, 4.0)
+    e = 0.5
+    field = FloeField(np.array([[41.0, 30.0]]), np.array([1.0]), 1.0, np.zeros((1, 2)),
+                      frozen=np.array([True]))
+    params = contact(e)
+    t_c = hull_contact_time(field.radii, 1.0, field.density, params, 0.5)
+    ship = Ship(hull, 1e5, mode="dynamic", position=(35.0 - 0.01, 30.0), speed=0.5)
+    sim = HertzSimulation(field, PeriodicBox(60.0), params, None, t_c / 1000, impact_speed=0.5,
+                          ship=ship)
+    sim.advance(0.01 / 0.5 + 20 * t_c)     # the ship's mass makes the contact ~4 t_c long
+    assert sim.hull_contacts()[0].size == 0
+    assert sim.ship.surge == pytest.approx(-e * 0.5, rel=1e-3)
+    assert sim.positions[0].tolist() == [41.0, 30.0]
+    ship = ship.replace(mode="prescribed")
+    sim = HertzSimulation(field, PeriodicBox(60.0), params, None, t_c / 1000, impact_speed=0.5,
+                          ship=ship)
+    sim.advance(0.01 / 0.5 + 3 * t_c)
+    assert sim.ship.surge == 0.5 and sim.ship.records()["contacts"].max() == 0
+
+
+@pytest.mark.parametrize("box_name", ["periodic", "channel", "walled", "transit"])
+def test_ship_in_every_box_with_wind_and_fast_ice(box_name):
+    """A prescribed ship crosses wind-driven ice with a frozen row of floes
+    in each kind of box: the run stays finite, the floes touching the hull
+    are all in its list (the list misses no contact: the same contacts as a
+    brute-force pass over all floes), and the ice pushes the ship back."""
+    from physics import HERMAN2013
+    from physics.domain import Box, WalledBox
+    from physics.floes import place_floes
+    from physics.forcing import Forcing
+    from physics.ship import TransitBox
+
+    rng = np.random.default_rng(5)
+    lx, ly = 200.0, 120.0
+    box = {"periodic": PeriodicBox(lx, ly), "channel": ChannelBox(lx, ly),
+           "walled": WalledBox(lx, ly), "transit": TransitBox(lx, ly, band=(60.0, 200.0))}[box_name]
+    radii = rng.uniform(1.5, 3.0, 260)
+    pos = place_floes(radii, Box(130.0, ly - 2.0, periodic=(False, False)), rng)
+    pos += [65.0, 1.0]
+    frozen = pos[:, 0] > 185.0
+    field = FloeField(pos, radii, 1.0, np.zeros((radii.size, 2)), frozen=frozen)
+    params = HERMAN2013.contact
+    forcing = Forcing(HERMAN2013.forcing)
+    ship = Ship(Hull.pointed(30.0, 8.0), 5e5, position=(30.0, 60.0), speed=2.0)
+    t_c = hull_contact_time(radii, 1.0, field.density, params, 2.0)
+    sim = HertzSimulation(field, box, params, forcing, 0.1 * t_c, impact_speed=2.0, ship=ship)
+    sim.advance(15.0)
+    listed = brute = 0
+    for _ in range(1000):
+        sim.advance(0.01)
+        listed += sim.hull_contacts()[0].size
+        brute += _touching(sim)
+    assert np.all(np.isfinite(sim.positions)) and np.all(np.isfinite(sim.ship.position))
+    assert listed == brute and brute > 0
+    loads = sim.ship_loads(start=10.0)
+    assert loads.collisions > 0 and loads.resistance > 0.0
+
+
+def _touching(sim):
+    """Floes touching the hull, by a pass over all floes."""
+    from physics.hull import disc_hull_contact
+
+    v = sim.ship.vertices - sim.ship.position
+    d = sim.box.minimum_image(sim.positions - sim.ship.position)
+    near = np.nonzero(np.hypot(d[:, 0], d[:, 1]) < sim.ship.reach + sim.radius)[0]
+    return sum(disc_hull_contact(d[i, 0], d[i, 1], sim.radius[i], v[:, 0].copy(),
+                                 v[:, 1].copy())[0] > 0 for i in near)
