@@ -9,7 +9,12 @@ Prints, for small systems, the measured errors that the test suite bounds:
 * oblique sliding impact: tangential impulse against μ times the normal
   impulse (Coulomb gross sliding);
 * an undamped, frictionless gas: momentum and energy drift;
-* a lone floe under wind, current and Coriolis: drift against eq 6.
+* a lone floe under wind, current and Coriolis: drift against eq 6;
+* a ship: restitution of a floe hitting the hull on an edge and on a
+  corner, and the resistance of a flat bow in dilute ice against the
+  momentum flux (1 + e) ρ h A W v², with every floe in a lane of its own
+  (what the tests bound) and in random fields (where floes pushed ahead
+  meet others first; reported, not bounded).
 """
 from __future__ import annotations
 
@@ -64,6 +69,95 @@ def binary_impact(contact: ContactParams, speed: float, angle_deg: float = 0.0,
             break
     return sim, dict(peak=peak, contact_time=steps_in * dt, t_c=t_c, k=k, m_eff=m_eff,
                      u_rel=u_rel, dt=dt)
+
+
+def lane_floes(concentration: float, width: float, x0: float, rng) -> tuple:
+    """Floes of radii 1–3 m (thickness 1 m) at rest, each in a lane of its
+    own across a channel of ``width`` (no two overlap in y), at random
+    places along a band starting at ``x0`` whose length gives the
+    concentration. Returns (field, band length)."""
+    radii, lanes, y = [], [], 0.0
+    while True:
+        r = rng.uniform(1.0, 3.0)
+        gap = rng.uniform(0.0, 0.5)
+        if y + gap + 2 * r > width:
+            break
+        radii.append(r)
+        lanes.append(y + gap + r)
+        y += gap + 2 * r
+    radii = np.array(radii)
+    band = math.pi * np.sum(radii ** 2) / (concentration * width)
+    xs = x0 + radii + rng.uniform(0.0, 1.0, radii.size) * (band - 2 * radii)
+    return FloeField(np.column_stack([xs, lanes]), radii, 1.0, np.zeros((radii.size, 2))), band
+
+
+def random_floes(concentration: float, width: float, x0: float, band: float, rng) -> FloeField:
+    """Floes of radii 1–3 m at rest placed at random in a band of length
+    ``band`` across a channel of ``width``, covering ``concentration`` of it."""
+    from .domain import Box
+    from .floes import place_floes
+
+    radii = []
+    while math.pi * np.sum(np.square(radii)) < concentration * band * width:
+        radii.append(rng.uniform(1.0, 3.0))
+    radii = np.array(radii)
+    pos = place_floes(radii, Box(band, width, periodic=(False, False)), rng)
+    pos[:, 0] += x0
+    return FloeField(pos, radii, 1.0, np.zeros((radii.size, 2)))
+
+
+def flat_bow_resistance(concentration: float, seed: int, lanes: bool = True,
+                        restitution: float = 0.5, speed: float = 2.0, width: float = 50.0):
+    """A flat bow as wide as its channel (W = 50 m, walls at its sides, so
+    the bow meets every floe and no corner does) at constant speed through
+    floes at rest, no drag. Returns (measured mean resistance over the
+    bow's crossing of the band / (1 + e) ρ h A W v², its standard error in
+    the same unit, floes the hull touched, floes)."""
+    from .domain import ChannelBox
+    from .hertz import hull_contact_time
+    from .hull import Hull
+    from .ship import Ship
+
+    rng = np.random.default_rng(seed)
+    x0 = 60.0
+    if lanes:
+        field, band = lane_floes(concentration, width, x0, rng)
+    else:
+        band = 400.0
+        field = random_floes(concentration, width, x0, band, rng)
+    params = ContactParams(elastic_modulus=1e8, restitution=restitution, friction=0.7)
+    ship = Ship(Hull.box(20.0, width), 1e9, position=(30.0, 0.5 * width), speed=speed)
+    t_c = hull_contact_time(field.radii, 1.0, field.density, params, 2 * speed)
+    sim = HertzSimulation(field, ChannelBox(x0 + band + 200.0, width), params, None, t_c / 20,
+                          impact_speed=2 * speed, ship=ship)
+    bow = 40.0
+    t_in, t_out = (x0 - bow) / speed, (x0 + band - bow) / speed
+    sim.advance(t_out + 2.0)
+    loads = sim.ship_loads(start=t_in, end=t_out)
+    area = math.pi * np.sum(field.radii ** 2) / (band * width)
+    expected = (1 + restitution) * field.density * 1.0 * area * width * speed ** 2
+    return (loads.resistance / expected, loads.resistance_error / expected,
+            loads.collided_floes, field.n)
+
+
+def hull_impact_restitution(feature: str, restitution: float, speed: float = 0.5) -> float:
+    """A floe (radius 1 m) hits a fixed hull head-on on the middle of a
+    flat bow ("edge") or on the stem of a pointed bow ("vertex");
+    returns its rebound speed / approach speed."""
+    from .hertz import hull_contact_time
+    from .hull import Hull
+    from .ship import Ship
+
+    hull = Hull.box(10.0, 4.0) if feature == "edge" else Hull.pointed(10.0, 4.0)
+    bow = hull.vertices[:, 0].max()
+    one = FloeField(np.array([[30.0 + bow + 1.05, 30.0]]), [1.0], 1.0,
+                    np.array([[-speed, 0.0]]))
+    params = ContactParams(elastic_modulus=1e8, restitution=restitution, friction=0.0)
+    t_c = hull_contact_time(one.radii, 1.0, one.density, params, speed)
+    sim = HertzSimulation(one, PeriodicBox(60.0), params, None, t_c / 1000, impact_speed=speed,
+                          ship=Ship(hull, 1e6, position=(30.0, 30.0)))
+    sim.advance(0.05 / speed + 3.0 * t_c)
+    return float(sim.velocities[0, 0] / speed)
 
 
 def report() -> list[tuple[str, str, str]]:
@@ -129,6 +223,21 @@ def report() -> list[tuple[str, str, str]]:
     u_eq = steady_drift(forcing, one.radii, one.thickness, one.masses)[0]
     rows.append(("lone floe drift, wind + current + Coriolis (eq 6)", "< 0.1 %",
                  f"{np.hypot(*(sim.velocities[0] - u_eq)) / np.hypot(*u_eq):.1e}"))
+    # 6. the ship
+    for feature in ("edge", "vertex"):
+        worst = max(abs(hull_impact_restitution(feature, e) - e) for e in (0.3, 0.5, 0.9))
+        rows.append((f"hull impact on {'an edge' if feature == 'edge' else 'a corner'}, "
+                     f"restitution e = 0.3, 0.5, 0.9", "< 1e-3", f"{worst:.1e}"))
+    for a in (0.02, 0.05):
+        ratio, err, touched, n = flat_bow_resistance(a, 11, lanes=True)
+        rows.append((f"flat bow, A = {a}, floes in lanes: R / (1+e)ρhAWv² − 1", "< 5 %",
+                     f"{ratio - 1:+.1e} ({touched}/{n} floes met)"))
+    for a in (0.02, 0.05):
+        out = [flat_bow_resistance(a, seed, lanes=False) for seed in (1, 2, 3)]
+        ratios = ", ".join(f"{r - 1:+.2f} ± {e:.2f}" for r, e, _, _ in out)
+        met = ", ".join(f"{t}/{n}" for _, _, t, n in out)
+        rows.append((f"flat bow, A = {a}, random floes (3 seeds): R / (1+e)ρhAWv² − 1",
+                     "reported", f"{ratios} (floes met {met})"))
     return rows
 
 
