@@ -37,6 +37,7 @@ bench: setup
 	$(PY) -m benchmarks.observables
 	$(PY) -m benchmarks.itd
 	$(PY) -m benchmarks.environments
+	$(PY) -m benchmarks.ship
 	$(PY) -m benchmarks.headline
 
 docs: setup

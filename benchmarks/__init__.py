@@ -18,6 +18,8 @@ suite              what is timed
 ``itd``            the ice-thickness-distribution models (:mod:`benchmarks.itd`)
 ``environments``   sustained steps/s of every environment
                    (:mod:`benchmarks.environments`)
+``ship``           floe-steps/s with and without a ship among the floes, and
+                   the ship's share of a step (:mod:`benchmarks.ship`)
 ``compare``        this tree against another revision, side by side
                    (:mod:`benchmarks.compare`)
 =================  ==============================================================
@@ -37,7 +39,8 @@ from __future__ import annotations
 import importlib
 
 #: the suites, in the order the documentation shows them
-SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "compare")
+SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "ship",
+          "compare")
 
 __all__ = ["SUITES", "main"]
 

@@ -45,6 +45,7 @@ BENCH_SUITES = {
     "observables": "clusters, g_ffd, g_rdf, fabric and stress on many floes",
     "itd": "the ice-thickness-distribution models",
     "environments": "sustained steps/s of every environment",
+    "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "compare": "this tree against another revision, side by side",
     "headline": "put the headline figures of the records into the README",
 }
