@@ -7,6 +7,8 @@
 * :mod:`physics.crosscheck.pymunk_checks` and
   :mod:`physics.crosscheck.lammps_checks` hold the comparisons; each returns
   a list of :class:`Check` rows.
+* :mod:`physics.crosscheck.pymunk_ship` drives a ship's hull as a kinematic
+  pymunk polygon through the same floes as the Hertz engine's ship.
 * ``python -m physics.crosscheck all`` runs every comparison and writes a
   table (``report.md``, ``results.json``) and figures.
 

@@ -4,6 +4,7 @@ Commands
 --------
 ``all``      every comparison (pymunk, and LAMMPS when it is installed)
 ``pymunk``   the hard-disc and Hertz engines against pymunk
+``ship``     the Hertz engine's ship against a kinematic hull in pymunk
 ``lammps``   the Hertz engine against LAMMPS
 ``list``     what each group compares
 
@@ -36,6 +37,9 @@ GROUPS = {
                "binary impacts (frictionless: restitution law; frictional: Hertz vs pymunk), "
                "inelastic gas cooling (Haff), relaxation to the drift under drag, "
                "hard-disc engine vs pymunk speed"),
+    "ship": ("physics.crosscheck.pymunk_ship",
+             "the Hertz engine's ship vs a kinematic pymunk polygon: head-on impacts on an edge "
+             "and a vertex, collisions and resistance of a hull through a dilute field"),
     "lammps": ("physics.crosscheck.lammps_checks",
                "forces and torques before any step, 500-step trajectories, the "
                "pressure–concentration curve of a convergence run, Hertz engine vs LAMMPS speed"),
@@ -99,6 +103,13 @@ NOTES = """\
   Mindlin spring of the Hertz engine stores tangential elastic energy and
   gives it back (β > 0 at small impact angles). In gross sliding both follow
   Coulomb's law.
+* **The ship against a kinematic pymunk polygon.** A head-on impact gives
+  the same impulse; in a field, the soft Hertz contact lasts tens of
+  milliseconds at the modulus used, during which a contact at a corner of the
+  hull turns with the hull's motion, and Mindlin friction differs from
+  pymunk's rigid friction where a contact sticks. A floe's path after such a
+  contact differs between the engines, so the transits are compared as two
+  realisations over several fields, not floe by floe.
 * **LAMMPS and a new contact with tangential damping.** With x_γt > 0, a new
   contact whose viscous tangential force alone exceeds μ F_n gets the capped
   force in our engine and none in LAMMPS; Herman's set-up (and our default)
