@@ -32,7 +32,7 @@ from pathlib import Path
 _REGISTRY: dict[str, type] = {}
 # modules whose import registers the shipped experiments
 _MODULES = ("physics.scenarios.herman2013", "physics.scenarios.herman2011",
-            "physics.scenarios.godlovitch")
+            "physics.scenarios.godlovitch", "physics.scenarios.ship_transit")
 
 
 def register(name: str):

@@ -1,0 +1,143 @@
+"""The ship-transit scenario: a small run writes the NetCDF (track, loads,
+collision log, resistance) and the figures, the resistance grows with the
+concentration, and the analysis functions on known data."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+xr = pytest.importorskip("xarray")
+pytest.importorskip("yaml")
+pytest.importorskip("matplotlib")
+
+from physics.scenarios import run_scenario  # noqa: E402
+from physics.scenarios.runner import find_config  # noqa: E402
+from physics.scenarios.ship_transit import (beset_concentration, pack_ice,  # noqa: E402
+                                            power_law_fit)
+
+# three (concentration, speed) pairs × two modes × with and without wind
+SMALL = dict(concentrations=[0.2, 0.5], speeds=[3.0], reference_concentration=0.5,
+             band_length=160.0, channel_width=150.0, output_interval=2.0)
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ship") / "run"
+    res = run_scenario("ship-transit", quick=True, overrides=SMALL, out=out, workers=1,
+                       progress=False, log=lambda *a: None)
+    with xr.open_dataset(res.dataset) as ds:
+        return res, ds.load()
+
+
+def test_small_run_writes_the_netcdf_and_the_figures(small_run):
+    res, ds = small_run
+    from physics.scenarios.ship_transit import ShipTransit
+    for name in ShipTransit.required:
+        assert name in ds, name
+    assert ds.sizes["case"] == 12 and ds.sizes["member"] == 1
+    assert sorted(set(ds.coords["dynamic"].values.tolist())) == [0, 1]
+    assert sorted(set(ds.coords["wind"].values.tolist())) == [0.0, 10.0]
+    # every run crossed the band; the collision log holds hull impacts
+    assert np.all(ds["completed"].values == 1)
+    n = np.isfinite(ds["collision_start"].values).sum(axis=-1)
+    assert np.all(n > 0)
+    imp = ds["impulse"].values
+    assert np.all(imp[np.isfinite(imp)] > 0)
+    assert np.all(ds["collision_floe_mass"].values[np.isfinite(imp)] > 0)
+    # impact points lie on the hull (ship frame: within its plan form, near its outline)
+    from physics.ship import psv_ship
+    v = psv_ship().hull.vertices
+    x, y = ds["impact_x"].values, ds["impact_y"].values
+    ok = np.isfinite(x)
+    assert np.all((x[ok] > v[:, 0].min() - 0.5) & (x[ok] < v[:, 0].max() + 0.5))
+    assert np.all(np.abs(y[ok]) < 0.5 * 18.0 + 0.5)
+    assert np.mean(np.abs(y[ok]) > 3.0) > 0.3        # many on the flanks, not only the stem
+    # a prescribed ship holds its speed; the ice slows a dynamic one
+    pres = ds.coords["dynamic"].values == 0
+    assert np.allclose(ds["speed_loss"].values[pres], 0.0, atol=1e-9)
+    assert np.all(ds["speed_loss"].values[~pres] > 0.0)
+    assert ds["x"].attrs["units"] == "m" and ds["resistance"].attrs["units"] == "N"
+    names = {p.name for p in res.figures}
+    assert names == {"ship_resistance.png", "ship_hull_impacts.png", "ship_force_chains.png",
+                     "ship_speed_loss.png"}
+    assert all(p.stat().st_size > 10_000 for p in res.figures)
+    assert (res.directory / "summary.md").read_text().count("R = a A^b") == 4
+
+
+def test_resistance_grows_with_concentration(small_run):
+    _, ds = small_run
+    conc = ds.coords["concentration"].values
+    speed = ds.coords["speed"].values
+    r = ds["resistance"].values[:, 0]
+    for dyn in (0, 1):
+        for wind in (0.0, 10.0):
+            sel = ((ds.coords["dynamic"].values == dyn) & (ds.coords["wind"].values == wind)
+                   & (speed == 2.0))
+            order = np.argsort(conc[sel])
+            assert list(conc[sel][order]) == [0.2, 0.5]
+            assert r[sel][order][1] > r[sel][order][0] > 0
+
+
+def test_power_law_fit_recovers_a_known_exponent():
+    rng = np.random.default_rng(2)
+    x = np.array([0.1, 0.2, 0.3, 0.5, 0.7, 0.9])
+    y = 3.0e5 * x ** 1.7 * np.exp(rng.normal(0.0, 0.01, x.size))
+    a, b = power_law_fit(x, y)
+    assert b == pytest.approx(1.7, abs=0.03) and a == pytest.approx(3.0e5, rel=0.05)
+    # exact data; non-positive and non-finite points are left out
+    v = np.array([1.0, 2.0, 4.0, 3.0, np.nan])
+    a, b = power_law_fit(np.append(v, 5.0), np.append(2.5 * v ** 2, -1.0))
+    assert (a, b) == (pytest.approx(2.5), pytest.approx(2.0))
+    assert all(math.isnan(q) for q in power_law_fit([1.0, 1.0], [2.0, 3.0]))
+
+
+def test_beset_concentration_is_the_lowest_beset_case():
+    assert beset_concentration([0.3, 0.9, 0.7, 0.5], [0, 1, 1, 0]) == 0.7
+    assert math.isnan(beset_concentration([0.3, 0.5], [0, 0]))
+
+
+def test_band_covers_its_concentration_and_jammed_bands_are_refused():
+    p = find_config("ship-transit").resolve(SMALL, quick=True)
+    field, box, geo = pack_ice(p, 0.5, 7)
+    x0, x1 = geo["x0"], geo["x1"]
+    assert field.total_area / ((x1 - x0) * box.ly) == pytest.approx(0.5, rel=1e-9)
+    assert np.all(field.positions[:, 0] - field.radii >= x0 - 1e-9)
+    assert np.all(field.positions[:, 0] + field.radii <= x1 + 1e-9)
+    # the ship starts in open water, its bow short of the band
+    assert geo["x_ship"] + geo["bow"] < x0
+    with pytest.raises(ValueError, match="jamming point"):
+        pack_ice(p, 0.9, 7)
+
+
+def test_interrupted_run_resumes_to_the_same_numbers(tmp_path, monkeypatch):
+    """A dynamic run in the wind stopped after its 15th checkpoint and
+    resumed gives the numbers of an uninterrupted run, collision log
+    included."""
+    from physics.scenarios import recorder as recorder_module
+    from physics.scenarios import resume_run
+
+    quiet = dict(quick=True, workers=1, progress=False, plots=False, log=lambda *a: None)
+    small = dict(SMALL, concentrations=[0.4], speeds=[], modes="dynamic", wind="on")
+    whole = run_scenario("ship-transit", overrides=small, out=tmp_path / "a", **quiet)
+    real = recorder_module.Recorder.checkpoint
+    calls = {"n": 0}
+
+    def checkpoint_then_crash(self, state, *, force=False):
+        wrote = real(self, state, force=True)
+        calls["n"] += 1
+        if calls["n"] == 15:
+            raise KeyboardInterrupt
+        return wrote
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", checkpoint_then_crash)
+    with pytest.raises(KeyboardInterrupt):
+        run_scenario("ship-transit", overrides=small, out=tmp_path / "b", **quiet)
+    monkeypatch.setattr(recorder_module.Recorder, "checkpoint", real)
+    res = resume_run(tmp_path / "b", workers=1, progress=False, plots=False,
+                     log=lambda *a: None)
+    with xr.open_dataset(whole.dataset) as a, xr.open_dataset(res.dataset) as b:
+        a, b = a.load(), b.load()
+    assert set(a.data_vars) == set(b.data_vars) and b.sizes["collision"] > 0
+    for name in a.data_vars:
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
