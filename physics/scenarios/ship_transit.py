@@ -12,7 +12,7 @@ ones. One run per (concentration, speed, mode, wind):
 * a concentration sweep at ``reference_speed`` and a speed sweep at
   ``reference_concentration``;
 * ``prescribed`` mode: the surge speed is held at the case's speed whatever
-  the ice does; ``dynamic`` mode: a constant thrust T = X_u v + X_|u|u v²
+  the ice does; ``dynamic`` mode: a constant thrust ``T = X_u v + X_uu v²``
   that gives the case's speed v in open water (the surge damping of
   :meth:`physics.ship.ShipHydrodynamics.fossen_supply`), a heading autopilot
   (yaw moment −I_z (ω² Δψ + 2 ω r), ω = 0.1 rad/s, within the ship's
@@ -22,6 +22,28 @@ ones. One run per (concentration, speed, mode, wind):
   free-drift velocity (no spin-up) and the drifting pack presses against
   the hull. Water drag acts in both; Coriolis is left out (a transit lasts
   minutes).
+
+The beset sweep (``sides`` ``walls`` or ``both``): in the periodic channel
+the onshore wind only drifts the pack across and the ship shoves a plug of
+ice into the open water ahead, so nothing compresses the ice and the ship is
+never beset. The walled variant closes the channel with rigid walls on all
+four sides (``Box(lx, ly, periodic=(False, False))``): the lee wall at
+y = 0 is the coast the onshore wind presses the pack against, the band runs
+to ``wall_gap`` (default 0) short of the wall ahead, and the ship starts
+with its centre line at ``ship_offset`` (default 1/3) of the width from the
+coast, in the pressed ice. The floes touch the walls with the wall contact
+law; the hull does not touch walls, so a run ends (with a note) if the hull
+comes within :data:`WALL_CLEARANCE` of one, and a transit ends (completed,
+not beset) with the bow ``walled_finish`` (default 80 m, about a ship
+length) short of the wall ahead: closer to it any pack is squeezed against
+that wall and besets the ship. The ice the ship displaces
+cannot escape across the channel: it is pushed ahead against the wall ahead
+and around the hull into the wake. One dynamic run per concentration of
+``walled_concentrations`` at the weak thrust of ``walled_speed`` (default
+0.25 m/s, 19 kN) and each wind setting. The wind itself adds little: its
+line load on a pack of fetch F is about τ_a F, τ_a = ρ_a C_a U² ≈ 0.25 Pa
+at 10 m/s (skin drag alone), some 50 N/m across a 200 m channel, 4 kN
+along the hull, against a thrust of 19 kN.
 
 The ice band ends where the floes end: its length is set so that the floes
 cover exactly the case's concentration of it. Above ``placement_limit`` the
@@ -82,6 +104,8 @@ LEAD_IN = 10.0
 OPEN_WATER_AHEAD = 80.0
 #: distance of the stern from the wall behind at the start [m]
 STERN_CLEARANCE = 5.0
+#: least distance of the bow from the wall ahead in a channel closed across [m]
+WALL_CLEARANCE = 5.0
 #: natural frequency of the heading autopilot of a dynamic ship [rad/s]
 AUTOPILOT_FREQUENCY = 0.1
 #: blocks of the standard error of the resistance
@@ -90,6 +114,7 @@ ERROR_BLOCKS = 20
 MODES = {"both": ("prescribed", "dynamic"), "prescribed": ("prescribed",),
          "dynamic": ("dynamic",)}
 WINDS = {"both": (False, True), "off": (False,), "on": (True,)}
+SIDES = {"both": ("periodic", "walls"), "periodic": ("periodic",), "walls": ("walls",)}
 
 TRACK_VARIABLES = {
     "x": ("m", "x of the ship's centroid (along the channel)"),
@@ -145,7 +170,9 @@ RESULT_VARIABLES = {
     "band_start": ("m", "x0: where the ice band begins"),
     "band_end": ("m", "x1: where it ends"),
     "band_concentration": ("1", "floe area over the band's area"),
-    "channel_width": ("m", "width of the channel (periodic across)"),
+    "channel_width": ("m", "width of the channel"),
+    "ship_start_y": ("m", "y of the ship's centroid at the start (walled channel: from the lee "
+                          "wall, the coast at y = 0)"),
     "hull_length": ("m", "length of the hull"),
     "dt": ("s", "time step"),
     "ice_drift": ("m/s", "free-drift speed of the mean floe in the wind (0 without)"),
@@ -185,9 +212,15 @@ def hull_extent(hull) -> tuple[float, float]:
     return float(hull.vertices[:, 0].max()), float(-hull.vertices[:, 0].min())
 
 
-def pack_ice(p: dict, concentration: float, seed: int):
+def pack_ice(p: dict, concentration: float, seed: int, walls: bool = False):
     """The floe field and the transit channel of a run, and its geometry
-    (a dict: band start and end, bow and stern offsets, ship start)."""
+    (a dict: band start and end, bow and stern offsets, ship start).
+
+    ``walls``: the channel is closed across by rigid walls (the lee wall,
+    the coast, at y = 0), the band runs to ``wall_gap`` short of the wall
+    ahead and the ship starts with its centre line at ``ship_offset`` of
+    the width from the coast; else the channel is periodic across, with
+    open water after the band, and the ship starts on its centre line."""
     rng = np.random.default_rng(int(seed))
     width = float(p["channel_width"])
     d = floe_diameters(p, concentration * p["band_length"] * width, rng)
@@ -195,8 +228,14 @@ def pack_ice(p: dict, concentration: float, seed: int):
     area = math.pi * float(np.sum(r ** 2))
     band = area / (concentration * width)           # the floes cover exactly A of it
     limit = p["placement_limit"]
+    walls = bool(walls)
     if concentration <= limit:
-        pos = place_floes(r, Box(band, width, periodic=(False, True)), rng)
+        pos = place_floes(r, Box(band, width, periodic=(False, not walls)), rng)
+    elif walls:
+        raise PlacementError(
+            f"concentration {concentration:g} is above placement_limit = {limit:g}: the floes "
+            f"of a channel closed by walls across are placed directly, up to placement_limit "
+            f"(the power-law fields cannot be placed between walls at 0.85: use at most 0.8)")
     else:
         from ..jamming import compress_floes
         k = math.sqrt(concentration / limit)
@@ -222,17 +261,25 @@ def pack_ice(p: dict, concentration: float, seed: int):
     x1 = x0 + band
     end_bow = x1 + bow + stern                      # the stern leaves the band
     pos = pos + [x0, 0.0]
-    box = TransitBox(end_bow + OPEN_WATER_AHEAD, width, band=(x0 - 1e-9, x1 + 1e-9))
+    if walls:
+        # rigid walls on all four sides: the lee wall (the coast) at y = 0
+        box = Box(x1 + p["wall_gap"], width, periodic=(False, False))
+        box.band = (x0 - 1e-9, x1 + 1e-9)
+        end_bow = min(end_bow, x1 + p["wall_gap"] - max(p["walled_finish"], WALL_CLEARANCE))
+        y_ship = p["ship_offset"] * width
+    else:
+        box = TransitBox(end_bow + OPEN_WATER_AHEAD, width, band=(x0 - 1e-9, x1 + 1e-9))
+        y_ship = 0.5 * width
     field = FloeField(pos, r, HERMAN2013.thickness, np.zeros((r.size, 2)),
                       density=HERMAN2013.forcing.ice_density)
     field = field.take(spatial_order(field.positions, box))
     geo = dict(x0=x0, x1=x1, bow=bow, stern=stern, length=bow + stern, x_ship=x_ship,
-               y_ship=0.5 * width, end_bow=end_bow, concentration=area / (band * width))
+               y_ship=y_ship, end_bow=end_bow, concentration=area / (band * width))
     return field, box, geo
 
 
 def open_water_thrust(ship, speed: float) -> float:
-    """Thrust [N] that holds ``speed`` [m/s] in open water: X_u v + X_|u|u v²."""
+    """Thrust [N] that holds ``speed`` [m/s] in open water, ``X_u v + X_uu v²``."""
     h = ship.hydrodynamics
     return h.linear_damping[0] * speed + h.quadratic_damping[0] * speed * abs(speed)
 
@@ -240,7 +287,8 @@ def open_water_thrust(ship, speed: float) -> float:
 def build_simulation(p: dict, case: dict, seed: int):
     """(simulation, geometry, constants) of one run."""
     c, v = float(case["concentration"]), float(case["speed"])
-    field, box, geo = pack_ice(p, c, seed)
+    walls = bool(case.get("walls", 0))
+    field, box, geo = pack_ice(p, c, seed, walls)
     wind = float(case["wind"])
     # onshore wind across the channel onto the ship's port side; water drag
     # in every run, no Coriolis
@@ -270,7 +318,8 @@ def build_simulation(p: dict, case: dict, seed: int):
         sim.ship.command(thrust=thrust, yaw_moment=0.0)
     constants = dict(thrust=thrust, open_water_speed=v, n_floes=field.n, band_start=geo["x0"],
                      band_end=geo["x1"], band_concentration=geo["concentration"],
-                     channel_width=box.ly, hull_length=geo["length"], dt=dt, ice_drift=drift)
+                     channel_width=box.ly, hull_length=geo["length"], dt=dt, ice_drift=drift,
+                     ship_start_y=geo["y_ship"])
     return sim, geo, constants
 
 
@@ -375,9 +424,22 @@ class ShipTransit(Experiment):
         pairs += [(float(p["reference_concentration"]), float(v)) for v in p["speeds"]]
         pairs = list(dict.fromkeys(pairs))
         winds = [w for w in WINDS[p["wind"]] if not (w and p["wind_speed"] <= 0.0)] or [False]
-        return [{"concentration": c, "speed": v, "dynamic": int(mode == "dynamic"),
-                 "wind": float(p["wind_speed"]) if w else 0.0}
-                for mode in MODES[p["modes"]] for w in winds for c, v in pairs]
+        sides = SIDES[p["sides"]]
+        out = []
+        if "periodic" in sides:
+            out += [{"concentration": c, "speed": v, "dynamic": int(mode == "dynamic"),
+                     "wind": float(p["wind_speed"]) if w else 0.0, "walls": 0}
+                    for mode in MODES[p["modes"]] for w in winds for c, v in pairs]
+        if "walls" in sides and "dynamic" in MODES[p["modes"]]:
+            # the beset sweep: a dynamic ship at walled_speed in the channel
+            # closed across, its band of ice running to the wall ahead
+            out += [{"concentration": float(c), "speed": float(p["walled_speed"]), "dynamic": 1,
+                     "wind": float(p["wind_speed"]) if w else 0.0, "walls": 1}
+                    for w in winds for c in dict.fromkeys(p["walled_concentrations"])]
+        if not out:
+            raise ValueError("sides = 'walls' runs only the dynamic ship (the beset sweep): "
+                             "choose modes 'dynamic' or 'both'")
+        return out
 
     def workload(self, p: dict, case: dict) -> float:
         # floes × steps: floes ∝ A, steps ∝ 1/(v dt) with dt ∝ v^(-1/5)
@@ -406,6 +468,8 @@ class ShipTransit(Experiment):
             if bow_x >= geo["end_bow"] or sim.time >= max_time - 0.5 * sim.dt:
                 break
             st["error"] = _advance(sim, min(p["output_interval"], max_time - sim.time))
+            if st["error"] is None and not all(sim.box.periodic):
+                st["error"] = _hull_at_wall(sim)
             records = sim.ship.records()
             log = sim.ship.collisions()
             st["log"].append(np.column_stack([log[k] for k in LOG_COLUMNS]).astype(float))
@@ -531,11 +595,15 @@ class ShipTransit(Experiment):
         rows = []
         for key, label in _groups(ds):
             conc = _sweep(ds, key, "concentration", p)
+            v0 = _sweep_speed(p, key)
             if conc is not None:
                 a, b = power_law_fit(conc["x"], conc["resistance"])
-                rows.append((f"{label}: R = a A^b at v = {p['reference_speed']:g} m/s",
-                             f"a = {a / 1e3:.3g} kN, b = {b:.2f}; R = "
-                             + ", ".join(f"{r / 1e3:.3g}" for r in conc["mean"]) + " kN at A = "
+                fit = (f"a = {a / 1e3:.3g} kN, b = {b:.2f}" if np.isfinite(b) else
+                       "no fit (fewer than two concentrations with a resistance window)")
+                rows.append((f"{label}: R = a A^b at v = {v0:g} m/s",
+                             f"{fit}; R = "
+                             + ", ".join("—" if not np.isfinite(r) else f"{r / 1e3:.3g}"
+                                         for r in conc["mean"]) + " kN at A = "
                              + ", ".join(f"{x:g}" for x in conc["xs"]),
                              "grows with A"))
             speed = _sweep(ds, key, "speed", p)
@@ -547,14 +615,29 @@ class ShipTransit(Experiment):
             if key[0] and conc is not None:
                 loss = ", ".join(f"{x:g}: {s:.2f}" for x, s in zip(conc["xs"], conc["loss"]))
                 bc = beset_concentration(conc["xs"], conc["beset"])
-                rows.append((f"{label}: speed loss by A (v = {p['reference_speed']:g} m/s in "
+                rows.append((f"{label}: speed loss by A (v = {v0:g} m/s in "
                              f"open water)", loss, "grows with A"))
                 rows.append((f"{label}: beset concentration",
                              f"{bc:g}" if np.isfinite(bc) else
-                             f"not beset up to A = {max(conc['xs']):g}", "—"))
-        sway = _wind_sway(ds)
+                             f"not beset up to A = {max(conc['xs']):g}",
+                             "the pack pressed against the walls and the wall ahead besets the "
+                             "ship" if key[2] else "—"))
+                if key[2]:
+                    with warnings.catch_warnings():     # runs never beset: all NaN
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                        dist = np.nanmean(ds["beset_distance"].values[conc["cases"]], axis=1)
+                    band = np.nanmean(ds["band_end"].values[conc["cases"]]
+                                      - ds["band_start"].values[conc["cases"]], axis=1)
+                    rows.append((f"{label}: bow's distance into the band when beset "
+                                 f"(band length)",
+                                 ", ".join(f"A = {x:g}: " + (f"{d:.0f} m" if np.isfinite(d)
+                                                             else "not beset")
+                                           + f" ({b_:.0f} m)"
+                                           for x, d, b_ in zip(conc["xs"], dist, band)),
+                                 "shorter in denser ice"))
+        sway = _wind_sway(ds, _walls(ds) == 0)
         if sway:
-            rows.append(("mean ice sway force without / with wind (all runs)", sway,
+            rows.append(("mean ice sway force without / with wind (periodic channel)", sway,
                          "the wind presses the pack onto the port side (sway force < 0)"))
         return rows
 
@@ -581,7 +664,9 @@ class ShipTransit(Experiment):
                     continue
                 colour = f"C{i}"
                 ax.errorbar(s["xs"], s["mean"] / 1e3, yerr=s["err"] / 1e3, marker="o" if not
-                            key[0] else "s", ls="none", color=colour, capsize=2, label=label)
+                            key[0] else "s", ls="none", color=colour, capsize=2,
+                            label=label + (f", v₀ = {p['walled_speed']:g} m/s" if key[2]
+                                           else ""))
                 a, b = power_law_fit(s["x"], s["resistance"])
                 if np.isfinite(b):
                     xx = np.geomspace(min(s["xs"]), max(s["xs"]), 50)
@@ -652,9 +737,12 @@ class ShipTransit(Experiment):
         plt = plots.pyplot()
         picks = []
         for w in sorted(set(ds.coords["wind"].values.tolist())):
+            walls = _walls(ds)
             cand = [c for c in range(ds.sizes["case"])
                     if ds.coords["wind"].values[c] == w
-                    and ds.coords["speed"].values[c] == p["reference_speed"]]
+                    and ds.coords["speed"].values[c] == p["reference_speed"] and not walls[c]]
+            cand = cand or [c for c in range(ds.sizes["case"])
+                            if ds.coords["wind"].values[c] == w]
             if not cand:
                 continue
             pres = [c for c in cand if ds.coords["dynamic"].values[c] == 0] or cand
@@ -701,7 +789,8 @@ class ShipTransit(Experiment):
             if s is None:
                 continue
             colour = f"C{i}"
-            axes[0].plot(s["xs"], s["loss"], marker="s", color=colour, label=label)
+            axes[0].plot(s["xs"], s["loss"], marker="s", color=colour, ls="--" if key[2] else "-",
+                         label=label + f", v₀ = {_sweep_speed(p, key):g} m/s")
             bc = beset_concentration(s["xs"], s["beset"])
             if np.isfinite(bc):
                 axes[0].axvline(bc, color=colour, ls=":", lw=1.2)
@@ -718,14 +807,28 @@ class ShipTransit(Experiment):
         axes[0].set_ylim(-0.05, 1.1)
         if axes[0].get_legend_handles_labels()[0]:
             axes[0].legend(fontsize=7)
-        axes[0].set_title(f"(a) dynamic ship, v₀ = {p['reference_speed']:g} m/s in open water; "
-                          f"beset: u < {p['beset_speed']:g} m/s for {p['beset_time']:g} s",
-                          fontsize=9)
+        axes[0].set_title(f"(a) dynamic ship, v₀: open-water speed; dotted: beset "
+                          f"concentration\n(beset: u < {p['beset_speed']:g} m/s for "
+                          f"{p['beset_time']:g} s)", fontsize=9)
         axes[1].axvline(0.0, color="0.5", lw=0.8)
         axes[1].set_xlabel("bow position from the start of the band [m]")
         axes[1].set_ylabel("surge speed u [m/s]")
         axes[1].set_title("(b) surge speed along the transit (darker: denser ice)", fontsize=9)
         return plots.savefig(fig, out_dir / "ship_speed_loss.png")
+
+
+def _hull_at_wall(sim) -> str | None:
+    """A message if the hull has come within :data:`WALL_CLEARANCE` of a
+    wall of the box (the hull does not touch walls, so the run must end
+    before it would), else None."""
+    ship = sim.ship
+    v = ship.ship.hull.world_vertices(ship.position[0], ship.position[1], ship.heading)
+    for k, (length, per) in enumerate(zip((sim.box.lx, sim.box.ly), sim.box.periodic)):
+        if not per and (v[:, k].min() < WALL_CLEARANCE or v[:, k].max() > length - WALL_CLEARANCE):
+            return (f"the hull came within {WALL_CLEARANCE:g} m of a wall at "
+                    f"{'xy'[k]} = {v[:, k].min():.1f}..{v[:, k].max():.1f} m (the hull does not "
+                    f"touch walls)")
+    return None
 
 
 def _no_records(sim) -> dict:
@@ -762,13 +865,26 @@ def _touching(snap, verts, ly) -> np.ndarray:
     return out
 
 
+def _walls(ds) -> np.ndarray:
+    """1 for the runs in the channel closed across (0 for the periodic one)."""
+    if "walls" in ds.coords:
+        return np.nan_to_num(np.asarray(ds.coords["walls"].values, float)).astype(int)
+    return np.zeros(ds.sizes["case"], int)
+
+
 def _groups(ds):
-    """((dynamic, wind), label) of the mode × wind groups present."""
+    """((dynamic, wind, walls), label) of the mode × wind × sides groups present."""
     dyn = ds.coords["dynamic"].values
     wind = ds.coords["wind"].values
-    keys = sorted({(int(d), float(w)) for d, w in zip(dyn, wind)})
+    keys = sorted({(int(d), float(w), int(s)) for d, w, s in zip(dyn, wind, _walls(ds))})
     return [(k, ("dynamic" if k[0] else "prescribed")
-             + (f", wind {k[1]:g} m/s" if k[1] > 0 else ", no wind")) for k in keys]
+             + (f", wind {k[1]:g} m/s" if k[1] > 0 else ", no wind")
+             + (", walled channel" if k[2] else "")) for k in keys]
+
+
+def _sweep_speed(p: dict, key) -> float:
+    """Speed of the concentration sweep of group ``key``."""
+    return float(p["walled_speed"] if key[2] else p["reference_speed"])
 
 
 def _sweep(ds, key, sweep: str, p: dict):
@@ -778,14 +894,17 @@ def _sweep(ds, key, sweep: str, p: dict):
     fewer than two cases."""
     dyn = ds.coords["dynamic"].values
     wind = ds.coords["wind"].values
+    walls = _walls(ds)
     conc = ds.coords["concentration"].values
     speed = ds.coords["speed"].values
     if sweep == "concentration":
-        sel = [c for c in range(ds.sizes["case"]) if (dyn[c], wind[c]) == key
-               and speed[c] == p["reference_speed"]]
+        sel = [c for c in range(ds.sizes["case"]) if (dyn[c], wind[c], walls[c]) == key
+               and speed[c] == _sweep_speed(p, key)]
         xs = conc
     else:
-        sel = [c for c in range(ds.sizes["case"]) if (dyn[c], wind[c]) == key
+        if key[2]:
+            return None
+        sel = [c for c in range(ds.sizes["case"]) if (dyn[c], wind[c], walls[c]) == key
                and conc[c] == p["reference_concentration"]]
         xs = speed
     sel = sorted(sel, key=lambda c: xs[c])
@@ -807,11 +926,12 @@ def _sweep(ds, key, sweep: str, p: dict):
                 beset=np.where(beset > 0.5, 1.0, 0.0))
 
 
-def _wind_sway(ds) -> str:
-    wind = ds.coords["wind"].values
+def _wind_sway(ds, keep=None) -> str:
+    keep = np.ones(ds.sizes["case"], bool) if keep is None else np.asarray(keep, bool)
+    wind = ds.coords["wind"].values[keep]
     if not (np.any(wind == 0) and np.any(wind > 0)):
         return ""
-    f = ds["mean_sway_force"].values
+    f = ds["mean_sway_force"].values[keep]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         a, b = np.nanmean(f[wind == 0]), np.nanmean(f[wind > 0])

@@ -19,7 +19,7 @@ from physics.scenarios.ship_transit import (beset_concentration, pack_ice,  # no
 
 # three (concentration, speed) pairs × two modes × with and without wind
 SMALL = dict(concentrations=[0.2, 0.5], speeds=[3.0], reference_concentration=0.5,
-             band_length=160.0, channel_width=150.0, output_interval=2.0)
+             band_length=160.0, channel_width=150.0, output_interval=2.0, sides="periodic")
 
 
 @pytest.fixture(scope="module")
@@ -141,3 +141,39 @@ def test_interrupted_run_resumes_to_the_same_numbers(tmp_path, monkeypatch):
     assert set(a.data_vars) == set(b.data_vars) and b.sizes["collision"] > 0
     for name in a.data_vars:
         np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+def test_walled_channel_besets_the_weak_ship_that_the_periodic_one_does_not(tmp_path):
+    """The same dense band (A = 0.8) and weak thrust (0.25 m/s in open water)
+    with the onshore wind: the periodic channel lets the ice escape and the
+    ship gets through; closed by walls across and ahead, the pack is
+    compressed against them and the ship is beset well short of the wall
+    ahead (more than 10 m short of the band's end).
+    The floes stay between the side walls and the hull clear of them."""
+    small = dict(concentrations=[0.8], speeds=[], reference_speed=0.25, modes="dynamic",
+                 wind="on", sides="both", walled_concentrations=[0.8], walled_speed=0.25,
+                 band_length=160.0, channel_width=140.0, output_interval=2.0,
+                 walled_finish=10.0)
+    res = run_scenario("ship-transit", quick=True, overrides=small, out=tmp_path / "w",
+                       workers=1, progress=False, log=lambda *a: None)
+    with xr.open_dataset(res.dataset) as ds:
+        ds = ds.load()
+    walls = ds.coords["walls"].values
+    assert sorted(walls.tolist()) == [0, 1]
+    w, f = int(np.argmax(walls == 1)), int(np.argmax(walls == 0))
+    assert ds["beset"].values[w, 0] == 1 and ds["beset"].values[f, 0] == 0
+    assert ds["completed"].values[f, 0] == 1 and ds["completed"].values[w, 0] == 0
+    band = float(ds["band_end"].values[w, 0] - ds["band_start"].values[w, 0])
+    assert 0.0 < ds["beset_distance"].values[w, 0] < band - 10.0
+    assert ds["speed_loss"].values[w, 0] == 1.0 and ds["speed_loss"].values[f, 0] < 1.0
+    # the ship starts at a third of the width from the coast (y = 0)
+    ly = float(ds["channel_width"].values[w, 0])
+    assert ds["ship_start_y"].values[w, 0] == pytest.approx(ly / 3.0)
+    # walls across: the floes stay between them (no periodic wrap), the hull clear of them
+    y, r = ds["floe_y"].values[w], ds["floe_radius"].values[w]
+    ok = np.isfinite(y)
+    assert np.all(y[ok] - r[ok] > -0.05 * r[ok]) and np.all(y[ok] + r[ok] < ly + 0.05 * r[ok])
+    ys = ds["y"].values[w, 0]
+    assert np.all((ys[np.isfinite(ys)] > 9.0 + 5.0) & (ys[np.isfinite(ys)] < ly - 14.0))
+    text = (res.directory / "summary.md").read_text()
+    assert "beset at t = " in text and "into the band" in text
