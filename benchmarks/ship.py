@@ -26,7 +26,7 @@ from .harness import PROCESSES, REPEATS
 
 SUITE = "ship"
 TITLE = "Ship among the floes"
-DESCRIPTION = """
+DESCRIPTION = f"""
 What a ship costs the Hertz engine: floe-steps per second (floes × steps / wall
 time, compile time excluded) of one floe field with and without the platform
 supply vessel (`psv_ship`, 76.2 m × 18 m, prescribed at 2 m/s), at N = 2000 and
@@ -58,12 +58,17 @@ on their own on the state of the run (the ship's kick–drift, the contacts of
 the floes in the hull's list with their forces, collision log and step record,
 and the O(N) build of the hull's list at the rate the run built it), and the
 difference of the two runs. What the difference holds beyond the hull kernels
-is the ship's effect on the floes: floes pushed at up to 3 m/s expire the
-floes' own Verlet list far more often (its skin is 0.1 mean radius), and each
-rebuild of that list is timed too. In ice of Ā = 0.7 the ship touches a floe in
-only a few per cent of its steps: an impact lasts about 10 ms and sends the
-floe ahead of the bow, so the ship's cost lies less in its own contacts than in
-what the pushed floes do to the floes' Verlet list.
+is the ship's effect on the floes: floes pushed at up to 3 m/s would expire the
+floes' own Verlet list (one skin of 0.1 mean radius) every hundred steps or so.
+With a ship the list gets a skin per floe instead: a floe moving at u relative
+to the pack gets 2 u T and a floe the hull may hit 4 V T (T = {HC.SKIN_HORIZON_STEPS} steps),
+within the floes' and the hull's skins, and the list expires when a floe has
+moved half its own skin: the kick–drift pass checks the floes of the common
+skin as before, and a short pass the few dozen wide-skinned ones. Each rebuild
+of the floes' list is timed too. In ice of Ā = 0.7 the ship touches a floe in only a
+few per cent of its steps: an impact lasts about 10 ms and sends the floe ahead
+of the bow, so the ship's cost lies less in its own contacts than in what the
+pushed floes do to the floes' Verlet list.
 """
 
 #: sizes of ``--quick``
@@ -193,7 +198,8 @@ def hull_kernel_times(sim: HertzSimulation, passes: int) -> dict:
         ship.state[HC.S_HULL_TRAVEL] = 0.0
         t0 = time.perf_counter()
         for _ in range(max(1, builds // 4)):
-            K.rebuild(sim._floes, sim._verlet, box.lengths[0], box.lengths[1], True, True, False)
+            K.rebuild(sim._floes, sim._verlet, box.lengths[0], box.lengths[1], True, True, False,
+                      sim._verlet.skins)
         rebuild.append((time.perf_counter() - t0) / max(1, builds // 4))
     return dict(hull_step=float(np.median(step)), hull_build=float(np.median(build)),
                 floe_rebuild=float(np.median(rebuild)), candidates=int(ship.counts[HC.C_CAND]))
@@ -390,8 +396,8 @@ def ship_tables(results: list) -> list[dict]:
     cost = harness.table(
         "What the ship costs per step",
         ["floes", "threads", "extra cost per step (same round, median)", "range",
-         "step without ship", "step with ship", "ship's share (difference of the runs)",
-         "hull kernels per step", "ship's share (hull kernels timed alone)",
+         "step without ship", "step with ship", "share of the ship (difference of the runs)",
+         "hull kernels per step", "share of the ship (hull kernels timed alone)",
          "extra floe-list rebuilds per step × rebuild time"], body,
         "The extra cost is the time per step with the ship over the time without it, "
         "minus one, of the two segments of one round. The hull kernels per step are the "

@@ -335,7 +335,9 @@ class HertzSimulation:
         n = self.n_floes
         empty = K.VerletList(np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64),
                              np.zeros((0, 2)), self._pos.copy(), np.array([b.lx, b.ly]),
-                             np.zeros(2), self.skin, self.cell_size, self.max_cut)
+                             np.zeros(2), self.skin, self.cell_size, self.max_cut,
+                             np.full(n, self.skin), self.skin, np.zeros(0, dtype=np.int64),
+                             np.zeros((0, 2)), np.zeros(0))
         self._verlet = K.rebuild(self._floes, empty, b.lx, b.ly, b.periodic[0], b.periodic[1],
                                  self.parallel)
 

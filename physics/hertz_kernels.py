@@ -64,7 +64,7 @@ from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
 from .domain import box_lengths_at, minimum_image
-from .hull_contact import hull_forces, ship_closing_kick, ship_kick_drift
+from .hull_contact import hull_forces, ship_closing_kick, ship_floe_skins, ship_kick_drift
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
                           wait_generation)
@@ -170,6 +170,17 @@ class VerletList(NamedTuple):
     cell_size: float
     #: longest cut-off 2 r_max + skin [m]
     max_cut: float
+    #: (N,) skin of each floe [m]: ``skin`` for all, but wider for the
+    #: floes a ship sets moving (:func:`physics.hull_contact.ship_floe_skins`)
+    skins: np.ndarray
+    #: largest of ``skins`` [m]
+    skin_max: float
+    #: (K,) the floes whose skin is wider than ``skin`` (:func:`wide_floes_pass`)
+    wide: np.ndarray
+    #: (K, 2) their positions at the build
+    wide_ref: np.ndarray
+    #: (K,) (skin / s_i)² of each
+    wide_weight: np.ndarray
 
 
 class Kick(NamedTuple):
@@ -794,10 +805,17 @@ def pass_status(worst, mx, my, vmax2, dt, skin):
 def list_expired(worst, lx, ly, verlet):
     """Whether the Verlet list may miss a pair: twice the largest
     displacement since the build, plus what a shrinking box takes off the
-    distances (up to the longest cut-off), reaches the skin."""
+    distances (up to the longest cut-off), reaches the skin.
+
+    With per-floe skins s_i ≥ s, ``worst`` is the largest |e_i|² (s/s_i)²
+    (:func:`wide_floes_pass`):
+    2 |e_i| s/s_i + shrink · cut_max < s gives
+    2 |e_i| + shrink · cut_max < s_i for every floe, so the pairs' cut-offs
+    r_i + r_j + (s_i + s_j)/2 still hold every contact."""
     ref_lengths = verlet.ref_lengths
     shrink = max(0.0, 1.0 - min(lx / ref_lengths[0], ly / ref_lengths[1]))
-    return 2.0 * math.sqrt(worst) + shrink * verlet.max_cut >= verlet.skin
+    max_cut = verlet.max_cut + (verlet.skin_max - verlet.skin)
+    return 2.0 * math.sqrt(worst) + shrink * max_cut >= verlet.skin
 
 
 @njit(cache=True, error_model="numpy")
@@ -892,6 +910,35 @@ def team_steps(team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box,
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
+def wide_floes_pass(pos, verlet, lx, ly, px, py, cx, cy, cx_new, cy_new, worst):
+    """The expiry test of the floes with a skin s_i wider than the list's s
+    (:func:`physics.hull_contact.ship_floe_skins`), after a kick–drift pass
+    that returned ``worst`` with the centre (cx, cy).
+
+    The list holds while every floe has moved less than s_i / 2 relative to
+    a common centre (:mod:`physics.neighbors`). The kick–drift pass finds
+    the largest displacement of all floes against s / 2; for a wide floe
+    it would be the wrong measure, so its entry in ``verlet.ref`` is a
+    shadow that moves with it: set here to x_i − (cx_new, cy_new) each step,
+    so that the next pass sees only its motion over one step (it cannot
+    decide the expiry). Its true displacement is measured here from
+    ``wide_ref``, weighted by (s / s_i)², and merged into the largest.
+    Returns the new largest squared (weighted) distance from the centre."""
+    ref, wide, wide_ref, weight = verlet.ref, verlet.wide, verlet.wide_ref, verlet.wide_weight
+    for k in range(wide.shape[0]):
+        i = wide[k]
+        x = pos[i, 0]
+        y = pos[i, 1]
+        ex = min_image_step(x - wide_ref[k, 0], lx, px) - cx
+        ey = min_image_step(y - wide_ref[k, 1], ly, py) - cy
+        e2 = (ex * ex + ey * ey) * weight[k]
+        worst = max_keep_nan(worst, e2)
+        ref[i, 0] = x - cx_new
+        ref[i, 1] = y - cy_new
+    return worst
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def half_kick(floes, dt):
     """v += Δt/2 F/m, ω += Δt/2 T/I with the floes' forces (the last half
     kick of a run)."""
@@ -905,25 +952,47 @@ def half_kick(floes, dt):
 
 
 @njit(cache=True, error_model="numpy")
-def rebuild(floes, verlet, lx, ly, px, py, parallel):
+def rebuild(floes, verlet, lx, ly, px, py, parallel, skins=None):
     """A new Verlet list at the floes' positions in a box of lengths
     (lx, ly), with the contact history of ``verlet`` carried over, the
-    positions at the build copied and the displacement centre reset."""
+    positions at the build copied and the displacement centre reset.
+    ``skins``: the skin of each floe (default: ``verlet.skin`` for all)."""
     pos, radius, rank = floes.pos, floes.radius, floes.rank
     skin, cell_size = verlet.skin, verlet.cell_size
+    n = pos.shape[0]
+    if skins is None:
+        sk = np.full(n, skin)
+    else:
+        sk = skins
+    skin_max = sk.max() if n > 0 else skin
+    n_wide = 0
+    for i in range(n):
+        n_wide += sk[i] > skin
+    wide = np.empty(n_wide, dtype=np.int64)
+    wide_ref = np.empty((n_wide, 2))
+    wide_weight = np.empty(n_wide)
+    k = 0
+    for i in range(n):
+        if sk[i] > skin:
+            wide[k] = i
+            wide_ref[k, 0] = pos[i, 0]
+            wide_ref[k, 1] = pos[i, 1]
+            q = skin / sk[i]
+            wide_weight[k] = q * q
+            k += 1
     expected = verlet.nbr.shape[0]
     if parallel:
-        new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size,
+        new_start, new_nbr = build_pair_list(pos, radius, rank, lx, ly, px, py, sk, cell_size,
                                              expected)
     else:
-        new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin,
+        new_start, new_nbr = build_pair_list_serial(pos, radius, rank, lx, ly, px, py, sk,
                                                     cell_size, expected)
     new_hist = transfer_history(verlet.start, verlet.nbr, verlet.hist, new_start, new_nbr, 2)
     ref_lengths = np.empty(2)
     ref_lengths[0] = lx
     ref_lengths[1] = ly
     return VerletList(new_start, new_nbr, new_hist, pos.copy(), ref_lengths, np.zeros(2), skin,
-                      cell_size, verlet.max_cut)
+                      cell_size, verlet.max_cut, sk, skin_max, wide, wide_ref, wide_weight)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1031,10 +1100,18 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             if ship.active:
                 log_full = not hull_forces(ship, floes, box, time + step * dt, dt,
                                            math.sqrt(vmax2), buffers.force[0], buffers.torque[0])
+            if verlet.wide.shape[0] > 0:
+                worst = wide_floes_pass(floes.pos, verlet, lx, ly, px, py, kick.cx, kick.cy,
+                                        mx / n, my / n, worst)
             verlet.centre[0] = mx / n
             verlet.centre[1] = my / n
             expired = list_expired(worst, lx, ly, verlet)
-        if expired:
+        if expired and ship.active and not box.deforming:
+            verlet = rebuild(floes, verlet, lx, ly, px, py, parallel,
+                             ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
+            chunks = pair_chunks(verlet, n_pair)
+            n_rebuilds += 1
+        elif expired:
             verlet = rebuild(floes, verlet, lx, ly, px, py, parallel)
             chunks = pair_chunks(verlet, n_pair)
             n_rebuilds += 1

@@ -36,6 +36,19 @@ the floes together have moved less than s since the build: the kernel adds
 up |V| Δt + R_c |r| Δt for the hull (R_c: its reach from the centroid) and
 the largest floe speed × Δt, and builds the list again when the sum reaches
 s. The cost per step is the contacts with the few floes along the hull.
+
+**The floes' own list.** A floe the hull pushes moves at the ship's speed,
+ten to a hundred times the drift of the pack, and with one skin for all
+floes it would expire the floes' Verlet list every few dozen steps. With a
+ship the list is built with a skin per floe (:func:`ship_floe_skins`): a
+floe moving at u relative to the mean drift gets 2 u T, and a floe within
+the hull's skin of the hull (one it may hit) 4 V T, with V the speed of the
+hull's fastest point (a floe leaves an impact at up to (1 + e) V ≤ 2 V);
+T is :data:`SKIN_HORIZON_STEPS` steps, every skin is at most the hull's,
+and one under twice the floes' own stays at theirs. The list then lasts
+until a floe has moved half its own skin (:mod:`physics.neighbors`); the
+few wide-skinned floes are checked in a pass of their own
+(:func:`physics.hertz_kernels.wide_floes_pass`).
 """
 from __future__ import annotations
 
@@ -244,6 +257,66 @@ def build_hull_list(ship, pos, radius, lx, ly, px, py):
     ship.counts[C_REBUILDS] += 1
     s[S_HULL_TRAVEL] = 0.0
     s[S_FLOE_TRAVEL] = 0.0
+
+
+#: time a floe's skin is sized to last with a ship, in steps (the floes'
+#: list is rebuilt about this often while the ship pushes floes)
+SKIN_HORIZON_STEPS = 3000
+
+
+@njit(cache=True, error_model="numpy")
+def ship_floe_skins(ship, floes, skin, dt, lx, ly, px, py):
+    """The skin of each floe for a list build with a ship: 2 u T for a floe
+    moving at u relative to the mean velocity, at least 4 V T for a floe
+    within the hull's skin of the hull (V: the speed of the hull's fastest
+    point), T = :data:`SKIN_HORIZON_STEPS` Δt; at most the hull's skin and
+    what the periodic sides allow (2 r_max + s_i under half a side). A floe
+    whose skin would be less than twice ``skin`` (the floes' own), and a
+    frozen floe, keeps ``skin``."""
+    pos, vel, radius, inv_mass = floes.pos, floes.vel, floes.radius, floes.inv_mass
+    n = radius.shape[0]
+    out = np.full(n, skin)
+    if n == 0:
+        return out
+    cap = ship.skin
+    r_max = radius.max()
+    if px:
+        cap = min(cap, 0.49 * lx - 2.0 * r_max)
+    if py:
+        cap = min(cap, 0.49 * ly - 2.0 * r_max)
+    if cap <= skin:
+        return out
+    mvx = 0.0
+    mvy = 0.0
+    for i in range(n):
+        mvx += vel[i, 0]
+        mvy += vel[i, 1]
+    mvx /= n
+    mvy /= n
+    horizon = SKIN_HORIZON_STEPS * dt
+    set_world_hull(ship)
+    s = ship.state
+    x0, y0 = s[S_X], s[S_Y]
+    hull_speed = math.sqrt(s[S_VX] ** 2 + s[S_VY] ** 2) + abs(s[S_R]) * ship.reach
+    near_skin = 4.0 * hull_speed * horizon
+    for i in range(n):
+        if inv_mass[i] == 0.0:
+            continue
+        ux = vel[i, 0] - mvx
+        uy = vel[i, 1] - mvy
+        si = 2.0 * math.sqrt(ux * ux + uy * uy) * horizon
+        if si < near_skin:
+            dx = minimum_image(pos[i, 0] - x0, lx, px)
+            dy = minimum_image(pos[i, 1] - y0, ly, py)
+            reach = ship.reach + radius[i] + ship.skin
+            if dx * dx + dy * dy < reach * reach:
+                if disc_hull_contact(dx, dy, radius[i] + ship.skin, ship.world_x,
+                                     ship.world_y)[0] > 0.0:
+                    si = near_skin
+        # a skin less than twice the floes' own is not worth the floe's
+        # place in the pass over the wide floes (wide_floes_pass)
+        out[i] = min(cap, si) if si >= 2.0 * skin else skin
+    return out
 
 
 @njit(cache=True, inline="always", error_model="numpy")

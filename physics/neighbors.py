@@ -22,13 +22,22 @@ A list built with skin s stays valid while, for every pair,
 ``|Δd_i − Δd_j| + (1 − scale)(r_i + r_j + s) < s`` where Δd are displacements
 since the build and ``scale`` is the affine factor of a deforming box;
 :func:`needs_rebuild` checks a sufficient form of this.
+
+The skin may also be given per floe (an array ``s``): the pair (i, j) is
+then listed within ``r_i + r_j + (s_i + s_j)/2``, and the list stays valid
+while every floe has moved less than ``s_i/2`` (relative to a common
+drift), because then ``|Δd_i − Δd_j| < (s_i + s_j)/2``. A fast floe can
+carry a wide skin without widening every other floe's; the owner of a pair
+scans ``2 r_i + (s_i + max s)/2``, which covers every partner of lower
+rank. With one skin for all floes the lists are the same as with a scalar.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
+from numba.extending import overload
 
 from .domain import minimum_image
 
@@ -90,6 +99,21 @@ def build_cells(pos, lx, ly, cell_size):
 N_CHUNKS = 64
 
 
+def floe_skins(skin, n):
+    """The skins of n floes: ``skin`` itself if it is an array, else n
+    copies of the scalar (plain Python; compiled code uses the overload)."""
+    if np.ndim(skin) == 0:
+        return np.full(n, float(skin))
+    return np.asarray(skin, dtype=float)
+
+
+@overload(floe_skins)
+def _floe_skins_overload(skin, n):
+    if isinstance(skin, (types.Float, types.Integer)):
+        return lambda skin, n: np.full(n, float(skin))
+    return lambda skin, n: skin
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _axis_range(c, reach, cell_width, ncell, periodic):
     """First cell and number of cells to scan along one axis. The first cell
@@ -110,10 +134,10 @@ COUNT, FILL, APPEND = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def _scan_floes(i_lo, i_hi, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+def _scan_floes(i_lo, i_hi, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy,
                 cell_start, cell_floes, cell_of, counts, start, out, mode, base, cap):
-    """Partners of lower rank within r_i + r_j + skin of floes
-    i_lo ≤ i < i_hi.
+    """Partners of lower rank within r_i + r_j + (s_i + s_j)/2 of floes
+    i_lo ≤ i < i_hi (``skins`` per floe, ``s_max`` their largest).
 
     ``mode`` COUNT: counts[i + 1] = number of partners. FILL: the partners
     of i written at out[start[i]:], sorted by index. APPEND: the partners of
@@ -130,7 +154,8 @@ def _scan_floes(i_lo, i_hi, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
         yi = pos[i, 1]
         ri = radius[i]
         rank_i = rank[i]
-        reach = 2.0 * ri + skin
+        si = skins[i]
+        reach = 2.0 * ri + 0.5 * (si + s_max)
         ci = cell_of[i]
         x0, nxc = _axis_range(ci % ncx, reach, wx, ncx, px)
         y0, nyc = _axis_range(ci // ncx, reach, wy, ncy, py)
@@ -156,7 +181,7 @@ def _scan_floes(i_lo, i_hi, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
                         continue
                     dx = minimum_image(pos[j, 0] - xi, lx, px)
                     dy = minimum_image(pos[j, 1] - yi, ly, py)
-                    cut = ri + radius[j] + skin
+                    cut = ri + radius[j] + 0.5 * (si + skins[j])
                     if dx * dx + dy * dy < cut * cut:
                         if mode != COUNT:
                             if mode == APPEND and at + count >= base + cap:
@@ -194,8 +219,8 @@ BLOCK = 32     # floes per block of a chunk of the parallel list build
 
 
 @njit(cache=True, error_model="numpy")
-def _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start, cell_floes,
-                cell_of, counts, start, out, mode, base, cap):
+def _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy, cell_start,
+                cell_floes, cell_of, counts, start, out, mode, base, cap):
     """:func:`_scan_floes` over chunk c of the parallel build: the blocks
     c, c + N_CHUNKS, c + 2 N_CHUNKS, ... of ``BLOCK`` consecutive floes.
     Consecutive floes are neighbours in space when the floes are numbered in
@@ -204,8 +229,8 @@ def _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_st
     over all threads. Returns the end of what APPEND wrote, or −1."""
     end = base
     for b in range(c * BLOCK, n, N_CHUNKS * BLOCK):
-        end = _scan_floes(b, min(b + BLOCK, n), pos, radius, rank, lx, ly, px, py, skin, ncx,
-                          ncy, cell_start, cell_floes, cell_of, counts, start, out, mode, end,
+        end = _scan_floes(b, min(b + BLOCK, n), pos, radius, rank, lx, ly, px, py, skins, s_max,
+                          ncx, ncy, cell_start, cell_floes, cell_of, counts, start, out, mode, end,
                           base + cap - end)
         if end < 0:
             return -1
@@ -241,6 +266,8 @@ def _all_fit(ends):
 def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size, expected=0):
     """Verlet list of all pairs with centre distance < r_i + r_j + skin.
 
+    ``skin`` is one skin for all floes or an (N,) array of skins per floe
+    (cut-off r_i + r_j + (s_i + s_j)/2, see the module notes).
     Each pair appears once, in the slice of its owner (higher rank).
     Returns (start (N+1,), nbr (M,)) with every slice sorted by partner index.
     Requires the largest cut-off to be below half of each periodic side
@@ -253,28 +280,30 @@ def build_pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size, expected
     filling pass instead (twice the scanning, the same list).
     """
     n = pos.shape[0]
+    skins = floe_skins(skin, n)
+    s_max = skins.max() if n > 0 else 0.0
     ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
     counts = np.zeros(n + 1, dtype=np.int64)
     cap = _append_capacity(n, expected, N_CHUNKS)
     buf = np.empty(cap * N_CHUNKS, dtype=np.int64)
     ends = np.empty(N_CHUNKS, dtype=np.int64)
     for c in prange(N_CHUNKS):
-        ends[c] = _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy,
+        ends[c] = _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy,
                               cell_start, cell_floes, cell_of, counts, counts, buf, APPEND,
                               c * cap, cap)
     fit = _all_fit(ends)
     if not fit:
         for c in prange(N_CHUNKS):
-            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
-                        cell_floes, cell_of, counts, counts, buf, COUNT, 0, 0)
+            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy,
+                        cell_start, cell_floes, cell_of, counts, counts, buf, COUNT, 0, 0)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
     for c in prange(N_CHUNKS):
         if fit:
             _copy_chunk(c, n, buf, c * cap, start, nbr)
         else:
-            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
-                        cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
+            _scan_chunk(c, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy,
+                        cell_start, cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
     return start, nbr
 
 
@@ -284,19 +313,21 @@ def build_pair_list_serial(pos, radius, rank, lx, ly, px, py, skin, cell_size, e
     engine path, which must not wake a thread pool). With one chunk the
     appended slices are already in floe order: the buffer is the list."""
     n = pos.shape[0]
+    skins = floe_skins(skin, n)
+    s_max = skins.max() if n > 0 else 0.0
     ncx, ncy, cell_start, cell_floes, cell_of = build_cells(pos, lx, ly, cell_size)
     counts = np.zeros(n + 1, dtype=np.int64)
     cap = _append_capacity(n, expected, 1)
     buf = np.empty(cap, dtype=np.int64)
-    end = _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    end = _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy, cell_start,
                       cell_floes, cell_of, counts, counts, buf, APPEND, 0, cap)
     if end >= 0:
         return np.cumsum(counts), buf[:end].copy()
-    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy, cell_start,
                 cell_floes, cell_of, counts, counts, counts, COUNT, 0, 0)
     start = np.cumsum(counts)
     nbr = np.empty(start[n], dtype=np.int64)
-    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skin, ncx, ncy, cell_start,
+    _scan_floes(0, n, pos, radius, rank, lx, ly, px, py, skins, s_max, ncx, ncy, cell_start,
                 cell_floes, cell_of, counts, start, nbr, FILL, 0, 0)
     return start, nbr
 
@@ -320,12 +351,14 @@ def pair_list(pos, radius, rank, lx, ly, px, py, skin, cell_size):
 
 
 def brute_force_pairs(pos, radius, box, skin):
-    """All pairs (i < j) with centre distance < r_i + r_j + skin, by testing
-    every pair (O(N²); for tests and tiny systems)."""
+    """All pairs (i < j) with centre distance < r_i + r_j + skin (or
+    r_i + r_j + (s_i + s_j)/2 with skins per floe), by testing every pair
+    (O(N²); for tests and tiny systems)."""
     pos = np.asarray(pos, dtype=float)
     d = box.minimum_image(pos[None, :, :] - pos[:, None, :])
     dist2 = (d ** 2).sum(-1)
-    cut = radius[:, None] + radius[None, :] + skin
+    skins = floe_skins(skin, len(radius))
+    cut = radius[:, None] + radius[None, :] + 0.5 * (skins[:, None] + skins[None, :])
     i, j = np.nonzero(np.triu(dist2 < cut ** 2, k=1))
     return np.stack([i, j], axis=1)
 

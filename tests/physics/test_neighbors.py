@@ -79,6 +79,47 @@ def test_pair_list_equals_brute_force(box_name, skin, cell):
     assert brute == expected
 
 
+@pytest.mark.parametrize("box_name", ["periodic-rectangle", "walled"])
+def test_pair_list_with_a_skin_per_floe_equals_brute_force(box_name):
+    """With a skin per floe (0.3 m for most, 5 m for 25 of the 600) the
+    serial and the parallel builder list exactly the pairs closer than
+    r_i + r_j + (s_i + s_j)/2, including the wide-skinned floes' partners of
+    higher rank; brute_force_pairs agrees. The same skin for every floe as an
+    array gives the arrays of the scalar skin."""
+    from physics.neighbors import build_pair_list_serial
+
+    rng = np.random.default_rng(23)
+    box = BOXES[box_name]()
+    pos, radius = random_floes(rng, 600, box)
+    rank = radius_rank(radius)
+    skins = np.full(600, 0.3)
+    wide = rng.choice(600, 25, replace=False)
+    skins[wide] = 5.0
+    cell = choose_cell_size(radius, box.lx, box.ly, 0.3)
+    d = pos[None, :, :] - pos[:, None, :]
+    for axis, (length, periodic) in enumerate(zip((box.lx, box.ly), box.periodic)):
+        if periodic:
+            d[..., axis] -= length * np.round(d[..., axis] / length)
+    cut = radius[:, None] + radius[None, :] + 0.5 * (skins[:, None] + skins[None, :])
+    i, j = np.nonzero(np.triu(np.hypot(d[..., 0], d[..., 1]) < cut, k=1))
+    expected = set(zip(i.tolist(), j.tolist()))
+    # the wide skins add pairs that one skin of 0.3 m would not list
+    assert len(expected - all_pairs_within(pos, radius, box, 0.3)) > 50
+    for build in (build_pair_list, build_pair_list_serial):
+        start, nbr = build(pos, radius, rank, box.lx, box.ly, box.periodic[0], box.periodic[1],
+                           skins, cell)
+        owner = np.repeat(np.arange(600), np.diff(start))
+        found = set(zip(np.minimum(owner, nbr).tolist(), np.maximum(owner, nbr).tolist()))
+        assert len(found) == len(nbr) and found == expected
+        assert np.all(rank[owner] > rank[nbr])
+        same = [build(pos, radius, rank, box.lx, box.ly, box.periodic[0], box.periodic[1], skin,
+                      cell) for skin in (0.3, np.full(600, 0.3))]
+        for a, b in zip(*same):
+            np.testing.assert_array_equal(a, b)
+    brute = {tuple(p) for p in brute_force_pairs(pos, radius, box, skins).tolist()}
+    assert brute == expected
+
+
 @pytest.mark.parametrize("skin", [0.7, 20.0])
 def test_single_pass_build_and_its_fallback_give_the_same_list(skin):
     """The list is built in one scan, each chunk of floes appending to a

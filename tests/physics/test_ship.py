@@ -344,3 +344,39 @@ def _touching(sim):
     near = np.nonzero(np.hypot(d[:, 0], d[:, 1]) < sim.ship.reach + sim.radius)[0]
     return sum(disc_hull_contact(d[i, 0], d[i, 1], sim.radius[i], v[:, 0].copy(),
                                  v[:, 1].copy())[0] > 0 for i in near)
+
+
+def test_floes_list_with_a_ship_misses_no_floe_contact():
+    """The ship pushes floes at several times the pack's drift, and with a
+    ship the floes' list gets a skin per floe (wide for the floes the hull
+    sets moving or may hit). While a ship at 3 m/s crosses ice of A = 0.6 in
+    a periodic box, the touching pairs that contacts() reports equal the
+    brute-force set of overlapping pairs at all of 80 checks, the skins did
+    widen (up to the hull list's skin), and the list was rebuilt."""
+    from physics.domain import Box
+    from physics.floes import place_floes
+
+    rng = np.random.default_rng(17)
+    lx, ly = 240.0, 120.0
+    radii = rng.uniform(1.0, 3.0, 900)
+    pos = place_floes(radii, Box(170.0, ly, periodic=(False, True)), rng) + [60.0, 0.0]
+    field = FloeField(pos, radii, 1.0, rng.normal(0.0, 0.02, (900, 2)))
+    params = ContactParams(elastic_modulus=E_MOD, restitution=0.5, friction=0.5)
+    ship = Ship(Hull.pointed(30.0, 8.0), 5e5, position=(25.0, 60.0), speed=3.0)
+    t_c = hull_contact_time(radii, 1.0, field.density, params, 3.0)
+    sim = HertzSimulation(field, PeriodicBox(lx, ly), params, None, 0.1 * t_c,
+                          impact_speed=3.0, ship=ship)
+    wide = 0.0
+    seen = 0
+    for _ in range(80):
+        sim.advance(0.5)
+        c = sim.contacts()
+        got = set(zip(np.minimum(c.i, c.j).tolist(), np.maximum(c.i, c.j).tolist()))
+        d = sim.box.minimum_image(sim.positions[None, :, :] - sim.positions[:, None, :])
+        i, j = np.nonzero(np.triu(np.hypot(d[..., 0], d[..., 1])
+                                  < radii[:, None] + radii[None, :], k=1))
+        assert got == set(zip(i.tolist(), j.tolist()))
+        seen += len(got)
+        wide = max(wide, sim._verlet.skin_max)
+    assert sim.ship.position[0] > 120.0 and seen > 500
+    assert sim.n_rebuilds > 3 and wide > 3.0 * sim.skin
