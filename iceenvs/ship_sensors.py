@@ -1,0 +1,406 @@
+"""What a ship among the floes senses: a sector lidar and an egocentric
+occupancy image.
+
+Both sensors read one snapshot of the ice, floes as discs (centres
+``positions`` (N, 2) [m], ``radii`` (N,) [m]), and the ship's pose
+(``ship_xy`` [m], ``heading`` [rad, anticlockwise from +x], as
+:class:`physics.ship.ShipState` gives it). They are plain NumPy functions
+of arrays, so an environment calls them on whatever engine it runs.
+
+Frames. The ship frame has x forward (along the heading) and y to port;
+angles are anticlockwise seen from above. Along a periodic axis of a box
+of side lengths ``box_lengths`` every displacement is taken as its minimum
+image, so the sensors see each floe once, through its nearest image: for
+an exact picture the sensor's reach should stay below half the box length.
+
+:func:`ice_lidar`
+    The field of view ``fov`` [rad], centred on the heading, is cut into
+    ``sectors`` equal angular sectors, sector 0 starting at
+    heading − fov/2 and the index growing anticlockwise (with an odd
+    number of sectors the middle one looks straight ahead). Per sector:
+
+    * ``distance`` [m]: along the sector's central ray, the distance from
+      the ship to the first floe edge it meets (exact ray–circle
+      intersection); 0 when the ship stands inside a floe, ``max_range``
+      when the ray meets nothing within ``max_range``;
+    * ``concentration`` [-]: the fraction of the sector's wedge (radius 0
+      to ``max_range``) covered by ice, counted on a fixed polar grid of
+      :data:`LIDAR_RINGS` × :data:`LIDAR_RAYS` sample points per sector:
+      rings at radii ``max_range sqrt((i + 1/2) / LIDAR_RINGS)`` (each
+      point stands for the same area, so uniform coverage gives the
+      true fraction) and angles at the midpoints of equal sub-sectors.
+      A point counts when it lies inside any floe.
+
+:func:`occupancy_image`
+    A (4, size, size) uint8 picture of a square of side ``extent`` [m]
+    around the ship, the ship at the centre and its heading up (towards
+    row 0), port to the left (towards column 0): a rotation of the map
+    seen from above, never a mirror image. The centre of pixel (row i,
+    column j) is the ship-frame point x = extent/2 − (i + 1/2) extent/size
+    (forward), y = extent/2 − (j + 1/2) extent/size (to port). Channels:
+
+    0. ice: 255 where the pixel centre lies inside a floe, else 0;
+    1. hull: 255 where the pixel centre lies inside the hull, a convex
+       polygon given by its world-frame corners, anticlockwise;
+    2. goal: 255 (1 − g / extent), rounded and clipped at 0, where g [m]
+       is the distance of the pixel centre to the goal line x = ``goal_x``
+       (the minimum image of it when x is periodic);
+    3. heading: the constant 255 (heading mod 2π) / 2π, rounded.
+
+Both sensors first keep the floes within reach of the ship by one
+vectorised distance test, so their cost grows with the number of floes
+with a small constant and otherwise with the ice near the ship.
+
+Example
+-------
+>>> import numpy as np
+>>> from iceenvs.ship_sensors import ice_lidar
+>>> distance, concentration = ice_lidar((0.0, 0.0), 0.0, np.array([[50.0, 0.0]]),
+...                                     np.array([5.0]), sectors=3)
+>>> distance.tolist()
+[200.0, 45.0, 200.0]
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from physics.params import check_range
+
+__all__ = ["ice_lidar", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
+
+#: radial sample points per lidar sector (the concentration grid)
+LIDAR_RINGS = 8
+#: angular sample points per lidar sector (the concentration grid)
+LIDAR_RAYS = 4
+
+_TWO_PI = 2.0 * math.pi
+
+
+# -- validation ------------------------------------------------------------------------------
+
+def _check_int(name: str, value, low: int) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer ≥ {low}, got {value!r}")
+    if value < low:
+        raise ValueError(f"{name} must be an integer ≥ {low}, got {value!r}")
+    return int(value)
+
+
+def _check_pose(ship_xy, heading) -> tuple[np.ndarray, float]:
+    try:
+        xy = np.asarray(ship_xy, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"ship_xy must be a pair of finite numbers, got {ship_xy!r}") from None
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+        raise ValueError(f"ship_xy must be a pair of finite numbers, got {ship_xy!r}")
+    check_range("heading", heading)
+    return xy, float(heading)
+
+
+def _check_floes(positions, radii) -> tuple[np.ndarray, np.ndarray]:
+    p = np.asarray(positions, dtype=float)
+    r = np.asarray(radii, dtype=float)
+    if p.size == 0 and r.size == 0:
+        return np.empty((0, 2)), np.empty(0)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise ValueError(f"positions must be an (N, 2) array, got shape {p.shape}")
+    if r.shape != (p.shape[0],):
+        raise ValueError(f"radii must be an (N,) array with N = {p.shape[0]} (one per "
+                         f"position), got shape {r.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("positions must be finite")
+    if not (np.all(np.isfinite(r)) and np.all(r > 0.0)):
+        raise ValueError("radii must be finite and positive")
+    return p, r
+
+
+def _check_box(box_lengths, periodic) -> tuple[np.ndarray | None, tuple[bool, bool]]:
+    try:
+        px, py = periodic
+    except (TypeError, ValueError):
+        raise ValueError(f"periodic must be a pair of booleans, got {periodic!r}") from None
+    per = (bool(px), bool(py))
+    if box_lengths is None:
+        if any(per):
+            raise ValueError("box_lengths must be given when an axis is periodic")
+        return None, per
+    lengths = np.asarray(box_lengths, dtype=float)
+    if lengths.shape != (2,) or not (np.all(np.isfinite(lengths)) and np.all(lengths > 0.0)):
+        raise ValueError(f"box_lengths must be two finite positive lengths, got {box_lengths!r}")
+    return lengths, per
+
+
+def _minimum_image(d: np.ndarray, lengths, periodic) -> np.ndarray:
+    """Displacements ``d`` (..., 2) in minimum-image form, in place."""
+    if lengths is not None:
+        for k in range(2):
+            if periodic[k]:
+                d[..., k] -= lengths[k] * np.floor(d[..., k] / lengths[k] + 0.5)
+    return d
+
+
+def _nearby(ship_xy, positions, radii, reach, lengths, periodic):
+    """Displacements (M, 2) and radii (M,) of the floes whose disc comes
+    within ``reach`` of the ship."""
+    d = _minimum_image(positions - ship_xy, lengths, periodic)
+    limit = reach + radii
+    near = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] <= limit * limit
+    return d[near], radii[near]
+
+
+def _angle_intervals(bearing, half, step, n):
+    """Grid angles within ``half`` of ``bearing`` (both [rad], bearings from
+    the start of the field of view, in [0, 2π)): for the grid angles
+    (j + 1/2) step, j = 0 … n − 1, the index ranges [lo, hi] as
+    (item, lo, hi), an item giving up to three ranges (the wrap at 2π)."""
+    items, lows, highs = [], [], []
+    for shift in (-_TWO_PI, 0.0, _TWO_PI):
+        lo = np.maximum(np.ceil((bearing - half + shift) / step - 0.5), 0.0)
+        hi = np.minimum(np.floor((bearing + half + shift) / step - 0.5), n - 1.0)
+        ok = np.nonzero(lo <= hi)[0]
+        items.append(ok)
+        lows.append(lo[ok].astype(np.intp))
+        highs.append(hi[ok].astype(np.intp))
+    return np.concatenate(items), np.concatenate(lows), np.concatenate(highs)
+
+
+def _expand(item, lo, hi):
+    """Every (item, index) pair of the index ranges [lo, hi]."""
+    count = hi - lo + 1
+    total = int(count.sum())
+    each = np.repeat(item, count)
+    index = np.arange(total) - np.repeat(np.cumsum(count) - count - lo, count)
+    return each, index
+
+
+# -- lidar -----------------------------------------------------------------------------------
+
+def ice_lidar(ship_xy, heading: float, positions, radii, *, sectors: int = 9,
+              fov: float = math.pi, max_range: float = 200.0, box_lengths=None,
+              periodic=(False, False)) -> tuple[np.ndarray, np.ndarray]:
+    """Distance to the nearest floe and ice concentration per angular sector.
+
+    Parameters
+    ----------
+    ship_xy : (2,) array_like
+        Ship position [m].
+    heading : float
+        Ship heading [rad, anticlockwise from +x].
+    positions : (N, 2) array_like
+        Floe centres [m].
+    radii : (N,) array_like
+        Floe radii [m], positive.
+    sectors : int
+        Number K ≥ 1 of equal sectors of the field of view.
+    fov : float
+        Field of view [rad], 0 < fov ≤ 2π, centred on the heading.
+    max_range : float
+        Range [m] > 0 of the sensor.
+    box_lengths : (2,) array_like, optional
+        Box side lengths [m]; needed when an axis is periodic.
+    periodic : (bool, bool)
+        Periodicity along x and y (minimum-image displacements).
+
+    Returns
+    -------
+    distance : (K,) float array
+        Per sector, the distance [m] along its central ray to the first floe
+        edge, 0 inside a floe, ``max_range`` when nothing is hit.
+    concentration : (K,) float array
+        Per sector, the fraction [-] of its wedge of radius ``max_range``
+        covered by floes (on the sample grid, see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        An argument out of range or of the wrong shape; the message names it.
+    """
+    xy, heading = _check_pose(ship_xy, heading)
+    k = _check_int("sectors", sectors, 1)
+    check_range("fov", fov, 0.0, _TWO_PI, low_open=True)
+    check_range("max_range", max_range, 0.0, None, low_open=True)
+    p, r = _check_floes(positions, radii)
+    lengths, per = _check_box(box_lengths, periodic)
+    fov, max_range = float(fov), float(max_range)
+
+    distance = np.full(k, max_range)
+    concentration = np.zeros(k)
+    d, r = _nearby(xy, p, r, max_range, lengths, per)
+    if r.size == 0:
+        return distance, concentration
+    inside = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] <= r * r
+    if np.any(inside):
+        distance[:] = 0.0
+    start = heading - 0.5 * fov
+    dist = np.hypot(d[:, 0], d[:, 1])
+    bearing = np.mod(np.arctan2(d[:, 1], d[:, 0]) - start, _TWO_PI)
+
+    # distance: a ray meets a disc outside the ship when its angle lies within
+    # asin(r / dist) of the disc's bearing; only those (ray, disc) pairs are solved
+    if not np.any(inside):
+        step = fov / k
+        floe, lo, hi = _angle_intervals(bearing, np.arcsin(r / dist), step, k)
+        floe, ray = _expand(floe, lo, hi)
+        if ray.size:
+            theta = start + (ray + 0.5) * step
+            dx, dy = d[floe, 0], d[floe, 1]
+            along = dx * np.cos(theta) + dy * np.sin(theta)
+            across = dx * np.sin(theta) - dy * np.cos(theta)
+            chord = np.sqrt(np.maximum(r[floe] ** 2 - across * across, 0.0))
+            np.minimum.at(distance, ray, along - chord)
+
+    # concentration: on ring i a disc covers the sample angles within an
+    # interval of half-width arccos((rho_i² + dist² − r²) / (2 rho_i dist))
+    # around its bearing, marked with a difference array
+    n_ang = k * LIDAR_RAYS
+    rho = max_range * np.sqrt((np.arange(LIDAR_RINGS) + 0.5) / LIDAR_RINGS)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos_half = (rho[:, None] ** 2 + dist * dist - r * r) / (2.0 * rho[:, None] * dist)
+    at_centre = dist == 0.0
+    if np.any(at_centre):
+        cos_half[:, at_centre] = np.where(rho[:, None] <= r[at_centre], -2.0, 2.0)
+    ring, floe = np.nonzero(cos_half <= 1.0)
+    half = np.arccos(np.maximum(cos_half[ring, floe], -1.0))
+    pair, lo, hi = _angle_intervals(bearing[floe], half, fov / n_ang, n_ang)
+    base = ring[pair] * (n_ang + 1)
+    width = LIDAR_RINGS * (n_ang + 1)
+    marks = (np.bincount(base + lo, minlength=width)
+             - np.bincount(base + hi + 1, minlength=width))
+    covered = np.cumsum(marks.reshape(LIDAR_RINGS, n_ang + 1), axis=1)[:, :n_ang] > 0
+    concentration = covered.reshape(LIDAR_RINGS, k, LIDAR_RAYS).mean(axis=(0, 2))
+    return distance, concentration
+
+
+# -- occupancy image -------------------------------------------------------------------------
+
+def _check_hull(hull_vertices) -> np.ndarray:
+    v = np.asarray(hull_vertices, dtype=float)
+    if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
+        raise ValueError(f"hull_vertices must be a (K, 2) array with K ≥ 3, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("hull_vertices must be finite")
+    edges = np.roll(v, -1, axis=0) - v
+    area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+    if area2 <= 0.0:
+        raise ValueError("hull_vertices must run counter-clockwise and enclose an area")
+    turn = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
+    side = np.hypot(edges[:, 0], edges[:, 1])
+    if np.any(turn < -1e-12 * side * np.roll(side, -1)):
+        raise ValueError("hull_vertices must be a convex polygon")
+    return v
+
+
+def _pixel_ranges(centre, radius, half_extent, pixel, size):
+    """First and last index of the pixel centres within ``centre ± radius``
+    along one image axis (the axis' coordinate falls with the index)."""
+    first = np.ceil((half_extent - (centre + radius)) / pixel - 0.5)
+    last = np.floor((half_extent - (centre - radius)) / pixel - 0.5)
+    first = np.clip(first, 0.0, size).astype(np.intp)
+    last = np.clip(last, -1.0, size - 1.0).astype(np.intp)
+    return first, last
+
+
+def occupancy_image(ship_xy, heading: float, positions, radii, hull_vertices, goal_x: float,
+                    *, size: int = 64, extent: float = 100.0, box_lengths=None,
+                    periodic=(False, False)) -> np.ndarray:
+    """Egocentric picture of ice, hull, goal distance and heading.
+
+    Parameters
+    ----------
+    ship_xy : (2,) array_like
+        Ship position [m], the centre of the image.
+    heading : float
+        Ship heading [rad, anticlockwise from +x], pointing up in the image.
+    positions : (N, 2) array_like
+        Floe centres [m].
+    radii : (N,) array_like
+        Floe radii [m], positive.
+    hull_vertices : (K, 2) array_like
+        The hull's corners in the world frame [m], convex, counter-clockwise.
+    goal_x : float
+        Position [m] of the goal line x = goal_x.
+    size : int
+        Image side in pixels, ≥ 8.
+    extent : float
+        Side [m] > 0 of the square the image covers.
+    box_lengths : (2,) array_like, optional
+        Box side lengths [m]; needed when an axis is periodic.
+    periodic : (bool, bool)
+        Periodicity along x and y (minimum-image displacements).
+
+    Returns
+    -------
+    (4, size, size) uint8 array
+        Channels ice, hull, goal and heading (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        An argument out of range or of the wrong shape; the message names it.
+    """
+    xy, heading = _check_pose(ship_xy, heading)
+    p, r = _check_floes(positions, radii)
+    hull = _check_hull(hull_vertices)
+    check_range("goal_x", goal_x)
+    size = _check_int("size", size, 8)
+    check_range("extent", extent, 0.0, None, low_open=True)
+    lengths, per = _check_box(box_lengths, periodic)
+    extent = float(extent)
+
+    image = np.zeros((4, size, size), dtype=np.uint8)
+    half_extent = 0.5 * extent
+    pixel = extent / size
+    # ship-frame coordinate of the pixel centres: x along rows, y along columns
+    centres = half_extent - (np.arange(size) + 0.5) * pixel
+    c, s = math.cos(heading), math.sin(heading)
+
+    # 0: ice, each nearby floe tested on the pixels of its bounding box only
+    d, r = _nearby(xy, p, r, half_extent * math.sqrt(2.0), lengths, per)
+    if r.size:
+        fx = c * d[:, 0] + s * d[:, 1]
+        fy = -s * d[:, 0] + c * d[:, 1]
+        row0, row1 = _pixel_ranges(fx, r, half_extent, pixel, size)
+        col0, col1 = _pixel_ranges(fy, r, half_extent, pixel, size)
+        rows_n = np.maximum(row1 - row0 + 1, 0)
+        cols_n = np.maximum(col1 - col0 + 1, 0)
+        count = rows_n * cols_n
+        if np.any(count):
+            floe, local = _expand(np.arange(r.size), np.zeros_like(count), count - 1)
+            width = cols_n[floe]
+            rows = row0[floe] + local // width
+            cols = col0[floe] + local % width
+            ex = centres[rows] - fx[floe]
+            ey = centres[cols] - fy[floe]
+            inside = ex * ex + ey * ey <= r[floe] ** 2
+            image[0, rows[inside], cols[inside]] = 255
+
+    # 1: hull, pixel centres on the inner side of every edge
+    v = _minimum_image(hull - xy, lengths, per)
+    hx = c * v[:, 0] + s * v[:, 1]
+    hy = -s * v[:, 0] + c * v[:, 1]
+    row0, row1 = _pixel_ranges(0.5 * (hx.max() + hx.min()), 0.5 * (hx.max() - hx.min()),
+                               half_extent, pixel, size)
+    col0, col1 = _pixel_ranges(0.5 * (hy.max() + hy.min()), 0.5 * (hy.max() - hy.min()),
+                               half_extent, pixel, size)
+    if row0 <= row1 and col0 <= col1:
+        px = centres[row0:row1 + 1][:, None]
+        py = centres[col0:col1 + 1][None, :]
+        inside = np.ones((row1 - row0 + 1, col1 - col0 + 1), dtype=bool)
+        ex, ey = np.roll(hx, -1) - hx, np.roll(hy, -1) - hy
+        for j in range(hx.size):
+            inside &= ex[j] * (py - hy[j]) - ey[j] * (px - hx[j]) >= 0.0
+        image[1, row0:row1 + 1, col0:col1 + 1][inside] = 255
+
+    # 2: goal, a linear ramp of the distance to the line x = goal_x
+    world_x = xy[0] + c * centres[:, None] - s * centres[None, :]
+    gap = world_x - float(goal_x)
+    if lengths is not None and per[0]:
+        gap -= lengths[0] * np.floor(gap / lengths[0] + 0.5)
+    ramp = 255.0 * (1.0 - np.abs(gap) / extent)
+    image[2] = np.rint(np.clip(ramp, 0.0, 255.0)).astype(np.uint8)
+
+    # 3: heading
+    image[3] = min(int(round(255.0 * (heading % _TWO_PI) / _TWO_PI)), 255)
+    return image

@@ -1,0 +1,338 @@
+"""Tests of iceenvs.ship_sensors: the sector lidar and the egocentric occupancy
+image against analytic geometry and against direct per-ray, per-sample and
+per-pixel evaluation of the documented conventions."""
+import math
+
+import numpy as np
+import pytest
+
+from iceenvs.ship_sensors import LIDAR_RAYS, LIDAR_RINGS, ice_lidar, occupancy_image
+
+TWO_PI = 2.0 * math.pi
+
+
+def unit(angle):
+    return np.array([math.cos(angle), math.sin(angle)])
+
+
+def rectangle_hull(centre, heading, length, beam):
+    """World corners, anticlockwise, of a length × beam rectangle."""
+    local = np.array([[-0.5 * length, -0.5 * beam], [0.5 * length, -0.5 * beam],
+                      [0.5 * length, 0.5 * beam], [-0.5 * length, 0.5 * beam]])
+    c, s = math.cos(heading), math.sin(heading)
+    return np.asarray(centre) + local @ np.array([[c, s], [-s, c]])
+
+
+# -- direct evaluation of the documented conventions ------------------------------------------
+
+def lidar_by_hand(ship, heading, positions, radii, sectors, fov, max_range):
+    """Per-ray and per-sample evaluation, floe by floe (no periodicity)."""
+    d = np.asarray(positions, float) - ship
+    start = heading - 0.5 * fov
+    distance = np.full(sectors, max_range)
+    for k in range(sectors):
+        u = unit(start + (k + 0.5) * fov / sectors)
+        for (dx, dy), r in zip(d, radii):
+            if dx * dx + dy * dy <= r * r:
+                distance[k] = 0.0
+                continue
+            along = dx * u[0] + dy * u[1]
+            across = dx * u[1] - dy * u[0]
+            if along > 0.0 and abs(across) <= r:
+                distance[k] = min(distance[k], along - math.sqrt(r * r - across * across))
+    rho = max_range * np.sqrt((np.arange(LIDAR_RINGS) + 0.5) / LIDAR_RINGS)
+    width = fov / sectors
+    concentration = np.zeros(sectors)
+    for k in range(sectors):
+        phi = start + k * width + (np.arange(LIDAR_RAYS) + 0.5) * width / LIDAR_RAYS
+        pts = (rho[:, None, None] * np.stack([np.cos(phi), np.sin(phi)], -1)[None]).reshape(-1, 2)
+        gap = pts[:, None, :] - d[None, :, :]
+        inside = np.any(np.sum(gap * gap, axis=-1) <= np.asarray(radii) ** 2, axis=1)
+        concentration[k] = inside.mean()
+    return distance, concentration
+
+
+def pixel_world_points(ship, heading, size, extent):
+    """(size, size, 2) world coordinates of the pixel centres."""
+    centres = 0.5 * extent - (np.arange(size) + 0.5) * extent / size
+    forward, port = unit(heading), unit(heading + 0.5 * math.pi)
+    return (np.asarray(ship)[None, None, :] + centres[:, None, None] * forward
+            + centres[None, :, None] * port)
+
+
+# -- lidar: distance ----------------------------------------------------------------------------
+
+def test_floe_straight_ahead_is_seen_by_the_central_sector_only():
+    ship, heading = np.array([10.0, -3.0]), 1.1
+    d, r = 50.0, 5.0
+    distance, _ = ice_lidar(ship, heading, [ship + d * unit(heading)], [r])
+    assert distance.shape == (9,) and distance.dtype == float
+    assert distance[4] == pytest.approx(d - r, abs=1e-9)
+    # the neighbouring rays (±20°) pass 50 sin 20° ≈ 17 m > 5 m from the centre
+    assert np.all(np.delete(distance, 4) == 200.0)
+
+
+def test_floe_at_port_moves_between_sectors_with_the_heading():
+    # 18 sectors of 20° over the full circle, sector 0 centred on heading − 170°:
+    # the ray of sector k looks towards heading − 170° + 20° k
+    floe, r = np.array([[0.0, 50.0]]), np.array([2.0])
+    for heading, expected in ((0.0, 13), (math.radians(20.0), 12), (math.radians(-40.0), 15)):
+        distance, _ = ice_lidar((0.0, 0.0), heading, floe, r, sectors=18, fov=TWO_PI)
+        assert np.flatnonzero(distance < 200.0).tolist() == [expected]
+        assert distance[expected] == pytest.approx(48.0, abs=1e-9)
+
+
+def test_floe_behind_or_beyond_range_is_not_seen():
+    distance, _ = ice_lidar((0.0, 0.0), 0.0, [[-50.0, 0.0], [206.0, 0.0]], [5.0, 5.0])
+    assert np.all(distance == 200.0)
+    # a disc whose edge comes within range counts although its centre lies beyond it
+    distance, _ = ice_lidar((0.0, 0.0), 0.0, [[203.0, 0.0]], [5.0])
+    assert distance[4] == pytest.approx(198.0, abs=1e-9)
+
+
+def test_nearest_of_two_floes_on_one_ray():
+    distance, _ = ice_lidar((0.0, 0.0), 0.0, [[80.0, 0.0], [30.0, 1.0]], [10.0, 3.0])
+    assert distance[4] == pytest.approx(30.0 - math.sqrt(9.0 - 1.0), abs=1e-9)
+
+
+def test_ray_starting_inside_a_floe_reads_zero():
+    distance, _ = ice_lidar((0.0, 0.0), 0.3, [[1.0, 0.5], [60.0, 0.0]], [4.0, 5.0])
+    assert np.all(distance == 0.0)
+    # with a range of 10 m the inner ring (2.5 m) lies inside the floe all round
+    distance, concentration = ice_lidar((0.0, 0.0), 0.3, [[1.0, 0.5]], [4.0], max_range=10.0)
+    assert np.all(distance == 0.0)
+    assert np.all(concentration >= 1.0 / LIDAR_RINGS)
+    # the ship at the centre of a 5 m floe, range 10 m: the rings at 10 sqrt((i + 1/2) / 8) m
+    # inside it are i = 0, 1
+    distance, concentration = ice_lidar((3.0, 4.0), 2.0, [[3.0, 4.0]], [5.0], max_range=10.0,
+                                        sectors=4, fov=TWO_PI)
+    assert np.all(distance == 0.0)
+    np.testing.assert_allclose(concentration, 2.0 / LIDAR_RINGS, rtol=0.0, atol=1e-12)
+
+
+def test_periodic_wrap_uses_the_minimum_image():
+    box = (1000.0, 800.0)
+    # across the right edge (x): the floe at x = 40 is 50 m ahead of the ship at x = 990
+    distance, _ = ice_lidar((990.0, 400.0), 0.0, [[40.0, 400.0]], [5.0], box_lengths=box,
+                            periodic=(True, False))
+    assert distance[4] == pytest.approx(45.0, abs=1e-9)
+    distance, _ = ice_lidar((990.0, 400.0), 0.0, [[40.0, 400.0]], [5.0])
+    assert np.all(distance == 200.0)
+    # across the top edge (y), the ship heading north
+    distance, _ = ice_lidar((500.0, 795.0), 0.5 * math.pi, [[500.0, 30.0]], [5.0],
+                            box_lengths=box, periodic=(False, True))
+    assert distance[4] == pytest.approx(30.0, abs=1e-9)
+
+
+def test_lidar_matches_ray_by_ray_and_sample_by_sample_evaluation():
+    rng = np.random.default_rng(3)
+    for sectors, fov, heading in ((9, math.pi, 0.4), (7, 2.0, -2.9), (12, TWO_PI, 3.0),
+                                  (1, 0.3, 1.0), (5, TWO_PI, -0.2)):
+        ship = rng.uniform(-20.0, 20.0, 2)
+        positions = rng.uniform(-150.0, 150.0, (120, 2))
+        radii = rng.uniform(1.0, 12.0, 120)
+        keep = np.hypot(*(positions - ship).T) > radii          # the ship in open water
+        positions, radii = positions[keep], radii[keep]
+        got = ice_lidar(ship, heading, positions, radii, sectors=sectors, fov=fov,
+                        max_range=120.0)
+        want = lidar_by_hand(ship, heading, positions, radii, sectors, fov, 120.0)
+        np.testing.assert_allclose(got[0], want[0], rtol=0.0, atol=1e-9)
+        np.testing.assert_allclose(got[1], want[1], rtol=0.0, atol=1e-12)
+
+
+# -- lidar: concentration -----------------------------------------------------------------------
+
+def test_concentration_of_open_water_and_of_a_covering_floe():
+    distance, concentration = ice_lidar((0.0, 0.0), 0.0, np.empty((0, 2)), np.empty(0))
+    assert np.all(concentration == 0.0) and np.all(distance == 200.0)
+    _, concentration = ice_lidar((0.0, 0.0), 0.0, [[30.0, -20.0]], [1000.0])
+    assert np.all(concentration == 1.0)
+
+
+def test_concentration_of_a_half_plane():
+    # a disc of radius 1e6 m whose edge runs along x, 1 m to starboard of the ship
+    big = 1e6
+    floe, r = [[0.0, -big - 1.0]], [big]
+    distance, concentration = ice_lidar((0.0, 0.0), 0.0, floe, r, sectors=2, fov=TWO_PI)
+    assert concentration.tolist() == [1.0, 0.0]            # starboard half, port half
+    # the starboard ray (−90°) meets the edge 1 m away, the port ray runs clear of it
+    assert distance[0] == pytest.approx(1.0, abs=1e-9) and distance[1] == 200.0
+    _, concentration = ice_lidar((0.0, 0.0), 0.0, floe, r, sectors=1)
+    assert concentration[0] == pytest.approx(0.5, abs=1e-12)
+
+
+def test_concentration_of_a_poisson_field():
+    # discs of radius 1 m at density n: covered fraction 1 − exp(−n π r²)
+    rng = np.random.default_rng(11)
+    side, r, target = 500.0, 1.0, 0.3
+    n = int(round(-math.log(1.0 - target) / (math.pi * r * r) * side * side))
+    positions = rng.uniform(0.0, side, (n, 2))
+    _, concentration = ice_lidar((250.0, 250.0), 0.7, positions, np.full(n, r), sectors=36,
+                                 fov=TWO_PI, max_range=200.0, box_lengths=(side, side),
+                                 periodic=(True, True))
+    assert concentration.mean() == pytest.approx(target, abs=0.08)
+    assert np.all((concentration >= 0.0) & (concentration <= 1.0))
+
+
+# -- occupancy image ----------------------------------------------------------------------------
+
+SIZE, EXTENT = 64, 100.0
+PIXEL_AREA = (EXTENT / SIZE) ** 2
+
+
+def image(ship, heading, positions, radii, hull=None, goal_x=1e3, **kw):
+    if hull is None:
+        hull = rectangle_hull(ship, heading, 20.0, 6.0)
+    return occupancy_image(ship, heading, np.asarray(positions, float).reshape(-1, 2),
+                           np.asarray(radii, float), hull, goal_x, **kw)
+
+
+def centroid(mask):
+    rows, cols = np.nonzero(mask)
+    return rows.mean(), cols.mean()
+
+
+def test_image_shape_and_dtype():
+    img = image((5.0, 5.0), 0.2, np.empty((0, 2)), np.empty(0))
+    assert img.shape == (4, SIZE, SIZE) and img.dtype == np.uint8
+    assert not img[0].any()
+    assert image((5.0, 5.0), 0.2, [], [], size=16).shape == (4, 16, 16)
+
+
+def test_floe_ahead_is_above_the_centre_and_floe_to_port_on_the_left():
+    ship, heading, r = np.array([100.0, 50.0]), 0.6, 8.0
+    expected = math.pi * r * r / PIXEL_AREA
+    # the centre of a floe 25 m ahead lies at row (50 − 25) / (100 / 64) − 1/2 = 15.5
+    ahead = image(ship, heading, ship + 25.0 * unit(heading), [r])[0]
+    assert set(np.unique(ahead)) == {0, 255}
+    assert (ahead > 0).sum() == pytest.approx(expected, rel=0.15)
+    row, col = centroid(ahead > 0)
+    assert row == pytest.approx(15.5, abs=0.5) and col == pytest.approx(31.5, abs=0.5)
+    port = image(ship, heading, ship + 25.0 * unit(heading + 0.5 * math.pi), [r])[0]
+    assert (port > 0).sum() == pytest.approx(expected, rel=0.15)
+    row, col = centroid(port > 0)
+    assert row == pytest.approx(31.5, abs=0.5) and col == pytest.approx(15.5, abs=0.5)
+
+
+def test_ice_channel_matches_pixel_by_pixel_evaluation():
+    rng = np.random.default_rng(5)
+    ship, heading, size, extent = np.array([3.0, -7.0]), -2.2, 32, 80.0
+    positions = ship + rng.uniform(-70.0, 70.0, (150, 2))
+    radii = rng.uniform(0.5, 9.0, 150)
+    got = image(ship, heading, positions, radii, size=size, extent=extent)[0]
+    pts = pixel_world_points(ship, heading, size, extent)
+    gap = pts[:, :, None, :] - positions[None, None]
+    want = np.any(np.sum(gap * gap, axis=-1) <= radii ** 2, axis=-1)
+    np.testing.assert_array_equal(got == 255, want)
+    assert np.all((got == 0) | (got == 255))
+
+
+def test_ice_channel_of_a_covering_floe_and_through_a_periodic_edge():
+    assert np.all(image((0.0, 0.0), 1.0, [[10.0, 10.0]], [500.0])[0] == 255)
+    wrapped = image((995.0, 500.0), 0.0, [[20.0, 500.0]], [5.0], box_lengths=(1000.0, 1000.0),
+                    periodic=(True, True))[0]
+    plain = image((0.0, 500.0), 0.0, [[25.0, 500.0]], [5.0])[0]
+    assert plain.any()
+    np.testing.assert_array_equal(wrapped, plain)
+
+
+def test_hull_channel_covers_the_hull_area():
+    ship, heading = np.array([40.0, 60.0]), 0.6
+    hull = rectangle_hull(ship, heading, 40.0, 10.0)
+    mask = image(ship, heading, [], [], hull=hull)[1] > 0
+    assert mask.sum() == pytest.approx(400.0 / PIXEL_AREA, rel=0.15)
+    rows, cols = np.nonzero(mask)
+    assert np.ptp(rows) > 3 * np.ptp(cols)                   # the bow points up
+    assert rows.mean() == pytest.approx(31.5, abs=0.5)
+    assert cols.mean() == pytest.approx(31.5, abs=0.5)
+    # a hull given in the world frame stays where it is when the image turns
+    off = rectangle_hull(ship + 20.0 * unit(heading), heading, 10.0, 10.0)
+    row, col = centroid(image(ship, heading, [], [], hull=off)[1] > 0)
+    assert row == pytest.approx(31.5 - 20.0 * SIZE / EXTENT, abs=0.5)
+    assert col == pytest.approx(31.5, abs=0.5)
+
+
+def test_goal_channel_is_a_ramp_of_the_distance_to_the_goal_line():
+    ship, goal_x = np.array([0.0, 10.0]), 30.0
+    goal = image(ship, 0.0, [], [], goal_x=goal_x)[2].astype(int)
+    # heading +x: every row is one distance; the row nearest x = 30 is row 12 (x = 30.47)
+    assert np.all(goal == goal[:, :1])
+    assert int(np.argmax(goal[:, 0])) == 12
+    assert goal[12, 0] >= 255 * (1.0 - 0.5 * EXTENT / SIZE / EXTENT) - 1
+    assert np.all(np.diff(goal[:13, 0]) >= 0) and np.all(np.diff(goal[12:, 0]) <= 0)
+    # the bottom row (x = −49.2 m) lies 79.2 m from the line
+    assert goal[-1, 0] == round(255 * (1.0 - 79.21875 / EXTENT))
+    assert not image(ship, 0.0, [], [], goal_x=150.0)[2].any()   # ≥ 100 m everywhere
+    for heading, periodic, box in ((0.0, (False, False), None), (1.3, (False, False), None),
+                                   (-2.0, (True, False), (70.0, 50.0))):
+        got = image(ship, heading, [], [], goal_x=goal_x, box_lengths=box,
+                    periodic=periodic)[2].astype(int)
+        gap = pixel_world_points(ship, heading, SIZE, EXTENT)[..., 0] - goal_x
+        if box is not None:
+            gap -= box[0] * np.round(gap / box[0])
+        want = np.clip(255.0 * (1.0 - np.abs(gap) / EXTENT), 0.0, 255.0)
+        assert np.max(np.abs(got - want)) <= 1.0
+
+
+def test_heading_channel_encodes_the_heading():
+    for heading in (0.0, 1.0, -1.0, 7.0, math.pi, -12.5):
+        channel = image((0.0, 0.0), heading, [], [])[3].astype(int)
+        assert np.all(channel == channel[0, 0])
+        assert abs(channel[0, 0] - round(255 * (heading % TWO_PI) / TWO_PI)) <= 1
+
+
+# -- validation ---------------------------------------------------------------------------------
+
+FLOE = dict(positions=[[1.0, 2.0]], radii=[1.0])
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(sectors=0), "sectors"),
+    (dict(sectors=2.5), "sectors"),
+    (dict(sectors=True), "sectors"),
+    (dict(fov=0.0), "fov"),
+    (dict(fov=7.0), "fov"),
+    (dict(max_range=0.0), "max_range"),
+    (dict(max_range=float("nan")), "max_range"),
+    (dict(positions=[[1.0, 2.0, 3.0]]), "positions"),
+    (dict(positions=[[1.0, float("inf")]]), "positions"),
+    (dict(radii=[1.0, 2.0]), "radii"),
+    (dict(radii=[-1.0]), "radii"),
+    (dict(radii=[0.0]), "radii"),
+    (dict(ship_xy=(0.0, float("nan"))), "ship_xy"),
+    (dict(ship_xy=(0.0, 1.0, 2.0)), "ship_xy"),
+    (dict(heading=float("inf")), "heading"),
+    (dict(periodic=(True, False)), "box_lengths"),
+    (dict(box_lengths=(10.0, -1.0), periodic=(True, True)), "box_lengths"),
+    (dict(periodic=True), "periodic"),
+])
+def test_lidar_rejects_bad_input(kwargs, name):
+    args = dict(ship_xy=(0.0, 0.0), heading=0.0, **FLOE)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=name):
+        ice_lidar(args.pop("ship_xy"), args.pop("heading"), args.pop("positions"),
+                  args.pop("radii"), **args)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(size=4), "size"),
+    (dict(size=64.0), "size"),
+    (dict(extent=0.0), "extent"),
+    (dict(extent=-5.0), "extent"),
+    (dict(goal_x=float("nan")), "goal_x"),
+    (dict(hull_vertices=[[0.0, 0.0], [1.0, 0.0]]), "hull_vertices"),
+    (dict(hull_vertices=[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]), "hull_vertices"),   # clockwise
+    (dict(hull_vertices=[[0.0, 0.0], [2.0, 0.0], [1.0, 0.2], [1.0, 1.0]]), "hull_vertices"),
+    (dict(radii=[-1.0]), "radii"),
+    (dict(heading=float("nan")), "heading"),
+    (dict(periodic=(False, True)), "box_lengths"),
+])
+def test_image_rejects_bad_input(kwargs, name):
+    args = dict(ship_xy=(0.0, 0.0), heading=0.0,
+                hull_vertices=[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
+                goal_x=10.0, **FLOE)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=name):
+        occupancy_image(args.pop("ship_xy"), args.pop("heading"), args.pop("positions"),
+                        args.pop("radii"), args.pop("hull_vertices"), args.pop("goal_x"),
+                        **args)
