@@ -1106,13 +1106,12 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             verlet.centre[0] = mx / n
             verlet.centre[1] = my / n
             expired = list_expired(worst, lx, ly, verlet)
-        if expired and ship.active and not box.deforming:
-            verlet = rebuild(floes, verlet, lx, ly, px, py, parallel,
-                             ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
-            chunks = pair_chunks(verlet, n_pair)
-            n_rebuilds += 1
-        elif expired:
-            verlet = rebuild(floes, verlet, lx, ly, px, py, parallel)
+        if expired:
+            if ship.active and not box.deforming:
+                verlet = rebuild(floes, verlet, lx, ly, px, py, parallel,
+                                 ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
+            else:
+                verlet = rebuild(floes, verlet, lx, ly, px, py, parallel)
             chunks = pair_chunks(verlet, n_pair)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces

@@ -264,7 +264,6 @@ def pack_ice(p: dict, concentration: float, seed: int, walls: bool = False):
     if walls:
         # rigid walls on all four sides: the lee wall (the coast) at y = 0
         box = Box(x1 + p["wall_gap"], width, periodic=(False, False))
-        box.band = (x0 - 1e-9, x1 + 1e-9)
         end_bow = min(end_bow, x1 + p["wall_gap"] - max(p["walled_finish"], WALL_CLEARANCE))
         y_ship = p["ship_offset"] * width
     else:
