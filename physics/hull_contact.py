@@ -67,7 +67,7 @@ __all__ = ["ShipBundle", "RECORD_COLUMNS", "LOG_COLUMNS", "ship_kick_drift", "hu
 
 #: columns of a step record (one row per step, :attr:`ShipBundle.record`)
 RECORD_COLUMNS = ("time", "x", "y", "heading", "surge", "sway", "yaw_rate", "ice_surge",
-                  "ice_sway", "ice_moment", "ice_power", "contacts")
+                  "ice_sway", "ice_moment", "ice_power", "contacts", "normal_force")
 #: columns of the collision log (one row per finished collision)
 LOG_COLUMNS = ("start", "end", "floe", "impulse_surge", "impulse_sway", "point_x", "point_y",
                "floe_mass", "peak_force")
@@ -390,6 +390,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
     fsy = 0.0
     ns = 0.0
     power = 0.0
+    normal = 0.0
     n_touch = 0
     room = True
     for k in range(counts[C_CAND]):
@@ -408,6 +409,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
             fsy -= fy
             ns += res[4]
             power += res[12]
+            normal += res[7]
             n_touch += 1
             # the impulse on the hull, in the ship frame
             jx = -(c * fx + sn * fy) * dt
@@ -461,6 +463,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
         rec[row, 9] = ns
         rec[row, 10] = power
         rec[row, 11] = n_touch
+        rec[row, 12] = normal
         counts[C_RECORD] = row + 1
     # a log with fewer free rows than the list has floes could overflow next step
     if log.shape[0] - counts[C_LOG] <= counts[C_CAND]:

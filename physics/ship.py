@@ -578,7 +578,9 @@ class ShipState:
         """Every step since the start (or :meth:`clear`) as arrays, one per
         column of :data:`~physics.hull_contact.RECORD_COLUMNS`: time, pose,
         velocities (ship frame), ice force (surge, sway) and moment, the
-        power of the hull on the ice and the number of floes touching."""
+        power of the hull on the ice, the number of floes touching and the
+        sum of their normal contact forces [N] (what presses on the hull,
+        also when the resultant cancels)."""
         rows = (np.concatenate(self._records) if self._records
                 else np.zeros((0, len(HC.RECORD_COLUMNS))))
         return {name: rows[:, k].copy() for k, name in enumerate(HC.RECORD_COLUMNS)}

@@ -380,3 +380,28 @@ def test_floes_list_with_a_ship_misses_no_floe_contact():
         wide = max(wide, sim._verlet.skin_max)
     assert sim.ship.position[0] > 120.0 and seen > 500
     assert sim.n_rebuilds > 3 and wide > 3.0 * sim.skin
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.2])
+def test_normal_force_record_is_the_sum_of_the_contact_normals(mu):
+    """The step record's ``normal_force`` of one floe sliding along the side
+    of a passing ship: with no friction the only force is the normal one,
+    so it equals the magnitude of the ice force; with friction μ the force
+    of one contact lies between Fn and Fn √(1 + μ²) (Coulomb), and in gross
+    sliding it reaches the top."""
+    hull = Hull.box(30.0, 4.0)
+    sim, t_c = single_floe_run(hull, (30.0, 30.0 + 2.0 + 1.01), (0.0, -0.05), restitution=0.5,
+                               ship_friction=mu, ship_speed=4.0, omega=0.0)
+    run_until_apart(sim, t_c)
+    rec = sim.ship.records()
+    touching = (rec["contacts"] == 1) & (rec["normal_force"] > 0.0)
+    assert touching.sum() > 10
+    force = np.hypot(rec["ice_surge"], rec["ice_sway"])[touching]
+    normal = rec["normal_force"][touching]
+    assert np.all(normal >= force * (1.0 - 1e-12) / math.sqrt(1.0 + mu ** 2))
+    assert np.all(normal <= force * (1.0 + 1e-12))
+    if mu == 0.0:
+        np.testing.assert_allclose(normal, force, rtol=1e-12)
+    else:
+        assert np.median(force / normal) == pytest.approx(math.sqrt(1.0 + mu ** 2), rel=1e-3)
+    assert np.all(rec["normal_force"][rec["contacts"] == 0] == 0.0)
