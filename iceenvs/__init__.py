@@ -10,6 +10,8 @@ id                                     task
 ``iceenvs/MarginalIceZone-v0``         transport ice along a fast-ice edge
 ``iceenvs/FloeClustering-v0``          herd hard-disc floes into clusters
 ``iceenvs/ThicknessDistribution-v0``   steer the ice thickness distribution
+``iceenvs/ShipNavigation-v0``          sail a ship through pack ice to a goal
+``iceenvs/ShipBeset-v0``               keep a ship moving in pressured ice
 =====================================  =========================================
 
 >>> import gymnasium as gym
@@ -30,6 +32,8 @@ _ENVS = {
     "MarginalIceZone-v0": ("iceenvs.marginal_ice_zone:MarginalIceZoneEnv", 200),
     "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400),
     "ThicknessDistribution-v0": ("iceenvs.thickness_distribution:ThicknessDistributionEnv", 360),
+    "ShipNavigation-v0": ("iceenvs.ship_navigation:ShipNavigationEnv", 300),
+    "ShipBeset-v0": ("iceenvs.ship_beset:ShipBesetEnv", 300),
 }
 
 #: every registered id

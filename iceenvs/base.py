@@ -55,7 +55,7 @@ from physics.params import check_range
 from .observations import FLOE_FEATURES, Feature, normalise
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
-           "sanitise_action", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
+           "sanitise_action", "choice", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
            "TIME_FEATURE", "task_table", "MAX_WIND"]
 
 #: every per-step reward of the built-in tasks lies in this range
@@ -127,6 +127,15 @@ def interval(low=None, high=None, *, low_open: bool = False,
     return check
 
 
+def choice(*options: str) -> Callable[[str, Any], Any]:
+    """A check for one of the strings ``options``."""
+    def check(name, value):
+        if value not in options:
+            raise ValueError(f"{name} must be one of {list(options)}, got {value!r}")
+        return value
+    return check
+
+
 def task_table(params) -> str:
     """The "Task parameters" section of an environment's docstring: how to
     set them, then their Markdown table."""
@@ -136,7 +145,7 @@ def task_table(params) -> str:
     for p in params:
         default = "None" if p.default is None else (
             f"({p.default[0]:g}, {p.default[1]:g})" if isinstance(p.default, tuple)
-            else f"{p.default:g}")
+            else f'"{p.default}"' if isinstance(p.default, str) else f"{p.default:g}")
         lines.append(f"| `{p.name}` | {default} | {p.meaning} |")
     return "\n".join(lines)
 
@@ -151,7 +160,9 @@ class ControlEnv(gym.Env):
     ``_info``. A physics failure (FloatingPointError, RuntimeError,
     ValueError), a non-finite reward or the task's failure
     (``_terminated``) ends the episode with ``failure_reward`` (0) and,
-    for a physics failure or a non-finite reward, ``info["error"]``.
+    for a physics failure or a non-finite reward, ``info["error"]``; a
+    task done (``_succeeded``, a goal reached) ends it with the step's
+    reward.
     Episodes are truncated by Gymnasium's ``TimeLimit`` (the registered
     ``max_episode_steps``), never by the environment itself.
 
@@ -272,6 +283,11 @@ class ControlEnv(gym.Env):
     def _terminated(self, now: dict) -> bool:
         return False
 
+    def _succeeded(self, now: dict) -> bool:
+        """The task is done (a goal reached): the episode ends with the
+        step's own reward, unlike a failure."""
+        return False
+
     def _reward_kwargs(self) -> dict:
         return {**self.reward_params, **{k: self.episode[k] for k in self.reward_task_keys}}
 
@@ -315,11 +331,13 @@ class ControlEnv(gym.Env):
             return self._obs.copy(), float(self.failure_reward), True, False, info
         reward = self._reward(a, now)
         info = self._info(now)
-        terminated = bool(self._terminated(now))
+        succeeded = bool(self._succeeded(now))
+        failed = bool(self._terminated(now))
         if not math.isfinite(reward):
             info["error"] = f"non-finite reward {reward}"
-            terminated = True
-        if terminated:
+            failed = True
+        terminated = succeeded or failed
+        if failed:
             reward = float(self.failure_reward)
         self._prev = now
         self._obs = self._vector(now)
@@ -381,6 +399,8 @@ class FloeEnv(ControlEnv):
     **task : the task parameters of the environment (its table)
     """
 
+    #: the observation entries every environment of the family has
+    base_features: tuple[Feature, ...] = FLOE_FEATURES
     extra_features: tuple[Feature, ...] = ()
     action_names: tuple[str, ...] = ()
     reward_fn: Callable = None
@@ -419,7 +439,7 @@ class FloeEnv(ControlEnv):
         self._init_reward_params(self.default_reward_params(), reward_params,
                                  custom=reward_fn is not None)
 
-        self.features = FLOE_FEATURES + self.extra_features
+        self.features = self.base_features + self.extra_features
         if self.horizon is not None:
             self.features = self.features + (TIME_FEATURE,)
         n_act = self.action_space.shape[0]

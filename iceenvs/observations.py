@@ -18,7 +18,10 @@ Scaling of the vector (every entry is clipped into the observation space):
   bounded to [0, 10];
 * a rate x [1/s] is ``log10(1 + x / 0.01 1/s)``, bounded to [0, 10];
 * the cluster exponent α is passed as it is (0 when undefined), bounded to
-  [0, 10].
+  [0, 10];
+* a force F [N] or moment M [N m] is ``sign(F) log10(1 + |F| / 1 N)`` (the
+  stress scaling with 1 N or 1 N m);
+* a distance is divided by 100 m and a yaw rate by 0.1 rad/s.
 """
 from __future__ import annotations
 
@@ -74,9 +77,18 @@ def _exponent(x):
     return 0.0 if not math.isfinite(x) else x
 
 
+def _distance(x):
+    return x / 100.0
+
+
+def _yaw_rate(x):
+    return x / 0.1
+
+
 _SCALERS = {"none": _identity, "log stress": log_stress, "/ 1 m/s": _velocity,
             "log temperature": _temperature, "log rate": _rate,
-            "exponent": _exponent}
+            "exponent": _exponent, "log force": log_stress, "/ 100 m": _distance,
+            "/ 0.1 rad/s": _yaw_rate}
 
 FLOE_FEATURES: tuple[Feature, ...] = (
     Feature("concentration", "ice concentration A = floe area / box area", "-", "none", 0.0, 1.0),

@@ -4,6 +4,8 @@
   a fixed scale (:data:`SPEED_SCALE`, frozen floes grey) or by cluster (the
   largest cluster highlighted), with their periodic images across the box edges
   and, optionally, the contact force chains;
+* :func:`draw_ship` — a ship over such a picture: the hull, its track, the
+  goal line and the channel's edges;
 * :func:`annotate` — a frame with a side panel on its right: lines of text
   (time, concentration, target...), one or two direction arrows (wind,
   heading), a colour bar of the speed colormap and a legend of colour swatches;
@@ -26,7 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 from gymnasium.error import DependencyNotInstalled
 
-__all__ = ["draw_floes", "annotate", "draw_itd", "season", "Window", "SPEED_SCALE",
+__all__ = ["draw_floes", "draw_ship", "annotate", "draw_itd", "season", "Window", "SPEED_SCALE",
            "LARGEST_CLUSTER", "CLUSTER_PALETTE", "SINGLE_FLOE", "FROZEN", "CLUSTER_LEGEND"]
 
 #: Speed [m/s] mapped to the top of the floe colormap by default; faster floes
@@ -331,6 +333,75 @@ def draw_floes(positions, radii, box_size, speeds, *, frozen=None, contact_i=Non
             line_width = 1 + int(round(4 * f / fmax))
             pygame.draw.line(surf, CHAIN, screen(pos[i]), screen(pos[i] + d), line_width)
 
+    return _to_array(surf, pygame)
+
+
+HULL = (235, 90, 40)            # orange
+TRACK = (250, 250, 250)         # white
+GOAL = (60, 220, 90)            # green
+CHANNEL = (120, 160, 200)       # light blue
+
+
+def draw_ship(picture, box_size, hull_vertices, track=None, *, goal_x=None,
+              channel=None) -> np.ndarray:
+    """The picture of :func:`draw_floes` with a ship drawn over it.
+
+    Parameters
+    ----------
+    picture : (H, W, 3) uint8
+        A frame of :func:`draw_floes` of the box ``box_size``.
+    box_size : (lx, ly)
+        Box side lengths [m].
+    hull_vertices : (K, 2) array of float
+        Hull corners in the world frame [m] (not wrapped; the hull is drawn
+        at its image whose centroid lies in the box).
+    track : (M, 2) array of float, optional
+        Past positions of the ship [m], drawn as a white line (wrapped into
+        the box; a jump across a periodic edge is not joined).
+    goal_x : float, optional
+        The goal line x = goal_x [m], drawn green across the box.
+    channel : (y0, y1), optional
+        The channel's edges [m], drawn as light-blue lines.
+
+    Returns
+    -------
+    np.ndarray
+        A new (H, W, 3) uint8 picture.
+    """
+    pic = np.asarray(picture)
+    if pic.ndim != 3 or pic.shape[2] != 3 or pic.dtype != np.uint8:
+        raise ValueError(f"picture must be an (H, W, 3) uint8 array, got {pic.shape} {pic.dtype}")
+    box = np.asarray(box_size, dtype=float)
+    if box.shape != (2,) or not np.all(np.isfinite(box)) or np.any(box <= 0):
+        raise ValueError(f"box_size must be two positive finite lengths, got {box_size!r}")
+    hull = np.asarray(hull_vertices, dtype=float)
+    if hull.ndim != 2 or hull.shape[1] != 2 or hull.shape[0] < 3 or not np.all(np.isfinite(hull)):
+        raise ValueError(f"hull_vertices must be a finite (K >= 3, 2) array, got {hull.shape}")
+    pygame = _pygame()
+    height, width = pic.shape[:2]
+    scale = width / box[0]
+
+    def screen(p):
+        return int(round(p[0] * scale)), int(round(height - p[1] * scale))
+
+    surf = pygame.surfarray.make_surface(np.ascontiguousarray(np.transpose(pic, (1, 0, 2))))
+    if channel is not None:
+        for y in channel:
+            pygame.draw.line(surf, CHANNEL, screen((0.0, y)), screen((box[0], y)), 1)
+    if goal_x is not None:
+        x = float(goal_x) % box[0]
+        pygame.draw.line(surf, GOAL, screen((x, 0.0)), screen((x, box[1])), 3)
+    if track is not None:
+        t = np.asarray(track, dtype=float).reshape(-1, 2)
+        wrapped = np.mod(t, box)
+        for a, b, ra, rb in zip(wrapped[:-1], wrapped[1:], t[:-1], t[1:]):
+            if np.allclose(b - a, rb - ra):
+                pygame.draw.line(surf, TRACK, screen(a), screen(b), 2)
+    centre = hull.mean(axis=0)
+    shift = np.mod(centre, box) - centre
+    points = [screen(p) for p in hull + shift]
+    pygame.draw.polygon(surf, HULL, points)
+    pygame.draw.polygon(surf, (0, 0, 0), points, 1)
     return _to_array(surf, pygame)
 
 

@@ -9,12 +9,22 @@ task's parameters. An environment calls its reward as
 ``task`` holds the episode's target (or heading); pass your own function
 with that signature as ``reward_fn=`` to study another task.
 
-Every built-in reward lies in [0, 1] each step: a score of how well the
-task is done (1: exactly on target) times a safety factor that falls
-from 1 to 0 as a stress passes its limit and reaches twice the limit
-(:func:`safety`). A failed episode ends with reward 0 (the failed state is
-absorbing and worth nothing), so no reward is ever negative and ending an
-episode early never pays.
+Every built-in reward of the ice-control tasks lies in [0, 1] each step:
+a score of how well the task is done (1: exactly on target) times a
+safety factor that falls from 1 to 0 as a stress passes its limit and
+reaches twice the limit (:func:`safety`). A failed episode ends with
+reward 0 (the failed state is absorbing and worth nothing), so no reward
+is ever negative and ending an episode early never pays.
+
+The ship tasks reward progress towards a goal line, so their rewards are
+signed: progress over the step (the distance gained over the distance
+the fastest ship sails in a step, in [−1, 1]), minus penalties that are
+each bounded (the ice impulse or the hull pressure, a time cost, leaving
+the channel), plus a bonus on the step that reaches the goal. A failure
+(beset, a physics failure, leaving a walled channel) ends the episode
+with −``failure_penalty``, below any sum of penalties a step can carry, so
+that ending early never pays there either. :func:`ship_reward_bounds`
+gives the bounds of one step.
 """
 from __future__ import annotations
 
@@ -24,7 +34,8 @@ import numpy as np
 
 __all__ = ["excess", "safety", "closeness", "wind_drift_reward", "convergence_reward",
            "marginal_ice_zone_reward", "floe_clustering_reward", "wasserstein1",
-           "thickness_distribution_reward"]
+           "thickness_distribution_reward", "ship_navigation_reward", "ship_beset_reward",
+           "ship_progress", "ship_reward_bounds"]
 
 
 def excess(value: float, threshold: float) -> float:
@@ -102,3 +113,54 @@ def thickness_distribution_reward(prev, action, now, *, target, h,
     thickness distribution ``now["g"]`` kept close to ``target`` on the
     class thicknesses ``h``."""
     return closeness(wasserstein1(now["g"], target, h), 0.0, distance_scale)
+
+
+# -- the ship tasks -------------------------------------------------------------------------
+
+def ship_progress(prev, now, step_length: float) -> float:
+    """Distance gained towards the goal line over the step,
+    (d_prev − d_now) / ``step_length`` [m], clipped to [−1, 1]."""
+    gained = (prev["goal_distance"] - now["goal_distance"]) / step_length
+    return min(1.0, max(-1.0, gained))
+
+
+def ship_navigation_reward(prev, action, now, *, step_length: float,
+                           impulse_weight: float = 1.0, impulse_scale: float = 1.0e6,
+                           time_weight: float = 0.05, exit_weight: float = 1.0,
+                           goal_bonus: float = 10.0, failure_penalty: float = 10.0) -> float:
+    """:func:`ship_progress` − ``impulse_weight`` × min(J / ``impulse_scale``, 2)
+    − ``time_weight`` − ``exit_weight`` (outside the channel) + ``goal_bonus``
+    (goal line reached).
+
+    J [N s] is the impulse of the ice on the hull over the step
+    (``now["step_impulse"]``, the time integral of the ice force's
+    magnitude); 10⁶ N s is about a head-on hit on a 20 m floe of 1.5 m ice at
+    2 m/s. ``step_length`` [m] is the distance the fastest ship of the
+    action set-up sails in a step. ``failure_penalty`` is the environment's
+    (a failed step's reward is −failure_penalty)."""
+    impact = min(now["step_impulse"] / impulse_scale, 2.0)
+    outside = abs(now["channel_offset"]) > 1.0
+    return (ship_progress(prev, now, step_length) - impulse_weight * impact - time_weight
+            - exit_weight * outside + goal_bonus * now["reached"])
+
+
+def ship_beset_reward(prev, action, now, *, step_length: float, pressure_limit: float,
+                      pressure_weight: float = 1.0, time_weight: float = 0.05,
+                      goal_bonus: float = 10.0, failure_penalty: float = 10.0) -> float:
+    """:func:`ship_progress` − ``pressure_weight`` × min(:func:`excess` of the
+    hull pressure over ``pressure_limit`` [N/m], 1) − ``time_weight`` +
+    ``goal_bonus`` (goal line reached). The hull pressure
+    (``now["hull_pressure"]``) is the sum of the normal contact forces on the
+    hull over its length, mean over the step; the penalty grows from 0
+    at the limit to its full weight at twice the limit."""
+    over = min(excess(now["hull_pressure"], pressure_limit), 1.0)
+    return (ship_progress(prev, now, step_length) - pressure_weight * over - time_weight
+            + goal_bonus * now["reached"])
+
+
+def ship_reward_bounds(params: dict) -> tuple[float, float]:
+    """(lowest, highest) reward of one step of a ship task with these reward
+    parameters (its ``env.reward_params``), a failure included."""
+    low = -1.0 - params.get("time_weight", 0.0) - 2.0 * params.get("impulse_weight", 0.0) \
+        - params.get("exit_weight", 0.0) - params.get("pressure_weight", 0.0)
+    return (min(low, -params["failure_penalty"]), 1.0 + params.get("goal_bonus", 0.0))

@@ -21,6 +21,8 @@ CONVERGENCE = "iceenvs/Convergence-v0"
 MIZ = "iceenvs/MarginalIceZone-v0"
 CLUSTERING = "iceenvs/FloeClustering-v0"
 ITD = "iceenvs/ThicknessDistribution-v0"
+NAV = "iceenvs/ShipNavigation-v0"
+BESET = "iceenvs/ShipBeset-v0"
 
 FLOE_IDS = (WIND, CONVERGENCE, MIZ, CLUSTERING)
 
@@ -32,6 +34,8 @@ SMALL = {
     MIZ: dict(n_floes=60),
     CLUSTERING: dict(n_floes=150),
     ITD: dict(n_classes=60),
+    NAV: dict(concentration=0.3),
+    BESET: dict(concentration=0.6),
 }
 
 # kwargs that end an episode after 3 steps (Gymnasium's TimeLimit)
@@ -162,13 +166,17 @@ def test_rgb_array_render_is_an_image(env_id):
 # default (fork) start method.
 ASYNC_KWARGS = {env_id: dict(vector_kwargs=dict(context="spawn")) for env_id in FLOE_IDS}
 ASYNC_KWARGS[ITD] = {}
+ASYNC_KWARGS[NAV] = ASYNC_KWARGS[BESET] = dict(vector_kwargs=dict(context="spawn"))
 
 # every spawned worker pays the interpreter and compiled-kernel start-up (seconds
 # each); one Hertz env and the hard-disc env cover both engines
 _SAME_AS_WIND_DRIFT = pytest.mark.skip(
     reason="spawning workers is slow; WindDrift-v0 covers the Hertz envs' shared base class")
 ASYNC_IDS = [WIND, pytest.param(CONVERGENCE, marks=_SAME_AS_WIND_DRIFT),
-             pytest.param(MIZ, marks=_SAME_AS_WIND_DRIFT), CLUSTERING, ITD]
+             pytest.param(MIZ, marks=_SAME_AS_WIND_DRIFT), CLUSTERING, ITD, NAV,
+             pytest.param(BESET, marks=pytest.mark.skip(
+                 reason="spawning workers is slow; ShipNavigation-v0 covers the ship envs' "
+                        "shared base class"))]
 
 
 @pytest.mark.parametrize("env_id", ASYNC_IDS)

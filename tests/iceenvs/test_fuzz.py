@@ -138,13 +138,25 @@ INVALID = [
     (CLUSTERING, {"target": True}),
     (MIZ, {"target_speed": "fast"}),
     (ITD, {"target": [1.0, 2.0]}),
+    ("iceenvs/ShipNavigation-v0", {"concentration": 0.95}),
+    ("iceenvs/ShipNavigation-v0", {"floe_sizes": "huge"}),
+    ("iceenvs/ShipNavigation-v0", {"channel_exit": "ignore"}),
+    ("iceenvs/ShipNavigation-v0", {"wind_speed": float("nan")}),
+    ("iceenvs/ShipBeset-v0", {"concentration": 0.85}),
+    ("iceenvs/ShipBeset-v0", {"ship_offset": 10.0}),
+    ("iceenvs/ShipBeset-v0", {"pressure_limit": 0.0}),
 ]
 
 
 @pytest.mark.parametrize("env_id, options", INVALID,
                          ids=[f"{e.split('/')[1]}-{sorted(o.items())}" for e, o in INVALID])
 def test_invalid_reset_options_raise_value_error(env_id, options):
-    env = ENVS[env_id] if env_id in ENVS else gym.make(env_id, n_classes=20).unwrapped
+    if env_id in ENVS:
+        env = ENVS[env_id]
+    elif env_id == ITD:
+        env = gym.make(env_id, n_classes=20).unwrapped
+    else:
+        env = gym.make(env_id).unwrapped
     with pytest.raises(ValueError):
         env.reset(seed=0, options=options)
     # the env is still usable afterwards

@@ -1,0 +1,546 @@
+"""Shared plumbing of the ship environments: :class:`ShipEnv`.
+
+A ship environment runs the Hertz engine with a ship among the floes
+(:class:`physics.HertzSimulation` with ``ship=``, :mod:`physics.ship`).
+The agent commands the ship; every step the engine advances by the control
+interval, and the environment reads from the ship's step records and
+collision log what happened in that interval (impulse and energy given to
+the ice, collisions, the path sailed), senses the ice ahead
+(:mod:`iceenvs.ship_sensors`) and measures the ice around the hull.
+
+Data flow of one step::
+
+    action → NaN/inf → 0, clip → ship commands → engine.advance(control interval)
+      → step loads (records, collision log) + sensors + local ice → SI dict
+      → reward(prev, action, now) and the observation (vector, image or both)
+
+Subclasses say what the task is:
+
+* ``_ice(rng)`` — the floe field and the box of an episode, and the forcing;
+* ``_ship_start()`` — where the ship starts (position, heading);
+* ``_succeeded(now)`` and ``_terminated(now)`` — goal reached, failure;
+* ``controls`` (the action set-ups the task offers) and the reward.
+
+Episode metrics (``info``, after every step, for the episode so far):
+``success``, ``time`` [s], ``path_length`` [m], ``efficiency`` (the
+straight-line distance to the goal over the path length, when the goal is
+reached, else 0), ``effort`` [J], ``collisions``, ``collided_floes``,
+``mean_impulse`` and ``max_impulse`` [N s] (of the finished collisions),
+``impulse_per_metre`` [N s/m] (their total over the path length),
+``energy_to_ice`` [J], ``ice_resistance`` [N] (mean ice force against
+surge) and ``max_hull_pressure`` [N/m] (the largest sum of the normal
+contact forces on the hull over its length in any engine step).
+"""
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from physics import FloeField, HERMAN2013
+from physics.hertz import hull_contact_time
+from physics.params import check_range
+
+from .base import TIME_FEATURE, HertzEnv
+from .observations import Feature, normalise
+from .ship_sensors import ice_lidar, occupancy_image
+
+__all__ = ["ShipEnv", "ship_features", "FLOE_SIZES", "CONTROLS", "OBS_TYPES", "METRICS"]
+
+#: floe-size presets: (``sizes`` of :func:`physics.ship.transit_field`,
+#: log-normal (median diameter [m], σ of ln d))
+FLOE_SIZES = {
+    "pack": ("lognormal", (20.0, 0.5)),
+    "brash": ("lognormal", (6.0, 0.5)),
+    "herman2013": ("power", (1.0, 0.5)),
+}
+
+#: the action set-ups: name → (ship mode, action names)
+CONTROLS = {
+    "yaw": ("prescribed", ("yaw_rate",)),
+    "speed_yaw": ("prescribed", ("surge_speed", "yaw_rate")),
+    "thrust": ("dynamic", ("thrust", "yaw_moment")),
+}
+
+OBS_TYPES = ("vector", "image", "dict")
+
+#: the episode metrics in ``info``
+METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
+           "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
+           "energy_to_ice", "ice_resistance", "max_hull_pressure")
+
+#: below this concentration the floes are placed directly; above it they are
+#: placed at it and compressed (FIRE relaxation)
+PLACEMENT_LIMIT = 0.8
+#: open water [m] left between the hull's reach and the floes at the start
+START_CLEARANCE = 2.0
+
+
+def ship_features(sectors: int, lidar_range: float) -> tuple[Feature, ...]:
+    """The observation entries of a ship environment with a lidar of
+    ``sectors`` sectors reaching ``lidar_range`` [m]."""
+    top = lidar_range / 100.0
+    head = (
+        Feature("goal_distance", "distance of the ship's centroid to the goal line (negative "
+                "once past it)", "m", "/ 100 m", -20.0, 20.0),
+        Feature("goal_cos", "cosine of the goal direction (normal to the goal line) in the "
+                "ship frame", "-", "none", -1.0, 1.0),
+        Feature("goal_sin", "sine of it (positive: the goal lies to port)", "-", "none",
+                -1.0, 1.0),
+        Feature("channel_offset", "distance of the centroid from the channel's centre line "
+                "over the channel's half-width (|x| > 1: outside)", "-", "none", -3.0, 3.0),
+        Feature("surge", "surge speed u (ship frame, forward)", "m/s", "/ 1 m/s", -10.0, 10.0),
+        Feature("sway", "sway speed v (ship frame, to port)", "m/s", "/ 1 m/s", -10.0, 10.0),
+        Feature("yaw_rate", "yaw rate r (anticlockwise)", "rad/s", "/ 0.1 rad/s", -10.0, 10.0),
+        Feature("ice_surge", "ice force on the hull along surge, mean over the step", "N",
+                "log force", -10.0, 10.0),
+        Feature("ice_sway", "ice force on the hull along sway, mean over the step", "N",
+                "log force", -10.0, 10.0),
+        Feature("ice_moment", "ice moment on the hull about its centroid, mean over the step",
+                "N m", "log force", -12.0, 12.0),
+        Feature("hull_pressure", "sum of the normal contact forces on the hull over its length, "
+                "mean over the step", "N/m", "log stress", 0.0, 10.0),
+    )
+    lidar = tuple(
+        Feature(f"lidar_distance_{k}", f"sector {k}: distance to the first floe edge along "
+                f"its central ray ({lidar_range:g} m: none within range)", "m", "/ 100 m",
+                0.0, top) for k in range(sectors)) + tuple(
+        Feature(f"lidar_concentration_{k}", f"sector {k}: ice concentration of its wedge",
+                "-", "none", 0.0, 1.0) for k in range(sectors))
+    tail = (
+        Feature("concentration", "ice concentration of the episode (floe area / box area)",
+                "-", "none", 0.0, 1.0),
+        Feature("local_concentration", "ice concentration within the local radius of the "
+                "ship", "-", "none", 0.0, 1.0),
+        Feature("local_contacts", "contacts per floe among the floes within the local "
+                "radius (2 contacts / floes)", "-", "none", 0.0, 20.0),
+        Feature("local_pressure", "pressure (σ₁ + σ₂)/2 of the floe-floe contact stress "
+                "within the local radius, compression > 0", "N/m", "log stress", -8.0, 8.0),
+    )
+    return head + lidar + tail
+
+
+class ShipEnv(HertzEnv):
+    """Base of the ship environments (not registered itself).
+
+    Arguments common to the ship environments
+    -----------------------------------------
+    control : str — the action set-up (a key of :data:`CONTROLS` the task offers)
+    obs_type : "vector", "image" or "dict"
+    image_size : int — pixels of a side of the image observation
+    image_extent : float — metres of a side of the image observation
+    lidar_sectors : int, lidar_range : float [m] — the sector lidar
+    local_radius : float [m] — radius of the local ice measures
+    length, width : float [m] — the box; channel_width [m] — the channel
+    goal_distance : float [m] — from the ship's start to the goal line
+    preset, control_interval, reward_fn, reward_params, stiffness_scale,
+    horizon, colour_scale, render_mode and the task parameters as every
+    floe environment.
+    """
+
+    controls: tuple[str, ...] = tuple(CONTROLS)
+    #: the goal line lies ahead along +x; the channel is centred on the box
+    start_x = 50.0
+
+    def __init__(self, *, control: str = "yaw", obs_type: str = "vector", image_size: int = 64,
+                 image_extent: float = 150.0, lidar_sectors: int = 9,
+                 lidar_range: float = 150.0, local_radius: float = 100.0,
+                 length: float = 400.0, width: float = 200.0, channel_width: float = 150.0,
+                 goal_distance: float = 300.0, preset=HERMAN2013,
+                 control_interval: float = 2.0, colour_scale: float = 1.0, **kwargs):
+        if control not in self.controls:
+            raise ValueError(f"control must be one of {self.controls}, got {control!r}")
+        if obs_type not in OBS_TYPES:
+            raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
+        for name, value, low in (("image_size", image_size, 8), ("lidar_sectors", lidar_sectors, 1)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+        for name, value in (("image_extent", image_extent), ("lidar_range", lidar_range),
+                            ("local_radius", local_radius), ("length", length),
+                            ("width", width), ("channel_width", channel_width),
+                            ("goal_distance", goal_distance)):
+            check_range(name, value, 0.0, None, low_open=True)
+        if self.start_x + goal_distance >= length:
+            raise ValueError(f"goal_distance {goal_distance:g} m puts the goal line beyond the "
+                             f"box: it must be below length − {self.start_x:g} m = "
+                             f"{length - self.start_x:g} m")
+        if channel_width > width:
+            raise ValueError(f"channel_width {channel_width:g} m exceeds the box width "
+                             f"{width:g} m")
+        self.control = control
+        self.mode, self.action_names = CONTROLS[control]
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.action_names),),
+                                           dtype=np.float32)
+        self.obs_type = obs_type
+        self.image_size = int(image_size)
+        self.image_extent = float(image_extent)
+        self.lidar_sectors = int(lidar_sectors)
+        self.lidar_range = float(lidar_range)
+        self.local_radius = float(local_radius)
+        self.length, self.width = float(length), float(width)
+        self.channel_width = float(channel_width)
+        self.goal_distance = float(goal_distance)
+        self.base_features = ship_features(self.lidar_sectors, self.lidar_range)
+        super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
+                         colour_scale=colour_scale, **kwargs)
+        self.failure_reward = -float(self.reward_params["failure_penalty"])
+        vector_space = self.observation_space
+        image_space = gym.spaces.Box(0, 255, (4, self.image_size, self.image_size),
+                                     dtype=np.uint8)
+        if obs_type == "image":
+            self.observation_space = image_space
+        elif obs_type == "dict":
+            self.observation_space = gym.spaces.Dict({"vector": vector_space,
+                                                      "image": image_space})
+        self.n_floes = 0
+
+    # -- geometry -------------------------------------------------------------------
+    @property
+    def goal_x(self) -> float:
+        """x of the goal line [m]."""
+        return self.start_x + self.goal_distance
+
+    @property
+    def centre_y(self) -> float:
+        return 0.5 * self.width
+
+    def _ship_start(self) -> tuple:
+        """((x, y), heading) of the ship at the start."""
+        return (self.start_x, self.centre_y), 0.0
+
+    # -- the episode's ice and ship --------------------------------------------------
+    def _ice(self, rng: np.random.Generator):
+        """(field, box, forcing) of a new episode."""
+        raise NotImplementedError
+
+    def _floe_field(self, box, rng, *, concentration: float, floe_sizes: str,
+                    band: float | None = None):
+        """Floes of the preset's material at rest covering ``concentration``
+        of ``box`` (compressed with FIRE relaxation above
+        :data:`PLACEMENT_LIMIT`), or of its strip 0 ≤ y < ``band`` [m], those
+        within reach of the ship's start removed. Sets the concentration the
+        observation reports (of the box or of the strip)."""
+        from physics.domain import Box
+        from physics.floes import place_floes, power_law_diameters, spatial_order
+        from physics.ship import _diameters
+
+        sizes, lognormal = FLOE_SIZES[floe_sizes]
+        p = self.preset
+        region = box if band is None else Box(box.lx, band, periodic=box.periodic)
+        target = concentration * region.area
+        d = _diameters(p, sizes, lognormal, 2.0 * target, rng, power_law_diameters)
+        # no floe wider than a third of the box's shorter side: drop those and
+        # keep the others until they cover the target
+        d = d[d < min(region.lx, region.ly) / 3.0]
+        area = np.cumsum(0.25 * math.pi * d ** 2)
+        d = d[: int(np.searchsorted(area, target)) + 1]
+        # the last floe overshoots the target: scale the diameters a little
+        # so that the floes cover it exactly
+        d *= math.sqrt(target / (0.25 * math.pi * float(np.sum(d ** 2))))
+        r = 0.5 * d
+        self._field_concentration = math.pi * float(np.sum(r ** 2)) / region.area
+        if concentration <= PLACEMENT_LIMIT or band is not None:
+            pos = place_floes(r, region, rng)
+        else:
+            from physics.domain import PeriodicBox
+            from physics.jamming import compress_floes
+
+            if not all(box.periodic):
+                raise ValueError(f"concentration {concentration:g} is above {PLACEMENT_LIMIT} "
+                                 f"and the box has walls: floes are compressed to it only in "
+                                 f"a periodic box")
+            a = math.pi * float(np.sum(r ** 2)) / box.area
+            k = math.sqrt(a / PLACEMENT_LIMIT)
+            box0 = PeriodicBox(box.lx * k, box.ly * k)
+            loose = FloeField(place_floes(r, box0, rng), r, p.thickness, np.zeros((r.size, 2)),
+                              density=p.forcing.ice_density)
+            packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
+            pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
+        (x0, y0), _ = self._ship_start()
+        gap = pos - np.array([x0, y0])
+        if box.periodic[0]:
+            gap[:, 0] -= box.lx * np.round(gap[:, 0] / box.lx)
+        if box.periodic[1]:
+            gap[:, 1] -= box.ly * np.round(gap[:, 1] / box.ly)
+        from physics.ship import psv_ship
+
+        reach = psv_ship().hull.circumradius
+        keep = np.hypot(gap[:, 0], gap[:, 1]) > reach + r + START_CLEARANCE
+        pos, r = pos[keep], r[keep]
+        field = FloeField(pos, r, p.thickness, np.zeros((r.size, 2)),
+                          density=p.forcing.ice_density)
+        return field.take(spatial_order(field.positions, box))
+
+    def _make_ship(self, rng):
+        from physics.ship import psv_ship
+
+        (x, y), heading = self._ship_start()
+        speed = self._start_speed()
+        extra = {} if self.mode == "dynamic" else dict(max_speed=self.max_speed,
+                                                       max_yaw_rate=self.episode["max_yaw_rate"])
+        return psv_ship(self.mode, position=(x, y), heading=heading, speed=speed,
+                        friction=self.episode["hull_friction"], **extra)
+
+    @property
+    def max_speed(self) -> float:
+        """Largest surge speed [m/s] the actions give (the reward's speed scale)."""
+        if self.control == "yaw":
+            return self.episode["speed"]
+        if self.control == "speed_yaw":
+            return self.episode["max_speed"]
+        return self._open_water_speed(self._ship.max_thrust)
+
+    def _open_water_speed(self, thrust: float) -> float:
+        """Surge speed [m/s] where the thrust balances the open-water damping."""
+        h = self._ship.hydrodynamics
+        a, b = h.quadratic_damping[0], h.linear_damping[0]
+        return (-b + math.sqrt(b * b + 4.0 * a * thrust)) / (2.0 * a) if a > 0 else thrust / b
+
+    def _start_speed(self) -> float:
+        return self.episode["speed"]
+
+    def _make_sim(self, rng):
+        from physics import HertzSimulation
+        from physics.hertz import hertz_time_step
+
+        field, box, forcing = self._ice(rng)
+        self.forcing = forcing
+        self._ship = self._make_ship(rng)
+        drift = float(np.max(np.hypot(field.velocities[:, 0], field.velocities[:, 1]))) \
+            if field.n else 0.0
+        impact = (1.0 + self.contact.restitution) * max(self.max_speed, self._start_speed()) \
+            + 2.0 * drift
+        dt = min(hertz_time_step(field, box, self.contact, impact, self.preset.time_step,
+                                 self.stiffness_scale),
+                 0.1 * hull_contact_time(field.radii, field.thickness, field.density,
+                                         self.contact, impact))
+        sim = HertzSimulation(field, box, self.contact, forcing, dt=dt, impact_speed=impact,
+                              parallel=False, ship=self._ship,
+                              allow_overlap=self.episode["concentration"] > PLACEMENT_LIMIT)
+        self.n_floes = field.n
+        self.impact_speed = impact
+        self._track = [sim.ship.position]
+        self._metrics = dict.fromkeys(METRICS, 0.0)
+        self._metrics["success"] = False
+        self._impulses = []
+        self._floes_hit = set()
+        self._slow_time = 0.0
+        self._resistance_sum = 0.0
+        self._step_loads = self._no_loads()
+        return sim
+
+    # -- actions ---------------------------------------------------------------------
+    def _apply_action(self, action):
+        ship = self.sim.ship
+        if self.control == "yaw":
+            ship.command(surge=self.episode["speed"],
+                         yaw_rate=float(action[0]) * self.episode["max_yaw_rate"])
+        elif self.control == "speed_yaw":
+            ship.command(surge=0.5 * (float(action[0]) + 1.0) * self.episode["max_speed"],
+                         yaw_rate=float(action[1]) * self.episode["max_yaw_rate"])
+        else:
+            ship.command(thrust=float(action[0]) * self._ship.max_thrust,
+                         yaw_moment=float(action[1]) * self._ship.max_yaw_moment)
+
+    # -- one step ----------------------------------------------------------------------
+    @staticmethod
+    def _no_loads() -> dict:
+        return dict(ice_surge=0.0, ice_sway=0.0, ice_moment=0.0, hull_pressure=0.0,
+                    peak_hull_pressure=0.0, step_impulse=0.0,
+                    step_energy=0.0, step_effort=0.0, step_path=0.0, step_collisions=0)
+
+    def _advance(self):
+        sim = self.sim
+        sim.advance(self.control_interval)
+        ship = sim.ship
+        rec = ship.records()
+        log = ship.collisions()
+        ship.clear()
+        dt = sim.dt
+        loads = self._no_loads()
+        if rec["time"].size:
+            xy = np.column_stack([rec["x"], rec["y"]])
+            path = np.diff(np.vstack([self._track[-1], xy]), axis=0)
+            force = np.hypot(rec["ice_surge"], rec["ice_sway"])
+            if self.mode == "dynamic":
+                c = ship.commands
+                power = np.abs(c["thrust"] * rec["surge"]) + np.abs(c["yaw_moment"]
+                                                                    * rec["yaw_rate"])
+            else:
+                h = self._ship.hydrodynamics
+                vel = np.column_stack([rec["surge"], rec["sway"], rec["yaw_rate"]])
+                drag = (np.asarray(h.linear_damping) * vel
+                        + np.asarray(h.quadratic_damping) * np.abs(vel) * vel)
+                power = rec["ice_power"] + np.sum(drag * vel, axis=1)
+            loads.update(ice_surge=float(rec["ice_surge"].mean()),
+                         ice_sway=float(rec["ice_sway"].mean()),
+                         ice_moment=float(rec["ice_moment"].mean()),
+                         hull_pressure=float(rec["normal_force"].mean()
+                                             / self._ship.hull.length),
+                         peak_hull_pressure=float(rec["normal_force"].max()
+                                                  / self._ship.hull.length),
+                         step_impulse=float(force.sum() * dt),
+                         step_energy=float(rec["ice_power"].sum() * dt),
+                         step_effort=float(power.sum() * dt),
+                         step_path=float(np.hypot(path[:, 0], path[:, 1]).sum()))
+            self._track.append(xy[-1].copy())
+            self._resistance_sum -= float(rec["ice_surge"].sum() * dt)
+        impulses = np.hypot(log["impulse_surge"], log["impulse_sway"])
+        loads["step_collisions"] = int(impulses.size)
+        self._impulses.extend(impulses.tolist())
+        self._floes_hit.update(log["floe"].tolist())
+        self._step_loads = loads
+        if self.mode == "dynamic" and ship.surge < self.episode["beset_speed"]:
+            self._slow_time += self.control_interval
+        else:
+            self._slow_time = 0.0
+
+    def _measure(self) -> dict:
+        sim = self.sim
+        ship = sim.ship
+        x, y = ship.position
+        heading = ship.heading
+        box = sim.box
+        lengths = (box.lx, box.ly)
+        now = {"goal_distance": float(self.goal_x - x), "goal_cos": math.cos(heading),
+               "goal_sin": -math.sin(heading),
+               "channel_offset": float((y - self.centre_y) / (0.5 * self.channel_width)),
+               "surge": ship.surge, "sway": ship.sway, "yaw_rate": ship.yaw_rate}
+        now.update(self._step_loads)
+        pos = sim.positions
+        dist, conc = ice_lidar((x, y), heading, pos, sim.radius, sectors=self.lidar_sectors,
+                               max_range=self.lidar_range, box_lengths=lengths,
+                               periodic=box.periodic)
+        for k in range(self.lidar_sectors):
+            now[f"lidar_distance_{k}"] = float(dist[k])
+            now[f"lidar_concentration_{k}"] = float(conc[k])
+        now["concentration"] = self._field_concentration
+        now.update(self._local_ice(x, y))
+        now["time"] = float(sim.time)
+        now["reached"] = float(x >= self.goal_x)
+        return now
+
+    def _minimum_image(self, d):
+        box = self.sim.box
+        d = np.array(d, dtype=float)
+        for axis, length in ((0, box.lx), (1, box.ly)):
+            if box.periodic[axis]:
+                d[..., axis] -= length * np.round(d[..., axis] / length)
+        return d
+
+    def _local_ice(self, x, y) -> dict:
+        """Concentration, contacts per floe and contact pressure of the ice
+        within ``local_radius`` of the ship."""
+        sim = self.sim
+        big_r = self.local_radius
+        area = math.pi * big_r ** 2
+        d = self._minimum_image(sim.positions - np.array([x, y]))
+        near = np.hypot(d[:, 0], d[:, 1]) < big_r
+        c = sim.contacts()
+        self._contacts = c
+        if len(c):
+            p = self._minimum_image(c.contact_point - np.array([x, y]))
+            inside = np.hypot(p[:, 0], p[:, 1]) < big_r
+            arm = c.branch_i[inside] - c.branch_j[inside]
+            f = c.force[inside]
+            pressure = -0.5 * float(np.sum(arm * f)) / area
+            n_contacts = int(inside.sum())
+        else:
+            pressure, n_contacts = 0.0, 0
+        n_near = int(near.sum())
+        return {"local_concentration": min(1.0, float(np.pi * np.sum(sim.radius[near] ** 2))
+                                           / area),
+                "local_contacts": 2.0 * n_contacts / n_near if n_near else 0.0,
+                "local_pressure": pressure}
+
+    # -- observation, info, end --------------------------------------------------------
+    def _vector(self, now: dict):
+        if self.obs_type == "vector":
+            return super()._vector(now)
+        image = self._image()
+        if self.obs_type == "image":
+            return image
+        return {"vector": super()._vector(now), "image": image}
+
+    def _image(self) -> np.ndarray:
+        sim = self.sim
+        ship = sim.ship
+        return occupancy_image(ship.position, ship.heading, sim.positions, sim.radius,
+                               ship.vertices, self.goal_x, size=self.image_size,
+                               extent=self.image_extent,
+                               box_lengths=(sim.box.lx, sim.box.ly), periodic=sim.box.periodic)
+
+    def _update_metrics(self, now: dict) -> dict:
+        m = self._metrics
+        m["time"] = float(self.sim.time)
+        m["path_length"] += self._step_loads["step_path"]
+        m["effort"] += self._step_loads["step_effort"]
+        m["energy_to_ice"] += self._step_loads["step_energy"]
+        m["collisions"] = len(self._impulses)
+        m["collided_floes"] = len(self._floes_hit)
+        total = float(np.sum(self._impulses)) if self._impulses else 0.0
+        m["mean_impulse"] = total / len(self._impulses) if self._impulses else 0.0
+        m["max_impulse"] = float(np.max(self._impulses)) if self._impulses else 0.0
+        m["impulse_per_metre"] = total / m["path_length"] if m["path_length"] > 0 else 0.0
+        m["ice_resistance"] = self._resistance_sum / m["time"] if m["time"] > 0 else 0.0
+        m["max_hull_pressure"] = max(m["max_hull_pressure"], now["peak_hull_pressure"])
+        m["success"] = bool(now["reached"])
+        m["efficiency"] = (self.goal_distance / m["path_length"]
+                           if m["success"] and m["path_length"] > 0 else 0.0)
+        return m
+
+    def _info(self, now: dict) -> dict:
+        info = super()._info(now)
+        if now is self._prev or self._steps == 0:
+            metrics = dict(self._metrics)
+        else:
+            metrics = dict(self._update_metrics(now))
+        info.update(metrics)
+        return info
+
+    def _succeeded(self, now: dict) -> bool:
+        return bool(now["reached"])
+
+    @property
+    def reward_bounds(self) -> tuple[float, float]:
+        """(lowest, highest) reward of one step (:func:`iceenvs.rewards.ship_reward_bounds`)."""
+        from .rewards import ship_reward_bounds
+
+        return ship_reward_bounds(self.reward_params)
+
+    def _reward_kwargs(self) -> dict:
+        kwargs = super()._reward_kwargs()
+        kwargs["step_length"] = self.max_speed * self.control_interval
+        return kwargs
+
+    # -- frames ------------------------------------------------------------------------
+    def _frame(self) -> np.ndarray:
+        from .rendering import annotate, draw_floes, draw_ship
+
+        sim = self.sim
+        c = self._contacts
+        box = (sim.box.lx, sim.box.ly)
+        picture = draw_floes(sim.positions, sim.radius, box,
+                             np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
+                             contact_i=c.i, contact_j=c.j, contact_force=c.normal_force,
+                             speed_scale=self.colour_scale)
+        y0 = self.centre_y - 0.5 * self.channel_width
+        picture = draw_ship(picture, box, sim.ship.vertices, np.array(self._track),
+                            goal_x=self.goal_x, channel=(y0, y0 + self.channel_width))
+        return annotate(picture, colour_bar=(self.colour_label, 0.0, self.colour_scale),
+                        arrow=self._frame_arrow(), text=self._frame_text())
+
+    def _frame_text(self) -> list[str]:
+        now = self._prev
+        m = self._metrics
+        return [f"t = {self.sim.time:.0f} s", f"A = {now['concentration']:.2f}",
+                f"speed {now['surge']:.2f} m/s", f"to goal {now['goal_distance']:.0f} m",
+                f"collisions {m['collisions']}", f"hull {now['hull_pressure'] / 1e3:.3g} kN/m"]
+
+    def _frame_arrow(self):
+        wind = np.asarray(self.forcing.wind, dtype=float)
+        speed = float(np.hypot(*wind))
+        if speed == 0.0:
+            return None
+        return [(wind / max(speed, 20.0), f"wind {speed:.1f} m/s")]

@@ -1,0 +1,345 @@
+"""The ship environments: kinematics of the prescribed ship, the episode
+metrics against the engine's own records, rewards against their formula,
+termination, task parameters, observation types and fuzzing."""
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import iceenvs  # noqa: F401  (registers the ids)
+from agents.metrics import EPISODE_METRICS
+from iceenvs.ship_env import METRICS
+
+NAV = "iceenvs/ShipNavigation-v0"
+BESET = "iceenvs/ShipBeset-v0"
+
+
+def _straight(env, steps=400):
+    """Sail the straight-line baseline to the end of the episode; returns
+    the rewards and the last info."""
+    from agents.baselines import StraightLinePolicy
+
+    policy = StraightLinePolicy(env)
+    rewards = []
+    obs = None
+    for _ in range(steps):
+        action, _ = policy.predict(obs)
+        obs, reward, terminated, truncated, info = env.step(action)
+        rewards.append(reward)
+        if terminated or truncated:
+            break
+    return rewards, info, terminated
+
+
+# -- kinematics and metrics -------------------------------------------------------------------
+
+def test_open_water_transit_reward_and_metrics_are_exact():
+    """A ship alone (a concentration so low that no floe lies on the line):
+    every step gains exactly the distance sailed at full speed, reward
+    1 − time_weight, and the goal step adds the bonus; path length = goal
+    distance to the last step's overshoot, efficiency 300/path."""
+    env = gym.make(NAV, concentration=0.01)
+    try:
+        env.reset(seed=0)
+        u = env.unwrapped
+        rewards, info, terminated = _straight(env)
+    finally:
+        env.close()
+    assert terminated and info["success"]
+    assert info["collisions"] == 0 and info["energy_to_ice"] == 0.0
+    steps = len(rewards)
+    assert steps == math.ceil(300.0 / (2.0 * 2.0))           # 2 m/s, 2 s steps
+    np.testing.assert_allclose(rewards[:-1], 1.0 - 0.05, atol=1e-9)
+    assert rewards[-1] == pytest.approx(1.0 - 0.05 + 10.0, abs=1e-9)
+    assert info["path_length"] == pytest.approx(2.0 * 2.0 * steps, rel=1e-6)
+    assert info["efficiency"] == pytest.approx(300.0 / info["path_length"], rel=1e-9)
+    assert info["time"] == pytest.approx(2.0 * steps, rel=1e-9)
+    # effort of the prescribed ship in open water: the surge damping's work
+    h = u._ship.hydrodynamics
+    power = (h.linear_damping[0] * 2.0 + h.quadratic_damping[0] * 4.0) * 2.0
+    assert info["effort"] == pytest.approx(power * info["time"], rel=1e-3)
+
+
+def test_yaw_rate_action_turns_the_prescribed_ship_at_that_rate():
+    """Heading after k steps of a constant yaw action a: a × max_yaw_rate × t."""
+    env = gym.make(NAV, concentration=0.01)
+    try:
+        env.reset(seed=0)
+        for _ in range(5):
+            env.step(np.array([0.5], np.float32))
+        ship = env.unwrapped.sim.ship
+        assert ship.heading == pytest.approx(0.5 * 0.04 * 10.0, rel=1e-6)
+        assert ship.surge == pytest.approx(2.0, rel=1e-9)
+    finally:
+        env.close()
+
+
+def test_collision_impulses_add_up_to_the_ice_impulse_on_the_hull():
+    """The reward's step impulses (the time integral of |F_ice|) over an
+    episode against the collision log's impulses: each collision's impulse
+    is the integral of its force, so the log's total |J| can only fall
+    short of it where floes touch at once or a contact is still open at
+    the end (within 15 % here), and never exceeds it."""
+    env = gym.make(NAV, concentration=0.5)
+    try:
+        env.reset(seed=3)
+        u = env.unwrapped
+        total = 0.0
+        impulses = []
+        obs = None
+        from agents.baselines import StraightLinePolicy
+
+        policy = StraightLinePolicy(env)
+        while True:
+            action, _ = policy.predict(obs)
+            obs, _, terminated, truncated, info = env.step(action)
+            total += info["physics"]["step_impulse"]
+            if terminated or truncated:
+                break
+        impulses = info["mean_impulse"] * info["collisions"]
+    finally:
+        env.close()
+    assert info["collisions"] >= 5
+    assert impulses <= total * (1.0 + 1e-9)
+    assert impulses >= 0.85 * total, (impulses, total)
+    assert u.n_floes > 50
+
+
+def test_episode_metrics_are_the_ones_agents_log():
+    assert set(EPISODE_METRICS["ShipNavigation-v0"]) == set(METRICS)
+    env = gym.make(NAV, concentration=0.3)
+    try:
+        _, info = env.reset(seed=0)
+        assert set(METRICS) <= set(info)
+        _, _, _, _, info = env.step(np.zeros(1, np.float32))
+        assert set(METRICS) <= set(info)
+    finally:
+        env.close()
+
+
+# -- termination and rewards -----------------------------------------------------------------
+
+def _turn_out(exit_rule, max_yaw_rate=0.04):
+    """Turn to port at the full rate from the centre line until the ship
+    leaves the channel or the episode ends: (rewards, info, terminated)."""
+    env = gym.make(NAV, concentration=0.01, channel_exit=exit_rule, max_yaw_rate=max_yaw_rate)
+    try:
+        env.reset(seed=0)
+        rewards = []
+        for _ in range(200):
+            _, reward, terminated, truncated, info = env.step(np.array([1.0], np.float32))
+            rewards.append(reward)
+            if terminated or truncated or abs(info["physics"]["channel_offset"]) > 1.0:
+                break
+    finally:
+        env.close()
+    return rewards, info, terminated
+
+
+def test_leaving_the_channel_is_penalised_or_ends_the_episode():
+    # a turn at 0.5 rad/s (a circle of radius 4 m) never leaves the channel
+    _, info, _ = _turn_out("terminate", max_yaw_rate=0.5)
+    assert abs(info["physics"]["channel_offset"]) <= 1.0
+    # at 0.04 rad/s (radius 50 m) from the centre line it leaves the 75 m half-channel
+    rewards, info, terminated = _turn_out("terminate")
+    assert terminated and not info["success"] and rewards[-1] == -10.0
+    assert abs(info["physics"]["channel_offset"]) > 1.0
+    rewards, info, terminated = _turn_out("penalty")
+    assert not terminated and abs(info["physics"]["channel_offset"]) > 1.0
+    # outside: progress − time cost − exit weight
+    assert rewards[-1] <= 1.0 - 0.05 - 1.0 + 1e-9
+
+
+def test_a_weak_ship_is_beset_and_the_episode_fails():
+    """The dynamic ship with a thousandth of its thrust in the pack along
+    the coast cannot hold 5 cm/s: after beset_time it is beset."""
+    env = gym.make(BESET, concentration=0.7, thrust_fraction=0.001, speed=0.0, beset_time=20.0)
+    try:
+        env.reset(seed=0)
+        for k in range(100):
+            _, reward, terminated, truncated, info = env.step(np.array([1.0, 0.0], np.float32))
+            if terminated or truncated:
+                break
+        assert terminated and not info["success"] and reward == -10.0
+        assert k + 1 == 10                 # 20 s of 2 s steps
+    finally:
+        env.close()
+
+
+def test_beset_reward_penalises_hull_pressure_above_the_limit():
+    from iceenvs.rewards import ship_beset_reward
+
+    prev = {"goal_distance": 100.0}
+    now = {"goal_distance": 95.0, "hull_pressure": 1.5e4, "reached": 0.0}
+    r = ship_beset_reward(prev, None, now, step_length=10.0, pressure_limit=1e4)
+    assert r == pytest.approx(0.5 - 0.5 - 0.05)
+    now["hull_pressure"] = 5e4
+    r = ship_beset_reward(prev, None, now, step_length=10.0, pressure_limit=1e4)
+    assert r == pytest.approx(0.5 - 1.0 - 0.05)
+
+
+# -- task parameters and observation types -----------------------------------------------------
+
+def test_concentration_drawn_per_episode_keyword_and_option():
+    env = gym.make(NAV)
+    try:
+        drawn = {env.reset(seed=s)[1]["task"]["concentration"] for s in range(4)}
+        assert len(drawn) == 4 and all(0.2 <= c <= 0.6 for c in drawn)
+    finally:
+        env.close()
+    env = gym.make(NAV, concentration=0.25)
+    try:
+        _, info = env.reset(seed=0)
+        assert info["task"]["concentration"] == 0.25
+        assert info["physics"]["concentration"] == pytest.approx(0.25, abs=0.01)
+        _, info = env.reset(seed=1, options={"concentration": 0.5})
+        assert info["physics"]["concentration"] == pytest.approx(0.5, abs=0.01)
+        _, info = env.reset(seed=2)
+        assert info["task"]["concentration"] == 0.25
+    finally:
+        env.close()
+
+
+def test_wind_sets_the_ice_drifting_at_its_free_drift():
+    env = gym.make(NAV, concentration=0.3, wind_speed=15.0, wind_direction=0.5)
+    try:
+        env.reset(seed=0)
+        v = env.unwrapped.sim.velocities
+        speed = np.hypot(v[:, 0], v[:, 1])
+        # free drift of 1.5 m ice at 15 m/s of wind: a few per cent of it
+        assert 0.1 < np.median(speed) < 0.8
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("control, n", [("yaw", 1), ("speed_yaw", 2), ("thrust", 2)])
+def test_controls_have_their_action_spaces(control, n):
+    env = gym.make(NAV, concentration=0.3, control=control)
+    try:
+        assert env.action_space.shape == (n,)
+        env.reset(seed=0)
+        _, _, _, _, info = env.step(np.ones(n, np.float32))
+        assert "error" not in info
+        ship = env.unwrapped.sim.ship
+        assert ship.mode == ("dynamic" if control == "thrust" else "prescribed")
+    finally:
+        env.close()
+    with pytest.raises(ValueError, match="control"):
+        gym.make(NAV, control="rudder")
+
+
+@pytest.mark.parametrize("obs_type", ["image", "dict"])
+def test_image_and_dict_observations(obs_type):
+    env = gym.make(NAV, concentration=0.4, obs_type=obs_type, image_size=48)
+    try:
+        obs, _ = env.reset(seed=0)
+        assert env.observation_space.contains(obs)
+        obs, *_ = env.step(np.zeros(1, np.float32))
+        assert env.observation_space.contains(obs)
+        image = obs if obs_type == "image" else obs["image"]
+        assert image.shape == (4, 48, 48) and image.dtype == np.uint8
+        assert image[1].max() == 255          # the hull is in the picture
+    finally:
+        env.close()
+
+
+def test_reset_at_concentration_06_takes_under_a_second():
+    import time
+
+    env = gym.make(NAV, concentration=0.6)
+    try:
+        env.reset(seed=0)
+        times = []
+        for seed in range(1, 6):
+            t0 = time.perf_counter()
+            env.reset(seed=seed)
+            times.append(time.perf_counter() - t0)
+    finally:
+        env.close()
+    assert max(times) < 1.0, times
+
+
+def test_cnn_policy_trains_on_images():
+    sb3 = pytest.importorskip("stable_baselines3")
+    env = gym.make(NAV, concentration=0.3, obs_type="image", image_size=36,
+                   max_episode_steps=20)
+    try:
+        model = sb3.PPO("CnnPolicy", env, n_steps=32, batch_size=16, n_epochs=1, seed=0,
+                        device="cpu", policy_kwargs=dict(normalize_images=True,
+                                                         features_extractor_kwargs=dict(
+                                                             features_dim=32)))
+        model.learn(total_timesteps=64)
+        action, _ = model.predict(env.reset(seed=1)[0], deterministic=True)
+        assert env.action_space.contains(action)
+    finally:
+        env.close()
+
+
+# -- fuzzing ------------------------------------------------------------------------------------
+
+ENVS = {NAV: gym.make(NAV, concentration=0.4).unwrapped,
+        BESET: gym.make(BESET, concentration=0.6).unwrapped}
+FUZZ = settings(max_examples=10, deadline=None, database=None,
+                suppress_health_check=[HealthCheck.too_slow])
+entries = st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=32),
+                    st.floats(min_value=-1.0, max_value=1.0, width=32))
+OPTIONS = {
+    NAV: st.fixed_dictionaries({}, optional={
+        "concentration": st.floats(min_value=0.05, max_value=0.7),
+        "wind_speed": st.floats(min_value=0.0, max_value=30.0),
+        "current_speed": st.floats(min_value=0.0, max_value=0.5),
+        "floe_sizes": st.sampled_from(["pack", "brash"])}),
+    BESET: st.fixed_dictionaries({}, optional={
+        "concentration": st.floats(min_value=0.3, max_value=0.75),
+        "wind_speed": st.floats(min_value=0.0, max_value=30.0),
+        "pressure_limit": st.floats(min_value=1.0, max_value=1e6)}),
+}
+
+
+def _fuzz(env_id, seed, options, acts):
+    env = ENVS[env_id]
+    low, high = env.reward_bounds
+    obs, _ = env.reset(seed=seed, options=options)
+    assert env.observation_space.contains(obs)
+    for a in acts:
+        obs, reward, terminated, truncated, info = env.step(np.array(a, dtype=np.float32))
+        assert "error" not in info, info.get("error")
+        assert env.observation_space.contains(obs) and np.all(np.isfinite(obs))
+        assert low <= reward <= high, reward
+        for key in METRICS:
+            assert math.isfinite(float(info[key])), key
+        if terminated or truncated:
+            break
+
+
+@FUZZ
+@given(seed=st.integers(0, 2 ** 32 - 1), options=OPTIONS[NAV],
+       acts=st.lists(st.lists(entries, min_size=1, max_size=1), min_size=1, max_size=3))
+def test_ship_navigation_fuzz(seed, options, acts):
+    _fuzz(NAV, seed, options, acts)
+
+
+@FUZZ
+@given(seed=st.integers(0, 2 ** 32 - 1), options=OPTIONS[BESET],
+       acts=st.lists(st.lists(entries, min_size=2, max_size=2), min_size=1, max_size=3))
+def test_ship_beset_fuzz(seed, options, acts):
+    _fuzz(BESET, seed, options, acts)
+
+
+def test_draw_ship_paints_the_hull_and_rejects_bad_input():
+    pytest.importorskip("pygame")
+    from iceenvs.rendering import HULL, draw_floes, draw_ship
+
+    pic = draw_floes(np.array([[10.0, 10.0]]), np.array([1.0]), (200.0, 100.0),
+                     np.array([0.0]), size=400)
+    hull = np.array([[90.0, 45.0], [110.0, 45.0], [110.0, 55.0], [90.0, 55.0]])
+    out = draw_ship(pic, (200.0, 100.0), hull, np.array([[20.0, 50.0], [100.0, 50.0]]),
+                    goal_x=150.0)
+    assert tuple(out[100, 200]) == HULL                   # centre of the hull, y up
+    with pytest.raises(ValueError, match="hull_vertices"):
+        draw_ship(pic, (200.0, 100.0), hull[:2])
+    with pytest.raises(ValueError, match="picture"):
+        draw_ship(pic[..., 0], (200.0, 100.0), hull)
