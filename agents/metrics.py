@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["PHYSICS_METRICS", "MAIN_METRIC", "env_name", "metric_names", "physics_metrics"]
+__all__ = ["PHYSICS_METRICS", "EPISODE_METRICS", "MAIN_METRIC", "env_name", "metric_names", "physics_metrics"]
 
 #: per env name: ``{key of info["physics"]: logged name}``
 PHYSICS_METRICS: dict[str, dict[str, str]] = {
@@ -35,7 +35,21 @@ PHYSICS_METRICS: dict[str, dict[str, str]] = {
                                  "mean_thickness": "mean_thickness",
                                  "kernel_scale": "kernel_scale",
                                  "rafting_factor": "rafting_factor"},
+    "ShipNavigation-v0": {"goal_distance": "goal_distance", "surge": "surge",
+                          "step_impulse": "step_impulse", "hull_pressure": "hull_pressure",
+                          "concentration": "concentration"},
+    "ShipBeset-v0": {"goal_distance": "goal_distance", "surge": "surge",
+                     "hull_pressure": "hull_pressure", "pressure_limit": "pressure_limit",
+                     "step_impulse": "step_impulse", "concentration": "concentration"},
 }
+
+#: per env name: the episode metrics of ``info`` (top level, the episode so
+#: far) logged with the physics
+_SHIP_METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
+                 "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
+                 "energy_to_ice", "ice_resistance", "max_hull_pressure")
+EPISODE_METRICS: dict[str, tuple[str, ...]] = {"ShipNavigation-v0": _SHIP_METRICS,
+                                               "ShipBeset-v0": _SHIP_METRICS}
 
 #: per env name: the logged name of the metric that says most about the task
 MAIN_METRIC: dict[str, str] = {
@@ -44,6 +58,8 @@ MAIN_METRIC: dict[str, str] = {
     "MarginalIceZone-v0": "u_x",
     "FloeClustering-v0": "largest_cluster_fraction",
     "ThicknessDistribution-v0": "wasserstein1",
+    "ShipNavigation-v0": "step_impulse",
+    "ShipBeset-v0": "hull_pressure",
 }
 
 
@@ -73,4 +89,9 @@ def physics_metrics(env_id: str, info: dict) -> dict[str, float]:
         if key in physics:
             value = float(physics[key])
             out[name] = value if math.isfinite(value) else float("nan")
+    # the ship environments' episode metrics (success, path length, impulses...)
+    for key in EPISODE_METRICS.get(env_name(env_id), ()):
+        if key in info:
+            value = float(info[key])
+            out[key] = value if math.isfinite(value) else float("nan")
     return out
