@@ -3,7 +3,7 @@
 ``python -m benchmarks.environments --stiffness``.
 
     python -m benchmarks.environments [--ids WindDrift-v0 ...] [--seconds 20] [--runs 3]
-                                      [--warmup 2] [--seed 0] [--quick]
+                                      [--warmup 2] [--seed 0] [--quick] [--no-peer]
                                       [--json PATH | --no-json]
     python -m benchmarks.environments --stiffness [--json PATH]
 """
@@ -28,6 +28,13 @@ episode that ends (terminated or truncated) is reset inside the run and the
 reset is timed too, as in training: these are the rates training sees. The
 table gives the mean steps/s over the runs, their range and standard
 deviation, the resets and the physics errors (steps with `info["error"]`).
+
+When ShipNavigation-v0 is among them, the peer environment BenchNPIN
+`ship-ice-v0` (pymunk; its package installed by the command into a
+virtualenv of its own, see `benchmarks.benchnpin_peer`) is timed in the
+same run with the same protocol, beside ShipNavigation-v0 in its default
+configuration and at a number of floes like BenchNPIN's (the brash preset
+at A = 0.09); the second table gives the ratios.
 """
 STIFFNESS_TITLE = "Reduced stiffness"
 STIFFNESS_DESCRIPTION = """
@@ -38,22 +45,28 @@ Convergence-v0 at 1 per hour (`max_rate=1`) from Ā = 0.80 for 150 steps of
 observables averaged over the last third of the run.
 """
 WARMUP_STEPS = 5
-TARGETS = {"ThicknessDistribution-v0": 5000, "FloeClustering-v0": 200}
+TARGETS = {"ThicknessDistribution-v0": 5000, "FloeClustering-v0": 200,
+           # ten times BenchNPIN ship-ice-v0 on the same machine (about 10 steps/s)
+           "ShipNavigation-v0": 100}
 #: settings of ``--quick``
 QUICK = dict(seconds=0.5, runs=2, warmup=0.0)
 
 
+#: ShipNavigation-v0 at a number of floes like BenchNPIN's ship-ice-v0 (124–141)
+PEER_LIKE = dict(floe_sizes="brash", concentration=0.09)
+
+
 def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0,
-                warmup: float = 2.0) -> dict:
-    """Sustained steps/s of ``env_id`` in this process: ``runs`` consecutive
-    timed runs of at least ``seconds`` each, after the warm-up, with resets
-    at episode ends."""
+                warmup: float = 2.0, kwargs: dict | None = None) -> dict:
+    """Sustained steps/s of ``env_id`` (made with ``kwargs``) in this
+    process: ``runs`` consecutive timed runs of at least ``seconds`` each,
+    after the warm-up, with resets at episode ends."""
     import gymnasium as gym
 
     import iceenvs  # noqa: F401
     from iceenvs.warmup import random_steps
 
-    env = gym.make(env_id)
+    env = gym.make(env_id, **(kwargs or {}))
     env.action_space.seed(seed)
     env.reset(seed=seed)
     random_steps(env, WARMUP_STEPS)
@@ -82,17 +95,20 @@ def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0
     interval = getattr(spec, "control_interval", getattr(spec, "days_per_step", math.nan))
     unit = "days" if hasattr(spec, "days_per_step") and not hasattr(spec, "control_interval") \
         else "s"
+    floes = getattr(spec, "n_floes", None) if hasattr(spec, "lidar_sectors") else None
     env.close()
     return dict(id=env_id, rates=rates, mean=statistics.fmean(rates), min=min(rates),
                 max=max(rates), std=statistics.stdev(rates) if len(rates) > 1 else 0.0,
                 steps=steps, seconds=walls, resets=resets, errors=errors,
-                interval=float(interval), unit=unit)
+                interval=float(interval), unit=unit, kwargs=dict(kwargs or {}), floes=floes)
 
 
-def _child(env_id: str, seconds: float, runs: int, seed: int, warmup: float) -> dict:
+def _child(env_id: str, seconds: float, runs: int, seed: int, warmup: float,
+           kwargs: dict | None = None) -> dict:
     """:func:`measure_env` in a fresh process limited to one Numba thread."""
     try:
-        return harness.spawn_call(measure_env, env_id, seconds, runs, seed, warmup, threads=1)
+        return harness.spawn_call(measure_env, env_id, seconds, runs, seed, warmup, kwargs,
+                                  threads=1)
     except harness.ChildError as exc:
         tail = (str(exc).strip().splitlines() or ["(no output)"])[-1]
         return dict(id=env_id, failed=tail)
@@ -139,6 +155,67 @@ def run_benchmark(ids, seconds: float = 20.0, runs: int = 3, seed: int = 0, warm
             bar.advance()
             bar.log("| " + " | ".join(map(str, env_row(row))) + " |")
     return result
+
+
+PEER_COLUMNS = ["environment", "floes", "model time per step", "steps/s (mean)", "min–max",
+                "ratio to BenchNPIN (range)"]
+
+
+def peer_comparison(seconds: float, runs: int, seed: int, warmup: float,
+                    quiet: bool = False) -> dict:
+    """BenchNPIN ``ship-ice-v0`` (in its own virtualenv,
+    :mod:`benchmarks.benchnpin_peer`) and ShipNavigation-v0 (default and
+    :data:`PEER_LIKE`) timed one after the other with the same protocol."""
+    from . import benchnpin_peer
+
+    ours = "iceenvs/ShipNavigation-v0"
+    with harness.Progress(3, "BenchNPIN side by side", quiet) as bar:
+        try:
+            peer = benchnpin_peer.measure(seconds=seconds, runs=runs, seed=seed)
+        except RuntimeError as exc:
+            peer = dict(failed=str(exc).strip().splitlines()[-1])
+        bar.advance()
+        default = _child(ours, seconds, runs, seed, warmup)
+        bar.advance()
+        like = _child(ours, seconds, runs, seed, warmup, PEER_LIKE)
+        bar.advance()
+    return dict(peer=peer, default=default, peer_like=like)
+
+
+def peer_table(result: dict) -> dict:
+    """The table of a :func:`peer_comparison` result."""
+    peer = result["peer"]
+    rows = []
+    if "failed" in peer:
+        rows.append(["BenchNPIN `ship-ice-v0`", f"failed: {peer['failed']}", "", "", "", ""])
+    else:
+        cfg = peer.get("config", {})
+        per = cfg.get("floes_per_episode") or {}
+        floes = f"{per['min']}–{per['max']}" if per else cfg.get("floes", "")
+        rows.append([f"BenchNPIN `ship-ice-v0` {peer.get('version', '')}, A = "
+                     f"{cfg.get('concentration', math.nan):g}", floes,
+                     f"{peer.get('interval', math.nan):g} s", f"{peer['mean']:.1f}",
+                     f"{peer['min']:.1f}–{peer['max']:.1f}", "1"])
+    for key, label in (("default", "`ShipNavigation-v0` (default: A 0.2–0.6, pack floes)"),
+                       ("peer_like", "`ShipNavigation-v0`, brash floes, A = 0.09")):
+        r = result[key]
+        if "failed" in r:
+            rows.append([label, f"failed: {r['failed']}", "", "", "", ""])
+            continue
+        ratio = ""
+        if "failed" not in peer:
+            ratio = (f"{r['mean'] / peer['mean']:.1f} ({r['min'] / peer['max']:.1f}–"
+                     f"{r['max'] / peer['min']:.1f})")
+        rows.append([label, r.get("floes", ""), f"{r['interval']:g} {r['unit']}",
+                     f"{r['mean']:.0f}", f"{r['min']:.0f}–{r['max']:.0f}", ratio])
+    return harness.table(
+        "Ship navigation side by side with BenchNPIN ship-ice-v0 (one core each, same "
+        "protocol, one benchmark run)", PEER_COLUMNS, rows,
+        "Floes: those of the last episode measured (BenchNPIN: the range over the episodes "
+        "it ran). The range of a ratio divides the slowest run of one by the fastest of the "
+        "other. BenchNPIN's ship is 2 m long at 0.3 m/s, ours 76.2 m at 2 m/s; both "
+        "advance about an eighth of the ship length per step and the same speed in ship "
+        "lengths per second scaled by Froude's law.")
 
 
 def stiffness_effect(scales=(1.0, 0.1, 0.01), steps: int = 60, seed: int = 3) -> list[dict]:
@@ -211,6 +288,8 @@ def main(argv=None, prog: str | None = None) -> int:
     parser.add_argument("--warmup", type=float, default=None,
                         help="untimed seconds of steps after the compiling steps (default 2)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the episodes and actions")
+    parser.add_argument("--no-peer", action="store_true",
+                        help="skip timing BenchNPIN ship-ice-v0 beside ShipNavigation-v0")
     parser.add_argument("--stiffness", action="store_true",
                         help="compare stiffness_scale = 1, 0.1, 0.01 instead (writes a record "
                              "only with --json)")
@@ -234,8 +313,13 @@ def main(argv=None, prog: str | None = None) -> int:
     ids = _resolve_ids(args.ids, ENV_IDS) if args.ids else list(ENV_IDS)
     result = run_benchmark(ids, settings["seconds"], settings["runs"], args.seed,
                            settings["warmup"], args.quiet)
+    tables = [environments_table(result)]
+    if "iceenvs/ShipNavigation-v0" in ids and not args.no_peer:
+        result["peer"] = peer_comparison(settings["seconds"], settings["runs"], args.seed,
+                                         settings["warmup"], args.quiet)
+        tables.append(peer_table(result["peer"]))
     record = harness.make_record(SUITE, TITLE, DESCRIPTION, command,
-                                 [environments_table(result)], dict(result, quick=args.quick),
+                                 tables, dict(result, quick=args.quick),
                                  time.perf_counter() - t0,
                                  machine=harness.machine_info(numba_threads=1))
     harness.finish(args, record, show=False)
