@@ -32,6 +32,8 @@ from typing import Callable
 ENV_KWARGS = {
     "FloeClustering-v0": dict(n_floes=150),
     "ThicknessDistribution-v0": dict(n_classes=60),
+    "ShipNavigation-v0": dict(concentration=0.3),
+    "ShipBeset-v0": dict(concentration=0.6),
 }
 FLOE_ENV_KWARGS = dict(n_floes=60)
 
