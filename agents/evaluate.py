@@ -146,18 +146,29 @@ def summarise(episodes: list[dict]) -> dict:
     return out
 
 
-def compare(policy: list[dict], baseline: list[dict]) -> dict:
-    """Paired comparison of returns on the same seeds: mean difference
-    (policy − baseline), its standard error and whether it exceeds two
-    standard errors."""
-    d = np.array([p["ret"] - b["ret"] for p, b in zip(policy, baseline)])
+def compare(policy: list[dict], baseline: list[dict], metric: str | None = None,
+            lower_is_better: bool = False) -> dict:
+    """Paired comparison on the same seeds of the returns (or of the final
+    physics ``metric``): mean difference (policy − baseline), its standard
+    error and whether the policy is better by more than two standard
+    errors (higher, or lower with ``lower_is_better``)."""
+    def value(e):
+        return e["ret"] if metric is None else e["final"].get(metric, math.nan)
+
+    d = np.array([value(p) - value(b) for p, b in zip(policy, baseline)])
     s = _stats(d)
-    return dict(diff=s["mean"], sem=s["sem"],
-                beats=bool(s["mean"] > 2.0 * s["sem"] and s["mean"] > 0))
+    gain = -s["mean"] if lower_is_better else s["mean"]
+    return dict(diff=s["mean"], sem=s["sem"], beats=bool(gain > 2.0 * s["sem"] and gain > 0))
+
+
+#: per env name: a final metric compared like the return, and whether lower is better
+COMPARED_METRIC = {"ShipNavigation-v0": ("impulse_per_metre", True),
+                   "ShipBeset-v0": ("impulse_per_metre", True)}
 
 
 def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
-                   seed: int, labels: dict | None = None) -> str:
+                   seed: int, labels: dict | None = None,
+                   metric_comparisons: dict | None = None) -> str:
     """The comparison as Markdown: one row per policy, one column per
     quantity (mean ± std, standard error in brackets); ``labels`` maps a
     policy name to the text of its rows (default: the name)."""
@@ -177,6 +188,14 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
                   "(mean [standard error of the difference]):", "",
                   "| baseline | difference | beaten by > 2 standard errors |", "|---|---|---|"]
         for name, c in comparisons.items():
+            lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
+                         f"{'yes' if c['beats'] else 'no'} |")
+    if metric_comparisons:
+        metric, lower = COMPARED_METRIC[env_id.split("/")[-1]]
+        lines += ["", f"Final `{metric}` of the policy minus the baseline's, paired by seed "
+                  f"({'lower' if lower else 'higher'} is better):", "",
+                  "| baseline | difference | better by > 2 standard errors |", "|---|---|---|"]
+        for name, c in metric_comparisons.items():
             lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
                          f"{'yes' if c['beats'] else 'no'} |")
     return "\n".join(lines) + "\n"
@@ -364,16 +383,22 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     finally:
         env.close()
     summaries = {name: summarise(eps) for name, eps in results.items()}
-    comparisons = {}
+    comparisons, metric_comparisons = {}, {}
     if args.baseline is None:
         first = next(iter(results))
         comparisons = {n: compare(results[first], results[n]) for n in names}
-    table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels)
+        if env_name(env_id) in COMPARED_METRIC:
+            metric, lower = COMPARED_METRIC[env_name(env_id)]
+            metric_comparisons = {n: compare(results[first], results[n], metric, lower)
+                                  for n in names}
+    table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels,
+                           metric_comparisons)
     print(table)
     out.mkdir(parents=True, exist_ok=True)
     (out / "evaluation.md").write_text(table)
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
+                  metric_comparisons=metric_comparisons,
                   main_metric=MAIN_METRIC.get(env_name(env_id)),
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
                                             terminated=e["terminated"], final=e["final"],
