@@ -90,7 +90,13 @@ class ShipNavigationEnv(ShipEnv):
       path. Any other constant yaw rate sails in a circle.
     * *What a good policy does:* reads the lidar (or the image) and steers
       through the openings between the large floes, keeping close to the
-      straight line, since every metre off it costs progress.
+      straight line, since every metre off it costs progress. How much
+      that can gain is small at the default settings: at A = 0.4 the
+      straight line loses about 11 of a return of 70 to the ice, and
+      swerving round one floe meets the next (the reactive planner and the
+      documented PPO run do worse than the straight line; see the docs'
+      training page). Larger `impulse_weight` values make the ice count
+      for more.
 
     ## Action Space
     `Box(-1, 1, (n,), float32)`. `control="yaw"` (default, n = 1): yaw rate
