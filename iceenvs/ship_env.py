@@ -257,16 +257,11 @@ class ShipEnv(HertzEnv):
                               density=p.forcing.ice_density)
             packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
             pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
-        (x0, y0), _ = self._ship_start()
-        gap = pos - np.array([x0, y0])
-        if box.periodic[0]:
-            gap[:, 0] -= box.lx * np.round(gap[:, 0] / box.lx)
-        if box.periodic[1]:
-            gap[:, 1] -= box.ly * np.round(gap[:, 1] / box.ly)
-        from physics.ship import psv_ship
+        from physics.hull import PSV_HULL
 
-        reach = psv_ship().hull.circumradius
-        keep = np.hypot(gap[:, 0], gap[:, 1]) > reach + r + START_CLEARANCE
+        start, _ = self._ship_start()
+        gap = box.minimum_image(pos - np.asarray(start))
+        keep = np.hypot(gap[:, 0], gap[:, 1]) > PSV_HULL.circumradius + r + START_CLEARANCE
         pos, r = pos[keep], r[keep]
         field = FloeField(pos, r, p.thickness, np.zeros((r.size, 2)),
                           density=p.forcing.ice_density)
@@ -421,26 +416,18 @@ class ShipEnv(HertzEnv):
         now["reached"] = float(x >= self.goal_x)
         return now
 
-    def _minimum_image(self, d):
-        box = self.sim.box
-        d = np.array(d, dtype=float)
-        for axis, length in ((0, box.lx), (1, box.ly)):
-            if box.periodic[axis]:
-                d[..., axis] -= length * np.round(d[..., axis] / length)
-        return d
-
     def _local_ice(self, x, y) -> dict:
         """Concentration, contacts per floe and contact pressure of the ice
         within ``local_radius`` of the ship."""
         sim = self.sim
         big_r = self.local_radius
         area = math.pi * big_r ** 2
-        d = self._minimum_image(sim.positions - np.array([x, y]))
+        d = sim.box.minimum_image(sim.positions - np.array([x, y]))
         near = np.hypot(d[:, 0], d[:, 1]) < big_r
         c = sim.contacts()
         self._contacts = c
         if len(c):
-            p = self._minimum_image(c.contact_point - np.array([x, y]))
+            p = sim.box.minimum_image(c.contact_point - np.array([x, y]))
             inside = np.hypot(p[:, 0], p[:, 1]) < big_r
             arm = c.branch_i[inside] - c.branch_j[inside]
             f = c.force[inside]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from physics import HERMAN2013
+from physics import HERMAN2013, FloeField
 from physics.domain import Box
 from physics.forcing import steady_drift
 
@@ -202,8 +202,8 @@ class ShipNavigationEnv(ShipEnv):
                                  floe_sizes=e["floe_sizes"])
         if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
             u = steady_drift(forcing, field.radii, field.thickness, field.masses)
-            field = field.__class__(field.positions, field.radii, field.thickness, u,
-                                    density=field.density)
+            field = FloeField(field.positions, field.radii, field.thickness, u,
+                              density=field.density)
         return field, box, forcing
 
     def _terminated(self, now):
