@@ -424,12 +424,10 @@ class StraightLinePolicy(Baseline):
     def _steer(self, bearing: float, get) -> np.ndarray:
         u = self.unwrapped
         if u.control == "thrust":
-            ship = u.sim.ship.ship if u.sim is not None else None
-            inertia = ship.total_mass[2] if ship else 1.0
-            top = ship.max_yaw_moment if ship else 1.0
+            ship = u._ship                # the episode's ship (set by reset)
             w = self.FREQUENCY
-            moment = inertia * (w * w * bearing - 2.0 * w * get("yaw_rate"))
-            return np.array([1.0, moment / top])
+            moment = ship.total_mass[2] * (w * w * bearing - 2.0 * w * get("yaw_rate"))
+            return np.array([1.0, moment / ship.max_yaw_moment])
         turn = bearing / self.GAIN_ANGLE
         return np.array([turn]) if u.control == "yaw" else np.array([1.0, turn])
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+from iceenvs.ship_env import METRICS as SHIP_METRICS
+
 __all__ = ["PHYSICS_METRICS", "EPISODE_METRICS", "MAIN_METRIC", "env_name", "metric_names", "physics_metrics"]
 
 #: per env name: ``{key of info["physics"]: logged name}``
@@ -45,11 +47,8 @@ PHYSICS_METRICS: dict[str, dict[str, str]] = {
 
 #: per env name: the episode metrics of ``info`` (top level, the episode so
 #: far) logged with the physics
-_SHIP_METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
-                 "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
-                 "energy_to_ice", "ice_resistance", "max_hull_pressure")
-EPISODE_METRICS: dict[str, tuple[str, ...]] = {"ShipNavigation-v0": _SHIP_METRICS,
-                                               "ShipBeset-v0": _SHIP_METRICS}
+EPISODE_METRICS: dict[str, tuple[str, ...]] = {"ShipNavigation-v0": SHIP_METRICS,
+                                               "ShipBeset-v0": SHIP_METRICS}
 
 #: per env name: the logged name of the metric that says most about the task
 MAIN_METRIC: dict[str, str] = {
