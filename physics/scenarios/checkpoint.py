@@ -16,7 +16,9 @@ Only these kinds of values are written:
 * :class:`numpy.random.Generator` and the bit generators of
   :mod:`numpy.random`, through their ``state``;
 * enumerations, named tuples, dataclasses and plain objects whose classes
-  are defined in the ``physics`` package. Such an object is rebuilt as
+  are defined in the ``physics`` package (an object whose class defines
+  ``__checkpoint_attrs__()`` is written with the attributes that method
+  returns instead of its ``__dict__``). Such an object is rebuilt as
   ``cls.__new__(cls)`` followed by an update of its ``__dict__`` (and
   ``__slots__``): no constructor, ``__setstate__`` or ``__reduce__`` runs,
   and a class is only looked up by module and qualified name in modules of
@@ -226,7 +228,11 @@ class _Encoder:
                             f"{builtin.__name__}, which is not written")
         node = self._remember(value, {"object": name})
         if hasattr(value, "__dict__"):
-            node["attrs"] = {k: self.encode(v, f"{path}.{k}") for k, v in vars(value).items()}
+            # an object whose attributes include a live handle (a LAMMPS
+            # instance) gives what stands for them through __checkpoint_attrs__
+            hook = getattr(cls, "__checkpoint_attrs__", None)
+            attrs = hook(value) if hook is not None else vars(value)
+            node["attrs"] = {k: self.encode(v, f"{path}.{k}") for k, v in attrs.items()}
         slots = {k: self.encode(getattr(value, k), f"{path}.{k}")
                  for k in _slot_names(cls) if hasattr(value, k)}
         if slots:

