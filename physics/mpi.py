@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import ctypes
 import os
+import sys
 
 import numpy as np
 
 __all__ = ["world_rank", "world_size", "under_mpiexec", "allreduce_max", "allgather_rows",
-           "barrier"]
+           "barrier", "abort", "finalize"]
 
 # MPICH ABI handles (mpi.h of MPICH ≥ 3.1, stable across its releases)
 _COMM_WORLD = 0x44000000
@@ -108,3 +109,29 @@ def allgather_rows(rows: np.ndarray) -> np.ndarray:
                               displs.ctypes.data_as(ctypes.c_void_p), _DOUBLE, _COMM_WORLD),
            "MPI_Allgatherv")
     return out.reshape(-1, width)
+
+
+def abort(code: int = 1) -> None:
+    """Stop every rank of the run (a rank that fails alone would leave the
+    others waiting in a collective); returns only outside ``mpiexec``."""
+    if under_mpiexec():
+        try:
+            lib = _lib()
+        except Exception:
+            os._exit(code)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        lib.MPI_Abort(_COMM_WORLD, int(code))
+        os._exit(code)
+
+
+def finalize() -> None:
+    """Wait for every rank, then end MPI: a rank that leaves without it
+    makes ``mpiexec`` stop the others, which may still be writing."""
+    if under_mpiexec():
+        lib = _lib()
+        lib.MPI_Barrier(_COMM_WORLD)
+        done = ctypes.c_int(0)
+        lib.MPI_Finalized(ctypes.byref(done))
+        if not done.value:
+            lib.MPI_Finalize()

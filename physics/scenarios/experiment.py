@@ -69,6 +69,8 @@ class Experiment:
     case_label: str | None = None
     #: whether runs store floe snapshots (their variables then always exist)
     takes_snapshots: bool = True
+    #: the engines it runs on (:mod:`physics.scenarios.engines`)
+    engines: tuple[str, ...] = ("numba",)
 
     def cases(self, p: dict) -> list[dict]:
         """One dict of coordinate values per independent run (default: one)."""

@@ -33,6 +33,7 @@ from ..hertz_kernels import floe_drag
 from ..observables import fabric, stress
 from ..params import HERMAN2013
 from . import plots
+from .engines import hertz_simulation
 from .experiment import Experiment, register
 
 NETWORK_VARIABLES = {
@@ -68,7 +69,7 @@ def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None) -> Hert
     contact = _contact_law(p)
     dt = hertz_time_step(field, box, contact, IMPACT_SPEED, HERMAN2013.time_step,
                          p["stiffness_scale"])
-    return HertzSimulation(field, box, contact, forcing, dt=dt, impact_speed=IMPACT_SPEED,
+    return hertz_simulation(field, box, contact, forcing, dt=dt, impact_speed=IMPACT_SPEED,
                            allow_overlap=True)
 
 
@@ -234,6 +235,8 @@ def first_crossing(concentration, values, level: float) -> float:
 class Convergence(Experiment):
     """Pure convergence of a periodic box at dA/dt, floes initially at rest."""
 
+    engines = ("numba", "lammps")
+
     variables = {**NETWORK_VARIABLES,
                  "a_j": ("1", "A_J: knee of ln p(A) (two-piece fit)"),
                  "a_j_network": ("1", "first A from which Z_c stays above 3"),
@@ -379,6 +382,8 @@ class Convergence(Experiment):
 class Wind(Experiment):
     """Constant wind along x in a periodic box, one run per concentration."""
 
+    engines = ("numba", "lammps")
+
     variables = {**NETWORK_VARIABLES}
     required = ("time", "p", "tau", "z_c", "z_a", "f_nr", "z_touch", "floe_x", "contact_force")
     case_label = "concentration"
@@ -491,6 +496,8 @@ def _spearman(x, y) -> float:
 class MarginalIceZone(Experiment):
     """Frozen floes along y = 0, periodic in x, a wall at the top; constant
     wind of fixed speed at an angle to the edge, one run per angle."""
+
+    engines = ("numba", "lammps")
 
     variables = {**NETWORK_VARIABLES,
                  "u_x_profile": ("m/s", "mean u_x of the mobile floes in bins of y")}

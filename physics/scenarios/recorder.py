@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import mpi
 from . import checkpoint as _checkpoint
 
 
@@ -104,16 +105,21 @@ class Recorder:
     log : callable(str) or None
         Receives the report on a checkpoint that cannot be read (default:
         standard error).
+    write : bool
+        Whether this recorder writes checkpoint files. In a run on several
+        MPI ranks only rank 0's does; the others read the checkpoints and
+        take part in writing them (:meth:`checkpoint`).
     """
 
     def __init__(self, checkpoint_path: Path | None = None, checkpoint_every: float = 60.0,
                  on_progress=None, variables: dict | None = None, keep_snapshots: bool = True,
-                 log=None):
+                 log=None, write: bool = True):
         self.checkpoint_path = Path(checkpoint_path) if checkpoint_path else None
         self.checkpoint_every = float(checkpoint_every)
         self.on_progress = on_progress
         self.variables = dict(variables or {})
         self.keep_snapshots = keep_snapshots
+        self.write = bool(write)
         self.rows: list[tuple[float, dict]] = []
         self.coords: dict[str, tuple[np.ndarray, dict]] = {}
         self.snapshots: list[dict] = []
@@ -188,11 +194,21 @@ class Recorder:
         if self.checkpoint_path is None:
             return False
         now = _time.monotonic()
-        if not force and now - self._last < self.checkpoint_every:
+        due = force or now - self._last >= self.checkpoint_every
+        if mpi.under_mpiexec():
+            # every rank of a parallel run takes the same decision (rank 0's
+            # clock may be ahead): the state of a LAMMPS engine is written
+            # by all ranks together
+            due = mpi.allreduce_max(float(due)) > 0.0
+        if not due:
             return False
         payload = dict(state=state, rows=self.rows, coords=self.coords,
                        snapshots=self.snapshots, results=self.results, notes=self.notes,
                        fraction=self._fraction)
+        if not self.write:
+            _checkpoint.dumps(payload)          # the engine's part is collective
+            self._last = now
+            return False
         newest, previous = checkpoint_files(self.checkpoint_path)
         # the newest file becomes the previous one only if it is a good checkpoint
         atomic_write(newest, lambda tmp: _checkpoint.save(tmp, payload,
