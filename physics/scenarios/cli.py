@@ -9,6 +9,8 @@ plot the papers' experiments.
     ice-scenarios run herman2011-clustering --floes 2000 --ensemble 2 --set concentrations=[0.6,0.8]
     ice-scenarios run my-copy.yaml --out runs/mine
     ice-scenarios run --resume runs/herman2013-convergence
+    ice-scenarios run herman2013-wind --floes 200000 --engine lammps --mpi 8
+    ice-scenarios run herman2013-wind --ensemble 8 --dask-local 4
     ice-scenarios plot runs/herman2013-convergence
     ice-scenarios summary runs/herman2013-convergence
 """
@@ -68,6 +70,16 @@ def build_parser(prog: str = "ice-scenarios") -> argparse.ArgumentParser:
     r.add_argument("--force", action="store_true", help="overwrite an existing run directory")
     r.add_argument("--resume", metavar="RUN_DIR", help="continue an interrupted run")
     r.add_argument("--workers", type=int, help="parallel processes (default: one per core)")
+    r.add_argument("--engine", choices=("numba", "lammps"), default="numba",
+                   help="the engine of the Hertz scenarios: numba (default) or lammps")
+    r.add_argument("--mpi", type=int, metavar="N",
+                   help="run each LAMMPS job on N MPI ranks (mpiexec -n N; with --engine lammps)")
+    dask = r.add_mutually_exclusive_group()
+    dask.add_argument("--scheduler", metavar="ADDRESS",
+                      help="run the jobs on the workers of this Dask scheduler "
+                           "(tcp://HOST:8786); they must see the run directory")
+    dask.add_argument("--dask-local", type=int, metavar="N",
+                      help="run the jobs on a local Dask cluster of N worker processes")
     r.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
                    help="wall seconds between checkpoints (default 60)")
     r.add_argument("--no-plots", action="store_true", help="skip the figures")
@@ -99,17 +111,24 @@ def main(argv=None, prog: str = "ice-scenarios") -> int:
             print(summarise_run(args.run_dir))
             return 0
         common = dict(workers=args.workers, checkpoint_every=args.checkpoint_every,
-                      progress=not args.no_progress, plots=not args.no_plots)
+                      progress=not args.no_progress, plots=not args.no_plots,
+                      dask=({"scheduler": args.scheduler} if args.scheduler is not None else
+                            {"local": args.dask_local} if args.dask_local is not None else None))
         if args.resume:
+            if args.engine != "numba" or args.mpi is not None:
+                raise ValueError("--resume continues a run on the engine and ranks it was "
+                                 "started with (recorded in its run.yaml)")
             if args.name or args.set or args.floes is not None or args.quick:
                 raise ValueError("--resume continues a run as it was started; give only the "
-                                 "run directory (and --workers, --checkpoint-every)")
+                                 "run directory (and --workers, --checkpoint-every, "
+                                 "--scheduler, --dask-local)")
             resume_run(args.resume, **common)
             return 0
         if not args.name:
             raise ValueError("run needs a scenario name (ice-scenarios list) or --resume RUN_DIR")
         run_scenario(args.name, overrides=parse_set(args.set), floes=args.floes, seed=args.seed,
                      ensemble=args.ensemble, quick=args.quick, out=args.out, force=args.force,
+                     engine=args.engine, mpi_ranks=args.mpi,
                      command=f"{prog} {shlex.join(argv)}", **common)
         return 0
     except (ValueError, FileExistsError, FileNotFoundError) as exc:

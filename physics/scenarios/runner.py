@@ -33,6 +33,11 @@ from types import SimpleNamespace
 import numpy as np
 
 from .config import ScenarioConfig, bundled_configs, dump_yaml, load_config, parse_config
+from .dask_pool import check_options as check_dask
+from .dask_pool import describe as describe_dask
+from .dask_pool import run_on_dask
+from .. import mpi
+from .engines import check_engine, use_engine
 from .experiment import get_experiment
 from .recorder import Recorder, atomic_write, checkpoint_files, checkpoint_fraction
 
@@ -108,8 +113,13 @@ def _job_paths(directory: Path, c: int, m: int) -> tuple[Path, Path]:
 
 
 def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: str, c: int,
-             m: int, checkpoint_every: float, job_id: int, on_progress=None) -> str:
-    """One simulation: (case c, member m). Returns the path of its NetCDF."""
+             m: int, checkpoint_every: float, job_id: int, on_progress=None,
+             engine: str = "numba") -> str:
+    """One simulation: (case c, member m) on ``engine``. Returns the path of
+    its NetCDF. In a run on several MPI ranks every rank calls it; rank 0
+    alone writes files."""
+    use_engine(engine)
+    root = mpi.world_rank() == 0
     cfg = parse_config(config_data)
     exp = get_experiment(cfg.name)
     out, ckpt = _job_paths(Path(directory), c, m)
@@ -122,14 +132,15 @@ def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: 
                 last[0] = now
                 _QUEUE.put((job_id, f))
     rec = Recorder(ckpt, checkpoint_every, on_progress, exp.variables,
-                   keep_snapshots=exp.takes_snapshots)
+                   keep_snapshots=exp.takes_snapshots, write=root)
     exp.simulate(params, case, seed, rec)
     rec.progress(1.0)
-    ds = rec.dataset()
-    ds.attrs.update(case=c, member=m, seed=str(seed))
-    atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
-    for file in checkpoint_files(ckpt):
-        file.unlink(missing_ok=True)
+    if root:
+        ds = rec.dataset()
+        ds.attrs.update(case=c, member=m, seed=str(seed))
+        atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+        for file in checkpoint_files(ckpt):
+            file.unlink(missing_ok=True)
     return str(out)
 
 
@@ -155,14 +166,20 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
                  seed: int = 0, ensemble: int = 1, quick: bool = False, out=None,
                  force: bool = False, workers: int | None = None,
                  checkpoint_every: float = 60.0, progress: bool = True, plots: bool = True,
-                 command: str | None = None, log=print) -> RunResult:
+                 command: str | None = None, log=print, dask: dict | None = None,
+                 engine: str = "numba", mpi_ranks: int | None = None) -> RunResult:
     """Run ``scenario`` (a name or a YAML path) and write its run directory.
 
     ``overrides`` are parameter values (checked against the file's ranges);
     ``floes`` is a shortcut for the ``floes`` parameter. ``out`` defaults to
     ``runs/NAME`` (``runs/NAME-quick`` with ``quick``); an existing directory
     is only replaced with ``force``. See :func:`resume_run` to continue an
-    interrupted run.
+    interrupted run. ``engine`` is "numba" (our engines) or "lammps"
+    (:mod:`physics.scenarios.engines`, the Herman 2013 scenarios); with
+    ``mpi_ranks`` N each LAMMPS run goes to ``mpiexec -n N``
+    (:mod:`physics.scenarios.lammps_job`). ``dask`` runs the jobs on Dask instead of local
+    processes: ``{"local": N}`` (a LocalCluster of N workers) or
+    ``{"scheduler": ADDRESS}`` (see :mod:`physics.scenarios.dask_pool`).
     """
     cfg = find_config(scenario)
     overrides = dict(overrides or {})
@@ -175,6 +192,18 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
         raise ValueError(f"ensemble must be a positive number of members, got {ensemble}")
     if int(seed) < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    dask = check_dask(dask)
+    check_engine(engine, get_experiment(cfg.name))
+    if mpi_ranks is not None:
+        from .lammps_job import check_ranks
+
+        check_ranks(mpi_ranks)
+        if engine != "lammps":
+            raise ValueError("--mpi runs the LAMMPS engine on several ranks; add --engine lammps "
+                             "(the numba engine uses threads on one machine)")
+    if engine == "lammps" and dask:
+        raise ValueError("the LAMMPS engine runs its jobs under mpiexec, not on Dask; drop "
+                         "--scheduler/--dask-local or use the numba engine")
     params = cfg.resolve(overrides, quick=quick)
     if not get_experiment(cfg.name).cases(params):
         raise ValueError(f"these parameters give scenario {cfg.name!r} nothing to run (an empty "
@@ -185,25 +214,35 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
                     quick=bool(quick), seed=int(seed), ensemble=int(ensemble),
                     member_seeds=member_seeds(seed, ensemble), parameters=params,
                     overrides=overrides, command=command or "", config=cfg.data,
+                    engine=engine, mpi_ranks=int(mpi_ranks or 1),
                     created=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                     versions=versions())
     atomic_write(out / RUN_FILE, lambda tmp: Path(tmp).write_text(dump_yaml(run_info)))
-    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log)
+    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log, dask)
 
 
 def resume_run(out, *, workers: int | None = None, checkpoint_every: float = 60.0,
-               progress: bool = True, plots: bool = True, log=print) -> RunResult:
+               progress: bool = True, plots: bool = True, log=print,
+               dask: dict | None = None) -> RunResult:
     """Continue the run in directory ``out``: finished simulations are kept,
-    interrupted ones restart from their last checkpoint, the rest start."""
+    interrupted ones restart from their last checkpoint, the rest start
+    (``dask`` as for :func:`run_scenario`)."""
     import yaml
 
+    dask = check_dask(dask)
     out = Path(out)
     _prepare_directory(out, False, resume=True)
     run_info = yaml.safe_load((out / RUN_FILE).read_text())
-    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log)
+    engine = run_info.get("engine", "numba")
+    check_engine(engine)
+    if engine == "lammps" and dask:
+        raise ValueError("this run is on the LAMMPS engine, whose jobs run under mpiexec, not "
+                         "on Dask; drop --scheduler/--dask-local")
+    return _execute(out, run_info, workers, checkpoint_every, progress, plots, log, dask)
 
 
-def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, log) -> RunResult:
+def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, log,
+             dask=None) -> RunResult:
     t0 = time.perf_counter()
     cfg = parse_config(info["config"])
     exp = get_experiment(cfg.name)
@@ -221,9 +260,12 @@ def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, 
     workers = min(len(todo), n_cpu) if workers is None else max(1, min(int(workers), len(todo) or 1))
     log(f"{cfg.name}: {len(cases)} case(s) x {len(seeds)} member(s) = {len(jobs)} run(s)"
         + (f", {len(jobs) - len(todo)} already finished" if len(todo) < len(jobs) else "")
-        + (f", {workers} in parallel" if workers > 1 else "") + f" -> {out}")
+        + (f", one after the other on LAMMPS with {info.get('mpi_ranks', 1)} MPI rank(s)"
+           if info.get("engine", "numba") == "lammps" else describe_dask(dask) if dask
+           else f", {workers} in parallel" if workers > 1 else "")
+        + f" -> {out}")
     if todo:
-        _run_jobs(out, info, todo, workers, checkpoint_every, progress)
+        _run_jobs(out, info, todo, workers, checkpoint_every, progress, dask, log)
     ds = combine(out, info, cases, exp)
     atomic_write(out / RESULTS_FILE, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
     figures = []
@@ -237,8 +279,10 @@ def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, 
     return RunResult(out, out / RESULTS_FILE, figures, rows, wall)
 
 
-def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every, progress):
-    """Run the unfinished jobs, ``workers`` at a time, with one progress bar."""
+def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every, progress,
+              dask=None, log=print):
+    """Run the unfinished jobs, ``workers`` at a time (or on Dask), with one
+    progress bar."""
     from tqdm.auto import tqdm
 
     fractions = {k: checkpoint_fraction(_job_paths(out, j["c"], j["m"])[1])
@@ -263,7 +307,7 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
         # process would surface as a SystemError from inside Numba, so an
         # in-process job stops at its next progress report (at most one
         # output interval later); a second signal stops at once.
-        if workers == 1 and not stop:
+        if workers == 1 and not dask and not stop:
             stop.append(signum)
             return
         raise KeyboardInterrupt
@@ -278,7 +322,13 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
             if signal.getsignal(sig) is not signal.SIG_IGN:    # nohup'ed: leave it ignored
                 previous[sig] = signal.signal(sig, on_signal)
     try:
-        if workers == 1:
+        if info.get("engine", "numba") == "lammps":
+            from .lammps_job import run_lammps_jobs
+
+            run_lammps_jobs(args, int(info.get("mpi_ranks", 1)), update)
+        elif dask:
+            run_on_dask(args, update, dask, log)
+        elif workers == 1:
             for k, a in enumerate(args):
                 _run_job(*a, on_progress=lambda f, k=k: in_process_update(k, f))
                 update(k, 1.0)
@@ -367,6 +417,7 @@ def combine(out: Path, info: dict, cases: list[dict], exp):
         scenario=info["scenario"], title=info["title"], reproduces=info["reproduces"],
         quick=int(info["quick"]), seed=int(info["seed"]), ensemble=int(info["ensemble"]),
         command=info.get("command", ""), created=info["created"],
+        engine=info.get("engine", "numba"), mpi_ranks=int(info.get("mpi_ranks", 1)),
         parameters=dump_yaml(params), versions=dump_yaml(info["versions"]),
         notes="\n".join(notes), Conventions="CF-1.8")
     for key, value in params.items():
