@@ -13,6 +13,7 @@ plot the papers' experiments.
     ice-scenarios run herman2013-wind --ensemble 8 --dask-local 4
     ice-scenarios plot runs/herman2013-convergence
     ice-scenarios summary runs/herman2013-convergence
+    ice-scenarios compare runs/wind runs/wind-lammps
 """
 from __future__ import annotations
 
@@ -89,6 +90,16 @@ def build_parser(prog: str = "ice-scenarios") -> argparse.ArgumentParser:
     m = sub.add_parser("summary", help="print the summary table of a run directory, "
                                        "computed afresh from its results")
     m.add_argument("run_dir")
+    c = sub.add_parser("compare", help="two runs of a scenario side by side: is the other's "
+                                       "ensemble mean within the reference's spread?")
+    c.add_argument("reference", help="run directory of the reference (e.g. our engine)")
+    c.add_argument("other", help="run directory to compare with it (e.g. --engine lammps)")
+    c.add_argument("--sigma", type=float, default=2.0, metavar="K",
+                   help="means within K standard deviations of the members agree (default 2)")
+    c.add_argument("--quantity", action="append", metavar="NAME",
+                   help="compare only this quantity (repeatable)")
+    c.add_argument("--check", action="store_true",
+                   help="exit with 1 if a quantity is outside the spread")
     return ap
 
 
@@ -110,6 +121,12 @@ def main(argv=None, prog: str = "ice-scenarios") -> int:
         if args.command == "summary":
             print(summarise_run(args.run_dir))
             return 0
+        if args.command == "compare":
+            from .compare import compare_runs
+            result = compare_runs(args.reference, args.other, k=args.sigma,
+                                  quantities=args.quantity)
+            print(result.markdown())
+            return 1 if args.check and result.outside else 0
         common = dict(workers=args.workers, checkpoint_every=args.checkpoint_every,
                       progress=not args.no_progress, plots=not args.no_plots,
                       dask=({"scheduler": args.scheduler} if args.scheduler is not None else
