@@ -14,7 +14,8 @@ have no spread, so no verdict.
 The quantities are the scenario's per-member results (variables with the
 dimensions (case, member), such as A_J) or, for a scenario that has none,
 the means over the second half of each member's time series (such as p, τ
-and Z_c under a steady wind, where the first half is the spin-up).
+and Z_c under a steady wind, where the first half is the spin-up), and the
+ratio p/τ of the means.
 
 The two runs must be of the same scenario, with the same cases; parameters
 that differ (floes, seeds, engine) are listed above the table.
@@ -31,6 +32,9 @@ from .runner import _load_run
 
 #: time series that are coordinates of the others, not quantities
 _AXES = ("time", "concentration")
+#: ratios of two time means compared as quantities of their own (p/τ, the
+#: stress ratio of Herman 2013)
+_RATIOS = (("p", "tau"),)
 
 
 @dataclass
@@ -141,6 +145,10 @@ def _per_member(ds) -> tuple[str, dict[str, np.ndarray]]:
         x = np.where(second_half, v.values, np.nan)
         with np.errstate(invalid="ignore"):
             means[name] = np.nanmean(x, axis=-1)
+    for num, den in _RATIOS:
+        if num in means and den in means:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                means[f"{num}/{den}"] = means[num] / means[den]
     return "time means over the second half of each member's run", means
 
 

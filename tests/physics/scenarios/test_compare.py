@@ -63,6 +63,9 @@ def test_a_run_against_itself_and_against_other_seeds(runs):
     half = t >= 0.5 * t.max(axis=-1, keepdims=True)
     expected = [np.mean(p[m][half[m]]) for m in range(2)]
     np.testing.assert_allclose(other.rows[2].reference, expected, rtol=1e-12)
+    ratio = compare_runs(a, a, quantities=["p", "tau", "p/tau"])
+    p, tau, p_tau = (ratio.rows[3 + k].reference for k in range(3))
+    np.testing.assert_allclose(p_tau, p / tau, rtol=1e-12)
 
 
 def test_command_line_table_and_check(runs, capsys):
