@@ -582,6 +582,10 @@ class LammpsHertzSimulation:
         when checkpoints were taken."""
         force, torque = self.force, self.torque
         self.lmp.command("run 0 post no")
+        # a set-up re-initialises fix deform, which from then on measures the
+        # side lengths from the box of this moment (the next runs skip the
+        # set-up, "pre no", and keep that origin)
+        self._deform_ref = self._lengths.copy()
         self._set_forces(force, torque)
         self._histories_stored = True
 

@@ -469,6 +469,24 @@ def test_deforming_box_lengths_and_concentration_limit(deforming):
     assert lm.time == pytest.approx(ours.time, rel=1e-12)
 
 
+def test_deforming_box_follows_its_rate_through_many_advances():
+    # advance() ends with a LAMMPS set-up, which re-initialises fix deform:
+    # the box must go on following A(t) = A0 + rate t, not restart from it
+    field, box = HERMAN2013.floe_field(200, 0.6, seed=2)
+    a0 = field.total_area / box.area
+    make = lambda: DeformingPeriodicBox(box.lx, box.ly, concentration_rate=RATE)  # noqa: E731
+    ours, lm = engines(field, make(), HERMAN2013.contact, None, lammps_box=make())
+    try:
+        for k in range(1, 5):
+            ours.advance(0.05)
+            lm.advance(0.05)
+            expected = a0 + RATE * lm.time
+            assert lm.concentration == pytest.approx(expected, rel=1e-9), (k, lm.concentration)
+            assert lm.box.lx == pytest.approx(ours.box.lx, rel=1e-9), (k, lm.box.lx, ours.box.lx)
+    finally:
+        lm.close()
+
+
 @pytest.mark.xfail(strict=True, reason=DEFORM_LAG_REASON)
 def test_deforming_box_positions_agree():
     # a fixture of its own: the one above runs to the concentration limit
