@@ -498,6 +498,8 @@ class LammpsHertzSimulation:
                 cmds.append(f"fix wall_{axis} all wall/gran granular {self._pair_model(True)} "
                             f"{axis}plane 0.0 {length!r}")
         if self.forcing is not None and (~f.frozen).any():
+            cmds.append("fix forcing_terms all property/atom d_steady_x d_steady_y d_water "
+                        "d_turning")
             cmds += self._forcing_commands()
             cmds.append("fix drag mobile addforce v_drag_x v_drag_y 0.0")
             scale = " ".join(f"scale {k + 1} {float(c)!r}" for k, c in enumerate(self._type_drag))
@@ -525,30 +527,36 @@ class LammpsHertzSimulation:
                 float(fo.current[1]), float(fo.coriolis))
 
     def _forcing_commands(self) -> list[str]:
-        """Herman (2013) eqs 6–7 as atom-style variables: the thickness from
-        each floe's mass and radius, the wind and water drag coefficients a
-        and b of :meth:`physics.forcing.Forcing.coefficients`, and the force
-        a|u_a|u_a + b(u_w − u) − m f k×u."""
+        """Herman (2013) eqs 6–7 on every floe: the force
+        a|u_a|u_a + b(u_w − u) − m f k×u with the wind and water drag
+        coefficients a and b of :meth:`physics.forcing.Forcing.coefficients`
+        (the thickness from each floe's mass and radius). What does not
+        change from step to step, a|u_a|u_a + b u_w, b and m f, is worked
+        out once per floe into per-atom properties (``set``), so that the
+        atom-style variables LAMMPS evaluates at every step are three
+        multiply-adds: they were nine tenths of a step when recomputed."""
         p = self.forcing.params
         uax, uay, uwx, uwy, cor = self._forcing_values()
         self._forcing_key = (uax, uay, uwx, uwy, cor)
         rho = self.field.density
         kf = (p.water_density - p.ice_density) / p.water_density
         e = p.edge_area_factor
+        speed = math.hypot(uax, uay)
         return [
-            f"variable wind_x equal {uax!r}", f"variable wind_y equal {uay!r}",
-            f"variable current_x equal {uwx!r}", f"variable current_y equal {uwy!r}",
-            f"variable wind_speed equal {math.hypot(uax, uay)!r}",
-            f"variable coriolis equal {cor!r}",
             f"variable thick atom mass/({rho!r}*PI*radius^2)",
             f"variable drag_a atom {p.air_density!r}*(PI*radius^2*{p.air_skin_drag!r}"
             f"+{e!r}*radius*v_thick*{kf!r}*{p.air_form_drag!r})",
             f"variable drag_b atom {p.water_density!r}*(PI*radius^2*{p.water_skin_drag!r}"
             f"+{e!r}*radius*v_thick*(1.0-{kf!r})*{p.water_form_drag!r})",
-            "variable drag_x atom v_drag_a*v_wind_speed*v_wind_x+v_drag_b*(v_current_x-vx)"
-            "+mass*v_coriolis*vy",
-            "variable drag_y atom v_drag_a*v_wind_speed*v_wind_y+v_drag_b*(v_current_y-vy)"
-            "-mass*v_coriolis*vx",
+            f"variable steady_x atom v_drag_a*{speed!r}*{uax!r}+v_drag_b*{uwx!r}",
+            f"variable steady_y atom v_drag_a*{speed!r}*{uay!r}+v_drag_b*{uwy!r}",
+            f"variable turning atom mass*{cor!r}",
+            "set group all d_steady_x v_steady_x",
+            "set group all d_steady_y v_steady_y",
+            "set group all d_water v_drag_b",
+            "set group all d_turning v_turning",
+            "variable drag_x atom d_steady_x-d_water*vx+d_turning*vy",
+            "variable drag_y atom d_steady_y-d_water*vy-d_turning*vx",
         ]
 
     def _sync_forcing(self) -> None:
@@ -556,7 +564,7 @@ class LammpsHertzSimulation:
         they were changed since the last run."""
         if self.forcing is None or self._forcing_key == self._forcing_values():
             return
-        for cmd in self._forcing_commands()[:6]:
+        for cmd in self._forcing_commands():
             self.lmp.command(cmd)
 
     # -- data exchange -------------------------------------------------------------

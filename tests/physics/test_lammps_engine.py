@@ -325,6 +325,24 @@ def test_an_interrupted_run_follows_one_run(setup, trajectory, run, what):
         f"{what} against ours: {errors} (tolerance {POSITION_TOL})")
 
 
+def test_a_wind_changed_mid_run_reaches_lammps(setup):
+    # the forcing's steady part is stored per floe; a new wind must renew it
+    field, box, contact, forcing = setup
+    ours, lm = engines(field, box, contact, ladder(forcing))
+    try:
+        ours.step(20)
+        lm.step(20)
+        for sim in (ours, lm):
+            sim.forcing.wind = (-3.0, 7.0)
+            sim.forcing.current = (0.0, -0.2)
+        ours.step(20)
+        lm.step(20)
+        err = relative(lm.force, ours.force, ~field.frozen)
+        assert err <= 1e-8, f"forces after the wind change differ by {err:.3g}"
+    finally:
+        lm.close()
+
+
 # -- 3. walls -------------------------------------------------------------------------
 
 def wall_setup(box_type, friction=None):
