@@ -5,24 +5,27 @@ One module per suite, each with a ``main(argv)`` and a ``python -m`` entry
 point (``seaice bench <suite>`` runs the same), all sharing
 :mod:`benchmarks.harness`:
 
-=================  ==============================================================
-suite              what is timed
-=================  ==============================================================
-``hertz``          floe-steps/s of the Hertz engine at Ā = 0.7 and jammed, on
-                   the serial and parallel kernels (:mod:`benchmarks.hertz`)
-``hertz_phases``   each phase of a Hertz step on its own
-                   (:mod:`benchmarks.hertz_phases`)
-``harddisk``       collisions/s of the hard-disc engine (:mod:`benchmarks.harddisk`)
-``observables``    clusters, g_ffd, g_rdf, fabric and stress on 10⁵ floes
-                   (:mod:`benchmarks.observables`)
-``itd``            the ice-thickness-distribution models (:mod:`benchmarks.itd`)
-``environments``   sustained steps/s of every environment
-                   (:mod:`benchmarks.environments`)
-``ship``           floe-steps/s with and without a ship among the floes, and
-                   the ship's share of a step (:mod:`benchmarks.ship`)
-``compare``        this tree against another revision, side by side
-                   (:mod:`benchmarks.compare`)
-=================  ==============================================================
+==================  ==============================================================
+suite               what is timed
+==================  ==============================================================
+``hertz``           floe-steps/s of the Hertz engine at Ā = 0.7 and jammed, on
+                    the serial and parallel kernels (:mod:`benchmarks.hertz`)
+``hertz_phases``    each phase of a Hertz step on its own
+                    (:mod:`benchmarks.hertz_phases`)
+``harddisk``        collisions/s of the hard-disc engine (:mod:`benchmarks.harddisk`)
+``observables``     clusters, g_ffd, g_rdf, fabric and stress on 10⁵ floes
+                    (:mod:`benchmarks.observables`)
+``itd``             the ice-thickness-distribution models (:mod:`benchmarks.itd`)
+``environments``    sustained steps/s of every environment
+                    (:mod:`benchmarks.environments`)
+``ship``            floe-steps/s with and without a ship among the floes, and
+                    the ship's share of a step (:mod:`benchmarks.ship`)
+``compare``         this tree against another revision, side by side
+                    (:mod:`benchmarks.compare`)
+``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
+                    N = 200000, its strong and weak scaling, and a projection
+                    to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
+==================  ==============================================================
 
 Every suite writes one JSON record to ``docs/benchmarks/<suite>.json``
 (:func:`benchmarks.harness.write_record`), which the documentation renders
@@ -40,7 +43,7 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "ship",
-          "compare")
+          "compare", "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

@@ -47,6 +47,7 @@ BENCH_SUITES = {
     "environments": "sustained steps/s of every environment",
     "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "compare": "this tree against another revision, side by side",
+    "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
     "headline": "put the headline figures of the records into the README",
 }
 
