@@ -20,8 +20,10 @@ The model, command by command (:meth:`LammpsHertzSimulation._model_commands`)
   our α (:func:`lammps_restitution`);
 * air and water drag, wind, current and Coriolis (Herman 2013, eqs 6–7,
   with the skin and form terms of :mod:`physics.forcing`): ``fix addforce``
-  with atom-style variables computed by LAMMPS on every rank from each
-  floe's radius and mass, no Python in the time loop;
+  with atom-style variables, evaluated by LAMMPS on every rank, no Python in
+  the time loop; the terms that do not change (from each floe's radius and
+  mass, the wind and the current) are worked out once into per-atom
+  properties (``fix property/atom``, ``set``);
 * rotational drag −c ω, c = b r²/2: ``fix viscous/sphere``, whose
   coefficient LAMMPS takes per atom type only. Floes are sorted into types
   by c on a geometric ladder (ratio ``rotation_drag_ratio``, default 1.02),
