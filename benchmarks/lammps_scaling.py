@@ -21,7 +21,6 @@ import json
 import math
 import os
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -29,6 +28,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from physics.scenarios.lammps_job import mpiexec
 
 from . import harness
 
@@ -399,16 +400,6 @@ def _child(spec_path: str, prefix: str) -> int:
 # ---------------------------------------------------------------------------
 # configurations, each in a fresh process
 # ---------------------------------------------------------------------------
-
-def mpiexec() -> str | None:
-    """The MPI launcher: ``SEAICE_MPIEXEC``, else the ``mpiexec`` beside this
-    Python (the lammps extra's MPICH), else one on the PATH."""
-    named = os.environ.get("SEAICE_MPIEXEC")
-    if named:
-        return shutil.which(named) or named
-    here = Path(sys.executable).parent / "mpiexec"
-    return str(here) if here.exists() else shutil.which("mpiexec")
-
 
 def launch(config: dict, field_path: str, seconds: float, workdir: str,
            timeout: float = 3600.0) -> dict:

@@ -41,8 +41,10 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from .domain import Box
-from .floes import FloeField
+from .floes import FloeField, max_overlap
+from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress
+from .params import ContactParams, check_range
 
 __all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
            "snapshot"]
@@ -184,3 +186,66 @@ def checked_motion(name: str, value, shape: tuple, frozen: np.ndarray, what: str
     if np.any(v[frozen] != 0.0):
         raise ValueError(f"frozen floes must have zero {what}")
     return v
+
+
+# -- the set-up checks of the Hertz engines (ours and LAMMPS's) ----------------------
+
+def checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed) -> ContactParams:
+    """The common arguments of a Hertz engine checked (``TypeError`` or
+    ``ValueError`` saying what is wrong); returns ``contact``, the default
+    :class:`~physics.params.ContactParams` when it is None."""
+    if not isinstance(field, FloeField):
+        raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
+    if not isinstance(box, Box):
+        raise TypeError(f"box must be a Box (e.g. PeriodicBox(L)), got {type(box).__name__}")
+    contact = ContactParams() if contact is None else contact
+    if not isinstance(contact, ContactParams):
+        raise TypeError(f"contact must be a ContactParams, got {type(contact).__name__}")
+    if forcing is not None and not isinstance(forcing, Forcing):
+        raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
+    check_range("dt", dt, 0.0, None, low_open=True)
+    check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
+    return contact
+
+
+def check_time_step(dt: float, contact_time: float, what: str) -> None:
+    """``ValueError`` unless ``dt`` is at most a tenth of ``contact_time``,
+    the shortest contact time (of ``what``)."""
+    if dt > 0.1 * contact_time:
+        raise ValueError(
+            f"dt={dt:g} s is above a tenth of the shortest contact time "
+            f"({contact_time:.4g} s for {what}); "
+            f"use dt <= {0.1 * contact_time:.3g} s")
+
+
+def neighbour_cut(radii: np.ndarray, box: Box, skin: float | None) -> tuple[float, float]:
+    """(skin, cut-off of the largest pair 2 r_max + skin) of a Hertz engine's
+    neighbour lists: the skin defaults to a tenth of the mean radius, and a
+    periodic side must exceed twice the cut-off (``ValueError``)."""
+    skin = 0.1 * float(np.mean(radii)) if skin is None else float(skin)
+    check_range("skin", skin, 0.0, None, low_open=True)
+    cut = 2.0 * float(radii.max()) + skin
+    for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
+        if per and cut >= 0.5 * length:
+            raise ValueError(
+                f"the box is too small along {axis} ({length:.4g} m) for the largest floe "
+                f"(radius {radii.max():.4g} m): periodic sides must exceed "
+                f"2 (2 r_max + skin) = {2 * cut:.4g} m")
+    return skin, cut
+
+
+def positions_in_box(field: FloeField, box: Box, allow_overlap: bool) -> np.ndarray:
+    """The floe centres wrapped into ``box``; ``ValueError`` if a floe lies
+    outside a walled box or, unless ``allow_overlap``, two floes overlap by
+    more than 1 % of the smaller radius."""
+    pos = box.wrap(field.positions)
+    if not np.all(box.contains(pos)):
+        bad = int(np.argmin(box.contains(pos)))
+        raise ValueError(f"floe {bad} at {pos[bad]} is outside the walled box {box}")
+    if not allow_overlap:
+        worst = max_overlap(pos, field.radii, box)
+        if worst > 0.01:
+            raise ValueError(
+                f"initial overlap of {worst:.3g} of the smaller radius exceeds 1 %; separate "
+                f"the floes (physics.floes.place_floes) or pass allow_overlap=True")
+    return pos

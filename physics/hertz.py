@@ -28,9 +28,10 @@ from . import hull_contact as HC
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
 from .engine import FailureReason, SimulationError, engine_from_preset
+from .engine import check_time_step, checked_hertz_arguments, neighbour_cut, positions_in_box
 from .engine import checked_motion as _checked_motion
 from .engine import snapshot as _snapshot
-from .floes import FloeField, max_overlap
+from .floes import FloeField
 from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .neighbors import choose_cell_size, radius_rank
@@ -155,17 +156,7 @@ class HertzSimulation:
                  impact_speed: float = 0.1, skin: float | None = None,
                  parallel: bool | None = None, allow_overlap: bool = False,
                  ship: Ship | None = None):
-        if not isinstance(field, FloeField):
-            raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
-        if not isinstance(box, Box):
-            raise TypeError(f"box must be a Box (e.g. PeriodicBox(L)), got {type(box).__name__}")
-        contact = ContactParams() if contact is None else contact
-        if not isinstance(contact, ContactParams):
-            raise TypeError(f"contact must be a ContactParams, got {type(contact).__name__}")
-        if forcing is not None and not isinstance(forcing, Forcing):
-            raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
-        check_range("dt", dt, 0.0, None, low_open=True)
-        check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
+        contact = checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed)
         if ship is not None and not isinstance(ship, Ship):
             raise TypeError(f"ship must be a physics.ship.Ship or None, got {type(ship).__name__}")
         self.field = field.copy()
@@ -187,38 +178,17 @@ class HertzSimulation:
             if t_hull < t_c:
                 t_c = t_hull
                 what = f"the smallest floes hitting the hull at {speed:g} m/s"
-        if self.dt > 0.1 * t_c:
-            raise ValueError(
-                f"dt={self.dt:g} s is above a tenth of the shortest contact time "
-                f"({t_c:.4g} s for {what}); "
-                f"use dt <= {0.1 * t_c:.3g} s")
+        check_time_step(self.dt, t_c, what)
         self.min_contact_time = t_c
 
         # neighbour-list sizing
-        self.skin = 0.1 * float(np.mean(f.radii)) if skin is None else float(skin)
-        check_range("skin", self.skin, 0.0, None, low_open=True)
-        self.max_cut = 2.0 * float(f.radii.max()) + self.skin
-        for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
-            if per and self.max_cut >= 0.5 * length:
-                raise ValueError(
-                    f"the box is too small along {axis} ({length:.4g} m) for the largest floe "
-                    f"(radius {f.radii.max():.4g} m): periodic sides must exceed "
-                    f"2 (2 r_max + skin) = {2 * self.max_cut:.4g} m")
+        self.skin, self.max_cut = neighbour_cut(f.radii, box, skin)
         if parallel is None:
             parallel = n >= 5000 and numba.get_num_threads() > 1
         self.parallel = bool(parallel)
 
         # positions inside the box; walls must not cut floes deeply
-        self._pos = box.wrap(f.positions)
-        if not np.all(box.contains(self._pos)):
-            bad = int(np.argmin(box.contains(self._pos)))
-            raise ValueError(f"floe {bad} at {self._pos[bad]} is outside the walled box {box}")
-        if not allow_overlap:
-            worst = max_overlap(self._pos, f.radii, box)
-            if worst > 0.01:
-                raise ValueError(
-                    f"initial overlap of {worst:.3g} of the smaller radius exceeds 1 %; separate "
-                    f"the floes (physics.floes.place_floes) or pass allow_overlap=True")
+        self._pos = positions_in_box(f, box, allow_overlap)
 
         # state arrays, shared with the kernels through the bundles below
         self._vel = f.velocities.copy()

@@ -80,10 +80,11 @@ import numpy as np
 
 from . import mpi
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
-from .engine import FailureReason, SimulationError
+from .engine import (FailureReason, SimulationError, check_time_step, checked_hertz_arguments,
+                     neighbour_cut, positions_in_box)
 from .engine import checked_motion as _checked_motion
 from .engine import snapshot as _snapshot
-from .floes import FloeField, max_overlap
+from .floes import FloeField
 from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, check_range
@@ -261,7 +262,33 @@ def steps_below_limit(box: DeformingPeriodicBox, n: int, dt: float) -> int:
     return k
 
 
-class LammpsHertzSimulation:
+class LammpsOwner:
+    """``close()``, the context manager and the finaliser of an object that
+    holds a LAMMPS instance in the attribute named ``_LAMMPS_ATTR``."""
+
+    _LAMMPS_ATTR = "_lmp"
+
+    def close(self) -> None:
+        """Free the LAMMPS instance."""
+        lmp = self.__dict__.get(self._LAMMPS_ATTR)
+        if lmp is not None:
+            lmp.close()
+            setattr(self, self._LAMMPS_ATTR, None)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+class LammpsHertzSimulation(LammpsOwner):
     """The Hertz engine's physics run by LAMMPS (see the module docstring).
 
     Same constructor, attributes and methods as
@@ -293,15 +320,7 @@ class LammpsHertzSimulation:
                  threads: int = 1, ship=None, parallel=None):
         from .hertz import minimum_contact_time
 
-        if not isinstance(field, FloeField):
-            raise TypeError(f"field must be a FloeField, got {type(field).__name__}")
-        if not isinstance(box, Box):
-            raise TypeError(f"box must be a Box (e.g. PeriodicBox(L)), got {type(box).__name__}")
-        contact = ContactParams() if contact is None else contact
-        if not isinstance(contact, ContactParams):
-            raise TypeError(f"contact must be a ContactParams, got {type(contact).__name__}")
-        if forcing is not None and not isinstance(forcing, Forcing):
-            raise TypeError(f"forcing must be a Forcing or None, got {type(forcing).__name__}")
+        contact = checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed)
         if ship is not None:
             raise ValueError("the LAMMPS engine has no ship (hull contact and ship dynamics "
                              "are in physics.HertzSimulation only); run ship scenarios with "
@@ -318,8 +337,6 @@ class LammpsHertzSimulation:
                              "(fix deform moves the box sides about its centre and would "
                              "shift the fast ice against the remapped floes); run it with "
                              "the numba engine")
-        check_range("dt", dt, 0.0, None, low_open=True)
-        check_range("impact_speed", impact_speed, 0.0, None, low_open=True)
         check_range("rotation_drag_ratio", rotation_drag_ratio, 1.0, None, low_open=True)
         check_range("threads", threads, 1, None)
         self.field = field.copy()
@@ -331,31 +348,10 @@ class LammpsHertzSimulation:
         f = self.field
         t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed,
                                    walls=not all(box.periodic))
-        if self.dt > 0.1 * t_c:
-            raise ValueError(
-                f"dt={self.dt:g} s is above a tenth of the shortest contact time ({t_c:.4g} s "
-                f"for the smallest floes at impact speed {impact_speed:g} m/s); "
-                f"use dt <= {0.1 * t_c:.3g} s")
+        check_time_step(self.dt, t_c, f"the smallest floes at impact speed {impact_speed:g} m/s")
         self.min_contact_time = t_c
-        self.skin = 0.1 * float(np.mean(f.radii)) if skin is None else float(skin)
-        check_range("skin", self.skin, 0.0, None, low_open=True)
-        cut = 2.0 * float(f.radii.max()) + self.skin
-        for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
-            if per and cut >= 0.5 * length:
-                raise ValueError(
-                    f"the box is too small along {axis} ({length:.4g} m) for the largest floe "
-                    f"(radius {f.radii.max():.4g} m): periodic sides must exceed "
-                    f"2 (2 r_max + skin) = {2 * cut:.4g} m")
-        pos = box.wrap(f.positions)
-        if not np.all(box.contains(pos)):
-            bad = int(np.argmin(box.contains(pos)))
-            raise ValueError(f"floe {bad} at {pos[bad]} is outside the walled box {box}")
-        if not allow_overlap:
-            worst = max_overlap(pos, f.radii, box)
-            if worst > 0.01:
-                raise ValueError(
-                    f"initial overlap of {worst:.3g} of the smaller radius exceeds 1 %; separate "
-                    f"the floes (physics.floes.place_floes) or pass allow_overlap=True")
+        self.skin, _ = neighbour_cut(f.radii, box, skin)
+        pos = positions_in_box(f, box, allow_overlap)
         self.radius = f.radii
         mobile = ~f.frozen
         self.inv_mass = np.where(mobile, 1.0 / f.masses, 0.0)
@@ -811,25 +807,6 @@ class LammpsHertzSimulation:
         attrs["_restart"] = data
         attrs["_saved_forces"] = (force, torque)
         return attrs
-
-    def close(self) -> None:
-        """Free the LAMMPS instance."""
-        lmp = self.__dict__.get("_lmp")
-        if lmp is not None:
-            lmp.close()
-            self._lmp = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
     def __repr__(self):
         return (f"LammpsHertzSimulation(n_floes={self.field.n}, box={self.box!r}, "

