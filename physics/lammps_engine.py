@@ -474,9 +474,13 @@ class LammpsHertzSimulation(LammpsOwner):
 
     def _model_commands(self, fresh: bool) -> list[str]:
         f, b = self.field, self.box
-        cmds = []
-        if fresh:
-            cmds += ["pair_style granular", f"pair_coeff * * {self._pair_model(False)}"]
+        # also after read_restart: the granular pair style that a restart
+        # file rebuilds has a member left uninitialised (the pair_style
+        # command's settings() sets it), which LAMMPS reads when it sizes the
+        # ghost communication; garbage there sent ghosts to ranks that do not
+        # exist, and MPI ended the process with exit code 6. Re-issuing the
+        # same style keeps the pair object and the contact histories it read
+        cmds = ["pair_style granular", f"pair_coeff * * {self._pair_model(False)}"]
         edges = _collections(f.radii)
         cmds += [f"neighbor {self.skin!r} multi",
                  "neigh_modify delay 0 every 1 check yes collection/interval "
