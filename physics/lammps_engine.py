@@ -68,6 +68,7 @@ and loads it first, so nobody has to set ``LD_LIBRARY_PATH``.
 """
 from __future__ import annotations
 
+import atexit
 import ctypes
 import glob
 import math
@@ -75,6 +76,7 @@ import os
 import sys
 import tempfile
 import time as _time
+import weakref
 
 import numpy as np
 
@@ -89,8 +91,8 @@ from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, check_range
 
-__all__ = ["LammpsHertzSimulation", "lammps_available", "load_lammps", "lammps_restitution",
-           "lammps_version", "find_mpi_library"]
+__all__ = ["LammpsHertzSimulation", "lammps_available", "load_lammps", "new_lammps",
+           "lammps_restitution", "lammps_version", "find_mpi_library"]
 
 _MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
 
@@ -115,7 +117,36 @@ def find_mpi_library() -> str | None:
     return None
 
 
-_LOADED = {"module": None, "error": None, "version": None}
+_LOADED = {"module": None, "error": None, "version": None, "lib": None}
+#: the LAMMPS instances of this process that may still be open
+_INSTANCES: "weakref.WeakSet" = weakref.WeakSet()
+
+
+def new_lammps(args: list[str]):
+    """A new LAMMPS instance with the command-line arguments ``args``,
+    closed (with MPI ended) when the process exits, see :func:`_end_mpi`."""
+    lmp = load_lammps().lammps(cmdargs=list(args))
+    _INSTANCES.add(lmp)
+    return lmp
+
+
+def _end_mpi() -> None:
+    """At exit of a process that is not one of several ``mpiexec`` ranks:
+    close the LAMMPS instances still open, then end MPI. Without it MPICH
+    leaves a shared-memory segment (``/dev/shm/mpich_shm_*``, 1 MiB) behind
+    for every process that used LAMMPS. Ranks under ``mpiexec`` end MPI
+    together (:func:`physics.mpi.finalize`), not each on its own."""
+    if mpi.under_mpiexec() or _LOADED["lib"] is None:
+        return
+    for lmp in list(_INSTANCES):
+        try:
+            lmp.close()
+        except Exception:
+            pass
+    try:
+        _LOADED["lib"].lammps_mpi_finalize()
+    except Exception:
+        pass
 
 
 def load_lammps():
@@ -139,8 +170,10 @@ def load_lammps():
             if not lmp.has_package("GRANULAR"):
                 raise ImportError("this LAMMPS build has no GRANULAR package")
             _LOADED["version"] = str(lmp.version())
+            _LOADED["lib"] = lmp.lib
         finally:
             lmp.close()
+        atexit.register(_end_mpi)
     except (ImportError, OSError) as exc:
         reason = str(exc)
         if isinstance(exc, ModuleNotFoundError):
@@ -394,11 +427,10 @@ class LammpsHertzSimulation(LammpsOwner):
     def _open(self, pos) -> None:
         """Create the LAMMPS instance: a fresh one with the floes at ``pos``,
         or (``pos`` None) one read from the restart data of a checkpoint."""
-        lammps = load_lammps()
         args = list(_ARGS)
         if self.threads > 1:
             args += ["-pk", "omp", str(self.threads), "-sf", "omp"]
-        self._lmp = lmp = lammps.lammps(cmdargs=args)
+        self._lmp = lmp = new_lammps(args)
         if pos is not None:
             for cmd in self._box_commands():
                 lmp.command(cmd)

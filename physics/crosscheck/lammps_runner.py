@@ -51,7 +51,7 @@ from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, max_overlap
 from ..lammps_engine import (LammpsOwner, _collections, deform_variables,  # noqa: F401
                              find_mpi_library, lammps_available, lammps_restitution,
-                             lammps_version, load_lammps)
+                             lammps_version, load_lammps, new_lammps)
 from ..params import ContactParams, check_range
 
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
@@ -124,11 +124,10 @@ class LammpsSimulation(LammpsOwner):
         self._deforming = isinstance(box, DeformingPeriodicBox)
         if self._deforming:
             box.bind(self.field.total_area)
-        lammps = load_lammps()
         args = ["-log", "none", "-screen", "none", "-nocite"]
         if self.threads > 1:
             args += ["-pk", "omp", str(self.threads), "-sf", "omp"]
-        self.lmp = lammps.lammps(cmdargs=args)
+        self.lmp = new_lammps(args)
         self.time = 0.0
         self.n_steps = 0
         self.wall_time = 0.0

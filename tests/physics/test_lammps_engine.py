@@ -696,6 +696,32 @@ def test_two_mpi_ranks_agree_with_one(tmp_path):
     assert abs(p2 - p1) <= 1e-6 * abs(p1), f"pressure: 1 rank {p1!r}, 2 ranks {p2!r}"
 
 
+
+EXIT_SCRIPT = """\
+import os
+from physics import HERMAN2013
+from physics.lammps_engine import LammpsHertzSimulation
+
+field, box = HERMAN2013.floe_field(50, 0.5, seed=1)
+sim = LammpsHertzSimulation(field, box, HERMAN2013.contact, None, dt={dt!r})
+sim.step(10)
+print(os.getpid())                # exits with the engine still open
+"""
+
+
+def test_a_process_that_used_lammps_leaves_no_shared_memory_behind(tmp_path):
+    # MPICH keeps a segment /dev/shm/mpich_shm_<pid in hex>_0 (1 MiB) while MPI
+    # runs; a process that exits without ending MPI leaves it there for good
+    if not os.path.isdir("/dev/shm"):
+        pytest.skip("no /dev/shm")
+    script = tmp_path / "exit.py"
+    script.write_text(EXIT_SCRIPT.format(dt=DT))
+    proc = _run([sys.executable, str(script)], tmp_path, "a run left open at exit")
+    pid = int(proc.stdout.split()[-1])
+    left = sorted(p.name for p in Path("/dev/shm").glob(f"mpich_shm_{pid:x}_*"))
+    assert not left, f"the process left {left} in /dev/shm"
+
+
 # -- 7. what the engine refuses -------------------------------------------------------
 
 @pytest.fixture(scope="module")
