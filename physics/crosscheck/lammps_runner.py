@@ -124,10 +124,7 @@ class LammpsSimulation(LammpsOwner):
         self._deforming = isinstance(box, DeformingPeriodicBox)
         if self._deforming:
             box.bind(self.field.total_area)
-        args = ["-log", "none", "-screen", "none", "-nocite"]
-        if self.threads > 1:
-            args += ["-pk", "omp", str(self.threads), "-sf", "omp"]
-        self.lmp = new_lammps(args)
+        self.lmp = new_lammps(self.threads)
         self.time = 0.0
         self.n_steps = 0
         self.wall_time = 0.0

