@@ -19,7 +19,7 @@ function of :mod:`iceenvs.rewards`. Subclasses say only what differs:
 
 Data flow of one step::
 
-    action → NaN/inf → 0, clip → forcing → engine.advance(control interval)
+    action → NaN → 0, ±inf → bound, clip → forcing → engine.advance(control interval)
       → observables (SI dict) → reward(prev, action, now) and float32 vector
 
 Conventions every environment keeps (see the environment docs):
@@ -69,12 +69,26 @@ TIME_FEATURE = Feature("time_left", "remaining fraction of the episode, 1 − t/
                        0.0, 1.0)
 
 
-def sanitise_action(action, space: gym.spaces.Box) -> np.ndarray:
-    """The action as float64 of the space's shape with NaN and ±inf set to
-    0 and every entry clipped into the space's bounds."""
-    a = np.array(action, dtype=np.float64).reshape(space.shape)
-    a[~np.isfinite(a)] = 0.0
-    return np.clip(a, space.low, space.high)
+def sanitise_action(action, space: gym.spaces.Box) -> tuple[np.ndarray, int]:
+    """The action as float64 of the space's shape, ready for a kernel, and
+    the number of its entries that were not finite.
+
+    NaN becomes 0 (no command), +inf and −inf become the upper and lower
+    bound (the limit they stand for), and every entry is clipped into the
+    bounds. A scalar is taken for a space of one entry; any other shape than
+    the space's raises ``ValueError`` naming the expected shape."""
+    a = np.array(action, dtype=np.float64)
+    if a.shape != space.shape:
+        if a.ndim == 0 and space.shape == (1,):
+            a = a.reshape(1)
+        else:
+            raise ValueError(f"an action of shape {a.shape}; this environment takes actions "
+                             f"of shape {space.shape} (its action_space is {space})")
+    bad = ~np.isfinite(a)
+    replaced = int(bad.sum())
+    if replaced:
+        a[np.isnan(a)] = 0.0
+    return np.clip(a, space.low, space.high), replaced
 
 
 # -- task parameters ---------------------------------------------------------------------------
@@ -317,7 +331,7 @@ class ControlEnv(gym.Env):
     def step(self, action):
         if not self._ready():
             raise RuntimeError("call reset() before step()")
-        a = sanitise_action(action, self.action_space)
+        a, replaced = sanitise_action(action, self.action_space)
         self._last_action = a
         self._steps += 1
         try:
@@ -328,9 +342,11 @@ class ControlEnv(gym.Env):
             # a physics failure ends the episode instead of crashing the caller
             info = self._info(self._prev)
             info["error"] = f"{type(err).__name__}: {err}"
+            info["nonfinite_action"] = replaced
             return self._obs.copy(), float(self.failure_reward), True, False, info
         reward = self._reward(a, now)
         info = self._info(now)
+        info["nonfinite_action"] = replaced
         succeeded = bool(self._succeeded(now))
         failed = bool(self._terminated(now))
         if not math.isfinite(reward):

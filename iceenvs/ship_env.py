@@ -10,7 +10,7 @@ the ice, collisions, the path sailed), senses the ice ahead
 
 Data flow of one step::
 
-    action → NaN/inf → 0, clip → ship commands → engine.advance(control interval)
+    action → NaN → 0, ±inf → bound, clip → ship commands → engine.advance(control interval)
       → step loads (records, collision log) + sensors + local ice → SI dict
       → reward(prev, action, now) and the observation (vector, image or both)
 

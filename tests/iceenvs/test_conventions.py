@@ -3,6 +3,7 @@ tasks, task parameters that stick (keywords, reset options, a vector
 environment's autoreset), Gymnasium's episode limits, bounded rewards and
 videos of the frames."""
 import math
+import re
 
 import gymnasium as gym
 import numpy as np
@@ -174,6 +175,39 @@ def test_unknown_option_lists_the_valid_ones(env_id):
     try:
         with pytest.raises(ValueError, match=r"unknown reset options \['targt'\].*valid"):
             env.reset(seed=0, options={"targt": 0.5})
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_wrong_action_shape_names_the_expected_shape(env_id):
+    env = gym.make(env_id, **SMALL[env_id])
+    try:
+        env.reset(seed=0)
+        shape = env.action_space.shape
+        bad = np.zeros((shape[0] + 1, shape[0]), np.float32)
+        with pytest.raises(ValueError, match=re.escape(
+                f"an action of shape {bad.shape}; this environment takes actions of shape {shape}")):
+            env.step(bad)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_nonfinite_action_entries_are_counted_in_info(env_id):
+    """NaN is no command (0), ±inf the bound it tends to; info counts them."""
+    env = gym.make(env_id, **SMALL[env_id])
+    try:
+        env.reset(seed=0)
+        n = env.action_space.shape[0]
+        _, _, _, _, info = env.step(np.zeros(n, np.float32))
+        assert info["nonfinite_action"] == 0
+        action = np.full(n, np.inf)
+        action[0] = np.nan
+        obs, _, _, _, info = env.step(action)
+        assert info["nonfinite_action"] == n
+        expected = np.minimum(np.nan_to_num(action, nan=0.0, posinf=np.inf), env.action_space.high)
+        np.testing.assert_array_equal(env.unwrapped._last_action, expected)
     finally:
         env.close()
 

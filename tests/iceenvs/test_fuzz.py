@@ -84,11 +84,13 @@ def run(env_id, seed, options, acts):
         assert "error" not in info, info.get("error")
         assert not terminated or env_id == CONVERGENCE
         check_step(env, obs, reward, info)
-        # the last action is observed sanitised: finite and in [-1, 1]
+        # the last action is observed sanitised: NaN as 0, ±inf as the bounds,
+        # clipped into [-1, 1]; info counts the entries that were not finite
         last = obs[-env.action_space.shape[0]:]
-        expected = np.clip(np.nan_to_num(np.array(a, dtype=np.float64), nan=0.0, posinf=0.0,
-                                         neginf=0.0), -1.0, 1.0)
+        raw = np.array(a, dtype=np.float32).astype(np.float64)
+        expected = np.clip(np.nan_to_num(raw, nan=0.0, posinf=1.0, neginf=-1.0), -1.0, 1.0)
         assert np.array_equal(last, expected.astype(np.float32))
+        assert info["nonfinite_action"] == int(np.sum(~np.isfinite(raw)))
         if terminated or truncated:
             break
 

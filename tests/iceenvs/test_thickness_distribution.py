@@ -111,8 +111,9 @@ def test_bad_actions_are_sanitised(env, action):
         last = obs[24:]
         assert np.all(np.isfinite(last)) and np.all(np.abs(last) <= 1.0)
     a = np.array(action, dtype=float)
-    expected = np.clip(np.where(np.isfinite(a), a, 0.0), -1, 1)
+    expected = np.clip(np.nan_to_num(a, nan=0.0, posinf=1.0, neginf=-1.0), -1, 1)
     np.testing.assert_allclose(obs[24:], expected, rtol=1e-6)
+    assert info["nonfinite_action"] == int(np.sum(~np.isfinite(a)))
 
 
 def test_action_mapping(env):
