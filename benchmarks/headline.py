@@ -3,7 +3,8 @@
 
 Rewrites the block between ``<!-- headline:start -->`` and
 ``<!-- headline:end -->`` with one small table: the Hertz engine's
-floe-steps/s at Ā = 0.7 and jammed, the hard-disc engine's collisions/s and
+floe-steps/s at Ā = 0.7 and jammed, each with its contacts per floe and a
+line on what the two regimes cost, the hard-disc engine's collisions/s and
 each environment's sustained steps/s, as far as records of full runs
 (not ``--quick``) exist, each with its date.
 """
@@ -19,23 +20,74 @@ START = "<!-- headline:start -->"
 END = "<!-- headline:end -->"
 #: the documentation page with every table, relative to the README
 BENCHMARKS_PAGE = "docs/benchmarks.md"
+#: contacts per floe below which the floes of a Hertz case are said to be in
+#: free flight (then at most one floe in a hundred touches another)
+FREE_FLIGHT = 0.01
 
 
-def _hertz_rows(record: dict) -> list[list[str]]:
+def _hertz_cases(record: dict) -> list[dict]:
+    """The timed cases of a Hertz record, in its order: name, contacts per
+    floe and its fastest and serial rows.
+
+    Raises
+    ------
+    ValueError
+        If a case has no contacts per floe: a floe-step's cost depends on how
+        often the floes touch, so a figure without it says nothing.
+    """
     rows = record["data"]["rows"]
     out = []
     for case in dict.fromkeys(r["case"] for r in rows):
         if not case.startswith(("Ā =", "jammed")):
             continue
         timed = [r for r in rows if r["case"] == case]
+        z = timed[0].get("contacts_per_floe")
+        if not isinstance(z, (int, float)) or not z >= 0.0:
+            raise ValueError(f"the Hertz record of {record['date'][:10]} has no contacts per "
+                             f"floe for the case {case!r} (found {z!r}); rerun "
+                             f"`seaice bench hertz`, which records them")
         serial = [r for r in timed if r["kernel"] == "serial"]
         most = max(timed, key=lambda r: (r["kernel"] == "parallel", r["threads"]))
+        out.append(dict(case=case, contacts=float(z), most=most,
+                        serial=serial[0] if serial else None))
+    return out
+
+
+def _hertz_rows(record: dict) -> list[list[str]]:
+    out = []
+    for c in _hertz_cases(record):
+        most, serial = c["most"], c["serial"]
         figure = f"{most['rate']:.3g} floe-steps/s on {most['threads']} thread" \
                  f"{'s' * (most['threads'] > 1)}"
-        if serial and most is not serial[0]:
-            figure += f" ({serial[0]['rate']:.3g} on one, serial kernels)"
-        out.append([f"Hertz engine, N = {record['data']['n']}, {case}", figure])
+        if serial and most is not serial:
+            figure += f" ({serial['rate']:.3g} on one, serial kernels)"
+        out.append([f"Hertz engine, N = {record['data']['n']}, {c['case']}, "
+                    f"{harness.format_number(c['contacts'])} contacts per floe", figure])
     return out
+
+
+def _hertz_note(record: dict) -> str:
+    """What the Hertz figures measure: the sparsest and the densest case,
+    their contacts per floe and how much more a floe-step of the dense one
+    costs at the same number of threads."""
+    cases = _hertz_cases(record)
+    if len(cases) < 2:
+        return ""
+    loose = min(cases, key=lambda c: c["contacts"])
+    dense = max(cases, key=lambda c: c["contacts"])
+    same = [r for r in record["data"]["rows"] if r["case"] == loose["case"]
+            and r["kernel"] == dense["most"]["kernel"] and r["threads"] == dense["most"]["threads"]]
+    if loose is dense or not same:
+        return ""
+    ratio = same[0]["rate"] / dense["most"]["rate"]
+    threads = dense["most"]["threads"]
+    # fewer than one floe in a hundred touching: nearly all drift untouched
+    free = " (nearly all its floes in free flight)" if loose["contacts"] < FREE_FLIGHT else ""
+    return (f"The Hertz engine's speed depends on how often floes touch: the "
+            f"{loose['case']} field has {harness.format_number(loose['contacts'])} contacts "
+            f"per floe{free}; in the {dense['case']} field, with "
+            f"{harness.format_number(dense['contacts'])} contacts per floe, a floe-step costs "
+            f"{ratio:.3g} times as much on {threads} thread{'s' * (threads > 1)}.")
 
 
 def _harddisk_rows(record: dict) -> list[list[str]]:
@@ -53,7 +105,7 @@ _ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _envi
 
 def headline_table(records: list[dict]) -> str:
     """The Markdown of the headline block (without the markers)."""
-    rows, machines = [], []
+    rows, machines, notes = [], [], []
     for record in records:
         if record.get("suite") not in _ROWS or record.get("data", {}).get("quick"):
             continue
@@ -62,10 +114,13 @@ def headline_table(records: list[dict]) -> str:
         rows += [[what, figure, record["date"][:10]]
                  for what, figure in _ROWS[record["suite"]](record)]
         machines.append(record["machine"].get("cpu") or "?")
+        if record["suite"] == "hertz":
+            notes.append(_hertz_note(record))
     if not rows:
         return "No benchmark records yet: `make bench` measures them."
     lines = ["| benchmark | figure | measured |", "|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
+    lines += [line for note in notes if note for line in ("", note)]
     lines += ["", f"Measured on {', '.join(dict.fromkeys(machines))} with `make bench`; "
                   f"commands, machines and every table are on the "
                   f"[Benchmarks]({BENCHMARKS_PAGE}) page."]

@@ -31,12 +31,19 @@ Floe-steps per second (floes × steps / wall time) of the Hertz engine with the
 Herman (2013) material table, α = 1.8 floe sizes with mean radius 4 m, no
 external forcing, compile time excluded:
 
-* **Ā = 0.7**, random velocities of 3 cm/s per component;
+* **Ā = 0.7**, random velocities of 3 cm/s per component: loose ice whose
+  floes, with no forcing, drift straight on and seldom touch, so this case
+  times the per-floe passes (integration, neighbour lists) rather than the
+  contact law;
 * **jammed ice, Ā = 0.95**: a packing in force balance made by FIRE relaxation
   (`physics.jamming`) above the field's jamming point A_J = 0.94, at rest:
   placed at 0.85, compressed to 0.925 in steps of 0.005 with a relaxation
   after each, then to 0.95 in one step and relaxed. The prepared fields are
   cached (`--cache-dir`) because the compression takes about a minute.
+
+The contacts per floe of each case (twice the touching pairs over N) are
+counted at the end of the timed steps of the first process: they tell the
+regime each figure belongs to.
 
 Each case is timed with the serial kernels, the parallel kernels on one thread
 and the parallel kernels on all threads, after a warm-up that compiles
@@ -314,8 +321,8 @@ def hertz_table(rows: list[dict], n: int) -> dict:
             continue
         lo, hi = r.get("spread", (r["rate"], r["rate"]))
         body.append([r["case"], r["kernel"], r["threads"], float(r["rate"]),
-                     f"{lo:.3g}–{hi:.3g}", f"{r['contacts_per_floe']:.2f}", f"{r['dt']:g}",
-                     r["rebuilds"]])
+                     f"{lo:.3g}–{hi:.3g}", harness.format_number(r["contacts_per_floe"]),
+                     f"{r['dt']:g}", r["rebuilds"]])
     return harness.table(f"Hertz engine, N = {n}, Herman (2013) material table",
                          ["case", "kernels", "threads", "floe-steps/s", "range over processes",
                           "contacts per floe", "Δt [s]", "list rebuilds"], body,

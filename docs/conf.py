@@ -19,6 +19,9 @@ extensions = [
     "sphinx.ext.intersphinx",
     "sphinx.ext.viewcode",
     "sphinx.ext.mathjax",
+    # MathJax served from the built site's _static/mathjax, not from a CDN, so
+    # that the equations render offline (the sphinx-mathjax-offline package)
+    "sphinx-mathjax-offline",
     "seaice_docs",
 ]
 

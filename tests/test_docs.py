@@ -16,6 +16,7 @@ from benchmarks.harness import load_records
 
 pytest.importorskip("sphinx")
 pytest.importorskip("myst_parser")
+pytest.importorskip("sphinx-mathjax-offline")
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -81,6 +82,29 @@ def test_docstring_labels_resolve_to_the_physics_page(site):
     for label in ("physics-fsd", "physics-drag", "physics-harddisk", "physics-contact",
                   "physics-observables", "physics-itd"):
         assert f'id="{label}"' in text, label
+
+
+def test_math_loads_mathjax_from_the_site_itself(site):
+    """Equations render offline: every page that loads MathJax loads it from
+    a file of the built site, and no page loads a script from the network."""
+    pages = sorted(site.rglob("*.html"))
+    with_math = []
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        sources = re.findall(r'<script[^>]*\bsrc="([^"]+)"', text)
+        remote = [s for s in sources if re.match(r"(https?:)?//", s)]
+        assert not remote, f"{page.relative_to(site)} loads scripts from the network: {remote}"
+        mathjax = [s for s in sources if "mathjax" in s.lower()]
+        if mathjax:
+            with_math.append(page.name)
+            for src in mathjax:
+                script = (page.parent / src.split("?")[0]).resolve()
+                assert script.is_file() and site.resolve() in script.parents, \
+                    f"{page.relative_to(site)} loads MathJax from {src}, not a file of the site"
+                assert "MathJax" in script.read_text(encoding="utf-8", errors="replace")
+    # the physics page is mostly equations: it has math and so loads MathJax
+    assert "\\(" in (site / "physics.html").read_text(encoding="utf-8")
+    assert "physics.html" in with_math
 
 
 def _project_files() -> list[Path]:

@@ -35,13 +35,14 @@ def test_table_reports_rows_ratios_and_ceilings():
             dict(case="Ā = 0.70", kernel="parallel", threads=1, rate=8.0e7, spread=[7e7, 8e7],
                  contacts_per_floe=0.0, dt=0.002, rebuilds=3),
             dict(case="Ā = 0.70", kernel="parallel", threads=2, rate=1.2e8, spread=[1e8, 1.2e8],
-                 contacts_per_floe=0.0, dt=0.002, rebuilds=3, paired=[1.5, 1.6, 1.9]),
+                 contacts_per_floe=0.0005, dt=0.002, rebuilds=3, paired=[1.5, 1.6, 1.9]),
             dict(case="cores", kernel="serial", threads=2, rate=1.5, alone=1e8,
                  together=[8e7, 7e7], contacts_per_floe=math.nan, dt=0.002, rebuilds=0),
             dict(case="control", kernel="scalar", threads=2, rate=1.4, paired=[1.3, 1.4, 2.0],
                  contacts_per_floe=math.nan, dt=0.0, rebuilds=0)]
     text = render_table(bench.hertz_table(rows, 20000), heading=None)
-    assert "| Ā = 0.70 | parallel | 2 | 1.2e+08 | 1e+08–1.2e+08 |" in text
+    # a field whose floes barely touch shows its contacts, not 0.00
+    assert "| Ā = 0.70 | parallel | 2 | 1.2e+08 | 1e+08–1.2e+08 | 0.0005 |" in text
     assert "best / best = 1.50, same round: median 1.60, best 1.90" in text
     assert "all threads / serial kernels = 1.20" in text
     assert "give 1.50x one core" in text and "8e+07 + 7e+07" in text

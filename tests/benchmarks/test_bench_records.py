@@ -111,11 +111,21 @@ def test_quick_run_writes_a_valid_record(module, tmp_path):
     assert not module.main(["--quick", "--quiet", "--no-json"])
 
 
+def _hertz_rows(contacts=(0.0005, 3.89)):
+    loose, dense = contacts
+    return [dict(case="Ā = 0.70", kernel="serial", threads=1, rate=3.15e8,
+                 contacts_per_floe=loose),
+            dict(case="Ā = 0.70", kernel="parallel", threads=2, rate=6.0e8,
+                 contacts_per_floe=loose),
+            dict(case="jammed, Ā = 0.95", kernel="serial", threads=1, rate=2.0e7,
+                 contacts_per_floe=dense),
+            dict(case="jammed, Ā = 0.95", kernel="parallel", threads=2, rate=4.0e7,
+                 contacts_per_floe=dense),
+            dict(case="control", kernel="scalar", threads=2, rate=1.9)]
+
+
 def test_headline_block_is_rewritten_from_the_records(tmp_path):
-    hertz = _record("hertz", data=dict(n=20000, rows=[
-        dict(case="Ā = 0.70", kernel="serial", threads=1, rate=3.15e8),
-        dict(case="Ā = 0.70", kernel="parallel", threads=2, rate=5.83e8),
-        dict(case="control", kernel="scalar", threads=2, rate=1.9)]))
+    hertz = _record("hertz", data=dict(n=20000, rows=_hertz_rows()))
     envs = _record("environments", data=dict(environments=[
         dict(id="iceenvs/WindDrift-v0", mean=162.3), dict(id="iceenvs/X-v0", failed="exit 1")]))
     quick = _record("harddisk", data=dict(quick=True, rows=[dict(case="elastic", rate=1.0)]))
@@ -127,14 +137,40 @@ def test_headline_block_is_rewritten_from_the_records(tmp_path):
     text = readme.read_text()
     assert text.startswith("# x\n\nbefore\n<!-- headline:start -->\n| benchmark |")
     assert text.endswith("<!-- headline:end -->\nafter\n") and "old" not in text
-    assert "| Hertz engine, N = 20000, Ā = 0.70 | 5.83e+08 floe-steps/s on 2 threads " \
-           "(3.15e+08 on one, serial kernels) |" in text
+    # each Hertz figure names its regime, concentration and contacts per
+    # floe, and the dense-ice row follows the loose-ice one
+    loose = "| Hertz engine, N = 20000, Ā = 0.70, 0.0005 contacts per floe | 6e+08 floe-steps/s " \
+            "on 2 threads (3.15e+08 on one, serial kernels) |"
+    dense = "| Hertz engine, N = 20000, jammed, Ā = 0.95, 3.89 contacts per floe | 4e+07 " \
+            "floe-steps/s on 2 threads (2e+07 on one, serial kernels) |"
+    assert f"{loose} {hertz['date'][:10]} |\n{dense}" in text
+    # the note under the table: 6e8 / 4e7 = 15 at the same 2 threads
+    assert "the Ā = 0.70 field has 0.0005 contacts per floe (nearly all its floes in free " \
+           "flight); in the jammed, Ā = 0.95 field, with 3.89 contacts per floe, a floe-step " \
+           "costs 15 times as much on 2 threads." in text
     assert "| `iceenvs/WindDrift-v0` | 162 steps/s, one core |" in text
     assert "control" not in text and "X-v0" not in text and "elastic" not in text
-    assert hertz["date"][:10] in text
     once = text
     assert headline.main(["--readme", str(readme), "--records", str(tmp_path)]) == 0
     assert readme.read_text() == once
+
+
+def test_headline_says_free_flight_only_of_a_field_whose_floes_barely_touch():
+    record = _record("hertz", data=dict(n=20000, rows=_hertz_rows((0.5, 3.89))))
+    text = headline.headline_table([record])
+    assert "0.5 contacts per floe;" in text and "free flight" not in text
+
+
+def test_headline_refuses_a_hertz_figure_without_its_contacts(tmp_path, capsys):
+    rows = _hertz_rows()
+    del rows[2]["contacts_per_floe"]
+    harness.write_record(_record("hertz", data=dict(n=20000, rows=rows)), tmp_path / "hertz.json")
+    readme = tmp_path / "README.md"
+    readme.write_text("<!-- headline:start -->\n<!-- headline:end -->\n")
+    assert headline.main(["--readme", str(readme), "--records", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "no contacts per floe" in err and "'jammed, Ā = 0.95'" in err
+    assert readme.read_text() == "<!-- headline:start -->\n<!-- headline:end -->\n"
 
 
 def test_headline_without_markers_is_an_error(tmp_path, capsys):
