@@ -37,6 +37,7 @@ from .dask_pool import check_options as check_dask
 from .dask_pool import describe as describe_dask
 from .dask_pool import run_on_dask
 from .. import mpi
+from ..markdown import table_row
 from .engines import check_engine, use_engine
 from .experiment import get_experiment
 from .recorder import Recorder, atomic_write, checkpoint_files, checkpoint_fraction
@@ -474,7 +475,7 @@ def format_summary(cfg: ScenarioConfig, rows, wall: float | None, out: Path,
              f"Reproduces {cfg.reproduces}. Output: {out}.{when}", ""]
     if rows:
         lines += ["| quantity | this run | paper |", "|---|---|---|"]
-        lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+        lines += [table_row(row) for row in rows]
     if notes:
         lines += ["", "Notes:"] + [f"- {n}" for n in notes.splitlines()]
     return "\n".join(lines)
