@@ -550,7 +550,10 @@ def format_number(value) -> str:
 
 def _cell(value) -> str:
     """A table cell as Markdown: :func:`format_number`, bars escaped, on one line."""
-    return format_number(value).replace("|", "\\|").replace("\n", " ")
+    # imported here: a child of the harness may import physics from another tree
+    from physics.markdown import table_cell
+
+    return table_cell(format_number(value))
 
 
 def render_table(t: dict, heading: str | None = "###") -> str:

@@ -50,6 +50,7 @@ import numpy as np
 
 from physics import PaperPreset
 from physics.hertz import hertz_time_step, scaled_contact  # noqa: F401  (used by the envs)
+from physics.markdown import table_row
 from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
@@ -160,7 +161,7 @@ def task_table(params) -> str:
         default = "None" if p.default is None else (
             f"({p.default[0]:g}, {p.default[1]:g})" if isinstance(p.default, tuple)
             else f'"{p.default}"' if isinstance(p.default, str) else f"{p.default:g}")
-        lines.append(f"| `{p.name}` | {default} | {p.meaning} |")
+        lines.append(table_row([f"`{p.name}`", default, p.meaning]))
     return "\n".join(lines)
 
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from physics import cluster_statistics, find_clusters
+from physics.markdown import table_row
 
 __all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "log_stress",
            "feature_table"]
@@ -182,6 +183,6 @@ def feature_table(features) -> str:
     """Markdown table of the observation entries (for docstrings and the README)."""
     lines = ["| index | name | meaning | unit | scaling | bounds |", "|---|---|---|---|---|---|"]
     for k, f in enumerate(features):
-        lines.append(f"| {k} | `{f.name}` | {f.meaning} | {f.unit} | {f.scaling} | "
-                     f"[{f.low:g}, {f.high:g}] |")
+        lines.append(table_row([k, f"`{f.name}`", f.meaning, f.unit, f.scaling,
+                                f"[{f.low:g}, {f.high:g}]"]))
     return "\n".join(lines)

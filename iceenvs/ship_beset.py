@@ -9,7 +9,7 @@ from physics.domain import Box
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .rewards import ship_beset_reward
-from .ship_env import FLOE_SIZES, ShipEnv, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_features
 
 __all__ = ["ShipBesetEnv", "MAX_EPISODE_STEPS"]
 
@@ -54,6 +54,8 @@ _TASK = (
 )
 
 _FEATURES = ship_features(9, 150.0) + _EXTRA
+#: entries of the vector observation: the features, then the last action
+_N_VECTOR = len(_FEATURES) + len(CONTROLS["thrust"][1])
 
 
 class ShipBesetEnv(ShipEnv):
@@ -94,10 +96,10 @@ class ShipBesetEnv(ShipEnv):
     yaw moment action[1] × `thrust_fraction` × 9.5 MN m.
 
     ## Observation Space
-    `obs_type="vector"` (default): `Box(float32)` of {len(_FEATURES)} entries (as
-    `ShipNavigation-v0`'s, the channel being the box between the walls, and
-    the pressure limit), then `time_left` with `horizon=N`, then the last
-    action:
+    `obs_type="vector"` (default): `Box(float32)` of {_N_VECTOR} entries: the
+    {len(_FEATURES)} of the table below (as `ShipNavigation-v0`'s, the channel
+    being the box between the walls, and the pressure limit), then
+    `time_left` with `horizon=N`, then the last action (two entries):
 
 {feature_table(_FEATURES)}
 

@@ -11,7 +11,7 @@ from physics.forcing import steady_drift
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
-from .ship_env import FLOE_SIZES, ShipEnv, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_features
 
 __all__ = ["ShipNavigationEnv", "MAX_EPISODE_STEPS"]
 
@@ -59,6 +59,8 @@ _TASK = (
 )
 
 _FEATURES = ship_features(9, 150.0)
+#: entries of the default vector observation: the features, then the last action
+_N_VECTOR = len(_FEATURES) + len(CONTROLS["yaw"][1])
 
 
 class ShipNavigationEnv(ShipEnv):
@@ -107,11 +109,12 @@ class ShipNavigationEnv(ShipEnv):
     full thrust: 5.5 m/s in open water) and yaw moment action[1] × 9.5 MN m.
 
     ## Observation Space
-    `obs_type="vector"` (default): `Box(float32)` of {len(_FEATURES)} entries with the
-    default 9-sector lidar (the lidar sees a half-disc of radius 150 m
-    ahead; sector 0 looks to starboard, sector 8 to port), then `time_left`
-    with `horizon=N`, then the last action. Forces are step means read
-    from the engine's step records.
+    `obs_type="vector"` (default): `Box(float32)` of {_N_VECTOR} entries: the
+    {len(_FEATURES)} of the table below with the default 9-sector lidar (the
+    lidar sees a half-disc of radius 150 m ahead; sector 0 looks to
+    starboard, sector 8 to port), then `time_left` with `horizon=N`, then
+    the last action (one entry with the default `control="yaw"`, two with
+    the others). Forces are step means read from the engine's step records.
 
 {feature_table(_FEATURES)}
 

@@ -137,3 +137,16 @@ def test_readme_links_resolve():
     assert local, "the README links into the documentation"
     missing = [t for t in local if not (ROOT / t.split("#")[0]).exists()]
     assert not missing, f"README links to missing files: {missing}"
+
+
+def test_readme_names_every_bundled_scenario_and_counts_them():
+    from physics.scenarios.config import bundled_configs
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    found = re.search(r"`ice-scenarios list` names the (\w+) scenarios:(.*?)`ice-scenarios show",
+                      text, re.S)
+    assert found, "the README's Scenarios section no longer lists the scenarios"
+    named = re.findall(r"`([\w-]+)`", found.group(2))
+    assert sorted(named) == sorted(bundled_configs())
+    words = "zero one two three four five six seven eight nine ten eleven twelve".split()
+    assert found.group(1) == words[len(named)]

@@ -161,7 +161,9 @@ def observation_table() -> str:
 def _cell(value) -> str:
     if isinstance(value, float):
         return f"{value:.3g}"
-    return str(value).replace("|", "\\|").replace("\n", " ")
+    from physics.markdown import table_cell
+
+    return table_cell(value)
 
 
 def generate_benchmarks(out: Path, directory: Path) -> None:

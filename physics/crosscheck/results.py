@@ -5,6 +5,8 @@ import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from ..markdown import table_row
+
 __all__ = ["Check", "format_table", "save_figure"]
 
 
@@ -61,7 +63,7 @@ def format_table(checks: list[Check]) -> str:
         verdict = {True: "pass", False: "**FAIL**", None: "report"}[c.passed]
         unit = f" {c.unit}" if c.unit else ""
         tol = "–" if c.tolerance is None else f"≤ {_num(c.tolerance)}{unit}"
-        lines.append(f"| {c.name} | {_num(c.measured)}{unit} | {tol} | {verdict} | {c.detail} |")
+        lines.append(table_row([c.name, f"{_num(c.measured)}{unit}", tol, verdict, c.detail]))
     return "\n".join(lines)
 
 

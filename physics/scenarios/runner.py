@@ -37,6 +37,7 @@ from .dask_pool import check_options as check_dask
 from .dask_pool import describe as describe_dask
 from .dask_pool import run_on_dask
 from .. import mpi
+from ..markdown import table_row
 from .engines import check_engine, use_engine
 from .experiment import get_experiment
 from .recorder import Recorder, atomic_write, checkpoint_files, checkpoint_fraction
@@ -276,7 +277,8 @@ def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, 
         figures = make_figures(out, ds, exp, params)
     rows = exp.summarise(ds, params)
     wall = time.perf_counter() - t0
-    table = format_summary(cfg, rows, wall, out, ds.attrs.get("notes", ""))
+    table = format_summary(cfg, rows, wall, out, ds.attrs.get("notes", ""),
+                           quick=bool(info.get("quick")))
     (out / "summary.md").write_text(table + "\n")
     log(table)
     return RunResult(out, out / RESULTS_FILE, figures, rows, wall)
@@ -464,17 +466,27 @@ def summarise_run(directory) -> str:
     cfg = SimpleNamespace(name=info["scenario"], title=info.get("title", ""),
                           reproduces=info.get("reproduces", ""))
     rows = exp.summarise(ds, info["parameters"])
-    return format_summary(cfg, rows, None, out, ds.attrs.get("notes", ""))
+    return format_summary(cfg, rows, None, out, ds.attrs.get("notes", ""),
+                          quick=bool(info.get("quick")))
+
+
+#: the line a summary of a ``--quick`` run carries under its heading
+QUICK_NOTE = ("This is the `--quick` form, a smaller and faster set-up than the paper's "
+              "(`ice-scenarios show NAME` lists both): it shows the scenario at work, and its "
+              "numbers are not expected to match the paper's column. The full runs are "
+              "compared with the papers on the documentation's Reproduction page.")
 
 
 def format_summary(cfg: ScenarioConfig, rows, wall: float | None, out: Path,
-                   notes: str = "") -> str:
+                   notes: str = "", quick: bool = False) -> str:
     when = "" if wall is None else f" Wall time {_hms(wall)}."
     lines = [f"## {cfg.name}: {cfg.title}", "",
              f"Reproduces {cfg.reproduces}. Output: {out}.{when}", ""]
+    if quick:
+        lines += [QUICK_NOTE, ""]
     if rows:
         lines += ["| quantity | this run | paper |", "|---|---|---|"]
-        lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+        lines += [table_row(row) for row in rows]
     if notes:
         lines += ["", "Notes:"] + [f"- {n}" for n in notes.splitlines()]
     return "\n".join(lines)

@@ -5,6 +5,7 @@ documentation and the end of an episode.
 The floe environments are built small (few floes) so that the whole module
 runs in seconds once the engines are compiled.
 """
+import re
 import subprocess
 import sys
 import warnings
@@ -257,6 +258,41 @@ def test_class_docstring_has_every_section(env_id):
     # and in the documented order
     positions = [doc.index(f"## {s}") for s in DOC_SECTIONS]
     assert positions == sorted(positions)
+
+
+def _doc(env_id) -> str:
+    module, name = gym.spec(env_id).entry_point.split(":")
+    return getattr(__import__(module, fromlist=[name]), name).__doc__
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_docstring_states_the_size_of_the_default_observation(env_id):
+    stated = re.search(r"`Box\(float32\)` of (\d+) entries", _doc(env_id))
+    assert stated, f"{env_id}: the Observation Space section names no size"
+    env = gym.make(env_id)
+    try:
+        assert int(stated.group(1)) == env.observation_space.shape[0]
+    finally:
+        env.close()
+
+
+def _cells(row: str) -> int:
+    """Cells of a Markdown table row; an escaped bar (``\\|``) is text."""
+    return len(re.split(r"(?<!\\)\|", row.strip().strip("|")))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_docstring_tables_keep_their_columns(env_id):
+    """A bar in a cell's text (an absolute value, |x|) is escaped, so that
+    every row of a table has the header's cells."""
+    columns = None
+    for line in _doc(env_id).splitlines():
+        if not line.lstrip().startswith("|"):
+            columns = None
+        elif columns is None:
+            columns = _cells(line)
+        else:
+            assert _cells(line) == columns, f"{env_id}: {line.strip()}"
 
 
 def test_package_docstring_lists_every_id():

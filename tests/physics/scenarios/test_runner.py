@@ -7,6 +7,7 @@ import pickle
 import shutil
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from physics.scenarios import get_experiment, load_config, resume_run, run_scena
 from physics.scenarios import recorder as recorder_module  # noqa: E402
 from physics.scenarios.config import bundled_configs, parse_set  # noqa: E402
 from physics.scenarios.recorder import checkpoint_files  # noqa: E402
-from physics.scenarios.runner import find_config, member_seeds  # noqa: E402
+from physics.scenarios.runner import QUICK_NOTE, find_config, format_summary, member_seeds  # noqa: E402
 
 ALL = ["godlovitch-kernels", "godlovitch-rafting", "godlovitch-thermo", "herman2013-convergence",
        "herman2013-miz", "herman2013-wind", "scm-analytic"]
@@ -295,3 +296,12 @@ def test_command_line_quick_run_end_to_end(tmp_path):
                              capture_output=True, text=True, timeout=600)
     assert summary.returncode == 0 and "| A_J, knee of ln p(A) |" in summary.stdout
     assert "Wall time" not in summary.stdout and "Wall time" in (out / "summary.md").read_text()
+    # a quick run says that its numbers are not the paper's, in both summaries
+    assert QUICK_NOTE in done.stdout and QUICK_NOTE in summary.stdout
+
+
+def test_only_a_quick_run_says_it_is_not_expected_to_match_the_paper(tmp_path):
+    cfg = SimpleNamespace(name="x", title="t", reproduces="r")
+    rows = [("A_J", "0.87", "0.918–0.921")]
+    assert QUICK_NOTE in format_summary(cfg, rows, 1.0, tmp_path, quick=True)
+    assert QUICK_NOTE not in format_summary(cfg, rows, 1.0, tmp_path)
