@@ -21,6 +21,18 @@ Subclasses say what the task is:
 * ``_succeeded(now)`` and ``_terminated(now)`` — goal reached, failure;
 * ``controls`` (the action set-ups the task offers) and the reward.
 
+Step loads (``info["physics"]``, for the last step; forces in the ship frame):
+``ice_surge``, ``ice_sway`` [N] and ``ice_moment`` [N m] (means over the
+engine steps), ``hull_pressure`` and ``peak_hull_pressure`` [N/m] (mean and
+largest sum of the normal contact forces over the hull's length),
+``step_impulse`` [N s] (∫ |Σ_c F_c| dt, the impulse of the resultant ice
+force), ``step_contact_impulse`` [N s] (Σ_c ∫ |F_c| dt, of each contact's
+force; at least ``step_impulse``, and over an episode at least the total of
+the collisions' impulses |J_c|), ``step_energy`` [J] (work of the hull on
+the ice), ``step_effort`` [J] (work of the thrust, or of the prescribed
+ship against ice and water), ``step_path`` [m] and ``step_collisions``
+(collisions that ended in the step).
+
 Episode metrics (``info``, after every step, for the episode so far):
 ``success``, ``time`` [s], ``path_length`` [m], ``efficiency`` (the
 straight-line distance to the goal over the path length, when the goal is
@@ -342,7 +354,7 @@ class ShipEnv(HertzEnv):
     @staticmethod
     def _no_loads() -> dict:
         return dict(ice_surge=0.0, ice_sway=0.0, ice_moment=0.0, hull_pressure=0.0,
-                    peak_hull_pressure=0.0, step_impulse=0.0,
+                    peak_hull_pressure=0.0, step_impulse=0.0, step_contact_impulse=0.0,
                     step_energy=0.0, step_effort=0.0, step_path=0.0, step_collisions=0)
 
     def _advance(self):
@@ -376,6 +388,7 @@ class ShipEnv(HertzEnv):
                          peak_hull_pressure=float(rec["normal_force"].max()
                                                   / self._ship.hull.length),
                          step_impulse=float(force.sum() * dt),
+                         step_contact_impulse=float(rec["force_magnitude_sum"].sum() * dt),
                          step_energy=float(rec["ice_power"].sum() * dt),
                          step_effort=float(power.sum() * dt),
                          step_path=float(np.hypot(path[:, 0], path[:, 1]).sum()))

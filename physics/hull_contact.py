@@ -65,9 +65,12 @@ from .hull import FEATURE_NONE, disc_hull_contact
 __all__ = ["ShipBundle", "RECORD_COLUMNS", "LOG_COLUMNS", "ship_kick_drift", "hull_forces",
            "ship_closing_kick", "hull_contact_list"]
 
-#: columns of a step record (one row per step, :attr:`ShipBundle.record`)
+#: columns of a step record (one row per step, :attr:`ShipBundle.record`);
+#: ``normal_force`` and ``force_magnitude_sum`` are Σ_c F_n,c and Σ_c |F_c|
+#: over the hull's contacts [N]
 RECORD_COLUMNS = ("time", "x", "y", "heading", "surge", "sway", "yaw_rate", "ice_surge",
-                  "ice_sway", "ice_moment", "ice_power", "contacts", "normal_force")
+                  "ice_sway", "ice_moment", "ice_power", "contacts", "normal_force",
+                  "force_magnitude_sum")
 #: columns of the collision log (one row per finished collision)
 LOG_COLUMNS = ("start", "end", "floe", "impulse_surge", "impulse_sway", "point_x", "point_y",
                "floe_mass", "peak_force")
@@ -391,6 +394,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
     ns = 0.0
     power = 0.0
     normal = 0.0
+    magnitude = 0.0
     n_touch = 0
     room = True
     for k in range(counts[C_CAND]):
@@ -415,6 +419,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
             jx = -(c * fx + sn * fy) * dt
             jy = -(-sn * fx + c * fy) * dt
             f_abs = math.sqrt(fx * fx + fy * fy)
+            magnitude += f_abs
             if contact[i, K_START] < 0.0:
                 contact[i, K_START] = time
                 contact[i, K_JX] = jx
@@ -464,6 +469,7 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
         rec[row, 10] = power
         rec[row, 11] = n_touch
         rec[row, 12] = normal
+        rec[row, 13] = magnitude
         counts[C_RECORD] = row + 1
     # a log with fewer free rows than the list has floes could overflow next step
     if log.shape[0] - counts[C_LOG] <= counts[C_CAND]:

@@ -12,7 +12,8 @@ Both engines describe their contacts with the same :class:`Contacts` table:
 From a contact table:
 
 * :func:`fabric` — the fabric tensor R of the non-rattlers (floes with at
-  least two contacts), Z_c = λ1 + λ2, Z_a = (λ1 − λ2)/Z_c, f_nr;
+  least two contacts), Z_c = λ1 + λ2 (counted: contact ends on
+  non-rattlers per non-rattler), Z_a = (λ1 − λ2)/Z_c, f_nr;
 * :func:`stress` — the Love–Weber stress σ = −(1/S) Σ_c l_c ⊗ F_c, where l_c
   is the centre-to-centre (branch) vector from floe i to floe j and F_c the
   contact force on i. The sign makes **compression positive**: two floes
@@ -118,7 +119,9 @@ class Fabric:
     ----------
     tensor : (2, 2) — R = (1/N_n) Σ_{i non-rattler} Σ_{j ∈ C_i} n_ij ⊗ n_ij
     eigenvalues : (2,) — λ1 ≥ λ2
-    z_c : float — λ1 + λ2, mean number of contacts of a non-rattler
+    z_c : float — λ1 + λ2 = tr R, mean number of contacts of a non-rattler;
+        computed as the count ratio it is (the normals are unit vectors), so
+        it is exact and the same for the same contact pairs on every machine
     z_a : float — (λ1 − λ2)/Z_c, 0 isotropic … 1 all contacts along one axis
         (0 when there are no non-rattlers)
     f_nr : float — fraction N_n/N of non-rattlers
@@ -252,6 +255,13 @@ def fabric(contacts, n_floes: int) -> Fabric:
     Every contact counts once for each of its floes that is a non-rattler
     (has at least two contacts); rattlers and their contacts with other
     rattlers do not enter R.
+
+    Z_c = tr R = λ1 + λ2 equals, since every normal is a unit vector, the
+    number of contact ends on non-rattlers divided by N_n; it is computed
+    from these two integers (one correctly rounded division), not from R,
+    whose floating-point sums depend on the summation order (and so on the
+    BLAS kernels of the machine). Z_a = (λ1 − λ2)/Z_c with
+    λ1 − λ2 = 2 √(((R_xx − R_yy)/2)² + R_xy²) from R.
     """
     n = _check_count("n_floes", n_floes)
     i, j, (normal,) = _contact_arrays(contacts, ["normal"], n)
@@ -261,11 +271,11 @@ def fabric(contacts, n_floes: int) -> Fabric:
     if n_n == 0:
         return Fabric(np.zeros((2, 2)), np.zeros(2), 0.0, 0.0, 0.0, math.nan,
                       coord.astype(np.int64), nr)
-    w = nr[i].astype(float) + nr[j].astype(float)
-    r = _outer_sum(normal, normal, w) / n_n
+    ends = nr[i].astype(np.int64) + nr[j].astype(np.int64)     # contact ends on non-rattlers
+    r = _outer_sum(normal, normal, ends.astype(float)) / n_n
     r = 0.5 * (r + r.T)
     lam, angle = _principal(r)
-    z_c = float(lam[0] + lam[1])
+    z_c = int(ends.sum()) / n_n
     z_a = float((lam[0] - lam[1]) / z_c) if z_c > 0 else 0.0
     return Fabric(r, lam, z_c, z_a, n_n / n if n else 0.0, angle, coord.astype(np.int64), nr)
 

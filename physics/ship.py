@@ -425,7 +425,8 @@ class ShipState:
             np.zeros(2), law._replace(mu=float(ship.friction)), np.zeros((n_floes, 2)),
             np.column_stack([-np.ones(n_floes), np.zeros((n_floes, 5))]),
             np.zeros(n_floes, dtype=np.int64), np.zeros(5, dtype=np.int64),
-            np.zeros((int(ship.log_capacity), len(HC.LOG_COLUMNS))), np.zeros((0, 12)))
+            np.zeros((int(ship.log_capacity), len(HC.LOG_COLUMNS))),
+            np.zeros((0, len(HC.RECORD_COLUMNS))))
         self._records = []
         self._log = []
 
@@ -578,9 +579,11 @@ class ShipState:
         """Every step since the start (or :meth:`clear`) as arrays, one per
         column of :data:`~physics.hull_contact.RECORD_COLUMNS`: time, pose,
         velocities (ship frame), ice force (surge, sway) and moment, the
-        power of the hull on the ice, the number of floes touching and the
+        power of the hull on the ice, the number of floes touching, the
         sum of their normal contact forces [N] (what presses on the hull,
-        also when the resultant cancels)."""
+        also when the resultant cancels) and the sum of the magnitudes of
+        their contact forces [N] (its time integral bounds the collisions'
+        impulses: Σ_c |J_c| ≤ Σ_c ∫ |F_c| dt)."""
         rows = (np.concatenate(self._records) if self._records
                 else np.zeros((0, len(HC.RECORD_COLUMNS))))
         return {name: rows[:, k].copy() for k, name in enumerate(HC.RECORD_COLUMNS)}

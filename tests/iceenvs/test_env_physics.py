@@ -151,10 +151,16 @@ def _largest_cluster_run(n_steps, concentration=0.85, **kwargs):
 
 
 def test_floe_clustering_wind_grows_the_largest_cluster():
-    """At Ā = 0.85 a steady 10 m/s wind (action (0.5, 0)) drives floes of
-    different sizes at different speeds until they pack into one large
-    cluster: after 3000 s the largest-cluster fraction is well above its value
-    in the random start.
+    """At Ā = 0.85 under a steady 10 m/s wind (action (0.5, 0)) the floes
+    pack into one large cluster: the largest-cluster fraction over the last
+    500 s of 3000 s is well above (by 0.2) its value over the first 500 s.
+
+    The first intervals, not the placement, are the reference: the random
+    placement at Ā = 0.85 leaves many floes within 1 cm of each other
+    (fractions 0.33-0.74 by seed), which the first 100 s break up (0.24-0.57
+    over the first 500 s). Over seeds 0-23 the rise is 0.32-0.65 and the
+    late fraction at least 0.81; above the start value it rises by as
+    little as 0.08 (seed 1).
 
     Clusters here are floes closer than 1 cm (``cluster_gap=0.01``, the same
     distance the env uses for contacts): with a gap of 0.5 m every
@@ -162,11 +168,12 @@ def test_floe_clustering_wind_grows_the_largest_cluster():
     concentration (with 0.1 m, the default, see the test below).
     """
     fractions = _largest_cluster_run(30, cluster_gap=0.01)
-    start, end = fractions[0], float(np.mean(fractions[-5:]))
+    start = fractions[0]
+    early, late = float(np.mean(fractions[1:6])), float(np.mean(fractions[-5:]))
     assert 0.0 < start < 0.9
-    assert end > start + 0.1, (f"largest-cluster fraction {start:.3f} at the start, "
-                               f"{end:.3f} (mean of the last 5 steps) after 3000 s: "
-                               f"{np.round(fractions, 3).tolist()}")
+    assert late > early + 0.2, (f"largest-cluster fraction {early:.3f} over the first 500 s, "
+                                f"{late:.3f} over the last 500 s of 3000 s: "
+                                f"{np.round(fractions, 3).tolist()}")
 
 
 def test_floe_clustering_default_gap_leaves_room_to_grow():

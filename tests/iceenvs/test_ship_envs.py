@@ -76,33 +76,42 @@ def test_yaw_rate_action_turns_the_prescribed_ship_at_that_rate():
         env.close()
 
 
-def test_collision_impulses_add_up_to_the_ice_impulse_on_the_hull():
-    """The reward's step impulses (the time integral of |F_ice|) over an
-    episode against the collision log's impulses: each collision's impulse
-    is the integral of its force, so the log's total |J| can only fall
-    short of it where floes touch at once or a contact is still open at
-    the end (within 15 % here), and never exceeds it."""
+def test_collision_impulses_are_bounded_by_the_contact_impulses():
+    """Over an episode, Σ_c |J_c| of the logged collisions ≤ Σ_c ∫ |F_c| dt
+    (``step_contact_impulse``): each J_c is the integral of its contact's
+    force (triangle inequality; turning it into the ship frame keeps its
+    length) and collisions still open at the end are not logged. And
+    ∫ |Σ_c F_c| dt (``step_impulse``) ≤ Σ_c ∫ |F_c| dt at every step. Neither
+    log total nor resultant bounds the other: floes pressing on opposite
+    sides cancel in the resultant, not in the log."""
     env = gym.make(NAV, concentration=0.5)
     try:
         obs, _ = env.reset(seed=3)
         u = env.unwrapped
-        total = 0.0
+        resultant = contact = 0.0
         from agents.baselines import StraightLinePolicy
 
         policy = StraightLinePolicy(env)
         while True:
             action, _ = policy.predict(obs)
             obs, _, terminated, truncated, info = env.step(action)
-            total += info["physics"]["step_impulse"]
+            loads = info["physics"]
+            # at every step; 1e-12: sums of ~2e3 engine steps of a few dozen contacts,
+            # each rounding to ~1e-16 relative
+            assert loads["step_impulse"] <= loads["step_contact_impulse"] * (1.0 + 1e-12)
+            resultant += loads["step_impulse"]
+            contact += loads["step_contact_impulse"]
             if terminated or truncated:
                 break
-        impulses = info["mean_impulse"] * info["collisions"]
+        impulses = float(np.sum(u._impulses))
     finally:
         env.close()
-    assert info["collisions"] >= 5
-    assert impulses <= total * (1.0 + 1e-9)
-    assert impulses >= 0.85 * total, (impulses, total)
-    assert u.n_floes > 50
+    assert info["collisions"] >= 5 and u.n_floes > 50
+    assert impulses > 0.0 and resultant > 0.0
+    # 1e-9: the two totals sum the same ~1e5 contact-step terms in different
+    # orders, each rounding to ~1e-16 relative
+    assert impulses <= contact * (1.0 + 1e-9), (impulses, contact)
+    assert resultant <= contact * (1.0 + 1e-9), (resultant, contact)
 
 
 def test_episode_metrics_are_the_ones_agents_log():

@@ -178,6 +178,8 @@ def compare_contacts(ours_c, lm_c, n, area):
         measured[name] = err
         if not err <= 1e-6:
             problems.append(f"{name}: ours {o:.10g}, LAMMPS {lv:.10g} (relative {err:.3g} > 1e-6)")
+    # Z_c is a ratio of contact counts, so the same contact pairs (checked
+    # above) give the same float: exact equality is the right test here
     zo, zl = fabric(ours_c, n).z_c, fabric(lm_c, n).z_c
     measured["z_c"] = (zo, zl)
     if zo != zl:

@@ -55,12 +55,13 @@ def rows_lattice(n=6, rows=4):
 
 def _isotropic_lattice(positions, box, z):
     """Contacts of a lattice where every floe has z contacts: checks
-    Z_c = z, Z_a = 0, f_nr = 1 (to 1e-12) and returns (sim, contacts)."""
+    Z_c = z exactly (a ratio of contact counts), Z_a = 0 (to 1e-12), f_nr = 1
+    and returns (sim, contacts)."""
     sim, c = _hertz_lattice(positions, box)
     n = len(positions)
     assert len(c) == z * n // 2
     fab = fabric(c, n)
-    assert fab.z_c == pytest.approx(z, rel=1e-12)
+    assert fab.z_c == z
     assert fab.z_a == pytest.approx(0.0, abs=1e-12)
     assert fab.f_nr == 1.0 and np.all(fab.coordination == z)
     return sim, c
@@ -162,6 +163,24 @@ def test_stress_is_the_sum_of_per_floe_stresses(seed):
     assert s.per_floe.shape == (n, 2, 2)
     np.testing.assert_allclose(s.per_floe.sum(axis=0), s.tensor, rtol=1e-12,
                                atol=1e-12 * np.abs(s.tensor).max())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_contact_number_is_the_count_ratio(seed):
+    """Z_c of a random contact table is exactly the number of contact ends on
+    non-rattlers over the number of non-rattlers (counted here floe by floe),
+    and equals tr R (to 1e-12: R sums ~100 products of unit-vector components)."""
+    c, n = _random_contacts(seed, k=60)            # ~2 contacts per floe: some rattlers
+    coordination = [0] * n
+    for a, b in zip(c.i.tolist(), c.j.tolist()):
+        coordination[a] += 1
+        coordination[b] += 1
+    ends = [k for k in coordination if k >= 2]
+    assert 0 < len(ends) < n                       # rattlers and non-rattlers both present
+    fab = fabric(c, n)
+    assert fab.z_c == sum(ends) / len(ends)
+    assert fab.z_c == pytest.approx(np.trace(fab.tensor), rel=1e-12)
+    assert fab.z_c == pytest.approx(fab.eigenvalues.sum(), rel=1e-12)
 
 
 @pytest.mark.parametrize("theta", [0.3, 1.1, 2.5])

@@ -388,7 +388,9 @@ def test_normal_force_record_is_the_sum_of_the_contact_normals(mu):
     of a passing ship: with no friction the only force is the normal one,
     so it equals the magnitude of the ice force; with friction μ the force
     of one contact lies between Fn and Fn √(1 + μ²) (Coulomb), and in gross
-    sliding it reaches the top."""
+    sliding it reaches the top. ``force_magnitude_sum`` of one contact is
+    the magnitude of the ice force (1e-12: the record turns the force into
+    the ship frame, which rounds)."""
     hull = Hull.box(30.0, 4.0)
     sim, t_c = single_floe_run(hull, (30.0, 30.0 + 2.0 + 1.01), (0.0, -0.05), restitution=0.5,
                                ship_friction=mu, ship_speed=4.0, omega=0.0)
@@ -405,3 +407,5 @@ def test_normal_force_record_is_the_sum_of_the_contact_normals(mu):
     else:
         assert np.median(force / normal) == pytest.approx(math.sqrt(1.0 + mu ** 2), rel=1e-3)
     assert np.all(rec["normal_force"][rec["contacts"] == 0] == 0.0)
+    np.testing.assert_allclose(rec["force_magnitude_sum"][touching], force, rtol=1e-12)
+    assert np.all(rec["force_magnitude_sum"][rec["contacts"] == 0] == 0.0)

@@ -54,15 +54,24 @@ def test_shear_zone_width_of_a_ramp_profile():
 
 
 def test_convergence_jams_with_the_papers_signatures(tmp_path):
-    """300 floes from A = 0.82 at 1 per hour: binary collisions well below
-    the knee (≤ 1.6 contacts per touching floe, f_nr < 0.1), Z_c > 3 and
-    f_nr > 0.3 beyond it, and a pressure rise of more than 4 decades."""
-    ds = _run("herman2013-convergence", tmp_path / "c", floes=300, start_concentration=0.82,
-              end_concentration=0.92, rate=1.0, output_step=0.002)
+    """1000 floes from A = 0.80 to 0.90 at 1 per hour: binary collisions well
+    below the knee (≤ 1.6 contacts per touching floe, f_nr < 0.1), Z_c > 3 and
+    f_nr > 0.3 beyond it, a pressure rise of more than 4 decades, and the
+    Z_c > 3 estimate of A_J within 0.02 of the knee.
+
+    The size and range are what makes these hold for any trajectory: with
+    300 floes from 0.82 the knee of ln p fell at 0.818-0.866 over seeds 0-11
+    (below 0.84, or with no output before it, for some), and Z_c > 3 came up
+    to 0.042 after it; with 1000 floes the knee lies at 0.864-0.878 and the
+    Z_c estimate 0.006-0.018 after it (seeds 0-11). max_pressure is raised
+    so that the run goes on past the knee (1e7 N/m stopped it within 0.01
+    of the knee), leaving at least 8 outputs beyond A_J + 0.01."""
+    ds = _run("herman2013-convergence", tmp_path / "c", floes=1000, start_concentration=0.80,
+              end_concentration=0.90, rate=1.0, output_step=0.002, max_pressure=1e9)
     a = ds["concentration"].values[0, 0]
     aj = float(ds["a_j"].values[0, 0])
-    assert 0.84 < aj < 0.92
-    early = (a > 0.825) & (a < aj - 0.015)
+    assert 0.84 < aj < 0.89
+    early = (a > 0.805) & (a < aj - 0.015)
     late = a > aj + 0.01
     assert early.sum() >= 3 and late.sum() >= 2
     assert np.mean(ds["z_touch"].values[0, 0][early]) <= 1.6
@@ -76,16 +85,24 @@ def test_convergence_jams_with_the_papers_signatures(tmp_path):
 
 
 def test_wind_anisotropy_falls_with_concentration(tmp_path):
-    """Under wind, loose ice (A = 0.80) has an anisotropic contact network
-    (Z_a > 0.15) and small stresses; jammed ice (A = 0.90, 200 floes) is
-    nearly isotropic (Z_a < 0.1) and carries orders of magnitude more
-    pressure (Fig 5: τ and Z_a grow as A decreases)."""
+    """Under wind, loose ice (A = 0.80) carries small and strongly
+    anisotropic stresses (τ/p > 0.5); jammed ice (A = 0.90, 200 floes) has a
+    nearly isotropic contact network (Z_a < 0.1), τ/p < 0.15 and orders of
+    magnitude more pressure (Fig 5: τ and Z_a grow as A decreases).
+
+    Z_a of the loose ice is not tested: there 200 floes have fewer than two
+    non-rattlers on average (f_nr ≤ 0.011), and the mean Z_a of one or two
+    floes ranged over 0.06-0.52 by seed. Over seeds 0-15 τ/p was 0.77-1.11
+    at A = 0.80 and 0.036-0.093 at A = 0.90, Z_a at A = 0.90 at most 0.035,
+    and the pressure ratio above 1e7."""
     ds = _run("herman2013-wind", tmp_path / "w", floes=200, concentrations=[0.8, 0.9],
               duration=150.0, output_interval=5.0, snapshot_times=[])
     late = ds["time"].values >= 75.0
     za = [np.nanmean(ds["z_a"].values[c][late[c]]) for c in range(2)]
     p = [np.nanmean(ds["p"].values[c][late[c]]) for c in range(2)]
-    assert za[0] > 0.15 and za[1] < 0.1
+    tau = [np.nanmean(ds["tau"].values[c][late[c]]) for c in range(2)]
+    assert tau[0] > 0.5 * p[0] and tau[1] < 0.15 * p[1]
+    assert za[1] < 0.1
     assert p[1] > 100 * p[0]
     assert list(ds.coords["concentration"].values) == [0.8, 0.9]
 

@@ -66,18 +66,28 @@ def test_small_run_writes_the_netcdf_and_the_figures(small_run):
     assert (res.directory / "summary.md").read_text().count("R = a A^b") == 4
 
 
-def test_resistance_grows_with_concentration(small_run):
-    _, ds = small_run
+def test_resistance_grows_with_concentration(tmp_path):
+    """The prescribed ship (2 m/s, no wind) meets more ice at A = 0.5 than
+    at 0.2 and its resistance is larger, over a band of 480 m (the
+    resistance window, with the whole hull in the band, 400 m long). Over
+    seeds 0-11 R was 11-34 kN at 0.2 and 60-109 kN at 0.5: the windows of
+    the shared small run (84 m, with a handful of collisions at 0.2) gave
+    resistances with errors as large as themselves, in either order."""
+    overrides = dict(concentrations=[0.2, 0.5], speeds=[], modes="prescribed", wind="off",
+                     band_length=480.0, channel_width=150.0, output_interval=2.0,
+                     sides="periodic")
+    res = run_scenario("ship-transit", quick=True, overrides=overrides, out=tmp_path / "r",
+                       workers=1, progress=False, plots=False, log=lambda *a: None)
+    with xr.open_dataset(res.dataset) as ds:
+        ds = ds.load()
     conc = ds.coords["concentration"].values
-    speed = ds.coords["speed"].values
-    r = ds["resistance"].values[:, 0]
-    for dyn in (0, 1):
-        for wind in (0.0, 10.0):
-            sel = ((ds.coords["dynamic"].values == dyn) & (ds.coords["wind"].values == wind)
-                   & (speed == 2.0))
-            order = np.argsort(conc[sel])
-            assert list(conc[sel][order]) == [0.2, 0.5]
-            assert r[sel][order][1] > r[sel][order][0] > 0
+    assert sorted(conc.tolist()) == [0.2, 0.5]
+    assert np.all(ds.coords["dynamic"].values == 0) and np.all(ds.coords["wind"].values == 0.0)
+    order = np.argsort(conc)
+    r = ds["resistance"].values[order, 0]
+    collisions = ds["window_collisions"].values[order, 0]
+    assert collisions[1] > collisions[0] > 0
+    assert r[1] > r[0] > 0
 
 
 def test_power_law_fit_recovers_a_known_exponent():
@@ -143,13 +153,19 @@ def test_interrupted_run_resumes_to_the_same_numbers(tmp_path, monkeypatch):
         np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
 
 
-def test_walled_channel_besets_the_weak_ship_that_the_periodic_one_does_not(tmp_path):
+def test_walled_channel_holds_back_the_weak_ship_that_the_periodic_one_lets_through(tmp_path):
     """The same dense band (A = 0.8) and weak thrust (0.25 m/s in open water)
     with the onshore wind: the periodic channel lets the ice escape and the
-    ship gets through; closed by walls across and ahead, the pack is
-    compressed against them and the ship is beset well short of the wall
-    ahead (more than 10 m short of the band's end).
-    The floes stay between the side walls and the hull clear of them."""
+    ship gets through, slowed by at most 0.2; closed by walls across and
+    ahead, the pack is compressed against them and the ship loses more
+    than 0.3 of its speed or is beset, well short of the wall ahead (more
+    than 10 m short of the band's end).
+
+    Whether the walled ship is beset (its surge below 0.05 m/s for 30 s)
+    depends on the trajectory: over seeds 0-9 it was beset 4 times, 74-122 m
+    into the band, and otherwise got through with a speed loss of 0.38-0.52,
+    while the periodic ship lost 0.08-0.12. The floes stay between the side
+    walls and the hull clear of them."""
     small = dict(concentrations=[0.8], speeds=[], reference_speed=0.25, modes="dynamic",
                  wind="on", sides="both", walled_concentrations=[0.8], walled_speed=0.25,
                  band_length=160.0, channel_width=140.0, output_interval=2.0,
@@ -161,11 +177,18 @@ def test_walled_channel_besets_the_weak_ship_that_the_periodic_one_does_not(tmp_
     walls = ds.coords["walls"].values
     assert sorted(walls.tolist()) == [0, 1]
     w, f = int(np.argmax(walls == 1)), int(np.argmax(walls == 0))
-    assert ds["beset"].values[w, 0] == 1 and ds["beset"].values[f, 0] == 0
-    assert ds["completed"].values[f, 0] == 1 and ds["completed"].values[w, 0] == 0
-    band = float(ds["band_end"].values[w, 0] - ds["band_start"].values[w, 0])
-    assert 0.0 < ds["beset_distance"].values[w, 0] < band - 10.0
-    assert ds["speed_loss"].values[w, 0] == 1.0 and ds["speed_loss"].values[f, 0] < 1.0
+    assert ds["beset"].values[f, 0] == 0 and ds["completed"].values[f, 0] == 1
+    assert ds["speed_loss"].values[f, 0] < 0.2
+    assert ds["speed_loss"].values[w, 0] > 0.3
+    text = (res.directory / "summary.md").read_text()
+    if ds["beset"].values[w, 0] == 1:
+        assert ds["completed"].values[w, 0] == 0 and ds["speed_loss"].values[w, 0] == 1.0
+        band = float(ds["band_end"].values[w, 0] - ds["band_start"].values[w, 0])
+        assert 0.0 < ds["beset_distance"].values[w, 0] < band - 10.0
+        assert "beset at t = " in text and "into the band" in text
+    else:
+        assert ds["completed"].values[w, 0] == 1 and ds["speed_loss"].values[w, 0] < 1.0
+        assert np.isnan(ds["beset_distance"].values[w, 0]) and "beset at t = " not in text
     # the ship starts at a third of the width from the coast (y = 0)
     ly = float(ds["channel_width"].values[w, 0])
     assert ds["ship_start_y"].values[w, 0] == pytest.approx(ly / 3.0)
@@ -175,5 +198,3 @@ def test_walled_channel_besets_the_weak_ship_that_the_periodic_one_does_not(tmp_
     assert np.all(y[ok] - r[ok] > -0.05 * r[ok]) and np.all(y[ok] + r[ok] < ly + 0.05 * r[ok])
     ys = ds["y"].values[w, 0]
     assert np.all((ys[np.isfinite(ys)] > 9.0 + 5.0) & (ys[np.isfinite(ys)] < ly - 14.0))
-    text = (res.directory / "summary.md").read_text()
-    assert "beset at t = " in text and "into the band" in text
