@@ -312,20 +312,6 @@ def test_existing_run_directory_needs_force(tmp_path):
     assert (out / "model.zip").read_text() == "earlier run"
 
 
-def test_demo_trains_evaluates_and_prints_the_table(tmp_path, capsys):
-    from agents.demo import main as demo_main
-
-    summaries = demo_main(["--timesteps", "256", "--episodes", "1", "--no-progress",
-                           "--out", str(tmp_path / "demo")])
-    out = capsys.readouterr().out
-    assert set(summaries) == {"ppo policy", "random", "zero", "heuristic"}
-    assert "| ppo policy |" in out and "| heuristic |" in out
-    assert (tmp_path / "demo" / "model.zip").is_file()
-    assert (tmp_path / "demo" / "evaluation.png").is_file()
-    with pytest.raises(SystemExit):
-        demo_main(["--timesteps", "0"])
-
-
 def test_learning_curve_from_progress_csv(tmp_path):
     from agents.curves import main as curves_main, read_progress
 
