@@ -20,9 +20,10 @@ $(STAMP): pyproject.toml Makefile
 	$(PY) -m iceenvs.warmup || echo "warm-up incomplete: the remaining kernels compile on first use"
 	touch $(STAMP)
 
+# the engine demo (python -m physics.demo), then the training demo
+# (python -m agents.demo), and the total wall time
 demo: setup
-	$(PY) -m physics.demo
-	$(PY) -m agents.demo
+	$(PY) -m seaice_gym demo
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"
