@@ -1,10 +1,11 @@
-"""A short training that beats the baselines: ``python -m agents.demo``.
+"""A short PPO training, compared with the baselines: ``python -m agents.demo``.
 
 Trains PPO on ``iceenvs/Convergence-v0`` with the budget of
 ``agents/hyperparams/demo.yaml`` (40 000 steps, two environment
-processes, about 100 s on two cores), then runs the policy and the
+processes: about 140 s on two cores), then runs the policy and the
 random, zero-action and hand-written baselines on the same 20 seeded
-episodes with :mod:`agents.evaluate`, and prints the returns, the paired
+episodes with :mod:`agents.evaluate` in two processes (about 25 s), and
+prints the returns, the paired
 differences and one line per baseline saying whether the policy beats it
 by more than two standard errors of the paired difference, and why not
 where it does not.
@@ -72,12 +73,14 @@ def run_seed(config: dict, seed: int, timesteps: int, episodes: int, out: Path,
     t0 = time.perf_counter()
     run_dir = train_main(train_args + quiet)
     t1 = time.perf_counter()
-    print(f"trained in {t1 - t0:.0f} s; evaluating on {episodes} seeded episodes ...", flush=True)
+    print(f"trained in {round(t1 - t0, 1):.0f} s; evaluating on {episodes} seeded episodes ...",
+          flush=True)
     # the full table (every final physics metric) goes to evaluation.md; the
     # demo prints the returns only
     with contextlib.redirect_stdout(io.StringIO()):
         evaluate_main([str(run_dir), "--episodes", str(episodes), "--baselines",
-                       ",".join(BASELINES), *quiet])
+                       ",".join(BASELINES), "--processes", str(config.get("eval_processes", 1)),
+                       *quiet])
     t2 = time.perf_counter()
     report = json.loads((Path(run_dir) / "evaluation.json").read_text())
     report.pop("episodes_detail", None)
@@ -169,7 +172,8 @@ def seeds_markdown(reports: list[dict], command: str, meta: dict) -> str:
 def build_parser(prog: str, config: dict) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n")[0],
                                 epilog=f"environment {config['env']}, algorithm {config['algo']}; "
-                                       f"budget and hyperparameters: {CONFIG_FILE.name}")
+                                       f"budget and hyperparameters: agents/hyperparams/"
+                                       f"{CONFIG_FILE.name}")
     p.add_argument("--timesteps", type=int, default=config["timesteps"],
                    help=f"training steps per seed (default {config['timesteps']})")
     p.add_argument("--episodes", type=int, default=config["episodes"],

@@ -90,7 +90,7 @@ def test_demo_budget_beats_random_and_zero_actions(tmp_path):
     """One training seed with the demo's budget (about 2 minutes on two
     idle cores): PPO beats random and zero actions by more than two
     standard errors of the paired difference (docs/agents/demo/seeds.md:
-    by 7 to 9 standard errors for seeds 0, 1 and 2)."""
+    by 8.3 and 8.7 standard errors)."""
     demo.main(["--seed", "0", "--no-progress", "--out", str(tmp_path / "run")])
     comparisons = json.loads((tmp_path / "run" / "evaluation.json").read_text())["comparisons"]
     assert comparisons["random"]["beats"] and comparisons["zero"]["beats"]
