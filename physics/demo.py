@@ -63,6 +63,16 @@ def _save(fig, path: Path) -> None:
     _pyplot().close(fig)
 
 
+def _frame(ax, box, title: str) -> None:
+    """The box as the limits of a map in metres, to scale."""
+    ax.set_xlim(0, box.lx)
+    ax.set_ylim(0, box.ly)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title, fontsize=9)
+
+
 def _advance(sim: HertzSimulation, duration: float, progress: bool) -> float:
     """Advance and return the wall time [s]."""
     t0 = time.perf_counter()
@@ -146,12 +156,7 @@ def draw(sim: HertzSimulation, path: Path, title: str) -> None:
     if forces.size:
         ax.add_collection(LineCollection(segments, colors="crimson",
                                          linewidths=0.3 + 3.0 * forces / forces.max()))
-    ax.set_xlim(0, sim.box.lx)
-    ax.set_ylim(0, sim.box.ly)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title, fontsize=9)
+    _frame(ax, sim.box, title)
     fig.colorbar(coll, ax=ax, label="floe speed [m/s]", shrink=0.8)
     fig.tight_layout()
     _save(fig, path)
@@ -200,12 +205,7 @@ def draw_transit(sim: HertzSimulation, path: Path, title: str, *,
                                  closed=True, fc="none", ec="crimson", lw=0.6, alpha=0.6))
     ax.add_patch(Polygon(sim.ship.vertices, closed=True, fc="crimson", ec="k", lw=0.8,
                          label=f"hull at t = {sim.time:.0f} s (outlines every {every:g} s)"))
-    ax.set_xlim(0, sim.box.lx)
-    ax.set_ylim(0, sim.box.ly)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title, fontsize=9)
+    _frame(ax, sim.box, title)
     ax.legend(loc="upper left", fontsize=7)
 
     if t.size:
