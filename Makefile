@@ -38,9 +38,10 @@ lock:
 	} > $(CONSTRAINTS)
 	rm -rf .lock-venv
 
+# the engine demo (python -m physics.demo), then the training demo
+# (python -m agents.demo), and the total wall time
 demo: setup
-	$(PY) -m physics.demo
-	$(PY) -m agents.demo
+	$(PY) -m seaice_gym demo
 
 test: setup
 	$(PY) -m pytest -q -m "not slow"

@@ -2,7 +2,7 @@
 
     python -m agents.evaluate RUN_DIR [--episodes 20] [--seed S]
         [--baselines random,zero,heuristic[,constant]] [--constant FILE.json]
-        [--env-kwargs key=value ...] [--out DIR]
+        [--env-kwargs key=value ...] [--processes N] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
         [--env-kwargs key=value ...] [--constant FILE.json]
 
@@ -43,8 +43,8 @@ import yaml
 
 from .metrics import MAIN_METRIC, env_name, physics_metrics
 
-__all__ = ["TrainedPolicy", "run_episode", "evaluate", "summarise", "compare",
-           "markdown_table", "plot_trajectories", "main"]
+__all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
+           "compare", "markdown_table", "plot_trajectories", "main"]
 
 
 class TrainedPolicy:
@@ -120,6 +120,67 @@ def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = 
             for k in range(episodes):
                 results[name].append(run_episode(env, policy, seed + k, main_metric))
                 bar.update()
+    return results
+
+
+#: the environment and the policies of a worker of :func:`evaluate_in_processes`
+_WORKER: dict = {}
+
+
+def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
+                    episode_seed: int) -> dict:
+    """One episode in a worker process: the worker builds its environment
+    once (``reset(seed=env_seed)``, as the evaluation's main process does)
+    and each policy once from its recipe, then runs
+    :func:`run_episode`."""
+    from .baselines import make_baseline
+    from .envs import make_checked_env
+
+    key = (env_id, repr(sorted(env_kwargs.items())), env_seed)
+    if _WORKER.get("key") != key:
+        import torch
+
+        torch.set_num_threads(1)
+        if "env" in _WORKER:
+            _WORKER["env"].close()
+        _WORKER.clear()
+        _WORKER.update(key=key, env=make_checked_env(env_id, env_kwargs, seed=env_seed))
+    env = _WORKER["env"]
+    if name not in _WORKER:
+        kind, target, kwargs = recipe
+        _WORKER[name] = (TrainedPolicy(target) if kind == "trained" else
+                         make_baseline(target, env, seed=env_seed, **kwargs))
+    return run_episode(env, _WORKER[name], episode_seed, MAIN_METRIC.get(env_name(env_id)))
+
+
+def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
+                          seed: int, processes: int, progress: bool = True) -> dict:
+    """:func:`evaluate` with the episodes shared among ``processes`` worker
+    processes; the same results, since every episode starts from
+    ``reset(seed=seed + k)`` and the policies are deterministic or, like
+    the random baseline, re-seeded with each episode.
+
+    ``recipes`` maps a policy name to ``("trained", run_dir, {})`` or
+    ``("baseline", baseline_name, constructor_kwargs)``; every worker builds
+    its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
+    reset with ``seed``) and policies from them."""
+    import concurrent.futures
+    import multiprocessing
+
+    from tqdm.auto import tqdm
+
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    results = {name: [None] * episodes for name in recipes}
+    with concurrent.futures.ProcessPoolExecutor(
+            processes, mp_context=multiprocessing.get_context(method)) as pool, \
+            tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
+                 disable=not progress) as bar:
+        jobs = {pool.submit(_worker_episode, env_id, env_kwargs, seed, name, recipe, seed + k):
+                (name, k) for name, recipe in recipes.items() for k in range(episodes)}
+        for job in concurrent.futures.as_completed(jobs):
+            name, k = jobs[job]
+            results[name][k] = job.result()
+            bar.update()
     return results
 
 
@@ -252,6 +313,9 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p.add_argument("--out", type=Path, default=None,
                    help="output directory (default: the run directory, or "
                         "runs/agents/baseline_<env-name>_<name>)")
+    p.add_argument("--processes", type=int, default=1,
+                   help="worker processes that share the episodes (default 1: this process); "
+                        "the results do not depend on it")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     return p
 
@@ -321,6 +385,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error("--episodes must be >= 1")
+    if args.processes < 1:
+        parser.error(f"--processes must be >= 1, got {args.processes}")
     names = [n.strip() for n in args.baselines.split(",") if n.strip()]
     if args.baseline is not None:
         names = [args.baseline]
@@ -365,6 +431,9 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
                                  f"has shape {getattr(env, kind).shape}, the run's policy "
                                  f"needs {run_shape}")
         labels = {}
+        recipes = {}
+        if trained is not None:
+            recipes[next(iter(policies))] = ("trained", str(args.run_dir), {})
         constant = None
         if "constant" in names:
             action, source = constant_action(parser, args, env_id, env_kwargs)
@@ -376,10 +445,17 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
                 except ValueError as err:
                     parser.error(f"--constant {args.constant}: {err}")
                 labels[name] = f"constant {format_action(policies[name].action)}"
+                recipes[name] = ("baseline", name, dict(action=policies[name].action))
             else:
                 policies[name] = make_baseline(name, env, seed=args.seed)
-        results = evaluate(env, policies, episodes=args.episodes, seed=args.seed,
-                           progress=not args.no_progress)
+                recipes[name] = ("baseline", name, {})
+        if args.processes > 1:
+            results = evaluate_in_processes(env_id, env_kwargs, recipes, episodes=args.episodes,
+                                            seed=args.seed, processes=args.processes,
+                                            progress=not args.no_progress)
+        else:
+            results = evaluate(env, policies, episodes=args.episodes, seed=args.seed,
+                               progress=not args.no_progress)
     finally:
         env.close()
     summaries = {name: summarise(eps) for name, eps in results.items()}

@@ -101,13 +101,16 @@ def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
 
 
 def warm_demo() -> str:
-    """``python -m physics.demo`` on 300 floes for 2 model seconds, its
-    output discarded (the kernels are the same as for the full demo)."""
+    """``python -m physics.demo`` with 30 floes pressed on the wall for 2
+    model seconds and a ship transit of 2 model seconds, its output
+    discarded (the kernels are the same as for the full demo; the training
+    demo of ``make demo`` uses Convergence-v0, warmed above)."""
     from physics import demo
 
     with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
         try:
-            demo.main(["--floes", "300", "--duration", "2", "--out", out])
+            demo.main(["--floes", "30", "--concentration", "0.7", "--duration", "2",
+                       "--ship-duration", "2", "--no-progress", "--out", out])
         except ImportError as exc:         # matplotlib missing: only the picture fails
             return f" (no picture: {exc})"
     return ""

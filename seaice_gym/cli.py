@@ -21,6 +21,7 @@ import argparse
 import importlib
 import inspect
 import sys
+import time
 
 from . import __version__
 
@@ -53,8 +54,9 @@ BENCH_SUITES = {
 
 #: the parts of ``seaice demo``, run in this order when none is named
 DEMOS = {
-    "physics": ("physics.demo:main", "a short Hertz-engine run, with a figure"),
-    "agents": ("agents.demo:main", "a short PPO training and its evaluation"),
+    "physics": ("physics.demo:main", "force chains and a ship transit in the Hertz engine, "
+                                     "with figures"),
+    "agents": ("agents.demo:main", "a short PPO training, evaluated against the baselines"),
 }
 
 
@@ -110,10 +112,12 @@ def _demo(argv: list[str], prog: str) -> int:
     part = _pick(parser, argv, "part")
     if part is not None:
         return _call(DEMOS[part][0], argv[1:], f"{prog} {part}")
+    t0 = time.perf_counter()
     for name, (target, _) in DEMOS.items():
         status = _call(target, [], f"{prog} {name}")
         if status:
             return status
+    print(f"{prog}: done in {time.perf_counter() - t0:.0f} s")
     return 0
 
 

@@ -151,6 +151,19 @@ def test_ppo_run_saves_reloads_and_evaluates(ppo_runs, env_id, tmp_path):
     assert (tmp_path / "evaluation.png").stat().st_size > 1000
 
 
+def test_evaluation_in_worker_processes_gives_the_same_episodes(ppo_runs, tmp_path):
+    from agents.evaluate import main as evaluate_main
+
+    for processes in ("1", "2"):
+        evaluate_main([str(ppo_runs[CONVERGENCE]), "--episodes", "2", "--no-progress",
+                       "--processes", processes, "--out", str(tmp_path / processes)])
+    one, two = (json.loads((tmp_path / p / "evaluation.json").read_text())["episodes_detail"]
+                for p in ("1", "2"))
+    assert set(one) == {"ppo policy", "random", "zero", "heuristic"}
+    # the same code on the same seeded episodes, only in other processes: bit for bit
+    assert one == two
+
+
 def test_sac_smoke(tmp_path):
     out = tmp_path / "sac"
     proc = run_train(["--env", ITD, "--algo", "sac", "--timesteps", "256", "--n-envs", "1",
@@ -310,20 +323,6 @@ def test_existing_run_directory_needs_force(tmp_path):
     assert proc.returncode == 2
     assert "--force" in proc.stderr
     assert (out / "model.zip").read_text() == "earlier run"
-
-
-def test_demo_trains_evaluates_and_prints_the_table(tmp_path, capsys):
-    from agents.demo import main as demo_main
-
-    summaries = demo_main(["--timesteps", "256", "--episodes", "1", "--no-progress",
-                           "--out", str(tmp_path / "demo")])
-    out = capsys.readouterr().out
-    assert set(summaries) == {"ppo policy", "random", "zero", "heuristic"}
-    assert "| ppo policy |" in out and "| heuristic |" in out
-    assert (tmp_path / "demo" / "model.zip").is_file()
-    assert (tmp_path / "demo" / "evaluation.png").is_file()
-    with pytest.raises(SystemExit):
-        demo_main(["--timesteps", "0"])
 
 
 def test_learning_curve_from_progress_csv(tmp_path):

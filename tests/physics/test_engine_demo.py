@@ -1,0 +1,65 @@
+"""The engine demo (``python -m physics.demo``): a pack that the wind has
+pressed on a wall and brought to rest is held by the wall with the wind's
+force, and the figures and the command work on tiny runs."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from physics.demo import (draw, draw_transit, force_chains, main, ship_transit, wall_force,
+                          wind_force)
+
+
+def test_walls_hold_the_wind_force_once_the_pack_is_at_rest():
+    sim = force_chains(60, 0.8, 20.0, seed=1)
+    sim.advance(300.0)
+    speed = np.hypot(*sim.velocities.T)
+    # at rest: the fastest floe creeps at 1 cm/s (against ~0.7 m/s of free drift at 20 m/s)
+    assert speed.max() < 0.02
+    c = sim.contacts()
+    assert 2 * len(c) / sim.n_floes > 2.0           # jammed: chains, not scattered pairs
+    push, back = wind_force(sim), wall_force(sim)
+    assert push[0] > 0 and push[1] == 0             # the wind blows along +x
+    # a pack at rest has no net force, so the walls (the sum of all contact
+    # forces: the floe-floe ones cancel pairwise) cancel the wind; 3 %: the
+    # water drag and inertia of the floes still creeping (1.1 % measured)
+    assert abs(back[0] + push[0]) < 0.03 * push[0]
+    assert abs(back[1]) < 0.03 * push[0]
+
+
+def test_force_network_and_transit_figures_are_written(tmp_path):
+    sim = force_chains(30, 0.7, 20.0, seed=2)
+    sim.advance(2.0)
+    draw(sim, tmp_path / "chains.png", "30 floes")
+    sim = ship_transit(seed=1)
+    sim.advance(60.0)                               # the bow meets the ice at about 31 s
+    assert len(sim.ship.collisions()["floe"]) > 0
+    draw_transit(sim, tmp_path / "transit.png", "transit")
+    for name in ("chains.png", "transit.png"):
+        assert (tmp_path / name).stat().st_size > 10_000
+
+
+def test_command_prints_the_contacts_and_draws_both_figures(tmp_path, capsys):
+    assert main(["--floes", "30", "--concentration", "0.7", "--duration", "2",
+                 "--ship-duration", "2", "--no-progress", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "per floe" in out and "force balance" in out and "Ship transit" in out
+    for name in ("force_chains.png", "ship_transit.png"):
+        assert (tmp_path / name).stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--floes", "5"], ["--floes", "5"]),
+    (["--concentration", "0.95"], ["--concentration", "0.95"]),
+    (["--wind", "0"], ["--wind", "0"]),
+    (["--ship-duration", "-1"], ["--ship-duration", "-1"]),
+    (["--floes", "10", "--concentration", "0.9"], ["--floes 10 --concentration 0.9"]),
+])
+def test_bad_arguments_are_refused_with_their_value(args, words, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--out", str(tmp_path)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    for word in words:
+        assert word in err
+    assert not any(tmp_path.iterdir())
