@@ -87,8 +87,8 @@ def test_bad_arguments_are_refused_before_training(args, words, tmp_path, capsys
 
 @pytest.mark.slow
 def test_demo_budget_beats_random_and_zero_actions(tmp_path):
-    """One training seed with the demo's budget (about 2 minutes on two
-    idle cores): PPO beats random and zero actions by more than two
+    """One training seed with the demo's budget (about 3 minutes on two
+    cores): PPO beats random and zero actions by more than two
     standard errors of the paired difference (docs/agents/demo/seeds.md:
     by 8.3 and 8.7 standard errors)."""
     demo.main(["--seed", "0", "--no-progress", "--out", str(tmp_path / "run")])
