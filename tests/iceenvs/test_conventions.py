@@ -169,47 +169,41 @@ def test_unknown_keyword_lists_the_valid_ones(env_id):
         gym.make(env_id, n_flos=50)
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
-def test_unknown_option_lists_the_valid_ones(env_id):
-    env = gym.make(env_id, **SMALL[env_id])
-    try:
-        with pytest.raises(ValueError, match=r"unknown reset options \['targt'\].*valid"):
-            env.reset(seed=0, options={"targt": 0.5})
-    finally:
-        env.close()
+@pytest.fixture(params=ENV_IDS)
+def small_env(request):
+    """Each environment at its small test size, closed afterwards."""
+    env = gym.make(request.param, **SMALL[request.param])
+    yield env
+    env.close()
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
-def test_wrong_action_shape_names_the_expected_shape(env_id):
-    env = gym.make(env_id, **SMALL[env_id])
-    try:
-        env.reset(seed=0)
-        shape = env.action_space.shape
-        bad = np.zeros((shape[0] + 1, shape[0]), np.float32)
-        with pytest.raises(ValueError, match=re.escape(
-                f"an action of shape {bad.shape}; this environment takes actions of shape {shape}")):
-            env.step(bad)
-    finally:
-        env.close()
+def test_unknown_option_lists_the_valid_ones(small_env):
+    with pytest.raises(ValueError, match=r"unknown reset options \['targt'\].*valid"):
+        small_env.reset(seed=0, options={"targt": 0.5})
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
-def test_nonfinite_action_entries_are_counted_in_info(env_id):
+def test_wrong_action_shape_names_the_expected_shape(small_env):
+    small_env.reset(seed=0)
+    shape = small_env.action_space.shape
+    bad = np.zeros((shape[0] + 1, shape[0]), np.float32)
+    with pytest.raises(ValueError, match=re.escape(
+            f"an action of shape {bad.shape}; this environment takes actions of shape {shape}")):
+        small_env.step(bad)
+
+
+def test_nonfinite_action_entries_are_counted_in_info(small_env):
     """NaN is no command (0), ±inf the bound it tends to; info counts them."""
-    env = gym.make(env_id, **SMALL[env_id])
-    try:
-        env.reset(seed=0)
-        n = env.action_space.shape[0]
-        _, _, _, _, info = env.step(np.zeros(n, np.float32))
-        assert info["nonfinite_action"] == 0
-        action = np.full(n, np.inf)
-        action[0] = np.nan
-        obs, _, _, _, info = env.step(action)
-        assert info["nonfinite_action"] == n
-        expected = np.minimum(np.nan_to_num(action, nan=0.0, posinf=np.inf), env.action_space.high)
-        np.testing.assert_array_equal(env.unwrapped._last_action, expected)
-    finally:
-        env.close()
+    small_env.reset(seed=0)
+    n = small_env.action_space.shape[0]
+    _, _, _, _, info = small_env.step(np.zeros(n, np.float32))
+    assert info["nonfinite_action"] == 0
+    action = np.full(n, np.inf)
+    action[0] = np.nan
+    _, _, _, _, info = small_env.step(action)
+    assert info["nonfinite_action"] == n
+    expected = np.minimum(np.nan_to_num(action, nan=0.0, posinf=np.inf),
+                          small_env.action_space.high)
+    np.testing.assert_array_equal(small_env.unwrapped._last_action, expected)
 
 
 def test_bad_keyword_value_names_the_parameter():
