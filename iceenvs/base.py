@@ -85,8 +85,7 @@ def sanitise_action(action, space: gym.spaces.Box) -> tuple[np.ndarray, int]:
         else:
             raise ValueError(f"an action of shape {a.shape}; this environment takes actions "
                              f"of shape {space.shape} (its action_space is {space})")
-    bad = ~np.isfinite(a)
-    replaced = int(bad.sum())
+    replaced = int(np.count_nonzero(~np.isfinite(a)))
     if replaced:
         a[np.isnan(a)] = 0.0
     return np.clip(a, space.low, space.high), replaced
