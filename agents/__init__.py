@@ -13,13 +13,16 @@ Commands::
         [--env-kwargs key=value ...] [--out FILE.json]
 
 Modules: :mod:`agents.train` (training runs), :mod:`agents.evaluate`
-(policy against baselines), :mod:`agents.baselines` (random, zero and
-hand-written controllers), :mod:`agents.constant` (the best constant
-action of a grid search as a baseline), :mod:`agents.callbacks` (physics
+(policy against baselines), :mod:`agents.rollouts` (seeded episodes and
+their statistics, shared by the commands), :mod:`agents.baselines`
+(random, zero, constant and each environment's own controllers),
+:mod:`agents.constant` (the best constant action of a grid search as a
+baseline), :mod:`agents.callbacks` (physics
 metrics, progress bar), :mod:`agents.envs` (vectorised environments,
 ``--env-kwargs`` parsing and checking),
-:mod:`agents.metrics` (which physics entries each task logs) and the
-hyperparameter tables ``agents/hyperparams/{ppo,sac}.yaml``.
+:mod:`agents.metrics` (the physics entries each task logs, read from its
+facts) and the hyperparameter tables ``agents/hyperparams/{ppo,sac}.yaml``
+(a ``default`` entry, and an entry per id only where the id needs one).
 
 Importing the package imports neither torch nor stable-baselines3.
 """

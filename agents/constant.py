@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .baselines import ConstantPolicy
+from .baselines import ConstantPolicy, best_action, load_results
 
 __all__ = ["ConstantPolicy", "SEARCH_SEED", "GRID", "SEEDS", "action_grid",
            "search_constant_actions", "load_results", "best_action", "markdown_table", "build_parser", "main"]
@@ -87,7 +87,7 @@ def _init_worker(env_id: str, env_kwargs: dict, one_thread: bool) -> None:
 def _episode_return(env, action: np.ndarray, seed: int) -> float:
     """The return of one episode from ``reset(seed=seed)`` playing ``action``
     (the same episode loop as :func:`agents.evaluate.run_episode`)."""
-    from .evaluate import run_episode
+    from .rollouts import run_episode
 
     policy = ConstantPolicy(env, action=action)
     return run_episode(env, policy, int(seed), None)["ret"]
@@ -146,7 +146,7 @@ def search_constant_actions(env_id: str, *, env_kwargs: dict | None = None, grid
     from tqdm.auto import tqdm
 
     from .envs import make_checked_env
-    from .evaluate import _stats
+    from .rollouts import stats
 
     for name, value, least in (("seeds", seeds, 1), ("processes", processes, 1)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
@@ -184,7 +184,7 @@ def search_constant_actions(env_id: str, *, env_kwargs: dict | None = None, grid
 
     results = []
     for i, action in enumerate(actions):
-        s = _stats(returns[i])
+        s = stats(returns[i])
         results.append(dict(action=[float(x) for x in np.ravel(action)], mean=s["mean"],
                             std=s["std"], sem=s["sem"],
                             returns=[float(r) for r in returns[i]], seeds=episode_seeds))
@@ -221,30 +221,6 @@ def _run_in_workers(env_id: str, env_kwargs: dict, tasks: list, returns: np.ndar
             for future in futures:
                 future.cancel()
             raise
-
-
-# -- results -------------------------------------------------------------------------------------
-def load_results(path: str | Path) -> dict:
-    """The JSON report of ``python -m agents.constant`` (``env``,
-    ``env_kwargs``, ``grid``, ``seeds``, ``results``, …)."""
-    with open(path) as fh:
-        report = json.load(fh)
-    if not isinstance(report, dict) or not report.get("results"):
-        raise ValueError(f"{path} holds no constant-action results")
-    return report
-
-
-def best_action(results) -> list[float]:
-    """The action of the first (best) result: ``results`` is the list of
-    :func:`search_constant_actions`, a report of :func:`load_results` or the
-    path of such a report."""
-    if isinstance(results, (str, Path)):
-        results = load_results(results)
-    if isinstance(results, dict):
-        results = results.get("results")
-    if not results:
-        raise ValueError("no constant-action results")
-    return list(results[0]["action"])
 
 
 def format_action(action) -> str:

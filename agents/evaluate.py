@@ -34,197 +34,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from .metrics import MAIN_METRIC, env_name, physics_metrics
+from iceenvs.facts import env_facts
+
+from .metrics import env_name
+from .rollouts import (TrainedPolicy, compare, evaluate, evaluate_in_processes, rounded,
+                       run_episode, summarise)
 
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
            "compare", "markdown_table", "plot_trajectories", "main"]
-
-
-class TrainedPolicy:
-    """A saved SB3 model with the ``predict`` interface of the baselines,
-    normalising raw observations with the run's frozen statistics.
-
-    Parameters
-    ----------
-    run_dir : path
-        A run directory of :mod:`agents.train`.
-    """
-
-    def __init__(self, run_dir: str | Path):
-        from .envs import load_normalization
-        from .train import algo_class
-
-        run_dir = Path(run_dir)
-        with open(run_dir / "args.yaml") as fh:
-            self.args = yaml.safe_load(fh)
-        with open(run_dir / "hyperparams.yaml") as fh:
-            self.hyperparams = yaml.safe_load(fh)
-        self.env_id = self.args["env"]
-        self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
-        self.model = algo_class(self.args["algo"]).load(run_dir / "model.zip", device="cpu")
-        self.normalization = load_normalization(run_dir / "vecnormalize.pkl", self.env_id,
-                                                self.env_kwargs)
-
-    def reset(self, seed: int | None = None) -> None:
-        """Nothing to reset: the policy is memoryless."""
-
-    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
-        obs = np.asarray(obs, dtype=np.float32)
-        if self.normalization is not None:
-            obs = self.normalization.normalize_obs(obs).astype(np.float32)
-        return self.model.predict(obs, deterministic=deterministic)
-
-
-def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
-    """One episode from ``reset(seed=seed)``: return, length, final physics
-    metrics and the per-step rewards and main metric."""
-    obs, info = env.reset(seed=seed)
-    policy.reset(seed)
-    rewards, trace = [], []
-    final = physics_metrics(env.spec.id, info)
-    while True:
-        action, _ = policy.predict(obs, deterministic=True)
-        obs, reward, terminated, truncated, info = env.step(action)
-        rewards.append(float(reward))
-        metrics = physics_metrics(env.spec.id, info)
-        final = metrics or final
-        trace.append(metrics.get(main_metric, math.nan) if main_metric else math.nan)
-        if terminated or truncated:
-            break
-    return dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
-                terminated=bool(terminated), final=final, rewards=rewards, trace=trace)
-
-
-def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = True) -> dict:
-    """Run every policy of ``{name: policy}`` in ``env`` on episodes seeded
-    ``seed, seed + 1, …``; returns ``{name: [episode dicts]}``.
-
-    The baselines must have been made for this very ``env``
-    (:func:`agents.baselines.make_baseline`): the model-based controllers
-    read its state."""
-    from tqdm.auto import tqdm
-
-    main_metric = MAIN_METRIC.get(env_name(env.spec.id))
-    results = {}
-    with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
-              disable=not progress) as bar:
-        for name, policy in policies.items():
-            results[name] = []
-            for k in range(episodes):
-                results[name].append(run_episode(env, policy, seed + k, main_metric))
-                bar.update()
-    return results
-
-
-#: the environment and the policies of a worker of :func:`evaluate_in_processes`
-_WORKER: dict = {}
-
-
-def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
-                    episode_seed: int) -> dict:
-    """One episode in a worker process: the worker builds its environment
-    once (``reset(seed=env_seed)``, as the evaluation's main process does)
-    and each policy once from its recipe, then runs
-    :func:`run_episode`."""
-    from .baselines import make_baseline
-    from .envs import make_checked_env
-
-    key = (env_id, repr(sorted(env_kwargs.items())), env_seed)
-    if _WORKER.get("key") != key:
-        import torch
-
-        torch.set_num_threads(1)
-        if "env" in _WORKER:
-            _WORKER["env"].close()
-        _WORKER.clear()
-        _WORKER.update(key=key, env=make_checked_env(env_id, env_kwargs, seed=env_seed))
-    env = _WORKER["env"]
-    if name not in _WORKER:
-        kind, target, kwargs = recipe
-        _WORKER[name] = (TrainedPolicy(target) if kind == "trained" else
-                         make_baseline(target, env, seed=env_seed, **kwargs))
-    return run_episode(env, _WORKER[name], episode_seed, MAIN_METRIC.get(env_name(env_id)))
-
-
-def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
-                          seed: int, processes: int, progress: bool = True) -> dict:
-    """:func:`evaluate` with the episodes shared among ``processes`` worker
-    processes; the same results, since every episode starts from
-    ``reset(seed=seed + k)`` and the policies are deterministic or, like
-    the random baseline, re-seeded with each episode.
-
-    ``recipes`` maps a policy name to ``("trained", run_dir, {})`` or
-    ``("baseline", baseline_name, constructor_kwargs)``; every worker builds
-    its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
-    reset with ``seed``) and policies from them."""
-    import concurrent.futures
-    import multiprocessing
-
-    from tqdm.auto import tqdm
-
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    results = {name: [None] * episodes for name in recipes}
-    with concurrent.futures.ProcessPoolExecutor(
-            processes, mp_context=multiprocessing.get_context(method)) as pool, \
-            tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
-                 disable=not progress) as bar:
-        jobs = {pool.submit(_worker_episode, env_id, env_kwargs, seed, name, recipe, seed + k):
-                (name, k) for name, recipe in recipes.items() for k in range(episodes)}
-        for job in concurrent.futures.as_completed(jobs):
-            name, k = jobs[job]
-            results[name][k] = job.result()
-            bar.update()
-    return results
-
-
-def _rounded(values, digits: int = 6) -> list:
-    """Floats to ``digits`` significant digits (the per-step series of the
-    JSON report)."""
-    return [float(f"{v:.{digits}g}") for v in values]
-
-
-def _stats(values) -> dict:
-    x = np.asarray(values, dtype=float)
-    n = x.size
-    std = float(np.std(x, ddof=1)) if n > 1 else 0.0
-    return dict(mean=float(np.mean(x)), std=std, sem=std / math.sqrt(n), n=int(n))
-
-
-def summarise(episodes: list[dict]) -> dict:
-    """Mean, std (ddof 1) and standard error of the return, the length and
-    every final physics metric over episodes."""
-    out = {"return": _stats([e["ret"] for e in episodes]),
-           "length": _stats([e["length"] for e in episodes])}
-    for key in episodes[0]["final"]:
-        out[key] = _stats([e["final"].get(key, math.nan) for e in episodes])
-    return out
-
-
-def compare(policy: list[dict], baseline: list[dict], metric: str | None = None,
-            lower_is_better: bool = False) -> dict:
-    """Paired comparison on the same seeds of the returns (or of the final
-    physics ``metric``): mean difference (policy − baseline), its standard
-    error and whether the policy is better by more than two standard
-    errors (higher, or lower with ``lower_is_better``)."""
-    def value(e):
-        return e["ret"] if metric is None else e["final"].get(metric, math.nan)
-
-    d = np.array([value(p) - value(b) for p, b in zip(policy, baseline)])
-    s = _stats(d)
-    gain = -s["mean"] if lower_is_better else s["mean"]
-    return dict(diff=s["mean"], sem=s["sem"], beats=bool(gain > 2.0 * s["sem"] and gain > 0))
-
-
-#: per env name: a final metric compared like the return, and whether lower is better
-COMPARED_METRIC = {"ShipNavigation-v0": ("impulse_per_metre", True),
-                   "ShipBeset-v0": ("impulse_per_metre", True)}
 
 
 def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
@@ -252,7 +74,7 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
             lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
                          f"{'yes' if c['beats'] else 'no'} |")
     if metric_comparisons:
-        metric, lower = COMPARED_METRIC[env_id.split("/")[-1]]
+        metric, lower = env_facts(env_id).compared_metric
         lines += ["", f"Final `{metric}` of the policy minus the baseline's, paired by seed "
                   f"({'lower' if lower else 'higher'} is better):", "",
                   "| baseline | difference | better by > 2 standard errors |", "|---|---|---|"]
@@ -268,7 +90,7 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
     from physics.scenarios import plots
 
     plt = plots.pyplot()
-    metric = MAIN_METRIC.get(env_name(env_id), "")
+    metric = env_facts(env_id).main_metric
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for k, (name, episodes) in enumerate(results.items()):
         colour = f"C{k}"
@@ -291,7 +113,7 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
 
 
 def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentParser:
-    from .baselines import BASELINES
+    from .baselines import GENERIC
 
     p = argparse.ArgumentParser(prog=prog,
                                 description="Compare a trained policy with baselines.")
@@ -300,8 +122,9 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p.add_argument("--seed", type=int, default=10_000,
                    help="episode k is seeded SEED + k (default 10000, away from training)")
     p.add_argument("--baselines", default="random,zero,heuristic",
-                   help="comma-separated baselines to compare with ('' for none); valid: "
-                        + ", ".join(BASELINES))
+                   help="comma-separated baselines to compare with ('' for none): "
+                        + ", ".join(GENERIC) + " and the environment's own controllers "
+                        "(heuristic, and straight, reactive for the ship environments)")
     p.add_argument("--baseline", help="evaluate this baseline alone (with --env)")
     p.add_argument("--env", help="environment id for --baseline")
     p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
@@ -334,8 +157,8 @@ def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, e
     the best result of ``--constant FILE.json``, or of a search run now
     with the defaults of :func:`agents.constant.search_constant_actions`
     on seeds apart from the evaluation episodes."""
-    from .constant import (GRID, SEARCH_SEED, SEEDS, best_action, format_action, load_results,
-                           search_constant_actions)
+    from .baselines import best_action, load_results
+    from .constant import GRID, SEARCH_SEED, SEEDS, format_action, search_constant_actions
 
     evaluated = (args.seed, args.episodes)
     if args.constant is not None:
@@ -375,10 +198,10 @@ def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, e
 def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate") -> dict:
     """Command-line entry point (``prog``: the command's name in the help);
     returns the summaries per policy."""
-    from iceenvs import ENV_IDS
+    from iceenvs.facts import registered_ids
 
-    from .baselines import BASELINES, make_baseline
-    from .constant import ConstantPolicy, format_action
+    from .baselines import ConstantPolicy, baseline_names, make_baseline
+    from .constant import format_action
     from .envs import make_checked_env, parse_key_values
 
     parser = build_parser(prog)
@@ -392,9 +215,6 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         names = [args.baseline]
     elif args.constant is not None and "constant" not in names:
         names.append("constant")
-    unknown = [n for n in names if n not in BASELINES]
-    if unknown:
-        parser.error(f"unknown baselines {unknown}; valid baselines: {', '.join(BASELINES)}")
     if args.constant is not None and "constant" not in names:
         parser.error(f"--constant is for the baseline 'constant', not {args.baseline!r}")
 
@@ -403,8 +223,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     if args.baseline is not None:
         if args.run_dir is not None:
             parser.error("give either RUN_DIR or --baseline, not both")
-        if args.env not in ENV_IDS:
-            parser.error(f"--baseline needs --env, one of: {', '.join(ENV_IDS)}")
+        if args.env not in registered_ids(args.env.split("/")[0] if args.env else "iceenvs"):
+            parser.error(f"--baseline needs --env, one of: {', '.join(registered_ids())}")
         env_id, base_kwargs = args.env, {}
         out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{args.baseline}"
     else:
@@ -416,6 +236,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         env_id, base_kwargs = trained.env_id, trained.env_kwargs
         policies[f"{trained.args['algo']} policy"] = trained
         out = args.out or args.run_dir
+    valid = baseline_names(env_id)
+    unknown = [n for n in names if n not in valid]
+    if unknown:
+        parser.error(f"unknown baselines {unknown} for {env_id}; valid baselines: "
+                     f"{', '.join(valid)}")
     try:
         env_kwargs = parse_key_values(args.env_kwargs, into=base_kwargs)
         env = make_checked_env(env_id, env_kwargs, seed=args.seed)
@@ -463,8 +288,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     if args.baseline is None:
         first = next(iter(results))
         comparisons = {n: compare(results[first], results[n]) for n in names}
-        if env_name(env_id) in COMPARED_METRIC:
-            metric, lower = COMPARED_METRIC[env_name(env_id)]
+        if env_facts(env_id).compared_metric is not None:
+            metric, lower = env_facts(env_id).compared_metric
             metric_comparisons = {n: compare(results[first], results[n], metric, lower)
                                   for n in names}
     table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels,
@@ -475,11 +300,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
                   metric_comparisons=metric_comparisons,
-                  main_metric=MAIN_METRIC.get(env_name(env_id)),
+                  main_metric=env_facts(env_id).main_metric,
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
                                             terminated=e["terminated"], final=e["final"],
-                                            rewards=_rounded(e["rewards"]),
-                                            trace=_rounded(e["trace"]))
+                                            rewards=rounded(e["rewards"]),
+                                            trace=rounded(e["trace"]))
                                        for e in eps] for n, eps in results.items()})
     with open(out / "evaluation.json", "w") as fh:
         json.dump(report, fh)

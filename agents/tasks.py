@@ -46,8 +46,9 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
     import iceenvs  # noqa: F401
 
     from .baselines import ConstantPolicy, make_baseline
-    from .constant import load_results, search_constant_actions
-    from .evaluate import compare, evaluate, summarise
+    from .baselines import load_results
+    from .constant import search_constant_actions
+    from .rollouts import compare, evaluate, summarise
     from .metrics import env_name
 
     path = out / f"constant_{env_name(env_id)}.json"

@@ -4,13 +4,15 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from physics import DeformingPeriodicBox, HERMAN2013
+from physics import HERMAN2013, DeformingPeriodicBox
 
 from .base import HertzEnv, TaskParameter, interval, number, task_table
-from .observations import FLOE_FEATURES, Feature, feature_table
+from .controllers import FloeController
+from .facts import EnvFacts
+from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import convergence_reward
 
-__all__ = ["ConvergenceEnv", "MAX_START"]
+__all__ = ["ConvergenceEnv", "ConvergenceController", "MAX_START"]
 
 MAX_EPISODE_STEPS = 150
 #: random placement of this floe-size distribution jams near 0.86
@@ -37,6 +39,32 @@ _TASK = (
     TaskParameter("failure_pressure", 1e5, "pressure [N/m] at which the ice breaks (the "
                   "episode terminates)", number(0.0, None, low_open=True)),
 )
+
+
+class ConvergenceController(FloeController):
+    """Proportional control of the concentration with a pressure limit.
+
+    The convergence rate is ``-gain`` × the observed error (A − A*)/0.1,
+    clipped to the action bounds: full convergence far below the target,
+    slowing down within 0.1/gain of it, divergence above it. As the ice
+    approaches jamming the pressure rises steeply; between half of the
+    task's ``pressure_max`` and ``pressure_max`` the convergence rate is
+    scaled down linearly in log pressure to 0, and above ``pressure_max``
+    the box diverges slowly (−0.2) to relieve the pressure.
+    """
+
+    gain = 20.0
+
+    def act(self, obs):
+        rate = float(np.clip(-self.gain * self._get(obs, "error"), -1.0, 1.0))
+        p = self._get(obs, "pressure")
+        p_max = log_stress(self.reward_params["pressure_max"])
+        p_soft = log_stress(0.5 * self.reward_params["pressure_max"])
+        if p > p_max:
+            rate = -0.2
+        elif p > p_soft and rate > 0:
+            rate *= (p_max - p) / (p_max - p_soft)
+        return np.array([rate])
 
 
 class ConvergenceEnv(HertzEnv):
@@ -119,6 +147,14 @@ class ConvergenceEnv(HertzEnv):
     reward_task_keys = ("target",)
     drawn = ("concentration", "target")
     reward_fn = staticmethod(convergence_reward)
+    facts = EnvFacts(
+        summary="compress ice to a target concentration",
+        metrics={"concentration": "concentration", "target": "target", "pressure": "pressure",
+                 "z_c": "Z_c", "f_nr": "non_rattler_fraction",
+                 "largest_cluster": "largest_cluster_fraction"},
+        main_metric="concentration",
+        controllers={"heuristic": ConvergenceController},
+        small={"n_floes": 60})
     impact_speed = 0.5
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 2.0,

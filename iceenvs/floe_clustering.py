@@ -7,10 +7,12 @@ import numpy as np
 from physics import HERMAN2011, find_clusters
 
 from .base import MAX_WIND, FloeEnv, TaskParameter, interval, number, task_table
+from .controllers import FloeController
+from .facts import EnvFacts
 from .observations import FLOE_FEATURES, Feature, feature_table, floe_physics
 from .rewards import floe_clustering_reward
 
-__all__ = ["FloeClusteringEnv"]
+__all__ = ["FloeClusteringEnv", "FloeClusteringController"]
 
 MAX_EPISODE_STEPS = 400
 
@@ -30,6 +32,33 @@ _TASK = (
     TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] per component at |action| = 1",
                   number(0.0, 100.0, low_open=True)),
 )
+
+
+class FloeClusteringController(FloeController):
+    """Steady wind to build clusters, alternating wind to break them.
+
+    Below the target largest-cluster fraction the wind blows steadily
+    along +x with a strength proportional to the deficit (full at a
+    deficit of 0.2, at least 0.2): under Stokes drag floes of different
+    sizes drift at different speeds, collide and gather. Above the target
+    the wind reverses direction every step with a strength proportional to
+    the excess, which shears the clusters apart; within ±0.02 of the
+    target the wind is off.
+    """
+
+    _sign = 1.0        # direction of the last alternating wind
+
+    def reset(self, seed=None):
+        self._sign = 1.0
+
+    def act(self, obs):
+        error = self._get(obs, "target") - self._get(obs, "largest_cluster")
+        if error > 0.02:
+            return np.array([float(np.clip(error / 0.2, 0.2, 1.0)), 0.0])
+        if error < -0.02:
+            self._sign = -self._sign
+            return np.array([self._sign * float(np.clip(-error / 0.2, 0.2, 1.0)), 0.0])
+        return np.zeros(2)
 
 
 class FloeClusteringEnv(FloeEnv):
@@ -110,6 +139,15 @@ class FloeClusteringEnv(FloeEnv):
     reward_task_keys = ("target",)
     drawn = ("target",)
     reward_fn = staticmethod(floe_clustering_reward)
+    facts = EnvFacts(
+        summary="herd hard-disc floes into clusters",
+        metrics={"largest_cluster": "largest_cluster_fraction", "target": "target",
+                 "clusters_per_floe": "clusters_per_floe", "cluster_alpha": "cluster_alpha",
+                 "collision_rate": "collision_rate", "pressure": "pressure"},
+        main_metric="largest_cluster_fraction",
+        controllers={"heuristic": FloeClusteringController},
+        # the box must hold the largest floe of the power-law size distribution
+        small={"n_floes": 150})
 
     def __init__(self, n_floes: int = 300, preset=HERMAN2011, control_interval: float = 5.0,
                  cluster_gap: float = 0.1, **kwargs):

@@ -7,13 +7,15 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics import ChannelBox, FloeField, HERMAN2013
+from physics import HERMAN2013, ChannelBox, FloeField
 
 from .base import MAX_WIND, HertzEnv, TaskParameter, interval, number, task_table
-from .observations import FLOE_FEATURES, Feature, feature_table
+from .controllers import FloeController
+from .facts import EnvFacts
+from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import marginal_ice_zone_reward
 
-__all__ = ["MarginalIceZoneEnv"]
+__all__ = ["MarginalIceZoneEnv", "MarginalIceZoneController"]
 
 MAX_EPISODE_STEPS = 200
 
@@ -38,6 +40,45 @@ _TASK = (
     TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] at action[0] = +1",
                   number(0.0, 100.0, low_open=True)),
 )
+
+
+class MarginalIceZoneController(FloeController):
+    """Feed-forward and integral control of the wind speed towards the
+    target transport, with the wind turned away from the fast ice as the
+    edge stress rises.
+
+    The transport grows with the wind speed: 20 m/s of wind along the edge
+    gives about 0.1 m/s. The speed command (action[0]) therefore starts at
+    the wind that would give the target on that estimate, −1 + 2 u* /
+    0.1 m/s, and is then integrated from the observed transport error:
+    each step it changes by ``gain`` × (u* − u_x) / 0.05 m/s, within
+    [−1, 1]. With Coriolis the drift turns to the right of the wind,
+    i.e. towards the fast-ice edge for wind along +x; as the edge stress
+    rises from a quarter of the task's ``edge_stress_max`` to
+    ``edge_stress_max`` (in log stress) the wind is turned left, away from
+    the edge, by up to ``extra`` × π (36°), so that the ice is not pressed
+    onto the edge.
+    """
+
+    base = 0.0
+    extra = 0.2
+    gain = 0.4
+    _speed = None      # the current speed command (None: not yet set this episode)
+
+    def reset(self, seed=None):
+        self._speed = None
+
+    def act(self, obs):
+        target = self._get(obs, "target_speed")
+        if self._speed is None:
+            self._speed = float(np.clip(-1.0 + 2.0 * target / 0.1, -1.0, 1.0))
+        error = (target - self._get(obs, "u_x")) / 0.05
+        self._speed = float(np.clip(self._speed + self.gain * error, -1.0, 1.0))
+        s = self._get(obs, "edge_stress")
+        s_max = log_stress(self.reward_params["edge_stress_max"])
+        s_low = log_stress(0.25 * self.reward_params["edge_stress_max"])
+        load = float(np.clip((s - s_low) / (s_max - s_low), 0.0, 1.0))
+        return np.array([self._speed, self.base + self.extra * load])
 
 
 class MarginalIceZoneEnv(HertzEnv):
@@ -123,6 +164,14 @@ class MarginalIceZoneEnv(HertzEnv):
     reward_task_keys = ("target_speed",)
     drawn = ("target_speed",)
     reward_fn = staticmethod(marginal_ice_zone_reward)
+    facts = EnvFacts(
+        summary="transport ice along a fast-ice edge",
+        metrics={"u_x": "u_x", "target_speed": "target_speed", "edge_stress": "edge_stress",
+                 "edge_u_x": "edge_u_x", "pressure": "pressure", "z_c": "Z_c",
+                 "largest_cluster": "largest_cluster_fraction"},
+        main_metric="u_x",
+        controllers={"heuristic": MarginalIceZoneController},
+        small={"n_floes": 60})
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
                  colour_scale: float = 0.2, **kwargs):

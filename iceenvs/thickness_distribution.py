@@ -2,6 +2,7 @@
 at a target through the seasonal cycle."""
 from __future__ import annotations
 
+import copy
 import math
 
 import gymnasium as gym
@@ -11,10 +12,12 @@ from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
 from physics.params import GODLOVITCH, check_range
 
 from .base import ControlEnv, TaskParameter
+from .controllers import Controller
+from .facts import EnvFacts
 from .rewards import closeness, thickness_distribution_reward, wasserstein1
 
-__all__ = ["ThicknessDistributionEnv", "default_target", "RAFT_MAX", "RAFT_CUTOFF",
-           "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
+__all__ = ["ThicknessDistributionEnv", "ThicknessDistributionController", "default_target",
+           "RAFT_MAX", "RAFT_CUTOFF", "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
 
 RAFT_MAX = 2.0 * GODLOVITCH.raft_factor   # rafting factor at action[1] = +1 (1 at −1)
 RAFT_CUTOFF = 0.5                # m: rafting acts where both floes are thinner than this
@@ -90,6 +93,66 @@ _TABLE_ROWS = "\n".join(
     f"    | {1 + j} | `g_{1 + j}` | ice of {j * COARSE_WIDTH:g} m <= h < "
     f"{(j + 1) * COARSE_WIDTH:g} m | area fraction | [0, 1] |"
     for j in range(N_COARSE - 1))
+
+
+class ThicknessDistributionController(Controller):
+    """Receding-horizon choice of the kernel scale: the redistribution
+    strength that keeps g(h) closest to the target over the next
+    ``horizon`` steps.
+
+    Every ``replan`` steps, each redistribution action in ``levels``
+    (kernel scale 10**a: 0.1× … 10×) is tried on a copy of the
+    environment's thickness model, held for ``horizon`` steps of the
+    environment's ``days_per_step``, and the one with the smallest sum of
+    the Wasserstein-1 distances to the target along the way (the negative
+    of the rewards it would earn) is taken and held until the next
+    choice (ties: the first, i.e. the weakest). The sum, not the distance
+    at the end of the horizon, is what matters: the seasonal cycle moves
+    g(h) away from the target whatever the action, and a greedy end-point
+    rule does no better than the zero action. This is a model-based
+    controller: it reads the model state and the target from the
+    environment (``env.unwrapped``), not only the observation, which is
+    why it is a yardstick a learned policy must approach from
+    observations alone. Rafting consumes ice thinner than 0.5 m, so it is
+    full (+1) when the observed fraction of ice below 0.5 m exceeds the
+    target's and off (−1) otherwise.
+    """
+
+    levels = (-1.0, -0.5, 0.0, 0.5, 1.0)
+    horizon = 60
+    replan = 10
+    _step = 0          # steps of the episode so far
+    _choice = 0.0      # the redistribution action held until the next plan
+
+    def reset(self, seed=None):
+        self._step = 0
+        self._choice = 0.0
+
+    def _cost(self, model, target, h, redistribution: float, rafting: float) -> float:
+        env = self.env.unwrapped
+        trial = copy.deepcopy(model)
+        trial.kernel_scale = 10.0 ** redistribution
+        factor = 1.0 + (RAFT_MAX - 1.0) * (rafting + 1.0) * 0.5
+        if factor != trial.rafting_factor:
+            trial.set_rafting(factor, RAFT_CUTOFF)
+        total = 0.0
+        for _ in range(self.horizon):
+            trial.step(env.days_per_step)
+            total += wasserstein1(trial.g, target, h)
+        return total
+
+    def act(self, obs):
+        env = self.env.unwrapped
+        target = env.target
+        rafting = 1.0 if float(obs[1]) > float(env.coarse(target)[1]) else -1.0
+        step = self._step
+        self._step = step + 1
+        if env.model is None:
+            return np.array([0.0, rafting])
+        if step % self.replan == 0:
+            cost = [self._cost(env.model, target, env.h, a, rafting) for a in self.levels]
+            self._choice = self.levels[int(np.argmin(cost))]
+        return np.array([self._choice, rafting])
 
 
 class ThicknessDistributionEnv(ControlEnv):
@@ -215,6 +278,14 @@ class ThicknessDistributionEnv(ControlEnv):
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("redistribution", "rafting")
     reward_fn = staticmethod(thickness_distribution_reward)
+    facts = EnvFacts(
+        summary="steer the ice thickness distribution",
+        metrics={"w1": "wasserstein1", "open_water": "open_water",
+                 "mean_thickness": "mean_thickness", "kernel_scale": "kernel_scale",
+                 "rafting_factor": "rafting_factor"},
+        main_metric="wasserstein1",
+        controllers={"heuristic": ThicknessDistributionController},
+        small={"n_classes": 60})
     task_parameters = _TASK
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,

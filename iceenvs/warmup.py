@@ -28,15 +28,6 @@ import time
 import traceback
 from typing import Callable
 
-# small instances: the kernels' types do not depend on the sizes
-ENV_KWARGS = {
-    "FloeClustering-v0": dict(n_floes=150),
-    "ThicknessDistribution-v0": dict(n_classes=60),
-    "ShipNavigation-v0": dict(concentration=0.3),
-    "ShipBeset-v0": dict(concentration=0.6),
-}
-FLOE_ENV_KWARGS = dict(n_floes=60)
-
 
 class _CompileCounter:
     """Counts the compilations of the package's cached kernels (top level
@@ -78,13 +69,16 @@ def random_steps(env, steps: int) -> None:
 
 
 def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
-    """Make ``env_id`` small, reset it and take ``steps`` random actions
-    (resetting when an episode ends). Falls back to the default constructor
-    if the small-instance arguments are not accepted."""
+    """Make ``env_id`` at the small size of its facts
+    (:attr:`iceenvs.facts.EnvFacts.small`: the kernels' types do not depend
+    on the sizes), reset it and take ``steps`` random actions (resetting
+    when an episode ends). Falls back to the default constructor if the
+    small-instance arguments are not accepted."""
     import gymnasium as gym
 
-    name = env_id.split("/")[-1]
-    kwargs = ENV_KWARGS.get(name, FLOE_ENV_KWARGS)
+    from .facts import env_facts
+
+    kwargs = dict(env_facts(env_id).small)
     note = ""
     try:
         env = gym.make(env_id, **kwargs)

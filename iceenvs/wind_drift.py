@@ -9,10 +9,12 @@ import numpy as np
 from physics import HERMAN2013
 
 from .base import MAX_WIND, HertzEnv, TaskParameter, number, task_table
-from .observations import FLOE_FEATURES, Feature, feature_table
+from .controllers import FloeController
+from .facts import EnvFacts
+from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import wind_drift_reward
 
-__all__ = ["WindDriftEnv"]
+__all__ = ["WindDriftEnv", "WindDriftController"]
 
 MAX_EPISODE_STEPS = 200
 
@@ -34,6 +36,43 @@ _TASK = (
     TaskParameter("max_wind", MAX_WIND, "wind speed [m/s] per component at |action| = 1",
                   number(0.0, 100.0, low_open=True)),
 )
+
+
+class WindDriftController(FloeController):
+    """Blow along the target heading, corrected for the turning of the drift.
+
+    The wind points along the heading (read from the observation), turned
+    to the left by an angle ``turn`` and scaled so that its largest
+    component is 1 (the strongest wind the action box allows in that
+    direction; the drift speed grows with the wind, the action cost of
+    0.01 |a|² is small against it). Coriolis turns the drift to the right
+    of the wind, so ``turn`` is adapted from the measured drift: each step
+    it changes by ``-gain`` × the angle of the mean ice velocity from the
+    heading (once the ice moves faster than 1 cm/s), within ±45°. When the
+    pressure passes the task's ``pressure_max`` the wind is halved, because
+    the reward penalises the excess.
+    """
+
+    gain = 0.3
+    max_turn = math.pi / 4
+    turn = 0.0         # the current turn of the wind from the heading
+
+    def reset(self, seed=None):
+        self.turn = 0.0
+
+    def act(self, obs):
+        hx, hy = self._get(obs, "heading_cos"), self._get(obs, "heading_sin")
+        ux, uy = self._get(obs, "u_x"), self._get(obs, "u_y")
+        if math.hypot(ux, uy) > 0.01:
+            error = math.atan2(hx * uy - hy * ux, hx * ux + hy * uy)   # drift left of heading > 0
+            self.turn = float(np.clip(self.turn - self.gain * error, -self.max_turn,
+                                      self.max_turn))
+        heading = math.atan2(hy, hx) + self.turn
+        wind = np.array([math.cos(heading), math.sin(heading)])
+        wind /= np.max(np.abs(wind))
+        if self._get(obs, "pressure") > log_stress(self.reward_params["pressure_max"]):
+            wind *= 0.5
+        return wind
 
 
 class WindDriftEnv(HertzEnv):
@@ -122,6 +161,14 @@ class WindDriftEnv(HertzEnv):
     task_parameters = _TASK
     reward_task_keys = ("heading",)
     reward_fn = staticmethod(wind_drift_reward)
+    facts = EnvFacts(
+        summary="move ice along a heading with the wind",
+        metrics={"u_heading": "u_heading", "u_x": "u_x", "u_y": "u_y", "pressure": "pressure",
+                 "z_c": "Z_c", "largest_cluster": "largest_cluster_fraction",
+                 "temperature": "granular_temperature"},
+        main_metric="u_heading",
+        controllers={"heuristic": WindDriftController},
+        small={"n_floes": 60})
 
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
                  **kwargs):

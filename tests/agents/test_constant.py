@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import iceenvs  # noqa: F401
-from agents.baselines import BASELINES, make_baseline
+from agents.baselines import GENERIC, make_baseline
 from agents.constant import (ConstantPolicy, action_grid, best_action, main as constant_main,
                              search_constant_actions)
 
@@ -46,7 +46,7 @@ def test_constant_policy_rejects_bad_actions(env, action):
 
 
 def test_constant_is_a_registered_baseline(env):
-    assert BASELINES["constant"] is ConstantPolicy
+    assert GENERIC["constant"] is ConstantPolicy
     policy = make_baseline("constant", env, seed=3)      # the centre of the box
     np.testing.assert_array_equal(policy.action, [0.0, 0.0])
     assert ConstantPolicy.best(env, [{"action": [1.0, -1.0]}]).action.tolist() == [1.0, -1.0]

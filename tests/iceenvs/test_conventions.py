@@ -11,6 +11,7 @@ import pytest
 
 from iceenvs import ENV_IDS, convergence, floe_clustering, marginal_ice_zone
 from iceenvs.base import REWARD_RANGE
+from small_envs import SMALL
 
 WIND = "iceenvs/WindDrift-v0"
 CONVERGENCE = "iceenvs/Convergence-v0"
@@ -19,10 +20,6 @@ CLUSTERING = "iceenvs/FloeClustering-v0"
 ITD = "iceenvs/ThicknessDistribution-v0"
 NAV = "iceenvs/ShipNavigation-v0"
 BESET = "iceenvs/ShipBeset-v0"
-
-SMALL = {WIND: dict(n_floes=60), CONVERGENCE: dict(n_floes=60), MIZ: dict(n_floes=60),
-         CLUSTERING: dict(n_floes=150), ITD: dict(n_classes=60), NAV: dict(concentration=0.3),
-         BESET: dict(concentration=0.6)}
 
 #: per env: a task parameter, a value for the constructor, another for one
 #: episode, and the observation entry that shows it

@@ -16,6 +16,7 @@ import pytest
 
 import iceenvs
 from iceenvs import ENV_IDS
+from small_envs import SMALL
 
 WIND = "iceenvs/WindDrift-v0"
 CONVERGENCE = "iceenvs/Convergence-v0"
@@ -26,18 +27,6 @@ NAV = "iceenvs/ShipNavigation-v0"
 BESET = "iceenvs/ShipBeset-v0"
 
 FLOE_IDS = (WIND, CONVERGENCE, MIZ, CLUSTERING)
-
-# small instances; FloeClustering needs ~150 floes for its box to hold the
-# largest floe of the power-law size distribution
-SMALL = {
-    WIND: dict(n_floes=60),
-    CONVERGENCE: dict(n_floes=60),
-    MIZ: dict(n_floes=60),
-    CLUSTERING: dict(n_floes=150),
-    ITD: dict(n_classes=60),
-    NAV: dict(concentration=0.3),
-    BESET: dict(concentration=0.6),
-}
 
 # kwargs that end an episode after 3 steps (Gymnasium's TimeLimit)
 THREE_STEPS = {env_id: dict(max_episode_steps=3) for env_id in SMALL}

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 import iceenvs  # noqa: F401  (registers the ids)
 from iceenvs.base import REWARD_RANGE
+from small_envs import SMALL as ALL_SMALL
 
 WIND = "iceenvs/WindDrift-v0"
 CONVERGENCE = "iceenvs/Convergence-v0"
@@ -22,12 +23,7 @@ MIZ = "iceenvs/MarginalIceZone-v0"
 CLUSTERING = "iceenvs/FloeClustering-v0"
 ITD = "iceenvs/ThicknessDistribution-v0"
 
-SMALL = {
-    WIND: dict(n_floes=60),
-    CONVERGENCE: dict(n_floes=60),
-    MIZ: dict(n_floes=60),
-    CLUSTERING: dict(n_floes=150),
-}
+SMALL = {env_id: ALL_SMALL[env_id] for env_id in (WIND, CONVERGENCE, MIZ, CLUSTERING)}
 
 ENVS = {env_id: gym.make(env_id, **kwargs).unwrapped for env_id, kwargs in SMALL.items()}
 

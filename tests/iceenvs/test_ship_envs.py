@@ -10,7 +10,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import iceenvs  # noqa: F401  (registers the ids)
-from agents.metrics import EPISODE_METRICS, physics_metrics
+from agents.metrics import physics_metrics
+from iceenvs.facts import env_facts
 from iceenvs.ship_env import METRICS
 
 NAV = "iceenvs/ShipNavigation-v0"
@@ -20,7 +21,7 @@ BESET = "iceenvs/ShipBeset-v0"
 def _straight(env, obs, steps=400):
     """Sail the straight-line baseline from ``obs`` to the end of the
     episode; returns the rewards, the last info and whether it terminated."""
-    from agents.baselines import StraightLinePolicy
+    from iceenvs.ship_controllers import StraightLinePolicy
 
     policy = StraightLinePolicy(env)
     rewards = []
@@ -89,7 +90,7 @@ def test_collision_impulses_are_bounded_by_the_contact_impulses():
         obs, _ = env.reset(seed=3)
         u = env.unwrapped
         resultant = contact = 0.0
-        from agents.baselines import StraightLinePolicy
+        from iceenvs.ship_controllers import StraightLinePolicy
 
         policy = StraightLinePolicy(env)
         while True:
@@ -124,7 +125,7 @@ def test_episode_metrics_are_the_ones_agents_log():
     finally:
         env.close()
     logged = physics_metrics(NAV, info)
-    assert set(EPISODE_METRICS["ShipNavigation-v0"]) <= set(logged)
+    assert set(env_facts("iceenvs/ShipNavigation-v0").episode_metrics) <= set(logged)
     assert all(logged[k] == float(info[k]) for k in METRICS)
 
 

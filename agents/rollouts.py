@@ -1,0 +1,199 @@
+"""Episodes and their statistics: what evaluation, the constant-action
+search and the task analysis share.
+
+:func:`run_episode` plays one seeded episode, :func:`evaluate` (or
+:func:`evaluate_in_processes`) plays every policy on the same seeded
+episodes, :func:`summarise` and :func:`compare` turn them into means,
+standard errors and paired differences. :class:`TrainedPolicy` gives a
+saved model the ``predict`` interface of the baselines.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from iceenvs.facts import env_facts
+
+from .metrics import physics_metrics
+
+__all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "rounded",
+           "stats", "summarise", "compare"]
+
+
+class TrainedPolicy:
+    """A saved SB3 model with the ``predict`` interface of the baselines,
+    normalising raw observations with the run's frozen statistics.
+
+    Parameters
+    ----------
+    run_dir : path
+        A run directory of :mod:`agents.train`.
+    """
+
+    def __init__(self, run_dir: str | Path):
+        from .envs import load_normalization
+        from .train import algo_class
+
+        run_dir = Path(run_dir)
+        with open(run_dir / "args.yaml") as fh:
+            self.args = yaml.safe_load(fh)
+        with open(run_dir / "hyperparams.yaml") as fh:
+            self.hyperparams = yaml.safe_load(fh)
+        self.env_id = self.args["env"]
+        self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
+        self.model = algo_class(self.args["algo"]).load(run_dir / "model.zip", device="cpu")
+        self.normalization = load_normalization(run_dir / "vecnormalize.pkl", self.env_id,
+                                                self.env_kwargs)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Nothing to reset: the policy is memoryless."""
+
+    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
+        obs = np.asarray(obs, dtype=np.float32)
+        if self.normalization is not None:
+            obs = self.normalization.normalize_obs(obs).astype(np.float32)
+        return self.model.predict(obs, deterministic=deterministic)
+
+
+def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
+    """One episode from ``reset(seed=seed)``: return, length, final physics
+    metrics and the per-step rewards and main metric."""
+    obs, info = env.reset(seed=seed)
+    policy.reset(seed)
+    rewards, trace = [], []
+    final = physics_metrics(env.spec.id, info)
+    while True:
+        action, _ = policy.predict(obs, deterministic=True)
+        obs, reward, terminated, truncated, info = env.step(action)
+        rewards.append(float(reward))
+        metrics = physics_metrics(env.spec.id, info)
+        final = metrics or final
+        trace.append(metrics.get(main_metric, math.nan) if main_metric else math.nan)
+        if terminated or truncated:
+            break
+    return dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
+                terminated=bool(terminated), final=final, rewards=rewards, trace=trace)
+
+
+def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = True) -> dict:
+    """Run every policy of ``{name: policy}`` in ``env`` on episodes seeded
+    ``seed, seed + 1, …``; returns ``{name: [episode dicts]}``.
+
+    The baselines must have been made for this very ``env``
+    (:func:`agents.baselines.make_baseline`): the model-based controllers
+    read its state."""
+    from tqdm.auto import tqdm
+
+    main_metric = env_facts(env.spec.id).main_metric
+    results = {}
+    with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
+              disable=not progress) as bar:
+        for name, policy in policies.items():
+            results[name] = []
+            for k in range(episodes):
+                results[name].append(run_episode(env, policy, seed + k, main_metric))
+                bar.update()
+    return results
+
+
+#: the environment and the policies of a worker of :func:`evaluate_in_processes`
+_WORKER: dict = {}
+
+
+def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
+                    episode_seed: int) -> dict:
+    """One episode in a worker process: the worker builds its environment
+    once (``reset(seed=env_seed)``, as the evaluation's main process does)
+    and each policy once from its recipe, then runs
+    :func:`run_episode`."""
+    from .baselines import make_baseline
+    from .envs import make_checked_env
+
+    key = (env_id, repr(sorted(env_kwargs.items())), env_seed)
+    if _WORKER.get("key") != key:
+        import torch
+
+        torch.set_num_threads(1)
+        if "env" in _WORKER:
+            _WORKER["env"].close()
+        _WORKER.clear()
+        _WORKER.update(key=key, env=make_checked_env(env_id, env_kwargs, seed=env_seed))
+    env = _WORKER["env"]
+    if name not in _WORKER:
+        kind, target, kwargs = recipe
+        _WORKER[name] = (TrainedPolicy(target) if kind == "trained" else
+                         make_baseline(target, env, seed=env_seed, **kwargs))
+    return run_episode(env, _WORKER[name], episode_seed, env_facts(env_id).main_metric)
+
+
+def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
+                          seed: int, processes: int, progress: bool = True) -> dict:
+    """:func:`evaluate` with the episodes shared among ``processes`` worker
+    processes; the same results, since every episode starts from
+    ``reset(seed=seed + k)`` and the policies are deterministic or, like
+    the random baseline, re-seeded with each episode.
+
+    ``recipes`` maps a policy name to ``("trained", run_dir, {})`` or
+    ``("baseline", baseline_name, constructor_kwargs)``; every worker builds
+    its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
+    reset with ``seed``) and policies from them."""
+    import concurrent.futures
+    import multiprocessing
+
+    from tqdm.auto import tqdm
+
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    results = {name: [None] * episodes for name in recipes}
+    with concurrent.futures.ProcessPoolExecutor(
+            processes, mp_context=multiprocessing.get_context(method)) as pool, \
+            tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
+                 disable=not progress) as bar:
+        jobs = {pool.submit(_worker_episode, env_id, env_kwargs, seed, name, recipe, seed + k):
+                (name, k) for name, recipe in recipes.items() for k in range(episodes)}
+        for job in concurrent.futures.as_completed(jobs):
+            name, k = jobs[job]
+            results[name][k] = job.result()
+            bar.update()
+    return results
+
+
+def rounded(values, digits: int = 6) -> list:
+    """Floats to ``digits`` significant digits (the per-step series of the
+    JSON report)."""
+    return [float(f"{v:.{digits}g}") for v in values]
+
+
+def stats(values) -> dict:
+    """Mean, std (ddof 1), standard error and count of ``values``."""
+    x = np.asarray(values, dtype=float)
+    n = x.size
+    std = float(np.std(x, ddof=1)) if n > 1 else 0.0
+    return dict(mean=float(np.mean(x)), std=std, sem=std / math.sqrt(n), n=int(n))
+
+
+def summarise(episodes: list[dict]) -> dict:
+    """Mean, std (ddof 1) and standard error of the return, the length and
+    every final physics metric over episodes."""
+    out = {"return": stats([e["ret"] for e in episodes]),
+           "length": stats([e["length"] for e in episodes])}
+    for key in episodes[0]["final"]:
+        out[key] = stats([e["final"].get(key, math.nan) for e in episodes])
+    return out
+
+
+def compare(policy: list[dict], baseline: list[dict], metric: str | None = None,
+            lower_is_better: bool = False) -> dict:
+    """Paired comparison on the same seeds of the returns (or of the final
+    physics ``metric``): mean difference (policy − baseline), its standard
+    error and whether the policy is better by more than two standard
+    errors (higher, or lower with ``lower_is_better``)."""
+    def value(e):
+        return e["ret"] if metric is None else e["final"].get(metric, math.nan)
+
+    d = np.array([value(p) - value(b) for p, b in zip(policy, baseline)])
+    s = stats(d)
+    gain = -s["mean"] if lower_is_better else s["mean"]
+    return dict(diff=s["mean"], sem=s["sem"], beats=bool(gain > 2.0 * s["sem"] and gain > 0))

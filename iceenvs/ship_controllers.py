@@ -1,0 +1,113 @@
+"""Controllers of the ship environments: the straight line to the goal and
+a reactive planner on the ice lidar (``"straight"`` and ``"reactive"`` in
+the facts of :mod:`iceenvs.ship_navigation` and :mod:`iceenvs.ship_beset`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .controllers import Controller
+
+__all__ = ["StraightLinePolicy", "ReactivePlanner"]
+
+
+class StraightLinePolicy(Controller):
+    """A ship sailing straight for the goal line at full speed.
+
+    The heading error is the bearing of the goal direction in the ship
+    frame, atan2(``goal_sin``, ``goal_cos``). A prescribed ship turns at a
+    yaw rate proportional to it (full rate at 0.1 rad); a dynamic ship
+    runs at full thrust with a critically damped PD autopilot on it
+    (natural frequency 0.05 rad/s, the ship's yaw inertia with added mass).
+    The surge speed of ``control="speed_yaw"`` is the largest.
+
+    The policies read the observation vector (``obs["vector"]`` of a dict
+    observation); with ``obs_type="image"`` they read the environment's last
+    physical observation instead, one environment at a time.
+    """
+
+    #: heading error [rad] of a full yaw-rate command
+    GAIN_ANGLE = 0.1
+    #: natural frequency [rad/s] of the dynamic ship's heading autopilot
+    FREQUENCY = 0.05
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        u = env.unwrapped
+        if not hasattr(u, "lidar_sectors"):
+            raise ValueError(f"{type(self).__name__} steers a ship environment, got "
+                             f"{type(u).__name__}")
+        self.unwrapped = u
+        self._index = {f.name: k for k, f in enumerate(u.features)}
+        self._scale = {f.name: (100.0 if f.scaling == "/ 100 m" else
+                                0.1 if f.scaling == "/ 0.1 rad/s" else 1.0)
+                       for f in u.features}
+
+    def _reader(self, obs):
+        """``get(name)``: the raw value of an observation entry."""
+        if isinstance(obs, dict):
+            obs = obs["vector"]
+        if self.unwrapped.obs_type == "image":
+            now = self.unwrapped._prev
+            return lambda name: float(now[name])
+        return lambda name: float(obs[self._index[name]]) * self._scale[name]
+
+    def _bearing(self, get) -> float:
+        """Bearing of the goal [rad, ship frame, port positive]."""
+        return math.atan2(get("goal_sin"), get("goal_cos"))
+
+    def _steer(self, bearing: float, get) -> np.ndarray:
+        u = self.unwrapped
+        if u.control == "thrust":
+            ship = u._ship                # the episode's ship (set by reset)
+            w = self.FREQUENCY
+            moment = ship.total_mass[2] * (w * w * bearing - 2.0 * w * get("yaw_rate"))
+            return np.array([1.0, moment / ship.max_yaw_moment])
+        turn = bearing / self.GAIN_ANGLE
+        return np.array([turn]) if u.control == "yaw" else np.array([1.0, turn])
+
+    def act(self, obs):
+        get = self._reader(obs)
+        return self._steer(self._bearing(get), get)
+
+    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
+        space = self.action_space
+        vector = obs["vector"] if isinstance(obs, dict) else obs
+        if self.unwrapped.obs_type != "image" and np.ndim(vector) == 2:
+            if isinstance(obs, dict):
+                rows = [{"vector": v} for v in vector]
+            else:
+                rows = list(vector)
+            actions = np.stack([np.clip(self.act(o), space.low, space.high) for o in rows])
+            return actions.astype(space.dtype), None
+        return np.clip(self.act(obs), space.low, space.high).astype(space.dtype), None
+
+
+class ReactivePlanner(StraightLinePolicy):
+    """Steer for the least obstructed sector of the ice lidar.
+
+    Each sector k of the lidar (central bearing θ_k) scores
+    d_k / range − c_k − ``turn_cost`` |θ_k − θ_goal|, with d_k the distance
+    to the first floe edge, c_k the ice concentration of the sector and
+    θ_goal the bearing of the goal; the ship steers for the best sector
+    (bearings beyond 60° of the goal are clipped there) as
+    :class:`StraightLinePolicy` steers for the goal.
+    """
+
+    turn_cost = 0.5
+    max_off_goal = math.radians(60.0)
+
+    def act(self, obs):
+        u = self.unwrapped
+        get = self._reader(obs)
+        k = u.lidar_sectors
+        theta = -0.5 * math.pi + (np.arange(k) + 0.5) * math.pi / k
+        d = np.array([get(f"lidar_distance_{i}") for i in range(k)]) / u.lidar_range
+        c = np.array([get(f"lidar_concentration_{i}") for i in range(k)])
+        goal = self._bearing(get)
+        score = d - c - self.turn_cost * np.abs(theta - goal)
+        best = float(theta[int(np.argmax(score))])
+        return self._steer(float(np.clip(best, goal - self.max_off_goal,
+                                         goal + self.max_off_goal)), get)
