@@ -198,6 +198,9 @@ def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, e
 def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate") -> dict:
     """Command-line entry point (``prog``: the command's name in the help);
     returns the summaries per policy."""
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
     from iceenvs.facts import registered_ids
 
     from .baselines import ConstantPolicy, baseline_names, make_baseline
@@ -223,7 +226,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     if args.baseline is not None:
         if args.run_dir is not None:
             parser.error("give either RUN_DIR or --baseline, not both")
-        if args.env not in registered_ids(args.env.split("/")[0] if args.env else "iceenvs"):
+        if args.env is None or args.env not in gym.registry:
             parser.error(f"--baseline needs --env, one of: {', '.join(registered_ids())}")
         env_id, base_kwargs = args.env, {}
         out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{args.baseline}"

@@ -16,6 +16,7 @@ import pytest
 
 import iceenvs
 from iceenvs import ENV_IDS
+from iceenvs.checks import CHECKS
 from small_envs import SMALL
 
 WIND = "iceenvs/WindDrift-v0"
@@ -60,21 +61,13 @@ def test_every_id_is_registered_and_tested():
 
 # -- API checkers ------------------------------------------------------------------------
 
+@pytest.mark.parametrize("check", list(CHECKS))
 @pytest.mark.parametrize("env_id", ENV_IDS)
-def test_gymnasium_env_checker(env_id, headless):
-    from gymnasium.utils.env_checker import check_env
-
-    env = make(env_id, render_mode="rgb_array")
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            # also renders in every declared mode, through the env's spec
-            check_env(env.unwrapped)
-    finally:
-        env.close()
-    # the checker reports through gymnasium's logger ("WARN: ..."); those count
-    messages = [str(w.message) for w in caught if "WARN" in str(w.message)]
-    assert messages == [], f"{env_id}: checker warnings {messages}"
+def test_shared_checks(env_id, check, headless):
+    """Gymnasium's checker without warnings, determinism, sanitised wild
+    actions and facts that agree with the environment
+    (:mod:`iceenvs.checks`)."""
+    CHECKS[check](env_id)
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
@@ -87,36 +80,7 @@ def test_stable_baselines3_env_checker(env_id):
         env.close()
 
 
-# -- determinism ---------------------------------------------------------------------------
-
-def _rollout(env_id, seed, acts):
-    env = make(env_id)
-    try:
-        obs, _ = env.reset(seed=seed)
-        observations, rewards = [obs], []
-        for a in acts:
-            obs, reward, terminated, truncated, info = env.step(a)
-            assert "error" not in info, info.get("error")
-            observations.append(obs)
-            rewards.append(reward)
-    finally:
-        env.close()
-    return observations, rewards
-
-
-@pytest.mark.parametrize("env_id", ENV_IDS)
-def test_same_seed_same_trajectory(env_id):
-    env = make(env_id)
-    space = env.action_space
-    env.close()
-    acts = actions(space, 5)
-    obs_a, rew_a = _rollout(env_id, 123, acts)
-    obs_b, rew_b = _rollout(env_id, 123, acts)
-    assert len(obs_a) == len(obs_b) == 6
-    for k, (a, b) in enumerate(zip(obs_a, obs_b)):
-        assert np.array_equal(a, b), f"{env_id}: observations differ at step {k}"
-    assert rew_a == rew_b
-
+# -- seeding -------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_different_seed_different_start(env_id):

@@ -1,0 +1,202 @@
+"""The checks every environment of the package passes, for a new one too.
+
+    python -m iceenvs.checks ID [ID ...]      (default: every registered id)
+
+Each check builds the environment at its small size (its facts'
+:attr:`~iceenvs.facts.EnvFacts.small`) and raises ``AssertionError`` with
+the reason when the environment breaks a convention:
+
+- :func:`check_api`: Gymnasium's environment checker (spaces, seeding,
+  ``reset``/``step`` signatures, rendering in every declared mode) passes
+  without a warning;
+- :func:`check_determinism`: the same seed and actions give the same
+  observations and rewards, bit for bit;
+- :func:`check_fuzz`: seeded wild actions (NaN, ±inf, far out of range)
+  are sanitised: finite observations inside the space, finite rewards
+  in the environment's ``reward_bounds`` (default
+  :data:`iceenvs.base.REWARD_RANGE`), no physics failure;
+- :func:`check_facts`: the facts agree with the environment: the logged
+  metrics exist, the main metric is among them after a step, and every
+  controller acts inside the action space.
+
+The test suite runs them on every registered id; the docs' Contributing
+page runs them on a new environment.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import warnings
+
+import gymnasium as gym
+import numpy as np
+
+from .base import REWARD_RANGE
+from .facts import env_facts
+
+__all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_facts",
+           "check_all", "CHECKS"]
+
+
+def make_small(env_id: str, **kwargs) -> gym.Env:
+    """``gymnasium.make(env_id)`` at the small size of its facts
+    (``kwargs`` on top)."""
+    return gym.make(env_id, **{**env_facts(env_id).small, **kwargs})
+
+
+def check_api(env_id: str) -> None:
+    """Gymnasium's environment checker passes without a warning (rendering
+    through ``rgb_array`` where the environment declares it)."""
+    from gymnasium.utils.env_checker import check_env
+
+    probe = make_small(env_id)
+    modes = probe.metadata.get("render_modes", [])
+    probe.close()
+    env = make_small(env_id, **({"render_mode": "rgb_array"} if "rgb_array" in modes else {}))
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            check_env(env.unwrapped)
+    finally:
+        env.close()
+    # the checker reports through gymnasium's logger ("WARN: ..."); those count
+    messages = [str(w.message) for w in caught if "WARN" in str(w.message)]
+    assert not messages, f"{env_id}: Gymnasium's checker warns: {messages}"
+
+
+def _actions(space: gym.spaces.Space, n: int, seed: int) -> list:
+    space = gym.spaces.Box(space.low, space.high, space.shape, space.dtype, seed=seed) \
+        if isinstance(space, gym.spaces.Box) else space
+    if not isinstance(space, gym.spaces.Box):
+        space.seed(seed)
+    return [space.sample() for _ in range(n)]
+
+
+def _rollout(env_id: str, seed: int, actions: list) -> tuple[list, list]:
+    env = make_small(env_id)
+    try:
+        obs, _ = env.reset(seed=seed)
+        observations, rewards = [obs], []
+        for a in actions:
+            obs, reward, terminated, truncated, info = env.step(a)
+            assert "error" not in info, f"{env_id}: the physics failed: {info['error']}"
+            observations.append(obs)
+            rewards.append(float(reward))
+            if terminated or truncated:
+                break
+    finally:
+        env.close()
+    return observations, rewards
+
+
+def _flat(obs) -> np.ndarray:
+    if isinstance(obs, dict):
+        return np.concatenate([np.ravel(obs[k]).astype(np.float64) for k in sorted(obs)])
+    return np.ravel(obs)
+
+
+def check_determinism(env_id: str, steps: int = 5, seed: int = 123) -> None:
+    """Two instances, the same seed and the same ``steps`` actions: the
+    same observations and rewards, bit for bit."""
+    env = make_small(env_id)
+    actions = _actions(env.action_space, steps, seed)
+    env.close()
+    obs_a, rew_a = _rollout(env_id, seed, actions)
+    obs_b, rew_b = _rollout(env_id, seed, actions)
+    assert len(obs_a) == len(obs_b), f"{env_id}: episodes of different lengths"
+    for k, (a, b) in enumerate(zip(obs_a, obs_b)):
+        assert np.array_equal(_flat(a), _flat(b)), f"{env_id}: observations differ at step {k}"
+    assert rew_a == rew_b, f"{env_id}: rewards differ: {rew_a} against {rew_b}"
+
+
+def check_fuzz(env_id: str, steps: int = 12, seed: int = 0) -> None:
+    """Seeded wild actions (NaN, ±inf, 1e30, in range) are sanitised: the
+    observations stay finite and inside the space, the rewards finite and in
+    :data:`~iceenvs.base.REWARD_RANGE`, and the physics does not fail."""
+    rng = np.random.default_rng(seed)
+    env = make_small(env_id)
+    try:
+        space = env.action_space
+        # the built-in floe tasks reward in [0, 1]; others declare reward_bounds
+        low, high = getattr(env.unwrapped, "reward_bounds", REWARD_RANGE)
+        wild = np.array([np.nan, np.inf, -np.inf, 1e30, -1e30], dtype=np.float64)
+        obs, _ = env.reset(seed=seed)
+        for k in range(steps):
+            action = rng.uniform(-1.0, 1.0, space.shape)
+            mask = rng.random(space.shape) < 0.5
+            action[mask] = rng.choice(wild, size=int(mask.sum()))
+            obs, reward, terminated, truncated, info = env.step(action.astype(space.dtype))
+            assert "error" not in info, f"{env_id}: action {action} broke the physics"
+            flat = _flat(obs)
+            assert np.all(np.isfinite(flat)), f"{env_id}: non-finite observation at step {k}"
+            assert env.observation_space.contains(obs), f"{env_id}: observation outside its space"
+            assert math.isfinite(reward) and low <= reward <= high, \
+                f"{env_id}: reward {reward} outside [{low}, {high}]"
+            if terminated or truncated:
+                obs, _ = env.reset()
+    finally:
+        env.close()
+
+
+def check_facts(env_id: str, steps: int = 3, seed: int = 0) -> None:
+    """The facts agree with the environment: after ``steps`` steps every
+    mapped metric is logged and the main metric is among the logged names;
+    every controller acts inside the action space."""
+    facts = env_facts(env_id)
+    env = make_small(env_id)
+    try:
+        obs, info = env.reset(seed=seed)
+        for name, cls in facts.controllers.items():
+            controller = cls(env, seed)
+            controller.reset(seed)
+            action, state = controller.predict(obs)
+            assert state is None and env.action_space.contains(action), \
+                f"{env_id}: controller {name!r} acts outside the action space: {action}"
+        for _ in range(steps):
+            obs, _, terminated, truncated, info = env.step(env.action_space.sample())
+            if terminated or truncated:
+                break
+        logged = facts.logged_metrics(info)
+        assert facts.main_metric in logged, \
+            f"{env_id}: main metric {facts.main_metric!r} is not logged ({sorted(logged)})"
+        if facts.metrics is not None:
+            missing = sorted(set(facts.metrics) - set(info.get("physics", {})))
+            assert not missing, f"{env_id}: info['physics'] lacks the metrics {missing}"
+    finally:
+        env.close()
+
+
+#: name → check, in the order :func:`check_all` runs them
+CHECKS = {"api": check_api, "determinism": check_determinism, "fuzz": check_fuzz,
+          "facts": check_facts}
+
+
+def check_all(env_id: str) -> None:
+    """Every check of :data:`CHECKS` on ``env_id``."""
+    for check in CHECKS.values():
+        check(env_id)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from .facts import registered_ids
+
+    p = argparse.ArgumentParser(prog="python -m iceenvs.checks",
+                                description=__doc__.splitlines()[0])
+    p.add_argument("ids", nargs="*", help="environment ids (default: every registered id)")
+    args = p.parse_args(argv)
+    failed = 0
+    for env_id in args.ids or registered_ids():
+        for name, check in CHECKS.items():
+            try:
+                check(env_id)
+            except (AssertionError, ValueError) as err:
+                failed += 1
+                print(f"{env_id}: {name}: FAILED: {err}", flush=True)
+            else:
+                print(f"{env_id}: {name}: ok", flush=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
