@@ -8,7 +8,6 @@ runs in seconds once the engines are compiled.
 import re
 import subprocess
 import sys
-import warnings
 
 import gymnasium as gym
 import numpy as np
