@@ -125,6 +125,10 @@ def environment_page(env_id: str, spec, frame: str) -> str:
     if reward is not None and getattr(reward, "__module__", None):
         lines.append(f"| reward | {{func}}`{reward.__module__}.{reward.__name__}` "
                      f"(`{reward.__module__.replace('.', '/')}.py`) |")
+    facts = cls.facts
+    lines += [f"| main metric | `{facts.main_metric}` |",
+              f"| baselines | {_baselines(facts)} |",
+              f"| small instance (tests, warm-up) | {_kwargs(facts.small)} |"]
     lines += ["", "```python", "import gymnasium as gym",
               "import iceenvs  # noqa: F401  (registers the ids)", "",
               f'env = gym.make("{env_id}", render_mode="rgb_array")',
@@ -133,8 +137,33 @@ def environment_page(env_id: str, spec, frame: str) -> str:
     return "\n".join(lines)
 
 
+def _baselines(facts) -> str:
+    """The generic baselines and the environment's own controllers."""
+    own = ", ".join(f"`{name}` ({{class}}`~{cls.__module__}.{cls.__name__}`)"
+                    for name, cls in facts.controllers.items())
+    return "`random`, `zero`, `constant`" + (f", {own}" if own else "")
+
+
+def _kwargs(kwargs) -> str:
+    return ", ".join(f"`{k}={v!r}`" for k, v in kwargs.items()) or "the defaults"
+
+
+def environments_table(envs) -> str:
+    """One row per registered id, from its facts and its registration."""
+    rows = ["| id | task | actions | main metric | steps |", "|---|---|---|---|---|"]
+    for env_id, spec in envs:
+        cls = environment_class(spec)
+        name = env_id.split("/")[-1]
+        actions = ", ".join(f"`{a}`" for a in getattr(cls, "action_names", ()))
+        rows.append(f"| {{doc}}`{env_id} </_generated/environments/{name}>` | "
+                    f"{cls.facts.summary} | {actions} | `{cls.facts.main_metric}` | "
+                    f"{spec.max_episode_steps} |")
+    return "\n".join(rows + [""])
+
+
 def generate_environments(out: Path) -> None:
     envs = registered_environments()
+    write_if_changed(out / "include" / "environments_table.md", environments_table(envs))
     toc = ["```{toctree}", ":maxdepth: 1", ""]
     for env_id, spec in envs:
         name = env_id.split("/")[-1]
