@@ -1,6 +1,11 @@
 """Benchmarks of the engines, the observables, the ITD models and the
 environments, apart from the library.
 
+This package comes with a source checkout and is not installed with
+seaice-gym: run its suites from the checkout's root (``make bench``,
+``python -m benchmarks.<suite>``, or ``seaice bench <suite>``, which also
+finds the checkout named by ``SEAICE_GYM_SOURCE``).
+
 One module per suite, each with a ``main(argv)`` and a ``python -m`` entry
 point (``seaice bench <suite>`` runs the same), all sharing
 :mod:`benchmarks.harness`:
@@ -27,7 +32,8 @@ suite               what is timed
                     to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
 ==================  ==============================================================
 
-Every suite writes one JSON record to ``docs/benchmarks/<suite>.json``
+Every suite writes one JSON record to ``docs/benchmarks/<suite>.json`` of
+the checkout, whatever the working directory
 (:func:`benchmarks.harness.write_record`), which the documentation renders
 (:func:`benchmarks.harness.render_markdown`);
 ``python -m benchmarks.headline`` puts the headline figures into the README.

@@ -65,14 +65,13 @@ FULL = dict(floes=20000, steps=2000, segments=3, gas_floes=10000, gas_collisions
 QUICK = dict(floes=400, steps=20, segments=1, gas_floes=1000, gas_collisions=20_000,
              herman_floes=300, spin_up=200.0, herman_collisions=2000, seconds=0.5, runs=1,
              warmup=0.0)
-REPO = Path(__file__).resolve().parent.parent
 
 
 # ---------------------------------------------------------------------------
 # the old tree
 # ---------------------------------------------------------------------------
 
-def _git(*args: str, cwd: Path = REPO) -> str:
+def _git(*args: str, cwd: Path = harness.ROOT) -> str:
     out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, text=True)
     if out.returncode != 0:
         raise RuntimeError(f"git {' '.join(args)} failed: {out.stderr.strip()}")
@@ -89,7 +88,7 @@ class Worktree:
     time) serves a later comparison against the same revision.
     """
 
-    def __init__(self, rev: str, repo: Path = REPO):
+    def __init__(self, rev: str, repo: Path = harness.ROOT):
         self.repo = Path(repo)
         self.sha = _git("rev-parse", "--verify", f"{rev}^{{commit}}", cwd=self.repo)
         self.path: Path | None = None
@@ -319,8 +318,9 @@ def main(argv=None, prog: str | None = None) -> int:
     p.add_argument("--ids", nargs="+", metavar="ID",
                    help="environments to compare, e.g. WindDrift-v0 (default: all)")
     p.add_argument("--seed", type=int, default=1, help="seed of the prepared floe fields")
-    p.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
-                   help="where the Hertz suite's prepared fields are kept (default ./.bench_cache)")
+    p.add_argument("--cache-dir", type=Path, default=harness.CACHE_DIR,
+                   help=f"where the Hertz suite's prepared fields are kept "
+                        f"(default {harness.in_checkout(harness.CACHE_DIR)})")
     args, argv = harness.parse(p, argv)
     suites = [s.strip() for s in args.suites.split(",") if s.strip()]
     unknown = [s for s in suites if s not in SUITE_NAMES]
@@ -342,7 +342,7 @@ def main(argv=None, prog: str | None = None) -> int:
             print(f"old tree: {old} ({tree.sha[:12]}); preparing the workloads ...", flush=True)
         workloads = prepare(suites, sizes, Path(work), args.cache_dir, args.seed, args.ids,
                             args.quiet)
-        results, loaded = run_rounds(workloads, old, REPO, args.rounds, args.quiet)
+        results, loaded = run_rounds(workloads, old, harness.ROOT, args.rounds, args.quiet)
     record = harness.make_record(
         SUITE, f"This commit against {args.against}", DESCRIPTION,
         harness.command_line(SUITE, argv),
@@ -352,7 +352,7 @@ def main(argv=None, prog: str | None = None) -> int:
              imported_from={side: {k: f"{name}:{Path(v).resolve().relative_to(root.resolve())}"
                                    for k, v in loaded[side].items()}
                             for side, root, name in (("old", old, tree.sha[:7]),
-                                                     ("new", REPO, "this tree"))}),
+                                                     ("new", harness.ROOT, "this tree"))}),
         time.perf_counter() - t0)
     harness.finish(args, record)
     return 0

@@ -53,8 +53,13 @@ from . import SUITES
 REPEATS = 5
 #: fresh processes per case (host noise only slows a run down)
 PROCESSES = 3
-#: where the records go, relative to the working directory
-DEFAULT_DIR = Path("docs/benchmarks")
+#: the source checkout the suites come with (they are not installed), whatever
+#: the working directory
+ROOT = Path(__file__).resolve().parent.parent
+#: where the records go: docs/benchmarks of the checkout
+DEFAULT_DIR = ROOT / "docs" / "benchmarks"
+#: where the prepared floe fields are kept: .bench_cache of the checkout
+CACHE_DIR = ROOT / ".bench_cache"
 #: keys of every record, in the order they are written
 RECORD_KEYS = ("suite", "title", "description", "command", "machine", "date", "wall_seconds",
                "tables", "data")
@@ -404,6 +409,12 @@ class Progress:
 # records
 # ---------------------------------------------------------------------------
 
+def in_checkout(path: Path) -> str:
+    """A default path of the checkout as the help texts show it (not this
+    machine's absolute path), e.g. ``docs/benchmarks of the checkout``."""
+    return f"{path.relative_to(ROOT).as_posix()} of the checkout"
+
+
 def suite_parser(suite: str, description: str,
                  prog: str | None = None) -> argparse.ArgumentParser:
     """The command-line parser of ``python -m benchmarks.<suite>`` (shown as
@@ -424,7 +435,8 @@ def add_common_options(parser: argparse.ArgumentParser, suite: str) -> None:
                              "mean nothing)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--json", type=Path, default=DEFAULT_DIR / f"{suite}.json",
-                     help=f"where to write the record (default {DEFAULT_DIR / suite}.json)")
+                     help=f"where to write the record (default "
+                          f"{in_checkout(DEFAULT_DIR / f'{suite}.json')})")
     out.add_argument("--no-json", action="store_true", help="write no record")
 
 

@@ -149,10 +149,11 @@ def main(argv=None, prog: str | None = None) -> int:
     p = argparse.ArgumentParser(prog=prog or "python -m benchmarks.headline",
                                 description=__doc__.split("\n\n")[1],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--readme", type=Path, default=Path("README.md"),
-                   help="the file to rewrite (default README.md)")
-    p.add_argument("--records", type=Path, default=harness.DEFAULT_DIR,
-                   help=f"where the records are (default {harness.DEFAULT_DIR})")
+    readme, records = harness.ROOT / "README.md", harness.DEFAULT_DIR
+    p.add_argument("--readme", type=Path, default=readme,
+                   help=f"the file to rewrite (default {harness.in_checkout(readme)})")
+    p.add_argument("--records", type=Path, default=records,
+                   help=f"where the records are (default {harness.in_checkout(records)})")
     args = p.parse_args(argv)
     try:
         text = args.readme.read_text(encoding="utf-8")

@@ -252,7 +252,7 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
     """Time every case and kernel (see :data:`DESCRIPTION`); one row each.
     ``ceilings=False`` leaves out the host and machine ceilings."""
     threads_all = numba.config.NUMBA_NUM_THREADS
-    cache_dir = Path(cache_dir) if cache_dir is not None else Path.cwd() / ".bench_cache"
+    cache_dir = Path(cache_dir) if cache_dir is not None else harness.CACHE_DIR
     rows = []
     if not quiet:
         print(f"dense ice (N = {n}) ...", flush=True)
@@ -372,8 +372,9 @@ def main(argv=None, prog: str | None = None) -> int:
                    help="floes of the memory measurement (default 100000; 0: skip)")
     p.add_argument("--processes", type=int, default=None,
                    help=f"fresh processes per case (default {PROCESSES})")
-    p.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
-                   help="where the prepared floe fields are kept (default ./.bench_cache)")
+    p.add_argument("--cache-dir", type=Path, default=harness.CACHE_DIR,
+                   help=f"where the prepared floe fields are kept "
+                        f"(default {harness.in_checkout(harness.CACHE_DIR)})")
     args, argv = harness.parse(p, argv)
     sizes = dict(floes=20000, steps=2000, memory_floes=100000, processes=PROCESSES,
                  ceilings=True)

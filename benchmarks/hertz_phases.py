@@ -92,7 +92,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
     ``n_pairs`` and ``rows``, one per phase and configuration: the median
     time and the same-round speed-ups over the serial kernels."""
     threads_all = numba.config.NUMBA_NUM_THREADS
-    cache_dir = Path(cache_dir) if cache_dir is not None else Path.cwd() / ".bench_cache"
+    cache_dir = Path(cache_dir) if cache_dir is not None else harness.CACHE_DIR
     path = _loose_state(n, seed, cache_dir)
     dt = HERMAN2013.time_step
     sim = _warm_sim(str(path), dt, parallel=False)
@@ -166,8 +166,9 @@ def main(argv=None, prog: str | None = None) -> int:
     p.add_argument("--passes", type=int, default=None,
                    help="timed passes per phase and round (default 2000)")
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--cache-dir", type=Path, default=Path(".bench_cache"),
-                   help="where the prepared floe field is kept (default ./.bench_cache)")
+    p.add_argument("--cache-dir", type=Path, default=harness.CACHE_DIR,
+                   help=f"where the prepared floe field is kept "
+                        f"(default {harness.in_checkout(harness.CACHE_DIR)})")
     args, argv = harness.parse(p, argv)
     sizes = dict(floes=20000, passes=2000)
     if args.quick:

@@ -20,8 +20,10 @@ from __future__ import annotations
 import argparse
 import importlib
 import inspect
+import os
 import sys
 import time
+from pathlib import Path
 
 from . import __version__
 
@@ -51,6 +53,10 @@ BENCH_SUITES = {
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
     "headline": "put the headline figures of the records into the README",
 }
+
+#: the variable that names the source checkout whose suites ``seaice bench`` runs
+#: (default: the current directory, when it holds ``benchmarks/``)
+SOURCE_VARIABLE = "SEAICE_GYM_SOURCE"
 
 #: the parts of ``seaice demo``, run in this order when none is named
 DEMOS = {
@@ -89,18 +95,50 @@ def _call(target: str, argv: list[str], prog: str) -> int:
     return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 
+def benchmarks_checkout() -> Path | None:
+    """The source checkout whose benchmark suites ``seaice bench`` runs: the
+    directory named by :data:`SOURCE_VARIABLE` if it is set, else the current
+    directory if it holds the ``benchmarks`` package, else ``None`` (then
+    ``benchmarks`` is imported from the module path, if it is there at all).
+
+    Raises
+    ------
+    ValueError
+        If :data:`SOURCE_VARIABLE` names a directory without ``benchmarks/``.
+    """
+    named = os.environ.get(SOURCE_VARIABLE, "")
+    root = Path(named or os.curdir).resolve()
+    if (root / "benchmarks" / "__init__.py").is_file():
+        return root
+    if named:
+        raise ValueError(f"{SOURCE_VARIABLE}={named!r} has no benchmarks/ folder; it must "
+                         f"name the root of a source checkout of seaice-gym")
+    return None
+
+
 def _bench(argv: list[str], prog: str) -> int:
     entries = {name: (f"benchmarks.{name}:main", text) for name, text in BENCH_SUITES.items()}
     parser = _parser(prog, "Run one benchmark suite (python -m benchmarks.SUITE).", entries,
-                     "suite", epilog=f"{prog} SUITE --help shows the options of a suite.")
+                     "suite", epilog=f"{prog} SUITE --help shows the options of a suite.\n\n"
+                                     f"The suites come with a source checkout, not with the "
+                                     f"installed package: run\n{prog} from the root of a "
+                                     f"checkout, or set {SOURCE_VARIABLE} to that root.")
     suite = _pick(parser, argv, "suite")
+    try:
+        root = benchmarks_checkout()
+    except ValueError as exc:
+        parser.error(str(exc))
+    if root is not None and str(root) not in sys.path:
+        sys.path.insert(0, str(root))        # as python -m benchmarks.SUITE from the root
     try:
         importlib.import_module(f"benchmarks.{suite}")
     except ModuleNotFoundError as exc:
         if exc.name not in ("benchmarks", f"benchmarks.{suite}"):
             raise
-        parser.error(f"the benchmark suite {suite!r} is not available here ({exc}); the "
-                     f"benchmarks package comes with the source tree")
+        parser.error(f"the benchmark suites are not installed with seaice-gym: they come with "
+                     f"a source checkout. Run `{prog} {suite}` (or `python -m "
+                     f"benchmarks.{suite}`) from the root of a checkout, or set "
+                     f"{SOURCE_VARIABLE} to that root.")
     return _call(entries[suite][0], argv[1:], f"{prog} {suite}")
 
 

@@ -127,13 +127,55 @@ def test_bench_forwards_to_the_suite(monkeypatch, capsys):
     assert code == 0 and all(s in out for s in cli.BENCH_SUITES)
 
 
-def test_without_the_benchmarks_package_bench_says_so_and_the_rest_works(monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "benchmarks", None)       # as if it were not installed
+def test_without_the_benchmarks_bench_says_where_they_are_and_the_rest_works(monkeypatch, capsys,
+                                                                           tmp_path):
+    monkeypatch.chdir(tmp_path)                                # not a checkout
+    monkeypatch.delenv(cli.SOURCE_VARIABLE, raising=False)
+    monkeypatch.setitem(sys.modules, "benchmarks", None)       # and not on the module path
     monkeypatch.delitem(sys.modules, "benchmarks.hertz", raising=False)
     code, _, err = _exit(["bench", "hertz"], capsys)
-    assert code == 2 and "not available" in err and "Traceback" not in err
+    assert code == 2 and "Traceback" not in err
+    assert "not installed" in err and "source checkout" in err
+    for hint in ("`seaice bench hertz`", "`python -m benchmarks.hertz`", "from the root",
+                 cli.SOURCE_VARIABLE):
+        assert hint in err, hint
     assert _exit(["bench", "--help"], capsys)[0] == 0
     assert _exit(["scenarios", "--help"], capsys)[0] == 0
+
+
+def test_a_source_variable_without_benchmarks_is_refused(monkeypatch, capsys, tmp_path):
+    monkeypatch.setenv(cli.SOURCE_VARIABLE, str(tmp_path))
+    code, _, err = _exit(["bench", "itd"], capsys)
+    assert code == 2 and f"{cli.SOURCE_VARIABLE}={str(tmp_path)!r}" in err
+    assert "root of a source checkout" in err
+
+
+@pytest.mark.parametrize("named", [False, True])
+def test_bench_runs_the_suites_of_the_checkout_in_the_current_directory_or_named(
+        monkeypatch, tmp_path, named):
+    """A checkout (here a stand-in with one suite) in the current directory,
+    or named by the variable from elsewhere, comes first on the module path,
+    as ``python -m benchmarks.SUITE`` from its root."""
+    checkout = tmp_path / "checkout"
+    (checkout / "benchmarks").mkdir(parents=True)
+    (checkout / "benchmarks" / "__init__.py").write_text("")
+    (checkout / "benchmarks" / "itd.py").write_text(
+        "seen = []\n\ndef main(argv):\n    seen.append(argv)\n    return 5\n")
+    if named:
+        monkeypatch.setenv(cli.SOURCE_VARIABLE, str(checkout))
+        monkeypatch.chdir(tmp_path)
+    else:
+        monkeypatch.delenv(cli.SOURCE_VARIABLE, raising=False)
+        monkeypatch.chdir(checkout)
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    for name in ("benchmarks", "benchmarks.itd"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    assert cli.benchmarks_checkout() == checkout.resolve()
+    # --no-json: should the real suite run instead, it writes nothing
+    assert cli.main(["bench", "itd", "--quick", "--no-json"]) == 5
+    suite = sys.modules["benchmarks.itd"]
+    assert Path(suite.__file__).resolve() == (checkout / "benchmarks" / "itd.py").resolve()
+    assert suite.seen == [["--quick", "--no-json"]]
 
 
 def test_console_script_and_module_entry_points():

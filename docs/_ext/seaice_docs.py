@@ -36,8 +36,6 @@ log = logging.getLogger(__name__)
 
 #: packages whose public modules get an API page
 API_PACKAGES = ("physics", "iceenvs", "agents", "seaice_gym")
-#: modules left out of the API reference: command shims kept for old entry points
-API_SKIP = {"physics.bench", "iceenvs.bench"}
 #: seed, number of steps and action seed of the rendered frames
 FRAME_SEED = 0
 FRAME_STEPS = 5
@@ -294,14 +292,14 @@ def generate_scenario_parameters(out: Path) -> None:
 
 def public_modules() -> list[tuple[str, bool]]:
     """(name, is a package) of every public module of :data:`API_PACKAGES`,
-    walked from the packages (no private module, no ``__main__``, no shim)."""
+    walked from the packages (no private module, no ``__main__``)."""
     found = []
     for package in API_PACKAGES:
         pkg = importlib.import_module(package)
         found.append((package, True))
         for info in pkgutil.walk_packages(pkg.__path__, prefix=package + "."):
             parts = info.name.split(".")
-            if any(p.startswith("_") for p in parts) or info.name in API_SKIP:
+            if any(p.startswith("_") for p in parts):
                 continue
             found.append((info.name, info.ispkg))
     return found

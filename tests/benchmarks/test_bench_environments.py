@@ -1,6 +1,5 @@
-"""``python -m benchmarks.environments`` (and ``python -m iceenvs.bench``,
-which forwards to it) on one fast environment with short runs (a smoke
-test; the figures themselves come from the full benchmark)."""
+"""``python -m benchmarks.environments`` on one fast environment with short
+runs (a smoke test; the figures themselves come from the full benchmark)."""
 from __future__ import annotations
 
 import json
@@ -8,14 +7,13 @@ import json
 import pytest
 
 from benchmarks import environments, harness
-from iceenvs import bench
 
 
 def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
     path = tmp_path / "bench" / "environments.json"
     argv = ["--ids", "ThicknessDistribution-v0", "--seconds", "0.5", "--runs", "2",
             "--warmup", "0", "--json", str(path)]
-    assert bench.main(argv) == 0
+    assert environments.main(argv) == 0
     record = json.loads(path.read_text())
     harness.validate_record(record)
     assert set(record) >= {"command", "machine", "date", "data"}
@@ -44,7 +42,7 @@ def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
 
 def test_unknown_ids_are_refused(tmp_path):
     with pytest.raises(SystemExit):
-        bench.main(["--ids", "NoSuchEnv-v0", "--json", str(tmp_path / "x.json")])
+        environments.main(["--ids", "NoSuchEnv-v0", "--json", str(tmp_path / "x.json")])
 
 
 def test_quick_option_shortens_the_runs(tmp_path):
