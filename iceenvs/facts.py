@@ -60,6 +60,10 @@ class EnvFacts:
         ``gymnasium.make`` keywords of a small instance: seconds per episode
         for the tests and the warm-up (the kernels' types do not depend on
         the size).
+    speed_target : float
+        Sustained steps/s on one core that the environments benchmark
+        expects of the default instance (its table shows it beside the
+        measured rate).
     """
 
     summary: str
@@ -69,6 +73,7 @@ class EnvFacts:
     compared_metric: tuple[str, bool] | None = None
     controllers: Mapping[str, type] = field(default_factory=dict)
     small: Mapping[str, Any] = field(default_factory=dict)
+    speed_target: float = 50.0
 
     def __post_init__(self):
         for name in ("summary", "main_metric"):

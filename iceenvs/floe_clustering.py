@@ -147,7 +147,8 @@ class FloeClusteringEnv(FloeEnv):
         main_metric="largest_cluster_fraction",
         controllers={"heuristic": FloeClusteringController},
         # the box must hold the largest floe of the power-law size distribution
-        small={"n_floes": 150})
+        small={"n_floes": 150},
+        speed_target=200)
 
     def __init__(self, n_floes: int = 300, preset=HERMAN2011, control_interval: float = 5.0,
                  cluster_gap: float = 0.1, **kwargs):

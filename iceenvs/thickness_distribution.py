@@ -285,7 +285,8 @@ class ThicknessDistributionEnv(ControlEnv):
                  "rafting_factor": "rafting_factor"},
         main_metric="wasserstein1",
         controllers={"heuristic": ThicknessDistributionController},
-        small={"n_classes": 60})
+        small={"n_classes": 60},
+        speed_target=5000)
     task_parameters = _TASK
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
