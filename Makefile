@@ -12,7 +12,7 @@ TORCH_PIN := torch==2.13.0
 # `make lock` regenerates it from a fresh install of the newest releases.
 CONSTRAINTS := constraints.txt
 
-.PHONY: setup lock demo test test-slow bench validate crosscheck docs clean
+.PHONY: setup lock demo test lint test-slow bench validate crosscheck docs clean
 
 setup: $(STAMP)
 
@@ -43,8 +43,13 @@ lock:
 demo: setup
 	$(PY) -m seaice_gym demo
 
-test: setup
+# the linter and the import layers (pyproject.toml), then the tests
+test: setup lint
 	$(PY) -m pytest -q -m "not slow"
+
+lint: setup
+	$(VENV)/bin/ruff check .
+	PYTHONPATH=. $(VENV)/bin/lint-imports
 
 test-slow: setup
 	$(PY) -m pytest -q -m slow
