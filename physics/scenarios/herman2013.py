@@ -56,7 +56,11 @@ IMPACT_SPEED = 1.0   # m/s: the time-step check admits impacts up to this relati
 # shared set-up and measurements
 # ---------------------------------------------------------------------------
 
-def _contact_law(p: dict):
+def contact_law(p: dict):
+    """The Herman (2013) contact law with the scenario parameters
+    ``friction``, ``restitution``, ``tangential_damping``,
+    ``tangential_stiffness``, ``friction_moves_floes`` and
+    ``stiffness_scale`` of ``p`` (also that of ship-transit)."""
     c = dataclasses.replace(HERMAN2013.contact, friction=p["friction"],
                             restitution=p["restitution"],
                             tangential_damping=p["tangential_damping"],
@@ -66,7 +70,7 @@ def _contact_law(p: dict):
 
 
 def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None) -> HertzSimulation:
-    contact = _contact_law(p)
+    contact = contact_law(p)
     dt = hertz_time_step(field, box, contact, IMPACT_SPEED, HERMAN2013.time_step,
                          p["stiffness_scale"])
     return hertz_simulation(field, box, contact, forcing, dt=dt, impact_speed=IMPACT_SPEED,
@@ -118,9 +122,10 @@ def _snapshot(rec, sim: HertzSimulation, contacts) -> None:
                  frozen=sim.inv_mass == 0)
 
 
-def _advance(sim: HertzSimulation, duration: float) -> str | None:
-    """Advance; a physics failure is returned as a message (the run ends
-    there, with everything recorded so far)."""
+def advance(sim: HertzSimulation, duration: float) -> str | None:
+    """Advance ``sim`` by ``duration`` (at least one step); a physics failure
+    is returned as a message (the run ends there, with everything recorded
+    so far), else None."""
     try:
         sim.advance(max(duration, sim.dt))     # at least one step: the loops always progress
     except (FloatingPointError, RuntimeError) as exc:
@@ -146,7 +151,7 @@ def _run_for_duration(p: dict, st: dict, rec, measure) -> None:
     sim = st["sim"]
     snaps = sorted(p["snapshot_times"]) + [p["duration"]]
     while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
-        st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
+        st["error"] = advance(sim, min(p["output_interval"], p["duration"] - sim.time))
         values, c = measure(sim)
         rec.record(sim.time, **values)
         while st["next_snap"] < len(snaps) and sim.time >= snaps[st["next_snap"]] - 1e-9:
@@ -269,7 +274,7 @@ class Convergence(Experiment):
         dt_out = p["output_step"] / rate
         while st["error"] is None and sim.concentration < a1 - 0.5 * rate * sim.dt:
             step = min(dt_out, (a1 - sim.concentration) / rate)
-            st["error"] = _advance(sim, step)
+            st["error"] = advance(sim, step)
             net, c = network(sim)
             rec.record(sim.time, **net)
             if net["concentration"] >= st["next_snap"] - 1e-9:

@@ -384,7 +384,7 @@ def make_figures(out: Path, ds, exp, params) -> list[Path]:
     return [Path(p) for p in exp.plot(ds, params, fig_dir)]
 
 
-def _load_run(directory):
+def load_run(directory):
     """(directory, run.yaml contents, experiment, results) of a finished
     run directory; a clear error if it holds no results."""
     import xarray as xr
@@ -406,7 +406,7 @@ def summarise_run(directory) -> str:
     """The summary table of a finished run directory, computed afresh from
     its results (the analysis may be newer than the run); summary.md, with
     the run's wall time, is left as it is."""
-    out, info, exp, ds = _load_run(directory)
+    out, info, exp, ds = load_run(directory)
     # the header from the run's own record: its scenario file may be a copy
     cfg = SimpleNamespace(name=info["scenario"], title=info.get("title", ""),
                           reproduces=info.get("reproduces", ""))
@@ -445,5 +445,5 @@ def _hms(seconds: float) -> str:
 
 def plot_run(directory) -> list[Path]:
     """(Re)make the figures of a finished run directory."""
-    out, info, exp, ds = _load_run(directory)
+    out, info, exp, ds = load_run(directory)
     return make_figures(out, ds, exp, info["parameters"])
