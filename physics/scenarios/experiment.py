@@ -29,6 +29,8 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
+from .engines import check_engine
+
 _REGISTRY: dict[str, type] = {}
 # modules whose import registers the shipped experiments
 _MODULES = ("physics.scenarios.herman2013", "physics.scenarios.herman2011",
@@ -50,11 +52,13 @@ def experiments() -> dict[str, type]:
     return dict(_REGISTRY)
 
 
-def get_experiment(name: str) -> "Experiment":
+def get_experiment(name: str, engine: str = "numba") -> "Experiment":
+    """The experiment ``name``, running on ``engine`` (checked with
+    :func:`~physics.scenarios.engines.check_engine`)."""
     found = experiments()
     if name not in found:
         raise ValueError(f"unknown scenario {name!r}; valid scenarios: {', '.join(sorted(found))}")
-    return found[name]()
+    return found[name](check_engine(engine, found[name]))
 
 
 class Experiment:
@@ -71,6 +75,10 @@ class Experiment:
     takes_snapshots: bool = True
     #: the engines it runs on (:mod:`physics.scenarios.engines`)
     engines: tuple[str, ...] = ("numba",)
+
+    def __init__(self, engine: str = "numba"):
+        #: the engine this instance runs on (one of ``engines``)
+        self.engine = engine
 
     def cases(self, p: dict) -> list[dict]:
         """One dict of coordinate values per independent run (default: one)."""

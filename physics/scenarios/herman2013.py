@@ -69,12 +69,13 @@ def contact_law(p: dict):
     return scaled_contact(c, p["stiffness_scale"])
 
 
-def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None) -> HertzSimulation:
+def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None,
+                engine: str) -> HertzSimulation:
     contact = contact_law(p)
     dt = hertz_time_step(field, box, contact, IMPACT_SPEED, HERMAN2013.time_step,
                          p["stiffness_scale"])
-    return hertz_simulation(field, box, contact, forcing, dt=dt, impact_speed=IMPACT_SPEED,
-                           allow_overlap=True)
+    return hertz_simulation(engine, field, box, contact, forcing, dt=dt,
+                            impact_speed=IMPACT_SPEED, allow_overlap=True)
 
 
 def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_type=PeriodicBox):
@@ -263,7 +264,7 @@ class Convergence(Experiment):
                                        max_concentration=min(0.999, p["end_concentration"] + 0.02))
             # no wind and no current, but water drag and Coriolis act on moving floes
             forcing = HERMAN2013.make_forcing(wind=(0.0, 0.0), current=(0.0, 0.0))
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, next_snap=p["start_concentration"] + p["snapshot_step"],
                       error=None)
             net, c = network(sim)
@@ -409,7 +410,7 @@ class Wind(Experiment):
             drift = steady_drift(forcing, field.radii, field.thickness, field.masses)
             field = FloeField(field.positions, field.radii, field.thickness, drift,
                               density=field.density)
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, error=None, next_snap=0)
 
         def measure(sim):
@@ -531,7 +532,7 @@ class MarginalIceZone(Experiment):
             field = FloeField(field.positions, field.radii, field.thickness, field.velocities,
                               density=field.density, frozen=frozen)
             forcing = HERMAN2013.make_forcing(wind=(math.sqrt(speed ** 2 - uy ** 2), uy))
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, error=None, next_snap=0)
         sim = st["sim"]
         edges = np.linspace(0.0, sim.box.ly, p["profile_bins"] + 1)

@@ -16,7 +16,6 @@ from pathlib import Path
 
 from .. import mpi
 from .config import parse_config
-from .engines import use_engine
 from .experiment import get_experiment
 from .recorder import Recorder, atomic_write, checkpoint_files
 
@@ -46,10 +45,9 @@ def run_job(config_data: dict, params: dict, case: dict, seed: int, directory: s
     """One simulation: (case c, member m) on ``engine``. Returns the path of
     its NetCDF. In a run on several MPI ranks every rank calls it; rank 0
     alone writes files."""
-    use_engine(engine)
     root = mpi.world_rank() == 0
     cfg = parse_config(config_data)
-    exp = get_experiment(cfg.name)
+    exp = get_experiment(cfg.name, engine)
     out, ckpt = job_paths(Path(directory), c, m)
     if on_progress is None and _QUEUE is not None:
         last = [0.0, -1.0]

@@ -83,6 +83,30 @@ def test_every_shipped_file_parses_and_names_an_experiment():
         cfg.resolve(quick=True)
 
 
+def test_an_experiment_builds_its_simulations_on_the_engine_it_was_made_for(monkeypatch):
+    """The engine is an argument of the experiment, not a setting of the
+    process: two instances in one process build on their own engines."""
+    from physics.scenarios import herman2013
+
+    class Built(Exception):
+        pass
+    seen = []
+
+    def spy(engine, *args, **kwargs):
+        seen.append(engine)
+        raise Built
+    monkeypatch.setattr(herman2013, "hertz_simulation", spy)
+    cls = type(get_experiment("herman2013-convergence"))
+    p = find_config("herman2013-convergence").resolve(TINY)
+    for engine in ("lammps", "numba", "lammps"):
+        with pytest.raises(Built):
+            cls(engine).simulate(p, {}, 0, recorder_module.Recorder(variables=cls.variables))
+    assert seen == ["lammps", "numba", "lammps"]
+    assert get_experiment("herman2013-convergence").engine == "numba"
+    with pytest.raises(ValueError, match="runs on the numba engine only, not on 'lammps'"):
+        get_experiment("herman2011-clustering", "lammps")
+
+
 def test_unknown_scenario_and_parameter_list_the_valid_ones():
     with pytest.raises(ValueError, match="valid scenarios: .*herman2013-convergence"):
         find_config("herman2099")
