@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .runner import _load_run
+from .runner import load_run
 
 #: time series that are coordinates of the others, not quantities
 _AXES = ("time", "concentration")
@@ -157,8 +157,8 @@ def compare_runs(reference, other, *, k: float = 2.0,
     """Compare two finished run directories (see the module docstring)."""
     if not (isinstance(k, (int, float)) and k > 0):
         raise ValueError(f"k must be a positive number of standard deviations, got {k!r}")
-    ref_dir, ref_info, _, ref = _load_run(reference)
-    oth_dir, oth_info, _, oth = _load_run(other)
+    ref_dir, ref_info, _, ref = load_run(reference)
+    oth_dir, oth_info, _, oth = load_run(other)
     if ref_info["scenario"] != oth_info["scenario"]:
         raise ValueError(f"the runs are of different scenarios: {ref_info['scenario']} "
                          f"({ref_dir}) and {oth_info['scenario']} ({oth_dir})")

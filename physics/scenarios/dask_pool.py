@@ -6,7 +6,7 @@ the workers of a running scheduler, e.g. one started with ``dask scheduler``
 and ``dask worker ADDRESS --nthreads 1`` on other machines. Both need the
 ``distributed`` package: ``pip install 'seaice-gym[dask]'``.
 
-Each job runs :func:`physics.scenarios.runner._run_job` in a task with Numba
+Each job runs :func:`physics.scenarios.jobs.run_job` in a task with Numba
 limited to one thread, as in the local pool, so an ensemble gives the same
 results bit for bit whichever way it is run.
 
@@ -23,6 +23,8 @@ import logging
 import signal
 import time
 import uuid
+
+from . import jobs
 
 INSTALL_HINT = "pip install 'seaice-gym[dask]'"
 CONNECT_TIMEOUT = 10.0        # seconds to reach a scheduler
@@ -122,16 +124,16 @@ class _Reporter:
 
 def _run_task(topic: str, *args) -> str:
     """One job in a Dask task: one Numba thread (as the local pool's workers
-    have), progress sent under ``topic``; ``args`` are those of ``_run_job``."""
+    have), progress sent under ``topic``; ``args`` are those of
+    :func:`~physics.scenarios.jobs.run_job`."""
     import numba
 
-    from .runner import _run_job
     numba.set_num_threads(1)
-    return _run_job(*args, on_progress=_Reporter(topic, args[-1]))
+    return jobs.run_job(*args, on_progress=_Reporter(topic, args[-1]))
 
 
 def run_on_dask(args: list, update, dask: dict, log=print) -> None:
-    """Run the jobs ``args`` (argument tuples of ``_run_job``, the last item
+    """Run the jobs ``args`` (argument tuples of ``run_job``, the last item
     the job's index) on Dask; ``update(index, fraction)`` receives their
     progress. A failed job's exception is raised here; on that or on Ctrl-C
     the remaining tasks are cancelled."""

@@ -4,15 +4,14 @@
 scenarios on :class:`~physics.lammps_engine.LammpsHertzSimulation` instead
 of :class:`~physics.hertz.HertzSimulation`; with ``--mpi N`` each run goes
 to ``mpiexec -n N`` (:mod:`physics.scenarios.lammps_job`). The experiments
-build their simulation with :func:`hertz_simulation`, which creates the
-engine of the run; an experiment lists the engines it supports in its
-``engines`` attribute.
+build their simulation with :func:`hertz_simulation`, naming the engine
+of the run, which the job gives the experiment
+(:func:`physics.scenarios.experiment.get_experiment`); an experiment lists
+the engines it supports in its ``engines`` attribute.
 """
 from __future__ import annotations
 
 ENGINES = ("numba", "lammps")
-
-_CURRENT = {"engine": "numba"}
 
 
 def check_engine(name: str, experiment=None) -> str:
@@ -32,19 +31,10 @@ def check_engine(name: str, experiment=None) -> str:
     return name
 
 
-def use_engine(name: str) -> None:
-    """Make :func:`hertz_simulation` create ``name``'s engine (this process)."""
-    _CURRENT["engine"] = check_engine(name)
-
-
-def current_engine() -> str:
-    return _CURRENT["engine"]
-
-
-def hertz_simulation(*args, **kwargs):
-    """The Hertz simulation of the current engine, created with these
-    arguments (those of :class:`~physics.hertz.HertzSimulation`)."""
-    if _CURRENT["engine"] == "lammps":
+def hertz_simulation(engine: str, *args, **kwargs):
+    """The Hertz simulation of ``engine`` ("numba" or "lammps"), created
+    with the other arguments (those of :class:`~physics.hertz.HertzSimulation`)."""
+    if engine == "lammps":
         from ..lammps_engine import LammpsHertzSimulation
 
         return LammpsHertzSimulation(*args, **kwargs)

@@ -1,9 +1,15 @@
 """The interface of a scenario's experiment, and the registry of experiments.
 
 An experiment is the code behind a scenario file: it turns the resolved
-parameters into runs, and runs into a summary and figures. Subclass
-:class:`Experiment`, decorate it with :func:`register` and give it a file
-in ``configs/``::
+parameters into runs, and runs into a summary and figures. Adding a
+scenario takes one module in this package and one scenario file in
+``configs/``:
+
+* ``physics/scenarios/my_scenario.py`` subclasses :class:`Experiment` and
+  registers it with :func:`register`, the decorator written at the start of
+  a line::
+
+    from .experiment import Experiment, register
 
     @register("my-scenario")
     class MyScenario(Experiment):
@@ -23,19 +29,56 @@ in ``configs/``::
 
         def plot(self, ds, p, out_dir):        # PNG paths
             ...
+
+* ``physics/scenarios/configs/my-scenario.yaml`` gives its parameters
+  (``name: my-scenario``; the format is in :mod:`physics.scenarios.config`).
+
+Nothing else lists the experiments: :func:`experiments` imports the modules
+of this package whose source has a line beginning with ``@register(`` (found
+by reading the files, so the other modules stay unimported), and the tests
+check that every registered experiment has a scenario file of its name and
+every scenario file an experiment. An experiment that runs on the Hertz
+engines lists them in ``engines`` and builds its simulation with
+``engines.hertz_simulation(self.engine, ...)``: :attr:`Experiment.engine` is
+the engine the run chose.
 """
 from __future__ import annotations
 
+import functools
 import importlib
+import pkgutil
+import re
 from pathlib import Path
 
+from .engines import check_engine
+
 _REGISTRY: dict[str, type] = {}
-# modules whose import registers the shipped experiments
-_MODULES = ("physics.scenarios.herman2013", "physics.scenarios.herman2011",
-            "physics.scenarios.godlovitch", "physics.scenarios.ship_transit")
+#: a line of a module that registers an experiment
+_REGISTERS = re.compile(r"^@register\(", re.MULTILINE)
+
+
+def experiment_modules(directory: Path = Path(__file__).parent,
+                       package: str = __package__) -> list[str]:
+    """The modules of ``package`` (in ``directory``) that register an
+    experiment: those whose source has a line beginning with ``@register(``."""
+    found = []
+    for info in pkgutil.iter_modules([str(directory)]):
+        path = directory / f"{info.name}.py"
+        if not info.ispkg and path.is_file() and _REGISTERS.search(path.read_text("utf-8")):
+            found.append(f"{package}.{info.name}")
+    return found
+
+
+@functools.cache
+def _import_experiment_modules() -> None:
+    for module in experiment_modules():
+        importlib.import_module(module)
 
 
 def register(name: str):
+    """Class decorator: register an :class:`Experiment` subclass as the
+    experiment of the scenario ``name`` (written at the start of a line, so
+    that :func:`experiments` finds its module)."""
     def deco(cls):
         cls.name = name
         _REGISTRY[name] = cls
@@ -44,17 +87,19 @@ def register(name: str):
 
 
 def experiments() -> dict[str, type]:
-    """Experiment name → class (imports the shipped experiment modules)."""
-    for mod in _MODULES:
-        importlib.import_module(mod)
+    """Experiment name → class (imports the modules of this package that
+    register experiments, see :func:`experiment_modules`)."""
+    _import_experiment_modules()
     return dict(_REGISTRY)
 
 
-def get_experiment(name: str) -> "Experiment":
+def get_experiment(name: str, engine: str = "numba") -> "Experiment":
+    """The experiment ``name``, running on ``engine`` (checked with
+    :func:`~physics.scenarios.engines.check_engine`)."""
     found = experiments()
     if name not in found:
         raise ValueError(f"unknown scenario {name!r}; valid scenarios: {', '.join(sorted(found))}")
-    return found[name]()
+    return found[name](check_engine(engine, found[name]))
 
 
 class Experiment:
@@ -71,6 +116,10 @@ class Experiment:
     takes_snapshots: bool = True
     #: the engines it runs on (:mod:`physics.scenarios.engines`)
     engines: tuple[str, ...] = ("numba",)
+
+    def __init__(self, engine: str = "numba"):
+        #: the engine this instance runs on (one of ``engines``)
+        self.engine = engine
 
     def cases(self, p: dict) -> list[dict]:
         """One dict of coordinate values per independent run (default: one)."""

@@ -56,7 +56,11 @@ IMPACT_SPEED = 1.0   # m/s: the time-step check admits impacts up to this relati
 # shared set-up and measurements
 # ---------------------------------------------------------------------------
 
-def _contact_law(p: dict):
+def contact_law(p: dict):
+    """The Herman (2013) contact law with the scenario parameters
+    ``friction``, ``restitution``, ``tangential_damping``,
+    ``tangential_stiffness``, ``friction_moves_floes`` and
+    ``stiffness_scale`` of ``p`` (also that of ship-transit)."""
     c = dataclasses.replace(HERMAN2013.contact, friction=p["friction"],
                             restitution=p["restitution"],
                             tangential_damping=p["tangential_damping"],
@@ -65,12 +69,13 @@ def _contact_law(p: dict):
     return scaled_contact(c, p["stiffness_scale"])
 
 
-def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None) -> HertzSimulation:
-    contact = _contact_law(p)
+def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None,
+                engine: str) -> HertzSimulation:
+    contact = contact_law(p)
     dt = hertz_time_step(field, box, contact, IMPACT_SPEED, HERMAN2013.time_step,
                          p["stiffness_scale"])
-    return hertz_simulation(field, box, contact, forcing, dt=dt, impact_speed=IMPACT_SPEED,
-                           allow_overlap=True)
+    return hertz_simulation(engine, field, box, contact, forcing, dt=dt,
+                            impact_speed=IMPACT_SPEED, allow_overlap=True)
 
 
 def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_type=PeriodicBox):
@@ -118,9 +123,10 @@ def _snapshot(rec, sim: HertzSimulation, contacts) -> None:
                  frozen=sim.inv_mass == 0)
 
 
-def _advance(sim: HertzSimulation, duration: float) -> str | None:
-    """Advance; a physics failure is returned as a message (the run ends
-    there, with everything recorded so far)."""
+def advance(sim: HertzSimulation, duration: float) -> str | None:
+    """Advance ``sim`` by ``duration`` (at least one step); a physics failure
+    is returned as a message (the run ends there, with everything recorded
+    so far), else None."""
     try:
         sim.advance(max(duration, sim.dt))     # at least one step: the loops always progress
     except (FloatingPointError, RuntimeError) as exc:
@@ -146,7 +152,7 @@ def _run_for_duration(p: dict, st: dict, rec, measure) -> None:
     sim = st["sim"]
     snaps = sorted(p["snapshot_times"]) + [p["duration"]]
     while st["error"] is None and sim.time < p["duration"] - 0.5 * sim.dt:
-        st["error"] = _advance(sim, min(p["output_interval"], p["duration"] - sim.time))
+        st["error"] = advance(sim, min(p["output_interval"], p["duration"] - sim.time))
         values, c = measure(sim)
         rec.record(sim.time, **values)
         while st["next_snap"] < len(snaps) and sim.time >= snaps[st["next_snap"]] - 1e-9:
@@ -258,7 +264,7 @@ class Convergence(Experiment):
                                        max_concentration=min(0.999, p["end_concentration"] + 0.02))
             # no wind and no current, but water drag and Coriolis act on moving floes
             forcing = HERMAN2013.make_forcing(wind=(0.0, 0.0), current=(0.0, 0.0))
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, next_snap=p["start_concentration"] + p["snapshot_step"],
                       error=None)
             net, c = network(sim)
@@ -269,7 +275,7 @@ class Convergence(Experiment):
         dt_out = p["output_step"] / rate
         while st["error"] is None and sim.concentration < a1 - 0.5 * rate * sim.dt:
             step = min(dt_out, (a1 - sim.concentration) / rate)
-            st["error"] = _advance(sim, step)
+            st["error"] = advance(sim, step)
             net, c = network(sim)
             rec.record(sim.time, **net)
             if net["concentration"] >= st["next_snap"] - 1e-9:
@@ -404,7 +410,7 @@ class Wind(Experiment):
             drift = steady_drift(forcing, field.radii, field.thickness, field.masses)
             field = FloeField(field.positions, field.radii, field.thickness, drift,
                               density=field.density)
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, error=None, next_snap=0)
 
         def measure(sim):
@@ -526,7 +532,7 @@ class MarginalIceZone(Experiment):
             field = FloeField(field.positions, field.radii, field.thickness, field.velocities,
                               density=field.density, frozen=frozen)
             forcing = HERMAN2013.make_forcing(wind=(math.sqrt(speed ** 2 - uy ** 2), uy))
-            sim = _simulation(field, box, p, forcing)
+            sim = _simulation(field, box, p, forcing, self.engine)
             st = dict(sim=sim, error=None, next_snap=0)
         sim = st["sim"]
         edges = np.linspace(0.0, sim.box.ly, p["profile_bins"] + 1)

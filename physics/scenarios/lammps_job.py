@@ -30,6 +30,7 @@ from collections import deque
 from pathlib import Path
 
 from .. import mpi
+from .jobs import job_paths, run_job
 
 PROGRESS = "progress "
 
@@ -64,11 +65,12 @@ def command(spec: Path, ranks: int) -> list[str]:
 
 def run_lammps_jobs(args: list[tuple], ranks: int, update) -> None:
     """Run the jobs ``args`` (the argument tuples of
-    :func:`physics.scenarios.runner._run_job`) one after the other, each on
+    :func:`physics.scenarios.jobs.run_job`) one after the other, each on
     ``ranks`` ranks; ``update(k, fraction)`` gets their progress."""
     for k, a in enumerate(args):
-        directory, c, m = Path(a[4]), a[5], a[6]
-        spec = directory / "jobs" / f"case{c:02d}_member{m:02d}.job.json"
+        c, m = a[5], a[6]
+        result = job_paths(Path(a[4]), c, m)[0]
+        spec = result.with_suffix(".job.json")
         spec.write_text(json.dumps({"args": list(a[:8]) + [k]}))
         tail = deque(maxlen=30)
         env = dict(os.environ, PYTHONUNBUFFERED="1")
@@ -98,7 +100,6 @@ def run_lammps_jobs(args: list[tuple], ranks: int, update) -> None:
                 f"the LAMMPS job of case {c}, member {m} failed {where} (exit code {code}); "
                 f"its last checkpoint, if any, is intact. Its last output:\n{lines}")
         spec.unlink(missing_ok=True)
-        result = directory / "jobs" / f"case{c:02d}_member{m:02d}.nc"
         if not result.exists():
             raise RuntimeError(f"the LAMMPS job of case {c}, member {m} ended without writing "
                                f"{result}; its last output:\n" + "\n".join(tail))
@@ -107,8 +108,6 @@ def run_lammps_jobs(args: list[tuple], ranks: int, update) -> None:
 
 def main(argv=None) -> int:
     """Run the job of a ``JOB.json`` file on this rank (all ranks do)."""
-    from .runner import _run_job
-
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) != 1:
         print("usage: python -m physics.scenarios.lammps_job JOB.json", file=sys.stderr)
@@ -120,7 +119,7 @@ def main(argv=None) -> int:
         if root:
             print(f"{PROGRESS}{fraction:.6f}", flush=True)
     try:
-        _run_job(*args, on_progress=report, engine="lammps")
+        run_job(*args, on_progress=report, engine="lammps")
     except Exception as exc:
         print(f"rank {mpi.world_rank()}: {type(exc).__name__}: {exc}", file=sys.stderr,
               flush=True)

@@ -36,11 +36,11 @@ from .config import ScenarioConfig, bundled_configs, dump_yaml, load_config, par
 from .dask_pool import check_options as check_dask
 from .dask_pool import describe as describe_dask
 from .dask_pool import run_on_dask
-from .. import mpi
 from ..markdown import table_row
-from .engines import check_engine, use_engine
+from .engines import check_engine
 from .experiment import get_experiment
-from .recorder import Recorder, atomic_write, checkpoint_files, checkpoint_fraction
+from .jobs import init_worker, job_paths, run_job
+from .recorder import atomic_write, checkpoint_fraction
 
 RUN_FILE = "run.yaml"
 RESULTS_FILE = "results.nc"
@@ -88,61 +88,6 @@ class RunResult:
     figures: list[Path]
     summary: list[tuple[str, str, str]]
     wall_time: float
-
-
-# ---------------------------------------------------------------------------
-# jobs (run in worker processes or in-process)
-# ---------------------------------------------------------------------------
-
-_QUEUE = None
-
-
-def _init_worker(queue, threads):
-    """Worker start-up: progress queue, one Numba thread, and Ctrl-C left to
-    the parent (which stops the workers; their checkpoints are intact)."""
-    global _QUEUE
-    _QUEUE = queue
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if threads:
-        import numba
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-
-
-def _job_paths(directory: Path, c: int, m: int) -> tuple[Path, Path]:
-    base = directory / "jobs" / f"case{c:02d}_member{m:02d}"
-    return base.with_suffix(".nc"), base.with_suffix(".ckpt")
-
-
-def _run_job(config_data: dict, params: dict, case: dict, seed: int, directory: str, c: int,
-             m: int, checkpoint_every: float, job_id: int, on_progress=None,
-             engine: str = "numba") -> str:
-    """One simulation: (case c, member m) on ``engine``. Returns the path of
-    its NetCDF. In a run on several MPI ranks every rank calls it; rank 0
-    alone writes files."""
-    use_engine(engine)
-    root = mpi.world_rank() == 0
-    cfg = parse_config(config_data)
-    exp = get_experiment(cfg.name)
-    out, ckpt = _job_paths(Path(directory), c, m)
-    if on_progress is None and _QUEUE is not None:
-        last = [0.0, -1.0]
-
-        def on_progress(f):
-            now = time.monotonic()
-            if f >= 1.0 or now - last[0] > 0.5:
-                last[0] = now
-                _QUEUE.put((job_id, f))
-    rec = Recorder(ckpt, checkpoint_every, on_progress, exp.variables,
-                   keep_snapshots=exp.takes_snapshots, write=root)
-    exp.simulate(params, case, seed, rec)
-    rec.progress(1.0)
-    if root:
-        ds = rec.dataset()
-        ds.attrs.update(case=c, member=m, seed=str(seed))
-        atomic_write(out, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
-        for file in checkpoint_files(ckpt):
-            file.unlink(missing_ok=True)
-    return str(out)
 
 
 # ---------------------------------------------------------------------------
@@ -256,7 +201,7 @@ def _execute(out: Path, info: dict, workers, checkpoint_every, progress, plots, 
     jobs = []
     for c, case in enumerate(cases):
         for m, s in enumerate(seeds):
-            nc_path, _ = _job_paths(out, c, m)
+            nc_path, _ = job_paths(out, c, m)
             jobs.append(dict(c=c, m=m, case=case, seed=s, done=nc_path.exists(),
                              cost=exp.workload(params, case)))
     todo = sorted((j for j in jobs if not j["done"]), key=lambda j: -j["cost"])
@@ -290,7 +235,7 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
     progress bar."""
     from tqdm.auto import tqdm
 
-    fractions = {k: checkpoint_fraction(_job_paths(out, j["c"], j["m"])[1])
+    fractions = {k: checkpoint_fraction(job_paths(out, j["c"], j["m"])[1])
                  for k, j in enumerate(todo)}
     bar = tqdm(total=len(todo), unit="run", desc=info["scenario"], disable=not progress,
                dynamic_ncols=True, bar_format="{l_bar}{bar}| {n:.2f}/{total} runs "
@@ -335,7 +280,7 @@ def _run_jobs(out: Path, info: dict, todo: list, workers: int, checkpoint_every,
             run_on_dask(args, update, dask, log)
         elif workers == 1:
             for k, a in enumerate(args):
-                _run_job(*a, on_progress=lambda f, k=k: in_process_update(k, f))
+                run_job(*a, on_progress=lambda f, k=k: in_process_update(k, f))
                 update(k, 1.0)
         else:
             _run_pool(args, workers, update)
@@ -367,10 +312,10 @@ def _run_pool(args, workers, update):
             update(k, f)
     reader = threading.Thread(target=pump, daemon=True)
     reader.start()
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
                                initargs=(queue, 1))
     try:
-        futures = {pool.submit(_run_job, *a): a[-1] for a in args}
+        futures = {pool.submit(run_job, *a): a[-1] for a in args}
         for fut in as_completed(futures):
             fut.result()
             update(futures[fut], 1.0)
@@ -400,7 +345,7 @@ def combine(out: Path, info: dict, cases: list[dict], exp):
     for c in range(len(cases)):
         members = []
         for m in range(len(info["member_seeds"])):
-            path, _ = _job_paths(out, c, m)
+            path, _ = job_paths(out, c, m)
             with xr.open_dataset(path, engine="h5netcdf") as d:
                 members.append(d.load())
             if members[-1].attrs.get("notes"):
@@ -439,7 +384,7 @@ def make_figures(out: Path, ds, exp, params) -> list[Path]:
     return [Path(p) for p in exp.plot(ds, params, fig_dir)]
 
 
-def _load_run(directory):
+def load_run(directory):
     """(directory, run.yaml contents, experiment, results) of a finished
     run directory; a clear error if it holds no results."""
     import xarray as xr
@@ -461,7 +406,7 @@ def summarise_run(directory) -> str:
     """The summary table of a finished run directory, computed afresh from
     its results (the analysis may be newer than the run); summary.md, with
     the run's wall time, is left as it is."""
-    out, info, exp, ds = _load_run(directory)
+    out, info, exp, ds = load_run(directory)
     # the header from the run's own record: its scenario file may be a copy
     cfg = SimpleNamespace(name=info["scenario"], title=info.get("title", ""),
                           reproduces=info.get("reproduces", ""))
@@ -500,5 +445,5 @@ def _hms(seconds: float) -> str:
 
 def plot_run(directory) -> list[Path]:
     """(Re)make the figures of a finished run directory."""
-    out, info, exp, ds = _load_run(directory)
+    out, info, exp, ds = load_run(directory)
     return make_figures(out, ds, exp, info["parameters"])

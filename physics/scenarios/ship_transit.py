@@ -96,7 +96,7 @@ from ..params import HERMAN2013
 from ..ship import TransitBox, psv_ship
 from . import plots
 from .experiment import Experiment, register
-from .herman2013 import _advance, _contact_law
+from .herman2013 import advance, contact_law
 
 #: open water between the bow at the start and the ice [m]
 LEAD_IN = 10.0
@@ -298,7 +298,7 @@ def build_simulation(p: dict, case: dict, seed: int):
         field = FloeField(field.positions, field.radii, field.thickness, u,
                           density=field.density)
         drift = float(np.mean(np.hypot(u[:, 0], u[:, 1])))
-    contact = _contact_law(p)
+    contact = contact_law(p)
     impact = (1.0 + contact.restitution) * v + 2.0 * drift
     dt = min(hertz_time_step(field, box, contact, impact, HERMAN2013.time_step,
                              p["stiffness_scale"]),
@@ -466,7 +466,7 @@ class ShipTransit(Experiment):
             bow_x = sim.ship.position[0] + geo["bow"] * math.cos(sim.ship.heading)
             if bow_x >= geo["end_bow"] or sim.time >= max_time - 0.5 * sim.dt:
                 break
-            st["error"] = _advance(sim, min(p["output_interval"], max_time - sim.time))
+            st["error"] = advance(sim, min(p["output_interval"], max_time - sim.time))
             if st["error"] is None and not all(sim.box.periodic):
                 st["error"] = _hull_at_wall(sim)
             records = sim.ship.records()

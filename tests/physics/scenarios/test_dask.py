@@ -13,7 +13,7 @@ xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
 from physics.scenarios import cli, run_scenario  # noqa: E402
-from physics.scenarios import runner as runner_module  # noqa: E402
+from physics.scenarios import jobs as jobs_module  # noqa: E402
 
 # a two-member convergence ensemble of a few seconds
 TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.0,
@@ -89,7 +89,7 @@ def test_a_job_that_fails_on_a_worker_raises_its_error(tmp_path, monkeypatch, sc
     def collapse(*args, **kwargs):
         raise RuntimeError("inelastic collapse at t = 12.5 s")
 
-    monkeypatch.setattr(runner_module, "_run_job", collapse)
+    monkeypatch.setattr(jobs_module, "run_job", collapse)
     with pytest.raises(RuntimeError, match="inelastic collapse at t = 12.5 s"):
         run_scenario("herman2013-convergence", overrides=TINY, ensemble=2,
                      out=tmp_path / "a", dask={"scheduler": scheduler}, **QUIET)

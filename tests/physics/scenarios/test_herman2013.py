@@ -199,7 +199,7 @@ def test_contact_parameters_reach_the_contact_law(name):
     restitution 0.5, no tangential damping, the Mindlin stiffness, friction
     acting on translation)."""
     from physics.params import HERMAN2013
-    from physics.scenarios.herman2013 import _contact_law
+    from physics.scenarios.herman2013 import contact_law
     from physics.scenarios.runner import find_config
 
     defaults = find_config(name).defaults()
@@ -207,7 +207,7 @@ def test_contact_parameters_reach_the_contact_law(name):
         return (c.friction, c.restitution, c.tangential_damping, c.tangential_stiffness,
                 c.tangential_translation)
 
-    assert law(_contact_law(defaults)) == (HERMAN2013.contact.friction, 0.5, 0.0, 1.0, True)
+    assert law(contact_law(defaults)) == (HERMAN2013.contact.friction, 0.5, 0.0, 1.0, True)
     changed = dict(defaults, friction=0.3, restitution=0.9, tangential_damping=0.5,
                    tangential_stiffness=0.24, friction_moves_floes=False)
-    assert law(_contact_law(changed)) == (0.3, 0.9, 0.5, 0.24, False)
+    assert law(contact_law(changed)) == (0.3, 0.9, 0.5, 0.24, False)

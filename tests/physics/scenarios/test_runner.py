@@ -18,11 +18,10 @@ pytest.importorskip("yaml")
 from physics.scenarios import get_experiment, load_config, resume_run, run_scenario  # noqa: E402
 from physics.scenarios import recorder as recorder_module  # noqa: E402
 from physics.scenarios.config import bundled_configs, parse_set  # noqa: E402
+from physics.scenarios.experiment import experiment_modules, experiments  # noqa: E402
 from physics.scenarios.recorder import checkpoint_files  # noqa: E402
 from physics.scenarios.runner import QUICK_NOTE, find_config, format_summary, member_seeds  # noqa: E402
 
-ALL = ["godlovitch-kernels", "godlovitch-rafting", "godlovitch-thermo", "herman2013-convergence",
-       "herman2013-miz", "herman2013-wind", "scm-analytic"]
 # a convergence run of a few seconds
 TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.0,
             output_step=0.004)
@@ -74,13 +73,61 @@ def _assert_same_numbers(res, whole):
         np.testing.assert_array_equal(ds[name].values, whole[name].values, err_msg=name)
 
 
-def test_every_shipped_file_parses_and_names_an_experiment():
-    files = bundled_configs()
-    for name in ALL:
-        cfg = load_config(files[name])
-        assert cfg.name == name
-        get_experiment(name)
-        cfg.resolve(quick=True)
+@pytest.mark.parametrize("name, path", bundled_configs().items())
+def test_every_shipped_file_parses_and_names_an_experiment(name, path):
+    cfg = load_config(path)
+    assert cfg.name == name
+    get_experiment(name)
+    cfg.resolve(quick=True)
+
+
+def test_every_experiment_has_a_shipped_file_and_every_file_an_experiment():
+    assert len(bundled_configs()) >= 9       # the glob sees the shipped files
+    assert sorted(experiments()) == sorted(bundled_configs())
+
+
+def test_the_modules_that_register_an_experiment_are_found(tmp_path):
+    """A module with a line beginning with ``@register(`` is an experiment
+    module; one that shows the decorator indented (in a docstring) is not,
+    nor is a subpackage. Finding them reads the files, imports nothing."""
+    package = tmp_path / "extra_scenarios"
+    (package / "sub").mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "flows.py").write_text(
+        "from physics.scenarios.experiment import Experiment, register\n\n\n"
+        "@register('extra-flows')\nclass Flows(Experiment):\n    pass\n")
+    (package / "helpers.py").write_text(
+        '"""How to add one::\n\n    @register("not-this")\n"""\nraise ImportError\n')
+    (package / "sub" / "__init__.py").write_text("@register('nor-this')\n")
+    assert experiment_modules(package, "extra_scenarios") == ["extra_scenarios.flows"]
+    assert "extra-flows" not in experiments()
+    shipped = experiment_modules()
+    assert {"physics.scenarios.herman2011", "physics.scenarios.ship_transit"} <= set(shipped)
+    assert "physics.scenarios.experiment" not in shipped
+
+
+def test_an_experiment_builds_its_simulations_on_the_engine_it_was_made_for(monkeypatch):
+    """The engine is an argument of the experiment, not a setting of the
+    process: two instances in one process build on their own engines."""
+    from physics.scenarios import herman2013
+
+    class Built(Exception):
+        pass
+    seen = []
+
+    def spy(engine, *args, **kwargs):
+        seen.append(engine)
+        raise Built
+    monkeypatch.setattr(herman2013, "hertz_simulation", spy)
+    cls = type(get_experiment("herman2013-convergence"))
+    p = find_config("herman2013-convergence").resolve(TINY)
+    for engine in ("lammps", "numba", "lammps"):
+        with pytest.raises(Built):
+            cls(engine).simulate(p, {}, 0, recorder_module.Recorder(variables=cls.variables))
+    assert seen == ["lammps", "numba", "lammps"]
+    assert get_experiment("herman2013-convergence").engine == "numba"
+    with pytest.raises(ValueError, match="runs on the numba engine only, not on 'lammps'"):
+        get_experiment("herman2011-clustering", "lammps")
 
 
 def test_unknown_scenario_and_parameter_list_the_valid_ones():
