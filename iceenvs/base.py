@@ -49,9 +49,9 @@ import gymnasium as gym
 import numpy as np
 
 from physics import PaperPreset
+from physics.checks import check_range
 from physics.hertz import hertz_time_step, scaled_contact  # noqa: F401  (used by the envs)
 from physics.markdown import table_row
-from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
 

@@ -51,8 +51,8 @@ import gymnasium as gym
 import numpy as np
 
 from physics import FloeField, HERMAN2013
+from physics.checks import check_range
 from physics.hertz import hull_contact_time
-from physics.params import check_range
 
 from .base import TIME_FEATURE, HertzEnv
 from .observations import Feature, normalise

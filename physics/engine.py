@@ -40,11 +40,12 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from .checks import check_range
 from .domain import Box
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress
-from .params import ContactParams, check_range
+from .params import ContactParams, PaperPreset
 
 __all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
            "snapshot"]
@@ -153,8 +154,6 @@ def engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, k
     (:meth:`~physics.params.PaperPreset.make_forcing`), False or None
     none, a :class:`~physics.forcing.Forcing` that one.
     """
-    from .params import PaperPreset
-
     if not isinstance(preset, PaperPreset):
         raise TypeError(f"preset must be a PaperPreset, got {type(preset).__name__}")
     own = set(inspect.signature(cls.__init__).parameters) - {"self", "field", "box", "forcing"}

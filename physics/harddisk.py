@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import harddisk_kernels as K
+from .checks import check_range
 from .domain import Box, PeriodicBox
 from .engine import FailureReason, SimulationError, checked_motion, engine_from_preset, snapshot
 from .event_calendar import new_calendar
@@ -36,7 +37,7 @@ from .floes import FloeField, max_overlap
 from .forcing import Forcing
 from .harddisk_kernels import HardDiskStatus
 from .observables import Contacts, Fabric, Stress, collision_stress, contacts_within, fabric
-from .params import PaperPreset, check_range
+from .params import PaperPreset
 
 __all__ = ["HardDiskSimulation", "HardDiskStatus", "CollisionLog", "choose_cells"]
 

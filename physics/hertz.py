@@ -25,6 +25,7 @@ import numpy as np
 
 from . import hertz_kernels as K
 from . import hull_contact as HC
+from .checks import check_range
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
 from .engine import FailureReason, SimulationError, engine_from_preset
@@ -36,7 +37,7 @@ from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
-from .params import ContactParams, PaperPreset, check_range
+from .params import ContactParams, PaperPreset
 from .progress import steps_with_bar
 from .ship import Ship, ShipLoads, ShipState
 

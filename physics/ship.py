@@ -45,10 +45,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import hull_contact as HC
+from .checks import check_range
 from .domain import Box
 from .floes import FloeField, place_floes, spatial_order
 from .hull import MODEL_HULL, PSV_HULL, Hull
-from .params import check_range
 
 __all__ = ["Ship", "ShipHydrodynamics", "ShipState", "ShipLoads", "psv_ship", "model_ship",
            "TransitBox", "transit_field", "FOSSEN_SUPPLY"]
