@@ -12,8 +12,10 @@ The contract
 Names
     The same name always means the same thing: ``n_floes``, ``time``,
     ``box``, ``positions``, ``velocities``, ``angular_velocities``,
-    ``advance``, ``contacts``, ``fabric``, ``contact_stress``,
-    ``kinetic_energy``, ``momentum`` and ``state``.
+    ``radii``, ``masses``, ``frozen``, ``concentration``, ``advance``,
+    ``contacts``, ``fabric``, ``contact_stress``, ``kinetic_energy``,
+    ``momentum`` and ``state``. The per-floe names are those of
+    :class:`~physics.floes.FloeField`.
 Input
     The :class:`~physics.floes.FloeField` given to the constructor is
     copied; the caller's arrays are never modified.
@@ -23,6 +25,9 @@ Arrays exposed
     advances, and writing into them raises ``ValueError``. Assign a whole
     array to ``velocities`` (or ``angular_velocities``) to change the state;
     the assignment is checked (shape, finiteness, frozen floes at rest).
+    ``radii``, ``masses`` and ``frozen`` never change during a run; they
+    are read-only too (writing raises ``ValueError``), and may be views of
+    the engine's own arrays rather than copies (:func:`read_only`).
 Mistakes
     A wrong type is a ``TypeError``, a wrong value (out of range, wrong
     shape, not finite, overlapping floes) a ``ValueError``, both raised
@@ -48,7 +53,7 @@ from .observables import Contacts, Fabric, Stress
 from .params import ContactParams, PaperPreset
 
 __all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
-           "snapshot"]
+           "read_only", "snapshot"]
 
 
 class FailureReason(str, Enum):
@@ -113,6 +118,27 @@ class FloeEngine(Protocol):
         """(N,) angular velocities [1/s]; a read-only snapshot (zero for hard discs)."""
         ...
 
+    @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii r [m]; read-only."""
+        ...
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses m = ρ h π r² [kg]; read-only."""
+        ...
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the floes held fixed (inverse mass 0: they
+        never move but take part in contacts); read-only."""
+        ...
+
+    @property
+    def concentration(self) -> float:
+        """Ice concentration A = Σ π r² / S of the box now [-]."""
+        ...
+
     def advance(self, duration: float, *, progress: bool = False) -> None:
         """Advance the model time by ``duration`` seconds."""
         ...
@@ -172,6 +198,15 @@ def snapshot(a: np.ndarray) -> np.ndarray:
     c = np.array(a, copy=True)
     c.flags.writeable = False
     return c
+
+
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a``, without a copy: what the engines'
+    ``radii``, ``masses`` and ``frozen`` return, arrays that do not change
+    during a run."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
 
 def checked_motion(name: str, value, shape: tuple, frozen: np.ndarray, what: str) -> np.ndarray:

@@ -31,7 +31,8 @@ import numpy as np
 from . import harddisk_kernels as K
 from .checks import check_range
 from .domain import Box, PeriodicBox
-from .engine import FailureReason, SimulationError, checked_motion, engine_from_preset, snapshot
+from .engine import (FailureReason, SimulationError, checked_motion, engine_from_preset, read_only,
+                     snapshot)
 from .event_calendar import new_calendar
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
@@ -132,7 +133,8 @@ class HardDiskSimulation:
     box : PeriodicBox
     field : FloeField
         The simulation's copy of the initial field.
-    radius, mass : (N,) arrays
+    radii, masses, frozen : (N,) read-only arrays
+        Radii [m], masses [kg] and the frozen flags of the floes.
     L : float
         Side of the box [m].
 
@@ -190,8 +192,8 @@ class HardDiskSimulation:
                 f"largest floe (radius {field.radii.max():.4g} m) with 2 cells to spare")
 
         self.field = f = field.copy()
-        self.radius = f.radii.copy()
-        self.mass = f.masses.copy()
+        self._radius = f.radii.copy()
+        self._mass = f.masses.copy()
         self.n_cells, self.cell = nc, cell
         rank = np.full(n, -1, dtype=np.int64)
         rank[bigs] = np.arange(bigs.size)
@@ -205,7 +207,7 @@ class HardDiskSimulation:
             lists=np.zeros((nc * nc, 8), dtype=np.int64), sizes=np.zeros(nc * nc, dtype=np.int64))
         self._discs = K.Discs(
             pos=pos.copy(), vel=f.velocities.copy(), t_loc=np.zeros(n),
-            radius=self.radius, inv_mass=np.where(f.frozen, 0.0, 1.0 / self.mass),
+            radius=self._radius, inv_mass=np.where(f.frozen, 0.0, 1.0 / self._mass),
             changes=np.zeros(n, dtype=np.int64), last_collision=np.full(n, -np.inf),
             rapid_time=np.full(n, -np.inf), rapid_run=np.zeros(n, dtype=np.int64))
         self._calendar = new_calendar(n, K.EV_NONE)
@@ -313,8 +315,8 @@ class HardDiskSimulation:
         f = self.field
         if self.forcing is None:
             return K.Drag(False, self.max_velocity_step, np.zeros(f.n), np.zeros((f.n, 2)))
-        tau = self.forcing.time_constant(f.radii, f.thickness, self.mass)
-        u_eq = self.forcing.equilibrium_velocity(f.radii, f.thickness, self.mass)
+        tau = self.forcing.time_constant(f.radii, f.thickness, self._mass)
+        u_eq = self.forcing.equilibrium_velocity(f.radii, f.thickness, self._mass)
         inv_tau = np.where(f.frozen, 0.0, 1.0 / tau)
         return K.Drag(True, self.max_velocity_step, inv_tau, np.ascontiguousarray(u_eq))
 
@@ -413,6 +415,22 @@ class HardDiskSimulation:
         return snapshot(np.zeros(self.n_floes))
 
     @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii [m] (a read-only view; they never change)."""
+        return read_only(self._radius)
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses ρ h π r² [kg] (a read-only view; they never change)."""
+        return read_only(self._mass)
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the floes held fixed (inverse mass 0; a
+        read-only view)."""
+        return read_only(self.field.frozen)
+
+    @property
     def collision_count(self) -> int:
         return int(self._counters[K.Counter.COLLISIONS])
 
@@ -439,13 +457,13 @@ class HardDiskSimulation:
         """Σ m u²/2 of the mobile floes [J] (no rotation in this engine)."""
         d = self._discs
         mobile = d.inv_mass > 0
-        return float(0.5 * np.sum(self.mass[mobile] * np.sum(d.vel[mobile] ** 2, axis=1)))
+        return float(0.5 * np.sum(self._mass[mobile] * np.sum(d.vel[mobile] ** 2, axis=1)))
 
     def momentum(self) -> np.ndarray:
         """Σ m u of the mobile floes [kg m/s]."""
         d = self._discs
         mobile = d.inv_mass > 0
-        return (self.mass[mobile, None] * d.vel[mobile]).sum(axis=0)
+        return (self._mass[mobile, None] * d.vel[mobile]).sum(axis=0)
 
     # -- collision log and virial ----------------------------------------------
     @property
@@ -469,7 +487,7 @@ class HardDiskSimulation:
         """Floe pairs whose edges are closer than ``gap`` [m] now (hard discs
         touch only at the instants of collision, so a contact is a near
         neighbour), without forces; see :func:`physics.observables.contacts_within`."""
-        return contacts_within(self.positions, self.radius, self.box, gap)
+        return contacts_within(self.positions, self._radius, self.box, gap)
 
     def fabric(self, gap: float = 0.01) -> Fabric:
         """Contact fabric of the pairs closer than ``gap`` [m] (see :meth:`contacts`)."""
@@ -484,7 +502,7 @@ class HardDiskSimulation:
         span = self.time - self._log_t0
         if span <= 0:
             raise ValueError("the collision window is empty: advance the simulation first")
-        return collision_stress(log, self.radius, self.L * self.L, span, per_floe=per_floe)
+        return collision_stress(log, self._radius, self.L * self.L, span, per_floe=per_floe)
 
     def reset_stress(self) -> None:
         """Start a new averaging window for :meth:`stress`."""
@@ -520,7 +538,8 @@ class HardDiskSimulation:
 
     @property
     def concentration(self) -> float:
-        return float(np.sum(np.pi * self.radius ** 2) / self.L ** 2)
+        """Ice concentration A = Σ π r² / L² [-]."""
+        return float(np.sum(np.pi * self._radius ** 2) / self.L ** 2)
 
     def __repr__(self):
         return (f"HardDiskSimulation(n_floes={self.n_floes}, L={self.L:.4g}, "
