@@ -234,14 +234,14 @@ class ShipEnv(HertzEnv):
         within reach of the ship's start removed. Sets the concentration the
         observation reports (of the box or of the strip)."""
         from physics.domain import Box
-        from physics.floes import place_floes, power_law_diameters, spatial_order
-        from physics.ship import _diameters
+        from physics.floes import place_floes, spatial_order
+        from physics.ship import covering_diameters
 
         sizes, lognormal = FLOE_SIZES[floe_sizes]
         p = self.preset
         region = box if band is None else Box(box.lx, band, periodic=box.periodic)
         target = concentration * region.area
-        d = _diameters(p, sizes, lognormal, 2.0 * target, rng, power_law_diameters)
+        d = covering_diameters(p, sizes, lognormal, 2.0 * target, rng)
         # no floe wider than a third of the box's shorter side: drop those and
         # keep the others until they cover the target
         d = d[d < min(region.lx, region.ly) / 3.0]
