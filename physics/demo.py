@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .engine import FloeEngine
 from .floes import PlacementError
 from .hertz import HertzSimulation, hertz_time_step
 from .params import HERMAN2013
@@ -73,7 +74,7 @@ def _frame(ax, box, title: str) -> None:
     ax.set_title(title, fontsize=9)
 
 
-def _advance(sim: HertzSimulation, duration: float, progress: bool) -> float:
+def _advance(sim: FloeEngine, duration: float, progress: bool) -> float:
     """Advance and return the wall time [s]."""
     t0 = time.perf_counter()
     sim.advance(duration, progress=progress)

@@ -52,8 +52,8 @@ from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress
 from .params import ContactParams, PaperPreset
 
-__all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
-           "read_only", "snapshot"]
+__all__ = ["FailureReason", "FloeEngine", "FloeProperties", "SimulationError", "checked_motion",
+           "engine_from_preset", "read_only", "snapshot"]
 
 
 class FailureReason(str, Enum):
@@ -207,6 +207,32 @@ def read_only(a: np.ndarray) -> np.ndarray:
     v = a.view()
     v.flags.writeable = False
     return v
+
+
+class FloeProperties:
+    """``radii``, ``masses`` and ``frozen`` of :class:`FloeEngine` for an
+    engine that keeps them in its arrays ``_radius``, ``_mass`` and
+    ``_frozen``: read-only views of those (:func:`read_only`)."""
+
+    _radius: np.ndarray
+    _mass: np.ndarray
+    _frozen: np.ndarray
+
+    @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii [m] (a read-only view; they never change)."""
+        return read_only(self._radius)
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses ρ h π r² [kg] (a read-only view; they never change)."""
+        return read_only(self._mass)
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the floes held fixed (inverse mass 0; a
+        read-only view)."""
+        return read_only(self._frozen)
 
 
 def checked_motion(name: str, value, shape: tuple, frozen: np.ndarray, what: str) -> np.ndarray:

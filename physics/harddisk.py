@@ -31,8 +31,8 @@ import numpy as np
 from . import harddisk_kernels as K
 from .checks import check_range
 from .domain import Box, PeriodicBox
-from .engine import (FailureReason, SimulationError, checked_motion, engine_from_preset, read_only,
-                     snapshot)
+from .engine import (FailureReason, FloeProperties, SimulationError, checked_motion,
+                     engine_from_preset, snapshot)
 from .event_calendar import new_calendar
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
@@ -91,7 +91,7 @@ def choose_cells(radii: np.ndarray, length: float, floes_per_cell: float = 1.5,
     return nc, length / max(nc, 1), np.sort(bigs).astype(np.int64)
 
 
-class HardDiskSimulation:
+class HardDiskSimulation(FloeProperties):
     """Hard-disc floes with instantaneous inelastic collisions (Herman 2011).
 
     It keeps the :class:`~physics.engine.FloeEngine` contract: the input
@@ -194,6 +194,7 @@ class HardDiskSimulation:
         self.field = f = field.copy()
         self._radius = f.radii.copy()
         self._mass = f.masses.copy()
+        self._frozen = f.frozen.copy()
         self.n_cells, self.cell = nc, cell
         rank = np.full(n, -1, dtype=np.int64)
         rank[bigs] = np.arange(bigs.size)
@@ -207,7 +208,7 @@ class HardDiskSimulation:
             lists=np.zeros((nc * nc, 8), dtype=np.int64), sizes=np.zeros(nc * nc, dtype=np.int64))
         self._discs = K.Discs(
             pos=pos.copy(), vel=f.velocities.copy(), t_loc=np.zeros(n),
-            radius=self._radius, inv_mass=np.where(f.frozen, 0.0, 1.0 / self._mass),
+            radius=self._radius, inv_mass=np.where(self._frozen, 0.0, 1.0 / self._mass),
             changes=np.zeros(n, dtype=np.int64), last_collision=np.full(n, -np.inf),
             rapid_time=np.full(n, -np.inf), rapid_run=np.zeros(n, dtype=np.int64))
         self._calendar = new_calendar(n, K.EV_NONE)
@@ -402,7 +403,7 @@ class HardDiskSimulation:
     @velocities.setter
     def velocities(self, value):
         vel = self._discs.vel
-        v = checked_motion("velocities", value, vel.shape, self.field.frozen, "velocity")
+        v = checked_motion("velocities", value, vel.shape, self._frozen, "velocity")
         K.sync_all(self.time, self._discs)
         vel[:] = v
         K.accumulate(self.time, self._acc)
@@ -413,22 +414,6 @@ class HardDiskSimulation:
     def angular_velocities(self) -> np.ndarray:
         """(N,) zeros: hard discs do not rotate (read-only)."""
         return snapshot(np.zeros(self.n_floes))
-
-    @property
-    def radii(self) -> np.ndarray:
-        """(N,) floe radii [m] (a read-only view; they never change)."""
-        return read_only(self._radius)
-
-    @property
-    def masses(self) -> np.ndarray:
-        """(N,) floe masses ρ h π r² [kg] (a read-only view; they never change)."""
-        return read_only(self._mass)
-
-    @property
-    def frozen(self) -> np.ndarray:
-        """(N,) bool, True for the floes held fixed (inverse mass 0; a
-        read-only view)."""
-        return read_only(self.field.frozen)
 
     @property
     def collision_count(self) -> int:

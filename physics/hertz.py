@@ -28,10 +28,9 @@ from . import hull_contact as HC
 from .checks import check_range
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
-from .engine import FailureReason, SimulationError, engine_from_preset
+from .engine import FailureReason, FloeProperties, SimulationError, engine_from_preset
 from .engine import check_time_step, checked_hertz_arguments, neighbour_cut, positions_in_box
 from .engine import checked_motion as _checked_motion
-from .engine import read_only as _read_only
 from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
@@ -87,7 +86,7 @@ def hertz_time_step(field: FloeField, box: Box, contact: ContactParams, impact_s
     return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
 
 
-class HertzSimulation:
+class HertzSimulation(FloeProperties):
     """Soft-contact discrete-element simulation of floes (Herman 2013).
 
     It keeps the engine contract (:class:`~physics.engine.FloeEngine`):
@@ -198,7 +197,8 @@ class HertzSimulation:
         self._vel = f.velocities.copy()
         self._omega = f.angular_velocities.copy()
         self._mass = f.masses
-        mobile = ~f.frozen
+        self._frozen = f.frozen.copy()
+        mobile = ~self._frozen
         self._inv_mass = np.where(mobile, 1.0 / self._mass, 0.0)
         self._inv_inertia = np.where(mobile, 1.0 / f.inertia, 0.0)
         self._rank = radius_rank(f.radii)
@@ -426,7 +426,7 @@ class HertzSimulation:
 
     @velocities.setter
     def velocities(self, value):
-        self._vel[...] = _checked_motion("velocities", value, self._vel.shape, self.field.frozen,
+        self._vel[...] = _checked_motion("velocities", value, self._vel.shape, self._frozen,
                                          "velocity")
 
     @property
@@ -437,7 +437,7 @@ class HertzSimulation:
     @angular_velocities.setter
     def angular_velocities(self, value):
         self._omega[...] = _checked_motion("angular_velocities", value, self._omega.shape,
-                                           self.field.frozen, "angular velocity")
+                                           self._frozen, "angular velocity")
 
     # -- observation ---------------------------------------------------------
     @property
@@ -448,22 +448,6 @@ class HertzSimulation:
     @property
     def n_floes(self) -> int:
         return self.field.n
-
-    @property
-    def radii(self) -> np.ndarray:
-        """(N,) floe radii [m] (a read-only view; they never change)."""
-        return _read_only(self._radius)
-
-    @property
-    def masses(self) -> np.ndarray:
-        """(N,) floe masses ρ h π r² [kg] (a read-only view; they never change)."""
-        return _read_only(self._mass)
-
-    @property
-    def frozen(self) -> np.ndarray:
-        """(N,) bool, True for the floes held fixed (inverse mass 0; a
-        read-only view)."""
-        return _read_only(self.field.frozen)
 
     @property
     def force(self) -> np.ndarray:
