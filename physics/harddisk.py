@@ -96,9 +96,11 @@ class HardDiskSimulation(FloeProperties):
 
     It keeps the :class:`~physics.engine.FloeEngine` contract: the input
     field is copied, ``positions``, ``velocities`` and
-    ``angular_velocities`` are read-only snapshots, wrong types raise
-    ``TypeError``, wrong values ``ValueError``, and a breakdown of the
-    physics during :meth:`advance` a :class:`~physics.engine.SimulationError`.
+    ``angular_velocities`` are read-only snapshots, ``radii``, ``masses``
+    and ``frozen`` read-only views (:class:`~physics.engine.FloeProperties`),
+    wrong types raise ``TypeError``, wrong values ``ValueError``, and a
+    breakdown of the physics during :meth:`advance` a
+    :class:`~physics.engine.SimulationError`.
 
     Parameters
     ----------
@@ -133,8 +135,6 @@ class HardDiskSimulation(FloeProperties):
     box : PeriodicBox
     field : FloeField
         The simulation's copy of the initial field.
-    radii, masses, frozen : (N,) read-only arrays
-        Radii [m], masses [kg] and the frozen flags of the floes.
     L : float
         Side of the box [m].
 

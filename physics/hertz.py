@@ -92,8 +92,10 @@ class HertzSimulation(FloeProperties):
     It keeps the engine contract (:class:`~physics.engine.FloeEngine`):
     the input field is copied, ``positions``, ``velocities`` and
     ``angular_velocities`` are read-only snapshots (assign a whole array to
-    ``velocities`` or ``angular_velocities`` to change them), and a
-    breakdown of the physics during :meth:`advance` raises
+    ``velocities`` or ``angular_velocities`` to change them), ``radii``,
+    ``masses`` and ``frozen`` are read-only views
+    (:class:`~physics.engine.FloeProperties`), and a breakdown of the
+    physics during :meth:`advance` raises
     :class:`~physics.engine.SimulationError`.
 
     Parameters
@@ -135,7 +137,6 @@ class HertzSimulation(FloeProperties):
     ----------
     time : float — model time [s]
     positions, velocities, angular_velocities : read-only snapshots of the current state
-    radii, masses, frozen : read-only views of the floes' fixed properties
     force, torque : read-only snapshots of the total force and torque of the last step
     n_steps, n_rebuilds : counters
 
