@@ -115,7 +115,7 @@ def bench_harddisk(seed: int = 1, quiet: bool = False, gas_floes: int = 10000,
         sim.advance(spin_up, progress=not quiet)
         rate, span, done = time_collisions(sim, herman_collisions, 100.0)
         bar.advance()
-        m = sim.mass
+        m = sim.masses
         u = float((m * sim.velocities[:, 0]).sum() / m.sum())
         d = sim.diagnostics
         rows.append(dict(case=f"Herman 2011, N = {herman_floes}, Ā = 0.75", rate=rate,

@@ -181,24 +181,25 @@ def hull_kernel_times(sim: HertzSimulation, passes: int) -> dict:
     ship.state[HC.S_HULL_TRAVEL] = 0.0
     ship.state[HC.S_FLOE_TRAVEL] = 0.0
     box = sim.box.kernel_box(sim.time)
-    force, torque = np.zeros_like(sim.force), np.zeros_like(sim.torque)
+    force, torque = np.zeros((sim.n_floes, 2)), np.zeros(sim.n_floes)
+    floes = sim._floes                 # the kernels' own bundle of the live arrays
     numba.set_num_threads(1)
-    _hull_loop(2, ship, sim._floes, box, sim.dt, force, torque)             # compile
-    _hull_build_loop(1, ship, sim._pos, sim.radius, box.lengths[0], box.lengths[1])
+    _hull_loop(2, ship, floes, box, sim.dt, force, torque)                  # compile
+    _hull_build_loop(1, ship, floes.pos, floes.radius, box.lengths[0], box.lengths[1])
     ship.state[HC.S_HULL_TRAVEL] = 0.0
     builds = max(1, passes // 20)
     step, build, rebuild = [], [], []
     for _ in range(REPEATS):
         t0 = time.perf_counter()
-        _hull_loop(passes, ship, sim._floes, box, sim.dt, force, torque)
+        _hull_loop(passes, ship, floes, box, sim.dt, force, torque)
         step.append((time.perf_counter() - t0) / passes)
         t0 = time.perf_counter()
-        _hull_build_loop(builds, ship, sim._pos, sim.radius, box.lengths[0], box.lengths[1])
+        _hull_build_loop(builds, ship, floes.pos, floes.radius, box.lengths[0], box.lengths[1])
         build.append((time.perf_counter() - t0) / builds)
         ship.state[HC.S_HULL_TRAVEL] = 0.0
         t0 = time.perf_counter()
         for _ in range(max(1, builds // 4)):
-            K.rebuild(sim._floes, sim._verlet, box.lengths[0], box.lengths[1], True, True, False,
+            K.rebuild(floes, sim._verlet, box.lengths[0], box.lengths[1], True, True, False,
                       sim._verlet.skins)
         rebuild.append((time.perf_counter() - t0) / max(1, builds // 4))
     return dict(hull_step=float(np.median(step)), hull_build=float(np.median(build)),

@@ -49,9 +49,10 @@ import gymnasium as gym
 import numpy as np
 
 from physics import PaperPreset
+from physics.checks import check_range
+from physics.engine import FloeEngine
 from physics.hertz import hertz_time_step, scaled_contact  # noqa: F401  (used by the envs)
 from physics.markdown import table_row
-from physics.params import check_range
 
 from .observations import FLOE_FEATURES, Feature, normalise
 
@@ -462,7 +463,9 @@ class FloeEnv(ControlEnv):
         low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
         high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
         self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
-        self.sim = None
+        #: the episode's engine (:meth:`_make_sim`); the code shared here uses only
+        #: :class:`~physics.engine.FloeEngine`, an environment may use more of its engine
+        self.sim: FloeEngine | None = None
         self._steps = 0
         self._last_action = np.zeros(n_act)
         self._prev = None
@@ -472,7 +475,7 @@ class FloeEnv(ControlEnv):
     def default_reward_params(self) -> dict:
         return {}
 
-    def _make_sim(self, rng: np.random.Generator):
+    def _make_sim(self, rng: np.random.Generator) -> FloeEngine:
         raise NotImplementedError
 
     def _ready(self) -> bool:
@@ -538,8 +541,8 @@ class HertzEnv(FloeEnv):
         self._contacts = sim.contacts()
         area = sim.box.area
         st = stress(self._contacts, area, n_floes=sim.n_floes, per_floe=False)
-        mobile = sim.inv_mass > 0
-        return floe_physics(sim.positions, sim.velocities, sim.mass, sim.radius, sim.box,
+        mobile = ~sim.frozen
+        return floe_physics(sim.positions, sim.velocities, sim.masses, sim.radii, sim.box,
                             self._contacts, st.tensor, area, mobile,
                             cluster_gap=self.cluster_gap)
 
@@ -551,9 +554,9 @@ class HertzEnv(FloeEnv):
 
         sim = self.sim
         c = self._contacts
-        picture = draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
+        picture = draw_floes(sim.positions, sim.radii, (sim.box.lx, sim.box.ly),
                              np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
-                             frozen=sim.inv_mass == 0, contact_i=c.i, contact_j=c.j,
+                             frozen=sim.frozen, contact_i=c.i, contact_j=c.j,
                              contact_force=c.normal_force, speed_scale=self.colour_scale)
         return annotate(picture, colour_bar=(self.colour_label, 0.0, self.colour_scale),
                         arrow=self._frame_arrow(), text=self._frame_text())

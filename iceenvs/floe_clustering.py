@@ -187,8 +187,8 @@ class FloeClusteringEnv(FloeEnv):
         span = sim.time - t0
         tensor = sim.stress() if span > 0 else np.zeros((2, 2))
         self._contacts = sim.contacts(0.01)
-        mobile = ~sim.field.frozen
-        now = floe_physics(sim.positions, sim.velocities, sim.mass, sim.radius, sim.box,
+        mobile = ~sim.frozen
+        now = floe_physics(sim.positions, sim.velocities, sim.masses, sim.radii, sim.box,
                            self._contacts, tensor, sim.box.area, mobile,
                            cluster_gap=self.cluster_gap)
         now["target"] = self.episode["target"]
@@ -200,8 +200,8 @@ class FloeClusteringEnv(FloeEnv):
 
         sim = self.sim
         v = sim.velocities
-        labels = find_clusters(sim.positions, sim.radius, sim.box, self.cluster_gap)
-        picture = draw_floes(sim.positions, sim.radius, (sim.box.lx, sim.box.ly),
+        labels = find_clusters(sim.positions, sim.radii, sim.box, self.cluster_gap)
+        picture = draw_floes(sim.positions, sim.radii, (sim.box.lx, sim.box.ly),
                              np.hypot(v[:, 0], v[:, 1]), labels=labels)
         now = self._prev
         text = [f"t = {sim.time:.0f} s", f"A = {now['concentration']:.3f}",

@@ -206,7 +206,7 @@ class MarginalIceZoneEnv(HertzEnv):
         now = self._contact_physics()
         sim = self.sim
         c = self._contacts
-        frozen = sim.inv_mass == 0
+        frozen = sim.frozen
         fi, fj = frozen[c.i], frozen[c.j]
         on_edge = (c.force * fi[:, None]).sum(axis=0) - (c.force * fj[:, None]).sum(axis=0)
         # only drifting floes pushing on the edge count (frozen pairs carry no force)

@@ -51,8 +51,8 @@ import gymnasium as gym
 import numpy as np
 
 from physics import FloeField, HERMAN2013
+from physics.checks import check_range
 from physics.hertz import hull_contact_time
-from physics.params import check_range
 
 from .base import TIME_FEATURE, HertzEnv
 from .observations import Feature, normalise
@@ -234,14 +234,14 @@ class ShipEnv(HertzEnv):
         within reach of the ship's start removed. Sets the concentration the
         observation reports (of the box or of the strip)."""
         from physics.domain import Box
-        from physics.floes import place_floes, power_law_diameters, spatial_order
-        from physics.ship import _diameters
+        from physics.floes import place_floes, spatial_order
+        from physics.ship import covering_diameters
 
         sizes, lognormal = FLOE_SIZES[floe_sizes]
         p = self.preset
         region = box if band is None else Box(box.lx, band, periodic=box.periodic)
         target = concentration * region.area
-        d = _diameters(p, sizes, lognormal, 2.0 * target, rng, power_law_diameters)
+        d = covering_diameters(p, sizes, lognormal, 2.0 * target, rng)
         # no floe wider than a third of the box's shorter side: drop those and
         # keep the others until they cover the target
         d = d[d < min(region.lx, region.ly) / 3.0]
@@ -417,7 +417,7 @@ class ShipEnv(HertzEnv):
                "surge": ship.surge, "sway": ship.sway, "yaw_rate": ship.yaw_rate}
         now.update(self._step_loads)
         pos = sim.positions
-        dist, conc = ice_lidar((x, y), heading, pos, sim.radius, sectors=self.lidar_sectors,
+        dist, conc = ice_lidar((x, y), heading, pos, sim.radii, sectors=self.lidar_sectors,
                                max_range=self.lidar_range, box_lengths=lengths,
                                periodic=box.periodic)
         for k in range(self.lidar_sectors):
@@ -449,7 +449,7 @@ class ShipEnv(HertzEnv):
         else:
             pressure, n_contacts = 0.0, 0
         n_near = int(near.sum())
-        return {"local_concentration": min(1.0, float(np.pi * np.sum(sim.radius[near] ** 2))
+        return {"local_concentration": min(1.0, float(np.pi * np.sum(sim.radii[near] ** 2))
                                            / area),
                 "local_contacts": 2.0 * n_contacts / n_near if n_near else 0.0,
                 "local_pressure": pressure}
@@ -466,7 +466,7 @@ class ShipEnv(HertzEnv):
     def _image(self) -> np.ndarray:
         sim = self.sim
         ship = sim.ship
-        return occupancy_image(ship.position, ship.heading, sim.positions, sim.radius,
+        return occupancy_image(ship.position, ship.heading, sim.positions, sim.radii,
                                ship.vertices, self.goal_x, size=self.image_size,
                                extent=self.image_extent,
                                box_lengths=(sim.box.lx, sim.box.ly), periodic=sim.box.periodic)
@@ -521,7 +521,7 @@ class ShipEnv(HertzEnv):
         sim = self.sim
         c = self._contacts
         box = (sim.box.lx, sim.box.ly)
-        picture = draw_floes(sim.positions, sim.radius, box,
+        picture = draw_floes(sim.positions, sim.radii, box,
                              np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
                              contact_i=c.i, contact_j=c.j, contact_force=c.normal_force,
                              speed_scale=self.colour_scale)

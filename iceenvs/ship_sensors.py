@@ -66,7 +66,7 @@ import math
 
 import numpy as np
 
-from physics.params import check_range
+from physics.checks import check_range
 
 __all__ = ["ice_lidar", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
 

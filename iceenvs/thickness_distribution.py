@@ -8,8 +8,9 @@ import math
 import gymnasium as gym
 import numpy as np
 
+from physics.checks import check_range
 from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
-from physics.params import GODLOVITCH, check_range
+from physics.params import GODLOVITCH
 
 from .base import ControlEnv, TaskParameter
 from .controllers import Controller

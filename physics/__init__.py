@@ -21,7 +21,7 @@ from .contact import damping_alpha
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
 from .floes import (FloeField, PlacementError, domain_size, make_floe_field, place_floes,
                     power_law_diameters, rank_order_diameters, sample_power_law_diameters)
-from .forcing import Forcing, steady_drift
+from .forcing import Forcing, ForcingParams, steady_drift
 from .clusters import (ClusterStats, cluster_statistics, find_clusters, fsd_exponent, g_ffd,
                        g_rdf, power_law_exponent, rank_order)
 from .harddisk import CollisionLog, HardDiskSimulation
@@ -29,8 +29,7 @@ from .hertz import HertzSimulation
 from .itd import ThorndikeModel, make_kernel, solve_fragmentation, solve_smoluchowski
 from .observables import (Contacts, Fabric, Stress, collision_stress, contacts_within, fabric,
                           stress)
-from .params import (GODLOVITCH, HERMAN2011, HERMAN2013, ContactParams, ForcingParams,
-                     ItdPreset, PaperPreset)
+from .params import GODLOVITCH, HERMAN2011, HERMAN2013, ContactParams, ItdPreset, PaperPreset
 
 __version__ = "0.1.0"
 

@@ -30,9 +30,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .checks import check_range
 from .domain import Box
 from .observables import check_positions, near_pairs
-from .params import check_range
 
 __all__ = ["find_clusters", "ClusterStats", "cluster_statistics", "PowerLawFit",
            "power_law_exponent", "exponent_series", "rank_order", "fsd_exponent",

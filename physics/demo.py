@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .engine import FloeEngine
 from .floes import PlacementError
 from .hertz import HertzSimulation, hertz_time_step
 from .params import HERMAN2013
@@ -73,7 +74,7 @@ def _frame(ax, box, title: str) -> None:
     ax.set_title(title, fontsize=9)
 
 
-def _advance(sim: HertzSimulation, duration: float, progress: bool) -> float:
+def _advance(sim: FloeEngine, duration: float, progress: bool) -> float:
     """Advance and return the wall time [s]."""
     t0 = time.perf_counter()
     sim.advance(duration, progress=progress)
@@ -100,7 +101,7 @@ def force_chains(n_floes: int = 200, concentration: float = 0.85, wind: float = 
 def wind_force(sim: HertzSimulation) -> np.ndarray:
     """Total air drag on the floes, Σ a |u_a| u_a (2,) [N] (Herman 2011,
     eq 6; the ice's own speed is neglected against the wind's, as there)."""
-    k = sim.forcing.coefficients(sim.radius, sim.field.thickness, sim.mass)
+    k = sim.forcing.coefficients(sim.radii, sim.field.thickness, sim.masses)
     u_a = np.asarray(sim.forcing.wind, dtype=float)
     return float(np.sum(k.wind)) * float(np.hypot(*u_a)) * u_a
 
@@ -133,7 +134,7 @@ def draw(sim: HertzSimulation, path: Path, title: str) -> None:
 
     speed = np.hypot(*sim.velocities.T)
     fig, ax = plt.subplots(figsize=(7.5, 7))
-    patches = [Circle(xy, r) for xy, r in zip(sim.positions, sim.radius)]
+    patches = [Circle(xy, r) for xy, r in zip(sim.positions, sim.radii)]
     coll = PatchCollection(patches, cmap="viridis", linewidths=0.2, edgecolors="k")
     coll.set_array(speed)
     ax.add_collection(coll)
@@ -149,7 +150,7 @@ def draw(sim: HertzSimulation, path: Path, title: str) -> None:
         f = np.hypot(*wall.T)
         on = f > 1e-9 * max(f.max(), 1.0)
         a = sim.positions[on]
-        tip = a - sim.radius[on, None] * wall[on] / f[on, None]     # the point on the wall
+        tip = a - sim.radii[on, None] * wall[on] / f[on, None]     # the point on the wall
         segments.append(np.stack([a, tip], axis=1))
         forces.append(f[on])
     segments, forces = np.concatenate(segments), np.concatenate(forces)
@@ -193,7 +194,7 @@ def draw_transit(sim: HertzSimulation, path: Path, title: str, *,
     if band is not None:
         ax.add_patch(Rectangle((band[0], 0.0), band[1] - band[0], sim.box.ly, color="lightblue",
                                alpha=0.3, lw=0, label="ice band at the start"))
-    ax.add_collection(PatchCollection([Circle(xy, r) for xy, r in zip(sim.positions, sim.radius)],
+    ax.add_collection(PatchCollection([Circle(xy, r) for xy, r in zip(sim.positions, sim.radii)],
                                       facecolors=np.where(hit, "tab:orange", "lightsteelblue"),
                                       edgecolors="k", linewidths=0.3))
     t = rec["time"]
@@ -289,7 +290,7 @@ def main(argv=None, prog: str = "python -m physics.demo") -> int:
     c = sim.contacts()
     touching = np.zeros(sim.n_floes, dtype=bool)
     touching[c.i] = touching[c.j] = True
-    largest = (c.overlap / np.minimum(sim.radius[c.i], sim.radius[c.j])).max() if len(c) else 0.0
+    largest = (c.overlap / np.minimum(sim.radii[c.i], sim.radii[c.j])).max() if len(c) else 0.0
     push, back = wind_force(sim)[0], wall_force(sim)[0]
     print(f"   ran {args.duration:g} model s = {steps} steps of {sim.dt:g} s in {seconds:.1f} s "
           f"({sim.n_floes * steps / seconds:.3g} floe-steps/s); fastest floe now "

@@ -12,8 +12,10 @@ The contract
 Names
     The same name always means the same thing: ``n_floes``, ``time``,
     ``box``, ``positions``, ``velocities``, ``angular_velocities``,
-    ``advance``, ``contacts``, ``fabric``, ``contact_stress``,
-    ``kinetic_energy``, ``momentum`` and ``state``.
+    ``radii``, ``masses``, ``frozen``, ``concentration``, ``advance``,
+    ``contacts``, ``fabric``, ``contact_stress``, ``kinetic_energy``,
+    ``momentum`` and ``state``. The per-floe names are those of
+    :class:`~physics.floes.FloeField`.
 Input
     The :class:`~physics.floes.FloeField` given to the constructor is
     copied; the caller's arrays are never modified.
@@ -23,6 +25,9 @@ Arrays exposed
     advances, and writing into them raises ``ValueError``. Assign a whole
     array to ``velocities`` (or ``angular_velocities``) to change the state;
     the assignment is checked (shape, finiteness, frozen floes at rest).
+    ``radii``, ``masses`` and ``frozen`` never change during a run; they
+    are read-only too (writing raises ``ValueError``), and may be views of
+    the engine's own arrays rather than copies (:func:`read_only`).
 Mistakes
     A wrong type is a ``TypeError``, a wrong value (out of range, wrong
     shape, not finite, overlapping floes) a ``ValueError``, both raised
@@ -40,14 +45,15 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from .checks import check_range
 from .domain import Box
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress
-from .params import ContactParams, check_range
+from .params import ContactParams, PaperPreset
 
-__all__ = ["FailureReason", "FloeEngine", "SimulationError", "checked_motion", "engine_from_preset",
-           "snapshot"]
+__all__ = ["FailureReason", "FloeEngine", "FloeProperties", "SimulationError", "checked_motion",
+           "engine_from_preset", "read_only", "snapshot"]
 
 
 class FailureReason(str, Enum):
@@ -112,6 +118,27 @@ class FloeEngine(Protocol):
         """(N,) angular velocities [1/s]; a read-only snapshot (zero for hard discs)."""
         ...
 
+    @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii r [m]; read-only."""
+        ...
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses m = ρ h π r² [kg]; read-only."""
+        ...
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the floes held fixed (inverse mass 0: they
+        never move but take part in contacts); read-only."""
+        ...
+
+    @property
+    def concentration(self) -> float:
+        """Ice concentration A = Σ π r² / S of the box now [-]."""
+        ...
+
     def advance(self, duration: float, *, progress: bool = False) -> None:
         """Advance the model time by ``duration`` seconds."""
         ...
@@ -153,8 +180,6 @@ def engine_from_preset(cls, preset, n, concentration, seed, forcing, defaults, k
     (:meth:`~physics.params.PaperPreset.make_forcing`), False or None
     none, a :class:`~physics.forcing.Forcing` that one.
     """
-    from .params import PaperPreset
-
     if not isinstance(preset, PaperPreset):
         raise TypeError(f"preset must be a PaperPreset, got {type(preset).__name__}")
     own = set(inspect.signature(cls.__init__).parameters) - {"self", "field", "box", "forcing"}
@@ -173,6 +198,41 @@ def snapshot(a: np.ndarray) -> np.ndarray:
     c = np.array(a, copy=True)
     c.flags.writeable = False
     return c
+
+
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a``, without a copy: what the engines'
+    ``radii``, ``masses`` and ``frozen`` return, arrays that do not change
+    during a run."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
+class FloeProperties:
+    """``radii``, ``masses`` and ``frozen`` of :class:`FloeEngine` for an
+    engine that keeps them in its arrays ``_radius``, ``_mass`` and
+    ``_frozen``: read-only views of those (:func:`read_only`)."""
+
+    _radius: np.ndarray
+    _mass: np.ndarray
+    _frozen: np.ndarray
+
+    @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii [m] (a read-only view; they never change)."""
+        return read_only(self._radius)
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses ρ h π r² [kg] (a read-only view; they never change)."""
+        return read_only(self._mass)
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the floes held fixed (inverse mass 0; a
+        read-only view)."""
+        return read_only(self._frozen)
 
 
 def checked_motion(name: str, value, shape: tuple, frozen: np.ndarray, what: str) -> np.ndarray:

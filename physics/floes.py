@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .checks import check_range
 from .domain import Box, PeriodicBox, minimum_image, wrap_coordinate
 from .neighbors import choose_cell_size, pair_list, radius_rank
-from .params import check_range
 
 __all__ = [
     "FloeField",

@@ -21,12 +21,88 @@ The Stokes form of Herman (2011), eqs 5–8, used by the hard-disc engine, is
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from .params import ForcingParams, check_range
+from .checks import NONNEG, POSITIVE, check_fields, check_range
 
-__all__ = ["Forcing", "DragCoefficients", "steady_drift"]
+__all__ = ["Forcing", "ForcingParams", "DragCoefficients", "steady_drift"]
+
+
+@dataclass(frozen=True)
+class ForcingParams:
+    """Densities, drag coefficients and the wind/current/Coriolis set-up.
+
+    Attributes
+    ----------
+    ice_density, water_density, air_density : float
+        ρ, ρ_w, ρ_a [kg/m³].
+    air_skin_drag, air_form_drag : float
+        C_ha, C_va [-].
+    water_skin_drag, water_form_drag : float
+        C_hw, C_vw [m/s] (linear drag laws of both papers).
+    edge_area_factor : float
+        The exposed edge area of a floe is ``edge_area_factor · r · h_f`` above
+        the waterline and ``edge_area_factor · r · (h − h_f)`` below it:
+        π in Herman (2013), 2 (the diameter times the freeboard) in Herman (2011).
+    wind_speed : float
+        |u_a| [m/s].
+    wind_direction : float
+        Direction the wind blows towards, counter-clockwise from +x [degrees].
+    current_speed : float
+        |u_w| [m/s].
+    current_angle : float
+        Direction of the current relative to the wind direction [degrees]
+        (Herman 2011 does not state it; 0, along the wind, is the choice here).
+    coriolis : float
+        Coriolis parameter f [1/s].
+    """
+
+    ice_density: float = 910.0
+    water_density: float = 1025.0
+    air_density: float = 1.23
+    air_skin_drag: float = 2.0e-3
+    air_form_drag: float = 2.0e-3
+    water_skin_drag: float = 1.0e-3
+    water_form_drag: float = 1.0e-3
+    edge_area_factor: float = math.pi
+    wind_speed: float = 10.0
+    wind_direction: float = 0.0
+    current_speed: float = 0.0
+    current_angle: float = 0.0
+    coriolis: float = 1.3e-4
+
+    def __post_init__(self):
+        check_fields(self, {
+            "ice_density": POSITIVE,
+            "water_density": POSITIVE,
+            "air_density": NONNEG,
+            "air_skin_drag": NONNEG,
+            "air_form_drag": NONNEG,
+            "water_skin_drag": NONNEG,
+            "water_form_drag": NONNEG,
+            "edge_area_factor": NONNEG,
+            "wind_speed": NONNEG,
+            "wind_direction": (None, None, False, False),
+            "current_speed": NONNEG,
+            "current_angle": (None, None, False, False),
+            "coriolis": (None, None, False, False),
+        })
+        if self.ice_density >= self.water_density:
+            raise ValueError(
+                f"ForcingParams.ice_density must be below water_density={self.water_density:g} "
+                f"for floes to float, got {self.ice_density!r}")
+
+    def wind_vector(self) -> tuple[float, float]:
+        """(u_a,x, u_a,y) [m/s]."""
+        a = math.radians(self.wind_direction)
+        return self.wind_speed * math.cos(a), self.wind_speed * math.sin(a)
+
+    def current_vector(self) -> tuple[float, float]:
+        """(u_w,x, u_w,y) [m/s]."""
+        a = math.radians(self.wind_direction + self.current_angle)
+        return self.current_speed * math.cos(a), self.current_speed * math.sin(a)
 
 
 class DragCoefficients:

@@ -29,14 +29,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import harddisk_kernels as K
+from .checks import check_range
 from .domain import Box, PeriodicBox
-from .engine import FailureReason, SimulationError, checked_motion, engine_from_preset, snapshot
+from .engine import (FailureReason, FloeProperties, SimulationError, checked_motion,
+                     engine_from_preset, snapshot)
 from .event_calendar import new_calendar
 from .floes import FloeField, max_overlap
 from .forcing import Forcing
 from .harddisk_kernels import HardDiskStatus
 from .observables import Contacts, Fabric, Stress, collision_stress, contacts_within, fabric
-from .params import PaperPreset, check_range
+from .params import PaperPreset
 
 __all__ = ["HardDiskSimulation", "HardDiskStatus", "CollisionLog", "choose_cells"]
 
@@ -89,14 +91,16 @@ def choose_cells(radii: np.ndarray, length: float, floes_per_cell: float = 1.5,
     return nc, length / max(nc, 1), np.sort(bigs).astype(np.int64)
 
 
-class HardDiskSimulation:
+class HardDiskSimulation(FloeProperties):
     """Hard-disc floes with instantaneous inelastic collisions (Herman 2011).
 
     It keeps the :class:`~physics.engine.FloeEngine` contract: the input
     field is copied, ``positions``, ``velocities`` and
-    ``angular_velocities`` are read-only snapshots, wrong types raise
-    ``TypeError``, wrong values ``ValueError``, and a breakdown of the
-    physics during :meth:`advance` a :class:`~physics.engine.SimulationError`.
+    ``angular_velocities`` are read-only snapshots, ``radii``, ``masses``
+    and ``frozen`` read-only views (:class:`~physics.engine.FloeProperties`),
+    wrong types raise ``TypeError``, wrong values ``ValueError``, and a
+    breakdown of the physics during :meth:`advance` a
+    :class:`~physics.engine.SimulationError`.
 
     Parameters
     ----------
@@ -131,7 +135,6 @@ class HardDiskSimulation:
     box : PeriodicBox
     field : FloeField
         The simulation's copy of the initial field.
-    radius, mass : (N,) arrays
     L : float
         Side of the box [m].
 
@@ -189,8 +192,9 @@ class HardDiskSimulation:
                 f"largest floe (radius {field.radii.max():.4g} m) with 2 cells to spare")
 
         self.field = f = field.copy()
-        self.radius = f.radii.copy()
-        self.mass = f.masses.copy()
+        self._radius = f.radii.copy()
+        self._mass = f.masses.copy()
+        self._frozen = f.frozen.copy()
         self.n_cells, self.cell = nc, cell
         rank = np.full(n, -1, dtype=np.int64)
         rank[bigs] = np.arange(bigs.size)
@@ -204,7 +208,7 @@ class HardDiskSimulation:
             lists=np.zeros((nc * nc, 8), dtype=np.int64), sizes=np.zeros(nc * nc, dtype=np.int64))
         self._discs = K.Discs(
             pos=pos.copy(), vel=f.velocities.copy(), t_loc=np.zeros(n),
-            radius=self.radius, inv_mass=np.where(f.frozen, 0.0, 1.0 / self.mass),
+            radius=self._radius, inv_mass=np.where(self._frozen, 0.0, 1.0 / self._mass),
             changes=np.zeros(n, dtype=np.int64), last_collision=np.full(n, -np.inf),
             rapid_time=np.full(n, -np.inf), rapid_run=np.zeros(n, dtype=np.int64))
         self._calendar = new_calendar(n, K.EV_NONE)
@@ -312,8 +316,8 @@ class HardDiskSimulation:
         f = self.field
         if self.forcing is None:
             return K.Drag(False, self.max_velocity_step, np.zeros(f.n), np.zeros((f.n, 2)))
-        tau = self.forcing.time_constant(f.radii, f.thickness, self.mass)
-        u_eq = self.forcing.equilibrium_velocity(f.radii, f.thickness, self.mass)
+        tau = self.forcing.time_constant(f.radii, f.thickness, self._mass)
+        u_eq = self.forcing.equilibrium_velocity(f.radii, f.thickness, self._mass)
         inv_tau = np.where(f.frozen, 0.0, 1.0 / tau)
         return K.Drag(True, self.max_velocity_step, inv_tau, np.ascontiguousarray(u_eq))
 
@@ -399,7 +403,7 @@ class HardDiskSimulation:
     @velocities.setter
     def velocities(self, value):
         vel = self._discs.vel
-        v = checked_motion("velocities", value, vel.shape, self.field.frozen, "velocity")
+        v = checked_motion("velocities", value, vel.shape, self._frozen, "velocity")
         K.sync_all(self.time, self._discs)
         vel[:] = v
         K.accumulate(self.time, self._acc)
@@ -438,13 +442,13 @@ class HardDiskSimulation:
         """Σ m u²/2 of the mobile floes [J] (no rotation in this engine)."""
         d = self._discs
         mobile = d.inv_mass > 0
-        return float(0.5 * np.sum(self.mass[mobile] * np.sum(d.vel[mobile] ** 2, axis=1)))
+        return float(0.5 * np.sum(self._mass[mobile] * np.sum(d.vel[mobile] ** 2, axis=1)))
 
     def momentum(self) -> np.ndarray:
         """Σ m u of the mobile floes [kg m/s]."""
         d = self._discs
         mobile = d.inv_mass > 0
-        return (self.mass[mobile, None] * d.vel[mobile]).sum(axis=0)
+        return (self._mass[mobile, None] * d.vel[mobile]).sum(axis=0)
 
     # -- collision log and virial ----------------------------------------------
     @property
@@ -468,7 +472,7 @@ class HardDiskSimulation:
         """Floe pairs whose edges are closer than ``gap`` [m] now (hard discs
         touch only at the instants of collision, so a contact is a near
         neighbour), without forces; see :func:`physics.observables.contacts_within`."""
-        return contacts_within(self.positions, self.radius, self.box, gap)
+        return contacts_within(self.positions, self._radius, self.box, gap)
 
     def fabric(self, gap: float = 0.01) -> Fabric:
         """Contact fabric of the pairs closer than ``gap`` [m] (see :meth:`contacts`)."""
@@ -483,7 +487,7 @@ class HardDiskSimulation:
         span = self.time - self._log_t0
         if span <= 0:
             raise ValueError("the collision window is empty: advance the simulation first")
-        return collision_stress(log, self.radius, self.L * self.L, span, per_floe=per_floe)
+        return collision_stress(log, self._radius, self.L * self.L, span, per_floe=per_floe)
 
     def reset_stress(self) -> None:
         """Start a new averaging window for :meth:`stress`."""
@@ -519,7 +523,8 @@ class HardDiskSimulation:
 
     @property
     def concentration(self) -> float:
-        return float(np.sum(np.pi * self.radius ** 2) / self.L ** 2)
+        """Ice concentration A = Σ π r² / L² [-]."""
+        return float(np.sum(np.pi * self._radius ** 2) / self.L ** 2)
 
     def __repr__(self):
         return (f"HardDiskSimulation(n_floes={self.n_floes}, L={self.L:.4g}, "

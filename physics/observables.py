@@ -43,9 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .checks import check_range
 from .domain import Box
 from .neighbors import choose_cell_size, pair_list, radius_rank
-from .params import check_range
 
 __all__ = ["Contacts", "Fabric", "Stress", "fabric", "stress", "collision_stress",
            "near_pairs", "contacts_within", "check_positions"]

@@ -2,6 +2,9 @@
 
 Every dataclass here is frozen and validated in ``__post_init__``: a bad value
 raises :class:`ValueError` naming the field, the value and the allowed range.
+The densities, drags, wind and current of a preset are a
+:class:`~physics.forcing.ForcingParams`, defined beside the
+:class:`~physics.forcing.Forcing` they set up.
 
 Presets
 -------
@@ -21,50 +24,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .checks import NONNEG, POSITIVE, check_fields, check_range
+from .floes import make_floe_field
+from .forcing import Forcing, ForcingParams
+
 __all__ = [
     "ContactParams",
-    "ForcingParams",
     "PaperPreset",
     "ItdPreset",
     "HERMAN2011",
     "HERMAN2013",
     "GODLOVITCH",
-    "check_range",
 ]
-
-
-def check_range(name: str, value, low=None, high=None, *, low_open=False,
-                high_open=False) -> None:
-    """Raise ``ValueError`` unless ``value`` is a finite number in the range.
-
-    ``low_open``/``high_open`` make the corresponding bound strict.
-    The message names the field, the value and the allowed range.
-    """
-    lo = "-inf" if low is None else f"{low:g}"
-    hi = "inf" if high is None else f"{high:g}"
-    interval = f"{'(' if (low_open or low is None) else '['}{lo}, {hi}{')' if (high_open or high is None) else ']'}"
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number in {interval}, got {value!r}") from None
-    ok = math.isfinite(v)
-    if ok and low is not None:
-        ok = v > low if low_open else v >= low
-    if ok and high is not None:
-        ok = v < high if high_open else v <= high
-    if not ok:
-        raise ValueError(f"{name} must be in {interval}, got {value!r}")
-
-
-def _check_fields(obj, spec: dict) -> None:
-    for name, (low, high, low_open, high_open) in spec.items():
-        check_range(f"{type(obj).__name__}.{name}", getattr(obj, name), low, high,
-                    low_open=low_open, high_open=high_open)
-
-
-# (low, high, low_open, high_open)
-_POSITIVE = (0.0, None, True, False)
-_NONNEG = (0.0, None, False, False)
 
 
 @dataclass(frozen=True)
@@ -127,13 +98,13 @@ class ContactParams:
     limit_damping: bool = True
 
     def __post_init__(self):
-        _check_fields(self, {
-            "elastic_modulus": _POSITIVE,
+        check_fields(self, {
+            "elastic_modulus": POSITIVE,
             "poisson_ratio": (-1.0, 0.5, True, True),
             "restitution": (0.0, 1.0, True, False),
-            "friction": _NONNEG,
-            "tangential_damping": _NONNEG,
-            "tangential_stiffness": _POSITIVE,
+            "friction": NONNEG,
+            "tangential_damping": NONNEG,
+            "tangential_stiffness": POSITIVE,
         })
         for name in ("tangential_translation", "limit_damping"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
@@ -171,81 +142,6 @@ class ContactParams:
         from .contact import damping_alpha
 
         return damping_alpha(self.restitution, self.damping_model, self.limit_damping)
-
-
-@dataclass(frozen=True)
-class ForcingParams:
-    """Densities, drag coefficients and the wind/current/Coriolis set-up.
-
-    Attributes
-    ----------
-    ice_density, water_density, air_density : float
-        ρ, ρ_w, ρ_a [kg/m³].
-    air_skin_drag, air_form_drag : float
-        C_ha, C_va [-].
-    water_skin_drag, water_form_drag : float
-        C_hw, C_vw [m/s] (linear drag laws of both papers).
-    edge_area_factor : float
-        The exposed edge area of a floe is ``edge_area_factor · r · h_f`` above
-        the waterline and ``edge_area_factor · r · (h − h_f)`` below it:
-        π in Herman (2013), 2 (the diameter times the freeboard) in Herman (2011).
-    wind_speed : float
-        |u_a| [m/s].
-    wind_direction : float
-        Direction the wind blows towards, counter-clockwise from +x [degrees].
-    current_speed : float
-        |u_w| [m/s].
-    current_angle : float
-        Direction of the current relative to the wind direction [degrees]
-        (Herman 2011 does not state it; 0, along the wind, is the choice here).
-    coriolis : float
-        Coriolis parameter f [1/s].
-    """
-
-    ice_density: float = 910.0
-    water_density: float = 1025.0
-    air_density: float = 1.23
-    air_skin_drag: float = 2.0e-3
-    air_form_drag: float = 2.0e-3
-    water_skin_drag: float = 1.0e-3
-    water_form_drag: float = 1.0e-3
-    edge_area_factor: float = math.pi
-    wind_speed: float = 10.0
-    wind_direction: float = 0.0
-    current_speed: float = 0.0
-    current_angle: float = 0.0
-    coriolis: float = 1.3e-4
-
-    def __post_init__(self):
-        _check_fields(self, {
-            "ice_density": _POSITIVE,
-            "water_density": _POSITIVE,
-            "air_density": _NONNEG,
-            "air_skin_drag": _NONNEG,
-            "air_form_drag": _NONNEG,
-            "water_skin_drag": _NONNEG,
-            "water_form_drag": _NONNEG,
-            "edge_area_factor": _NONNEG,
-            "wind_speed": _NONNEG,
-            "wind_direction": (None, None, False, False),
-            "current_speed": _NONNEG,
-            "current_angle": (None, None, False, False),
-            "coriolis": (None, None, False, False),
-        })
-        if self.ice_density >= self.water_density:
-            raise ValueError(
-                f"ForcingParams.ice_density must be below water_density={self.water_density:g} "
-                f"for floes to float, got {self.ice_density!r}")
-
-    def wind_vector(self) -> tuple[float, float]:
-        """(u_a,x, u_a,y) [m/s]."""
-        a = math.radians(self.wind_direction)
-        return self.wind_speed * math.cos(a), self.wind_speed * math.sin(a)
-
-    def current_vector(self) -> tuple[float, float]:
-        """(u_w,x, u_w,y) [m/s]."""
-        a = math.radians(self.wind_direction + self.current_angle)
-        return self.current_speed * math.cos(a), self.current_speed * math.sin(a)
 
 
 @dataclass(frozen=True)
@@ -295,15 +191,15 @@ class PaperPreset:
     notes: str = field(default="", compare=False)
 
     def __post_init__(self):
-        _check_fields(self, {
-            "thickness": _POSITIVE,
-            "fsd_exponent": _POSITIVE,
-            "mean_diameter": _POSITIVE,
+        check_fields(self, {
+            "thickness": POSITIVE,
+            "fsd_exponent": POSITIVE,
+            "mean_diameter": POSITIVE,
             "n_floes": (1, None, False, False),
             "concentration": (0.0, 1.0, True, True),
-            "time_step": _POSITIVE,
-            "max_velocity_step": _POSITIVE,
-            "collision_duration": _NONNEG,
+            "time_step": POSITIVE,
+            "max_velocity_step": POSITIVE,
+            "collision_duration": NONNEG,
             "n_cells": (1, None, False, False),
             "ensemble_members": (1, None, False, False),
         })
@@ -355,8 +251,6 @@ class PaperPreset:
         >>> field.n, round(field.concentration(box), 2)
         (200, 0.7)
         """
-        from .floes import make_floe_field
-
         n = self.n_floes if n is None else n
         concentration = self.concentration if concentration is None else concentration
         check_range("n", n, 1, None)
@@ -398,8 +292,6 @@ class PaperPreset:
         >>> HERMAN2013.make_forcing(wind=(0.0, -3.0)).wind.tolist()
         [0.0, -3.0]
         """
-        from .forcing import Forcing
-
         unknown = sorted(set(changes) - set(ForcingParams.__dataclass_fields__))
         if unknown:
             raise TypeError(f"make_forcing() got keywords that are not fields of "
@@ -559,21 +451,21 @@ class ItdPreset:
     KERNEL_NAMES = ("constant", "exponential", "multiplicative", "additive")
 
     def __post_init__(self):
-        _check_fields(self, {
+        check_fields(self, {
             "n_classes": (2, None, False, False),
-            "class_width": _POSITIVE,
-            "year_days": _POSITIVE,
-            "time_step": _POSITIVE,
+            "class_width": POSITIVE,
+            "year_days": POSITIVE,
+            "time_step": POSITIVE,
             "days": (1, None, False, False),
-            "tail_min": _NONNEG,
-            "tail_target": _POSITIVE,
-            "r_constant": _POSITIVE,
-            "r_exponential": _POSITIVE,
-            "exponential_beta": _NONNEG,
-            "r_multiplicative": _POSITIVE,
-            "r_additive": _POSITIVE,
+            "tail_min": NONNEG,
+            "tail_target": POSITIVE,
+            "r_constant": POSITIVE,
+            "r_exponential": POSITIVE,
+            "exponential_beta": NONNEG,
+            "r_multiplicative": POSITIVE,
+            "r_additive": POSITIVE,
             "raft_factor": (1.0, None, False, False),
-            "raft_lambda_target": _POSITIVE,
+            "raft_lambda_target": POSITIVE,
             "scm_kmax": (1, None, False, False),
             "scm_classes": (2, None, False, False),
         })

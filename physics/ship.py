@@ -45,13 +45,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import hull_contact as HC
+from .checks import check_range
 from .domain import Box
-from .floes import FloeField, place_floes, spatial_order
+from .floes import FloeField, place_floes, power_law_diameters, spatial_order
 from .hull import MODEL_HULL, PSV_HULL, Hull
-from .params import check_range
 
 __all__ = ["Ship", "ShipHydrodynamics", "ShipState", "ShipLoads", "psv_ship", "model_ship",
-           "TransitBox", "transit_field", "FOSSEN_SUPPLY"]
+           "TransitBox", "transit_field", "covering_diameters", "FOSSEN_SUPPLY"]
 
 #: Fossen's supply-vessel model (length 76.2 m, 6000 t), diagonal terms in
 #: the bis system: (M_x, M_y, I_z) = m (1.1274, 1.8902, 0.1278 L²) with
@@ -310,8 +310,6 @@ def transit_field(preset, *, concentration: float, band: tuple, length: float, w
     -------
     (FloeField, Box)
     """
-    from .floes import power_law_diameters
-
     check_range("concentration", concentration, 0.0, 0.9, low_open=True)
     check_range("length", length, 0.0, None, low_open=True)
     check_range("width", width, 0.0, None, low_open=True)
@@ -323,7 +321,7 @@ def transit_field(preset, *, concentration: float, band: tuple, length: float, w
         raise ValueError(f"band must lie inside the channel (0, {length:g}), got {band!r}")
     rng = np.random.default_rng(seed)
     target = concentration * (x1 - x0) * width
-    d = _diameters(preset, sizes, lognormal, target, rng, power_law_diameters)
+    d = covering_diameters(preset, sizes, lognormal, target, rng)
     band_box = Box(x1 - x0, width, periodic=(False, box.periodic[1]))
     pos = place_floes(0.5 * d, band_box, rng)
     pos[:, 0] += x0
@@ -332,8 +330,13 @@ def transit_field(preset, *, concentration: float, band: tuple, length: float, w
     return field.take(spatial_order(field.positions, box)), box
 
 
-def _diameters(preset, sizes, lognormal, target_area, rng, power_law_diameters):
-    """Diameters whose discs cover ``target_area``."""
+def covering_diameters(preset, sizes: str, lognormal, target_area: float,
+                       rng: np.random.Generator) -> np.ndarray:
+    """Floe diameters [m] whose discs just cover ``target_area`` [m²]: the
+    floes of :func:`transit_field` (``sizes`` and ``lognormal`` as there,
+    ``preset`` a :class:`~physics.params.PaperPreset`), drawn from ``rng``.
+    The draw is repeated until it covers the area, and cut after the first
+    floe that reaches it."""
     if sizes == "power":
         mean_d = preset.mean_diameter
         alpha = preset.fsd_exponent

@@ -183,7 +183,7 @@ def report() -> list[tuple[str, str, str]]:
     # 3. Coulomb sliding: tangential impulse = mu * normal impulse
     mu, e = 0.4, 0.5
     sim, r = binary_impact(ContactParams(restitution=e, friction=mu), 0.1, angle_deg=75.0)
-    m = sim.mass[0]
+    m = sim.masses[0]
     du = (sim.velocities[0] - sim.velocities[1]) - r["u_rel"]
     j_n, j_t = 0.5 * m * abs(du[0]), 0.5 * m * abs(du[1])
     rows.append(("oblique sliding impact, J_t / (μ J_n) − 1", "< 3 %", f"{j_t / (mu * j_n) - 1:+.1e}"))
@@ -202,7 +202,7 @@ def report() -> list[tuple[str, str, str]]:
 
     def energy():
         cs = sim.contacts()
-        r_eff = sim.radius[cs.i] * sim.radius[cs.j] / (sim.radius[cs.i] + sim.radius[cs.j])
+        r_eff = sim.radii[cs.i] * sim.radii[cs.j] / (sim.radii[cs.i] + sim.radii[cs.j])
         pot = 0.4 * hertz_stiffness(c.effective_modulus, r_eff) * cs.overlap ** 2.5
         return sim.kinetic_energy() + pot.sum()
 

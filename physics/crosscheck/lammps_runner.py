@@ -47,12 +47,13 @@ import time as _time
 
 import numpy as np
 
+from ..checks import check_range
 from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, max_overlap
 from ..lammps_engine import (LammpsOwner, _collections, deform_variables,  # noqa: F401
                              find_mpi_library, lammps_available, lammps_restitution,
                              lammps_version, load_lammps, new_lammps)
-from ..params import ContactParams, check_range
+from ..params import ContactParams
 
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
            "lammps_version", "find_mpi_library"]

@@ -87,10 +87,10 @@ import math
 import numpy as np
 import pymunk
 
+from ..checks import check_range
 from ..domain import Box
 from ..floes import FloeField, max_overlap
 from ..forcing import Forcing
-from ..params import check_range
 from ..progress import steps_with_bar
 
 __all__ = ["PymunkSimulation", "FLOE", "WALL"]

@@ -309,9 +309,9 @@ class Herman2011Clustering(Experiment):
         """Per-run constants: box, largest floe, τ and u_eq ranges."""
         from ..clusters import fsd_exponent
 
-        d = 2.0 * sim.radius
+        d = 2.0 * sim.radii
         tau, ueq = _equilibrium(p, d)
-        areas = np.pi * sim.radius ** 2
+        areas = np.pi * sim.radii ** 2
         du = float(ueq.max() - ueq.min())
         rec.result(largest_floe_fraction=float(areas.max() / areas.sum()), box_length=sim.L,
                    tau_min=float(tau.min()), tau_max=float(tau.max()),
@@ -325,7 +325,7 @@ class Herman2011Clustering(Experiment):
         from ..clusters import cluster_statistics, find_clusters, power_law_exponent
 
         sim = st["sim"]
-        pos, vel, r = sim.positions, sim.velocities, sim.radius
+        pos, vel, r = sim.positions, sim.velocities, sim.radii
         labels = find_clusters(pos, r, sim.box, float(p["cluster_gap"]))
         cs = cluster_statistics(labels, r)
         alpha = err = alpha2 = math.nan
@@ -336,7 +336,7 @@ class Herman2011Clustering(Experiment):
                 alpha2 = power_law_exponent(re, k=2).alpha
         _, ueq = _equilibrium(p, 2.0 * r)
         speed = np.hypot(vel[:, 0], vel[:, 1])
-        mass = sim.mass
+        mass = sim.masses
         slip = np.hypot(vel[:, 0] - ueq, vel[:, 1])
         count = sim.collision_count
         rate = (count - st["count"]) / (sim.n_floes * interval) if st["step"] > 0 else math.nan

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..domain import ChannelBox, DeformingPeriodicBox, PeriodicBox
+from ..engine import FloeEngine
 from ..floes import FloeField
 from ..forcing import Forcing, steady_drift
 from ..hertz import HertzSimulation, hertz_time_step, scaled_contact
@@ -70,7 +71,7 @@ def contact_law(p: dict):
 
 
 def _simulation(field: FloeField, box, p: dict, forcing: Forcing | None,
-                engine: str) -> HertzSimulation:
+                engine: str) -> FloeEngine:
     contact = contact_law(p)
     dt = hertz_time_step(field, box, contact, IMPACT_SPEED, HERMAN2013.time_step,
                          p["stiffness_scale"])
@@ -98,7 +99,7 @@ def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_
     return field, box
 
 
-def network(sim: HertzSimulation) -> tuple[dict, object]:
+def network(sim: FloeEngine) -> tuple[dict, object]:
     """The contact-network and stress measures of NETWORK_VARIABLES, and the
     contact table."""
     c = sim.contacts()
@@ -107,7 +108,7 @@ def network(sim: HertzSimulation) -> tuple[dict, object]:
     st = stress(c, sim.box.area, n_floes=n, per_floe=False)
     coord = fab.coordination
     touching = coord > 0
-    mobile = sim.inv_mass > 0
+    mobile = ~sim.frozen
     vel = sim.velocities[mobile]
     return dict(concentration=sim.concentration, p=st.pressure, tau=st.shear, z_c=fab.z_c,
                 z_a=fab.z_a, f_nr=fab.f_nr,
@@ -116,14 +117,14 @@ def network(sim: HertzSimulation) -> tuple[dict, object]:
                 mean_v=float(vel[:, 1].mean())), c
 
 
-def _snapshot(rec, sim: HertzSimulation, contacts) -> None:
-    rec.snapshot(sim.time, sim.positions, sim.radius, sim.velocities,
+def _snapshot(rec, sim: FloeEngine, contacts) -> None:
+    rec.snapshot(sim.time, sim.positions, sim.radii, sim.velocities,
                  box=(sim.box.lx, sim.box.ly), contacts=(contacts.i, contacts.j,
                                                          contacts.normal_force),
-                 frozen=sim.inv_mass == 0)
+                 frozen=sim.frozen)
 
 
-def advance(sim: HertzSimulation, duration: float) -> str | None:
+def advance(sim: FloeEngine, duration: float) -> str | None:
     """Advance ``sim`` by ``duration`` (at least one step); a physics failure
     is returned as a message (the run ends there, with everything recorded
     so far), else None."""
@@ -134,7 +135,7 @@ def advance(sim: HertzSimulation, duration: float) -> str | None:
     return None
 
 
-def _finish(rec, sim: HertzSimulation, st: dict) -> None:
+def _finish(rec, sim: FloeEngine, st: dict) -> None:
     """End of a run: a last snapshot if the state changed since the last
     one, and a note if the run ended early."""
     if not rec.snapshots or rec.snapshots[-1]["time"] < sim.time:
@@ -537,7 +538,7 @@ class MarginalIceZone(Experiment):
         sim = st["sim"]
         edges = np.linspace(0.0, sim.box.ly, p["profile_bins"] + 1)
         rec.coord("y", 0.5 * (edges[1:] + edges[:-1]), "m", "distance from the fast-ice side")
-        mobile = sim.inv_mass > 0
+        mobile = ~sim.frozen
 
         def measure(sim):
             net, c = network(sim)

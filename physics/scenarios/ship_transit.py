@@ -87,6 +87,7 @@ from pathlib import Path
 import numpy as np
 
 from ..domain import Box, PeriodicBox
+from ..engine import FloeEngine
 from ..floes import (FloeField, PlacementError, max_overlap, place_floes, power_law_diameters,
                      spatial_order)
 from ..forcing import steady_drift
@@ -835,9 +836,9 @@ def _no_records(sim) -> dict:
     return {k: np.zeros(0) for k in RECORD_COLUMNS}
 
 
-def _snapshot(rec, sim) -> None:
+def _snapshot(rec, sim: FloeEngine) -> None:
     c = sim.contacts()
-    rec.snapshot(sim.time, sim.positions, sim.radius, sim.velocities,
+    rec.snapshot(sim.time, sim.positions, sim.radii, sim.velocities,
                  box=(sim.box.lx, sim.box.ly), contacts=(c.i, c.j, c.normal_force))
 
 

@@ -53,7 +53,7 @@ def test_wind_drift_reaches_the_free_drift_of_the_forcing():
     try:
         env.reset(seed=1)
         sim = env.unwrapped.sim
-        radii, thickness, masses = sim.radius, sim.field.thickness, sim.mass
+        radii, thickness, masses = sim.radii, sim.field.thickness, sim.masses
         forcing = Forcing(HERMAN2013.forcing, wind=(10.0, 0.0))
         tau = forcing.time_constant(radii, thickness, masses)
         tau_mean = float(np.sum(masses * tau) / masses.sum())
@@ -198,8 +198,8 @@ def _edge_stress(seed, action, n_steps=8):
             stresses.append(info["physics"]["edge_stress"])
         sim = env.unwrapped.sim
         forcing = env.unwrapped.forcing
-        mobile = sim.inv_mass > 0
-        drag = forcing.coefficients(sim.radius, sim.field.thickness, sim.mass)
+        mobile = ~sim.frozen
+        drag = forcing.coefficients(sim.radii, sim.field.thickness, sim.masses)
         wind_load = drag.wind[mobile].sum() * float(np.hypot(*forcing.wind)) * forcing.wind
         load_per_length = float(np.hypot(*wind_load)) / sim.box.lx
     finally:

@@ -4,8 +4,10 @@ Every test runs on :class:`HertzSimulation` and on :class:`HardDiskSimulation`
 with the same small field (Herman 2013 floes, N = 60, Ā = 0.4, one frozen
 floe) and checks what code written against :class:`FloeEngine` relies on:
 the names, the copy semantics of the input field and of the exposed
-arrays, the checks of an assignment to ``velocities``, the exception type
-of each mistake, and :class:`SimulationError` when the physics breaks down.
+arrays, the floes' radii, masses, frozen flags and the concentration
+against the field, the checks of an assignment to ``velocities``, the
+exception type of each mistake, and :class:`SimulationError` when the
+physics breaks down.
 """
 from __future__ import annotations
 
@@ -91,6 +93,63 @@ def test_exposed_arrays_are_read_only_snapshots(kind):
         np.testing.assert_array_equal(a, b)      # taken at the call: they do not follow
     assert not np.array_equal(sim.positions, pos)
     assert sim.positions is not sim.positions
+
+
+def test_floe_properties_are_the_fields_and_read_only(kind):
+    """``radii`` and ``frozen`` are the field's, ``masses`` are ρ h π r²,
+    and none of them can be written or changes as the engine advances."""
+    field, box = small_field()
+    sim = make(kind, field, box)
+    radii, masses, frozen = sim.radii, sim.masses, sim.frozen
+    assert radii.shape == masses.shape == frozen.shape == (60,) and frozen.dtype == bool
+    np.testing.assert_array_equal(radii, field.radii)          # copied, not computed
+    np.testing.assert_array_equal(frozen, field.frozen)
+    assert frozen.sum() == 1 and frozen[FROZEN]
+    expected = field.density * field.thickness * np.pi * field.radii ** 2
+    # a product of four factors: a few roundings
+    np.testing.assert_allclose(masses, expected, rtol=1e-14, atol=0.0)
+    for a, value in ((radii, 1.0), (masses, 1.0), (frozen, False)):
+        assert not a.flags.writeable
+        with pytest.raises(ValueError):
+            a[FROZEN] = value
+    kept = radii.copy(), masses.copy(), frozen.copy()
+    pinned = sim.positions[FROZEN]
+    sim.advance(2.0)
+    for a, b in zip((sim.radii, sim.masses, sim.frozen), kept):
+        np.testing.assert_array_equal(a, b)
+    # the frozen floe is held fixed (inverse mass 0): it is exactly where it was
+    np.testing.assert_array_equal(sim.positions[FROZEN], pinned)
+    assert np.all(sim.velocities[FROZEN] == 0.0)
+
+
+def test_masses_and_frozen_give_momentum_and_energy(kind):
+    """The engine's momentum and kinetic energy are those of its ``masses``
+    and ``radii`` over the floes that are not ``frozen``: Σ m u and
+    Σ (m u²/2 + I ω²/2) with I = m r²/2 for discs."""
+    sim = make(kind)
+    sim.advance(2.0)
+    mobile = ~sim.frozen
+    m, r = sim.masses[mobile], sim.radii[mobile]
+    u, w = sim.velocities[mobile], sim.angular_velocities[mobile]
+    p = (m[:, None] * u).sum(axis=0)
+    # sums of 59 terms in another order: rounding only
+    scale = float(np.sum(m * np.hypot(u[:, 0], u[:, 1])))
+    np.testing.assert_allclose(sim.momentum(), p, rtol=0.0, atol=1e-12 * scale)
+    energy = float(np.sum(0.5 * m * (u ** 2).sum(axis=1) + 0.25 * m * r ** 2 * w ** 2))
+    assert sim.kinetic_energy() == pytest.approx(energy, rel=1e-12)
+
+
+def test_concentration_is_the_covered_fraction_of_the_box(kind):
+    """A = Σ π r² / (Lx Ly), before and after advancing (the box is fixed)."""
+    field, box = small_field()
+    sim = make(kind, field, box)
+    covered = float(np.sum(np.pi * field.radii ** 2)) / (box.lx * box.ly)
+    # sums of 60 areas in another order, and one division: rounding only
+    assert isinstance(sim.concentration, float)
+    assert sim.concentration == pytest.approx(covered, rel=1e-12)
+    assert covered == pytest.approx(0.4, rel=1e-9)             # the field's target
+    sim.advance(1.0)
+    assert sim.concentration == pytest.approx(covered, rel=1e-12)
 
 
 def test_assigning_velocities_is_checked(kind):

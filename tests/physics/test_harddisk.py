@@ -111,7 +111,7 @@ def _pair_times(sim):
     """Brute force: time of the next contact of every pair (inf if none)."""
     x = sim.positions
     v = sim.velocities
-    r = sim.radius
+    r = sim.radii
     L = sim.L
     dx = x[None, :, :] - x[:, None, :]
     dx -= L * np.round(dx / L)
@@ -269,7 +269,7 @@ def test_herman2011_quasi_steady_drift():
     sim = HardDiskSimulation(field, box, restitution=P.contact.restitution, forcing=forcing,
                              max_velocity_step=1.0, collision_duration=0.1)
     sim.advance(5000.0)
-    m = sim.mass
+    m = sim.masses
     u = (m * sim.velocities[:, 0]).sum() / m.sum()
     u_eq = forcing.equilibrium_velocity(field.radii, field.thickness, m)[:, 0]
     assert u == pytest.approx(0.23, rel=0.10)

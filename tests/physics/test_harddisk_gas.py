@@ -78,7 +78,7 @@ def enskog_rate(sim: HardDiskSimulation, eta: float) -> float:
     """Enskog collision frequency per floe at the current temperature [1/s]."""
     number_density = sim.n_floes / sim.L ** 2
     return (2.0 * number_density * SIGMA * henderson_g(eta)
-            * np.sqrt(np.pi * temperature(sim) / sim.mass[0]))
+            * np.sqrt(np.pi * temperature(sim) / sim.masses[0]))
 
 
 def equilibrated_gas(n: int, eta: float, seed: int, **kwargs) -> HardDiskSimulation:
@@ -93,7 +93,7 @@ def conservation_run(sim: HardDiskSimulation, duration: float, chunks: int) -> d
     momentum drift (relative to Σ m|u| at the start) and overlap seen."""
     e0 = sim.kinetic_energy()
     p0 = sim.momentum()
-    p_scale = float(np.sum(sim.mass * np.hypot(*sim.velocities.T)))
+    p_scale = float(np.sum(sim.masses * np.hypot(*sim.velocities.T)))
     radii = sim.field.radii
     worst = dict(energy=0.0, momentum=0.0, overlap=max_overlap(sim.positions, radii, sim.box))
     for _ in range(chunks):

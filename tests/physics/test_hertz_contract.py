@@ -1,13 +1,13 @@
 """The Hertz engine keeps the engine contract (physics.engine): read-only
-snapshots, checked assignment, SimulationError with its reason, and the
-set-up from a preset."""
+snapshots (also of its forces and torques), checked assignment,
+SimulationError with its reason, and the set-up from a preset."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from physics import (HERMAN2013, DeformingPeriodicBox, Forcing, HertzSimulation,
-                     make_floe_field)
+from physics import (HERMAN2013, DeformingPeriodicBox, FloeField, Forcing, HertzSimulation,
+                     PeriodicBox, make_floe_field)
 from physics.engine import FailureReason, FloeEngine, SimulationError
 
 
@@ -33,6 +33,31 @@ def test_arrays_are_read_only_snapshots(field):
     assert not np.array_equal(sim.positions, pos)     # the snapshot stayed as it was
     assert sim.positions is not sim.positions
     np.testing.assert_array_equal(floes.velocities, field[0].velocities)   # input untouched
+
+
+def test_force_and_torque_are_read_only_snapshots():
+    """``force`` and ``torque``, the totals of the last step, are read-only
+    snapshots. Three floes pressed together at rest, without forcing, in a
+    periodic box: the forces are the pairs' only, so they add up to zero
+    (Newton's third law)."""
+    pos = np.array([[10.0, 10.0], [11.98, 10.0], [13.9, 10.3]])    # radius 1 m: overlaps
+    floes = FloeField(pos, np.ones(3), 1.0)
+    sim = HertzSimulation(floes, PeriodicBox(40.0), HERMAN2013.contact, None, 0.001,
+                          allow_overlap=True, parallel=False)
+    force, torque = sim.force, sim.torque
+    assert force.shape == (3, 2) and torque.shape == (3,)
+    for a in (force, torque):
+        assert not a.flags.writeable
+        with pytest.raises(ValueError):
+            a[0] = 1.0
+    largest = float(np.abs(force).max())
+    assert largest > 0.0
+    # three pair forces added with opposite signs: rounding only
+    np.testing.assert_allclose(force.sum(axis=0), 0.0, rtol=0.0, atol=1e-12 * largest)
+    kept = force.copy()
+    sim.step(10)
+    np.testing.assert_array_equal(force, kept)                 # taken at the call
+    assert not np.array_equal(sim.force, kept)                 # the floes moved apart
 
 
 def test_assigned_velocities_are_checked_and_copied(field):

@@ -248,7 +248,7 @@ def test_collision_stress_equals_the_engine_virial():
                                atol=1e-12 * np.abs(s.tensor).max())
     assert s.pressure > 0 and s.area == pytest.approx(sim.L ** 2)
     # the same function on the log directly
-    s2 = collision_stress(sim.collision_log, sim.radius, sim.L ** 2, sim.time)
+    s2 = collision_stress(sim.collision_log, sim.radii, sim.L ** 2, sim.time)
     np.testing.assert_allclose(s2.tensor, s.tensor, rtol=1e-14)
     # a new window after clearing the log
     sim.clear_collision_log()

@@ -46,7 +46,8 @@ def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
                 fbuf.copy(), tbuf.copy()]
 
     def bundles(state):
-        return (_floes(*state[:3], state[3][0], state[4][0], sim.inv_mass, sim.inv_inertia),
+        return (_floes(*state[:3], state[3][0], state[4][0], sim._floes.inv_mass,
+                        sim._floes.inv_inertia),
                 K.ForceBuffers(state[3], state[4]))
 
     def run(kernel, n_tasks):

@@ -341,8 +341,8 @@ def _touching(sim):
 
     v = sim.ship.vertices - sim.ship.position
     d = sim.box.minimum_image(sim.positions - sim.ship.position)
-    near = np.nonzero(np.hypot(d[:, 0], d[:, 1]) < sim.ship.reach + sim.radius)[0]
-    return sum(disc_hull_contact(d[i, 0], d[i, 1], sim.radius[i], v[:, 0].copy(),
+    near = np.nonzero(np.hypot(d[:, 0], d[:, 1]) < sim.ship.reach + sim.radii)[0]
+    return sum(disc_hull_contact(d[i, 0], d[i, 1], sim.radii[i], v[:, 0].copy(),
                                  v[:, 1].copy())[0] > 0 for i in near)
 
 
