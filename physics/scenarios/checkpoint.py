@@ -43,7 +43,9 @@ import zipfile
 import numpy as np
 
 FORMAT = "seaice-gym checkpoint"
-VERSION = 2
+#: 3: the engines hold their per-floe arrays privately (``radii``, ``masses``,
+#: ``frozen`` are read-only views), so a saved engine of version 2 cannot be resumed
+VERSION = 3
 STRUCTURE = "structure.yaml"
 #: the package whose classes a checkpoint may hold
 PACKAGE = "physics"

@@ -179,7 +179,7 @@ def _file(tmp_path, structure: str, arrays=()):
 
 
 def test_classes_are_only_looked_up_in_the_physics_package(tmp_path):
-    head = "format: seaice-gym checkpoint\nversion: 2\nmeta: {}\ndata:\n"
+    head = f"format: seaice-gym checkpoint\nversion: {ck.VERSION}\nmeta: {{}}\ndata:\n"
     was_imported = "this" in sys.modules
     for name in ("this:Thing", "os:system", "builtins:dict", "physics.hertz:np.ndarray"):
         path = _file(tmp_path, head + f"  object: '{name}'\n")
@@ -212,7 +212,7 @@ def test_unreadable_files_say_why(tmp_path):
         with pytest.raises(ck.CheckpointError, match=reasons[name]):
             ck.load(path)
     other = _file(tmp_path, "format: seaice-gym checkpoint\nversion: 1\nmeta: {}\ndata: 1\n")
-    with pytest.raises(ck.CheckpointError, match="format version 1; this version reads 2"):
+    with pytest.raises(ck.CheckpointError, match=f"format version 1; this version reads {ck.VERSION}"):
         ck.load(other)
 
 
