@@ -372,6 +372,10 @@ class LammpsHertzSimulation(LammpsOwner):
                  "neigh_modify delay 0 every 1 check yes collection/interval "
                  + f"{len(edges)} " + " ".join(repr(e) for e in edges),
                  "comm_modify mode multi vel yes", f"timestep {self.dt!r}",
+                 # the virial of the pair forces, tallied for the thermo output
+                 # at the last step of every run, for virial_pressure()
+                 "compute pair_virial all pressure NULL pair",
+                 "thermo_style custom step c_pair_virial",
                  "thermo_modify lost error"]
         if fresh:
             mobile = np.flatnonzero(~f.frozen) + 1
@@ -647,6 +651,19 @@ class LammpsHertzSimulation(LammpsOwner):
         dist = np.hypot(sep[:, 0], sep[:, 1])
         normal = sep / dist[:, None] if dist.size else np.zeros((0, 2))
         return Contacts.from_geometry(self.positions, self.radius, i, j, normal, dist, force)
+
+    def virial_pressure(self) -> float:
+        """Pressure of the floe–floe contact forces of LAMMPS's last force
+        evaluation (the last step; after :meth:`advance`, its closing
+        set-up), compression positive [N/m], as LAMMPS computes it
+        (``compute pressure NULL pair``: the trace of the pair virial over
+        twice the box area). :meth:`contact_stress` sums the same forces but
+        reads :meth:`contacts`, whose ``compute pair/local`` rewrites the
+        springs of sliding contacts; reading this leaves the run as it is."""
+        from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR
+
+        return float(self.lmp.numpy.extract_compute("pair_virial", LMP_STYLE_GLOBAL,
+                                                    LMP_TYPE_SCALAR))
 
     def fabric(self) -> Fabric:
         """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts."""
