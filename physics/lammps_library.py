@@ -196,16 +196,14 @@ def finalize() -> None:
 
 class LammpsOwner:
     """``close()``, the context manager and the finaliser of an object that
-    holds a LAMMPS instance in the attribute named ``_LAMMPS_ATTR``."""
-
-    _LAMMPS_ATTR = "_lmp"
+    holds a LAMMPS instance in its attribute ``_lmp``."""
 
     def close(self) -> None:
         """Free the LAMMPS instance."""
-        lmp = self.__dict__.get(self._LAMMPS_ATTR)
+        lmp = self.__dict__.get("_lmp")
         if lmp is not None:
             lmp.close()
-            setattr(self, self._LAMMPS_ATTR, None)
+            self._lmp = None
 
     def __enter__(self):
         return self
