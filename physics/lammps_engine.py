@@ -182,8 +182,10 @@ class LammpsHertzSimulation(LammpsOwner):
     """The Hertz engine's physics run by LAMMPS (see the module docstring).
 
     Same constructor, attributes and methods as
-    :class:`~physics.hertz.HertzSimulation`, less the ship. Under
-    ``mpiexec -n N`` every rank creates it with the same arguments.
+    :class:`~physics.hertz.HertzSimulation`, less the ship, and the read-only
+    properties of the engine protocol (:mod:`physics.engine`): ``radii``,
+    ``masses``, ``frozen``, ``concentration``. Under ``mpiexec -n N`` every
+    rank creates it with the same arguments.
 
     Parameters
     ----------
@@ -242,7 +244,6 @@ class LammpsHertzSimulation(LammpsOwner):
         self.min_contact_time = t_c
         self.skin, _ = neighbour_cut(f.radii, box, skin)
         pos = positions_in_box(f, box, allow_overlap)
-        self.radius = f.radii
         mobile = ~f.frozen
         self.inv_mass = np.where(mobile, 1.0 / f.masses, 0.0)
         box.bind(f.total_area)
@@ -318,7 +319,7 @@ class LammpsHertzSimulation(LammpsOwner):
 
     def _box_commands(self) -> list[str]:
         b = self.box
-        zh = 2.0 * float(self.radius.max())
+        zh = 2.0 * float(self.field.radii.max())
         bounds = " ".join("p" if per else "f" for per in b.periodic) + " p"
         return ["units si", "dimension 2", f"boundary {bounds}", "atom_style sphere",
                 "atom_modify map array sort 0 0",
@@ -569,6 +570,21 @@ class LammpsHertzSimulation(LammpsOwner):
         return self.field.n
 
     @property
+    def radii(self) -> np.ndarray:
+        """(N,) floe radii [m] (a read-only copy)."""
+        return _snapshot(self.field.radii)
+
+    @property
+    def masses(self) -> np.ndarray:
+        """(N,) floe masses ρ h π r² [kg] (a read-only copy)."""
+        return _snapshot(self.field.masses)
+
+    @property
+    def frozen(self) -> np.ndarray:
+        """(N,) bool, True for the frozen (fast-ice) floes (a read-only copy)."""
+        return _snapshot(self.field.frozen)
+
+    @property
     def concentration(self) -> float:
         """Ice concentration A = F / S [-]."""
         return self.field.total_area / self.box.area
@@ -650,7 +666,8 @@ class LammpsHertzSimulation(LammpsOwner):
         i, j, force, sep = i[keep][order], j[keep][order], force[keep][order], sep[keep][order]
         dist = np.hypot(sep[:, 0], sep[:, 1])
         normal = sep / dist[:, None] if dist.size else np.zeros((0, 2))
-        return Contacts.from_geometry(self.positions, self.radius, i, j, normal, dist, force)
+        return Contacts.from_geometry(self.positions, self.field.radii, i, j, normal, dist,
+                                      force)
 
     def virial_pressure(self) -> float:
         """Pressure of the floe–floe contact forces of LAMMPS's last force

@@ -112,7 +112,7 @@ def network(sim: HertzSimulation) -> tuple[dict, object]:
 
 
 def _snapshot(rec, sim: HertzSimulation, contacts) -> None:
-    rec.snapshot(sim.time, sim.positions, sim.radius, sim.velocities,
+    rec.snapshot(sim.time, sim.positions, sim.field.radii, sim.velocities,
                  box=(sim.box.lx, sim.box.ly), contacts=(contacts.i, contacts.j,
                                                          contacts.normal_force),
                  frozen=sim.inv_mass == 0)
