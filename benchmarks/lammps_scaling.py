@@ -753,7 +753,7 @@ def versions() -> dict:
 
     out = {}
     try:
-        from physics.lammps_engine import lammps_version
+        from physics.lammps_library import lammps_version
 
         out["LAMMPS"] = lammps_version()
     except ImportError:
@@ -785,7 +785,7 @@ def main(argv=None, prog: str | None = None) -> int:
     args, argv = harness.parse(p, argv)
     if args.child:
         return _child(*args.child)
-    from physics.lammps_engine import lammps_available
+    from physics.lammps_library import lammps_available
 
     ok, reason = lammps_available()
     if not ok:

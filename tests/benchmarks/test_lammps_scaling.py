@@ -10,7 +10,7 @@ import pytest
 
 from benchmarks import harness
 from benchmarks import lammps_scaling as bench
-from physics.lammps_engine import lammps_available
+from physics.lammps_library import lammps_available
 
 _OK, _REASON = lammps_available()
 needs_lammps = pytest.mark.skipif(not _OK, reason=_REASON)

@@ -239,3 +239,45 @@ def test_from_preset_options(kind):
         cls.from_preset(preset, 80, 0.5, no_such_option=1)
     with pytest.raises(ValueError):
         cls.from_preset(preset, 80, 1.5)
+
+
+def test_the_lammps_engine_keeps_the_protocol():
+    from physics.lammps_library import lammps_available
+
+    ok, why = lammps_available()
+    if not ok:
+        pytest.skip(why)
+    from physics.lammps_engine import LammpsHertzSimulation
+
+    field, box = small_field()
+    with LammpsHertzSimulation(field, box) as sim:
+        assert isinstance(sim, FloeEngine)
+        assert sim.n_floes == 60 and sim.time == 0.0
+        sim.advance(1.0)
+        assert sim.time == pytest.approx(1.0)
+        assert isinstance(sim.contacts(), Contacts)
+        assert isinstance(sim.fabric(), Fabric)
+        assert isinstance(sim.contact_stress(), Stress)
+        assert isinstance(sim.state(), FloeField) and sim.state().n == 60
+        radii, masses, frozen = sim.radii, sim.masses, sim.frozen
+        for a in (radii, masses, frozen):
+            assert a.shape == (60,) and not a.flags.writeable
+            with pytest.raises(ValueError):
+                a[0] = 1
+        np.testing.assert_array_equal(radii, field.radii)
+        assert frozen.dtype == bool and frozen.tolist() == field.frozen.tolist()
+        # rtol: the same product ρ h π r² in another order of operations
+        np.testing.assert_allclose(masses, field.density * field.thickness * np.pi * radii ** 2,
+                                   rtol=1e-12)
+        # rtol: the same sum over the floes in another order of operations
+        assert sim.concentration == pytest.approx(np.sum(np.pi * radii ** 2) / (box.lx * box.ly),
+                                                  rel=1e-12)
+        # the masses are those of the dynamics: momentum and kinetic energy
+        # (disc inertia m r²/2) of the mobile floes, summed in another order
+        # (the momentum's tolerance relative to Σ m |u|, as its sum cancels)
+        v, w, m = sim.velocities[~frozen], sim.angular_velocities[~frozen], masses[~frozen]
+        np.testing.assert_allclose(sim.momentum(), (m[:, None] * v).sum(axis=0), rtol=0,
+                                   atol=1e-12 * np.sum(m[:, None] * np.abs(v)))
+        e = 0.5 * np.sum(m * np.sum(v ** 2, axis=1)) + 0.25 * np.sum(m * radii[~frozen] ** 2
+                                                                     * w ** 2)
+        assert sim.kinetic_energy() == pytest.approx(e, rel=1e-12)

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from physics.lammps_engine import lammps_available
+from physics.lammps_library import lammps_available
 
 OK, WHY = lammps_available()
 pytestmark = pytest.mark.skipif(not OK, reason=WHY)

@@ -14,8 +14,7 @@ import pytest
 from physics import ContactParams, FloeField, HertzSimulation, PeriodicBox
 from physics.contact import lammps_damping_alpha
 from physics.crosscheck import lammps_available
-from physics.crosscheck.lammps_runner import lammps_restitution
-from physics.domain import WalledBox
+from physics.lammps_engine import LammpsHertzSimulation, lammps_restitution
 
 OK, WHY = lammps_available()
 needs_lammps = pytest.mark.skipif(not OK, reason=WHY or "LAMMPS unavailable")
@@ -41,7 +40,7 @@ def test_restitution_beyond_lammps_damping_is_refused():
 
 @needs_lammps
 def test_mpi_library_is_found_in_the_environment():
-    from physics.crosscheck.lammps_runner import find_mpi_library
+    from physics.lammps_library import find_mpi_library
 
     path = find_mpi_library()
     assert path is not None and "libmpi" in path
@@ -69,20 +68,18 @@ def test_trajectories_agree_to_1e_6_of_the_mean_radius():
 
 @needs_lammps
 def test_head_on_impact_in_lammps_has_the_target_restitution():
-    # LAMMPS with the damping handed over by the runner gives the restitution
+    # LAMMPS with the damping handed over by the engine gives the restitution
     # our calibration promises (theory: e exactly, for the Hertz impact)
-    from physics.crosscheck.lammps_runner import LammpsSimulation
-
     e = 0.5
     r = np.array([2.0, 1.0])
     v0 = 0.3
     field = FloeField(np.array([[40.0, 40.0], [43.0 + 1e-6, 40.0]]), r, 1.0,
                       np.array([[v0, 0.0], [-v0, 0.0]]))
-    with LammpsSimulation(field, PeriodicBox(100.0), ContactParams(restitution=e),
-                          dt=2e-5) as lmp:
+    with LammpsHertzSimulation(field, PeriodicBox(100.0), ContactParams(restitution=e),
+                               dt=2e-5, impact_speed=2 * v0) as lmp:
         for _ in range(400):
             lmp.step(50)
-            f, _ = lmp.contact_forces()
+            f = lmp.force
             if not np.any(f) and lmp.velocities[0, 0] < lmp.velocities[1, 0]:
                 break
         u = lmp.velocities
@@ -103,34 +100,26 @@ def test_deforming_box_follows_our_box_and_pressures_agree():
 
 @needs_lammps
 def test_bad_input_is_refused():
-    from physics.crosscheck.lammps_runner import LammpsSimulation
-
     field = FloeField(np.array([[5.0, 5.0], [20.0, 5.0]]), np.array([1.0, 1.0]))
-    with pytest.raises(ValueError, match="PeriodicBox"):
-        LammpsSimulation(field, WalledBox(50.0, 50.0))
-    with pytest.raises(ValueError, match="FloeField"):
-        LammpsSimulation("floes", PeriodicBox(50.0))
     with pytest.raises(ValueError, match="dt"):
-        LammpsSimulation(field, PeriodicBox(50.0), dt=-1.0)
+        LammpsHertzSimulation(field, PeriodicBox(50.0), dt=-1.0)
     with pytest.raises(ValueError, match="too small"):
-        LammpsSimulation(field, PeriodicBox(3.0))
+        LammpsHertzSimulation(field, PeriodicBox(3.0), dt=1e-3)
     overlapping = FloeField(np.array([[5.0, 5.0], [6.0, 5.0]]), np.array([1.0, 1.0]))
     with pytest.raises(ValueError, match="overlap"):
-        LammpsSimulation(overlapping, PeriodicBox(50.0))
+        LammpsHertzSimulation(overlapping, PeriodicBox(50.0), dt=1e-3)
 
 
 @needs_lammps
 def test_same_state_as_our_engine_after_steps_in_chunks():
     # n runs of one step equal one run of n steps (forces are not recomputed
     # between runs), as in our engine
-    from physics.crosscheck.lammps_runner import LammpsSimulation
-
     r = np.array([2.0, 1.5])
     field = FloeField(np.array([[50.0, 50.0], [53.5005, 50.3]]), r, 1.0,
                       np.array([[0.2, 0.05], [-0.2, 0.0]]), np.array([0.01, -0.02]))
     c = ContactParams()
     ours = HertzSimulation(field, PeriodicBox(100.0), c, dt=1e-3)
-    with LammpsSimulation(field, PeriodicBox(100.0), c, dt=1e-3) as lmp:
+    with LammpsHertzSimulation(field, PeriodicBox(100.0), c, dt=1e-3) as lmp:
         for _ in range(60):
             ours.step(1)
             lmp.step(1)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from physics.lammps_engine import lammps_available
+from physics.lammps_library import lammps_available
 from physics.scenarios import run_scenario
 from physics.scenarios.cli import main
 from physics.scenarios.lammps_job import mpiexec
