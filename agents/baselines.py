@@ -125,7 +125,7 @@ class ConstantPolicy(Baseline):
         self.action = _check_action(space, action).astype(space.dtype)
 
     @classmethod
-    def best(cls, env, results, seed: int = 0) -> "ConstantPolicy":
+    def best(cls, env, results, seed: int = 0) -> ConstantPolicy:
         """The policy of the best action of a search: ``results`` is the list
         of :func:`search_constant_actions`, or the path of the JSON file of
         ``python -m agents.constant``."""

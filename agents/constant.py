@@ -79,7 +79,7 @@ def _init_worker(env_id: str, env_kwargs: dict, one_thread: bool) -> None:
             import numba
 
             numba.set_num_threads(1)
-        except Exception:       # numba absent or its threads already fixed
+        except (ImportError, ValueError):   # numba absent, or fewer threads than asked
             pass
     _WORKER["env"] = gym.make(env_id, **env_kwargs)
 

@@ -90,7 +90,7 @@ def task_table(rows: list[dict]) -> str:
         ret = r["returns"]
         c = r["heuristic_minus_constant"]
 
-        def cell(name):
+        def cell(name, ret=ret):
             return f"{ret[name]['mean']:.1f} ± {ret[name]['std']:.1f}"
 
         lines.append(f"| `{r['id']}` | {r['steps']} | {format_action(r['best_action'])} "

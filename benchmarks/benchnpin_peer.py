@@ -84,7 +84,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Sequence
+from collections.abc import Sequence
 
 PEER = "BenchNPIN ship-ice-v0"
 ENV_ID = "ship-ice-v0"

@@ -93,7 +93,7 @@ def _fetch_inventories() -> None:
         try:
             with urlopen(url + "objects.inv", timeout=3) as response:
                 data = response.read()
-        except Exception as exc:  # offline, DNS failure, timeout, HTTP error
+        except (OSError, ValueError) as exc:  # offline, DNS failure, timeout, HTTP error
             return name, url, exc
         cache.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)

@@ -43,7 +43,8 @@ from __future__ import annotations
 import inspect
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import gymnasium as gym
 import numpy as np
@@ -51,7 +52,7 @@ import numpy as np
 from physics import PaperPreset
 from physics.checks import check_range
 from physics.engine import FloeEngine
-from physics.hertz import hertz_time_step, scaled_contact  # noqa: F401  (used by the envs)
+from physics.hertz import hertz_time_step, scaled_contact
 from physics.markdown import table_row
 
 from .observations import FLOE_FEATURES, Feature, normalise

@@ -25,7 +25,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
+from collections.abc import Mapping
 
 __all__ = ["EnvFacts", "env_facts", "registered_ids"]
 
@@ -131,7 +132,7 @@ def _creator(env_id: str):
     import gymnasium as gym
     from gymnasium.envs.registration import load_env_creator
 
-    import iceenvs  # noqa: F401  (registers the package's ids)
+    import iceenvs
 
     try:
         spec = gym.spec(env_id)

@@ -130,7 +130,7 @@ class FloeClusteringEnv(FloeEnv):
     * v0: a target drawn per episode, rewards in [0, 1], frames coloured
       by cluster, task parameters as `gymnasium.make` keywords, episode
       length by `max_episode_steps`.
-    """
+    """  # noqa: E501  (Markdown table rows cannot wrap)
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_x", "wind_y")

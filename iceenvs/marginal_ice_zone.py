@@ -155,7 +155,7 @@ class MarginalIceZoneEnv(HertzEnv):
     * v0: a target transport speed drawn per episode, rewards in [0, 1],
       task parameters as `gymnasium.make` keywords, episode length by
       `max_episode_steps`.
-    """
+    """  # noqa: E501  (Markdown table rows cannot wrap)
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_speed", "wind_direction")

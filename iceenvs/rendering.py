@@ -90,7 +90,7 @@ def _pygame():
     """Import pygame (with gfxdraw) or say how to install it."""
     try:
         import pygame
-        import pygame.gfxdraw  # noqa: F401
+        import pygame.gfxdraw
     except ImportError as exc:
         raise DependencyNotInstalled(
             'pygame is needed for rendering; install it with pip install "seaice-gym[render]" '

@@ -54,8 +54,8 @@ from physics import FloeField, HERMAN2013
 from physics.checks import check_range
 from physics.hertz import hull_contact_time
 
-from .base import TIME_FEATURE, HertzEnv
-from .observations import Feature, normalise
+from .base import HertzEnv
+from .observations import Feature
 from .ship_sensors import ice_lidar, occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "FLOE_SIZES", "CONTROLS", "OBS_TYPES", "METRICS"]

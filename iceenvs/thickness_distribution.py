@@ -274,7 +274,7 @@ class ThicknessDistributionEnv(ControlEnv):
     ## Version History
     * v0: rewards in [0, 1], task parameters as `gymnasium.make` keywords,
       episode length by `max_episode_steps`.
-    """
+    """  # noqa: E501  (Markdown table rows cannot wrap)
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("redistribution", "rafting")

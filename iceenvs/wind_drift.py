@@ -153,7 +153,7 @@ class WindDriftEnv(HertzEnv):
     ## Version History
     * v0: a heading drawn per episode, rewards in [0, 1], task parameters
       as `gymnasium.make` keywords, episode length by `max_episode_steps`.
-    """
+    """  # noqa: E501  (Markdown table rows cannot wrap)
 
     action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
     action_names = ("wind_x", "wind_y")

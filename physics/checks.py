@@ -20,7 +20,9 @@ def check_range(name: str, value, low=None, high=None, *, low_open=False,
     """
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
-    interval = f"{'(' if (low_open or low is None) else '['}{lo}, {hi}{')' if (high_open or high is None) else ']'}"
+    opening = "(" if (low_open or low is None) else "["
+    closing = ")" if (high_open or high is None) else "]"
+    interval = f"{opening}{lo}, {hi}{closing}"
     try:
         v = float(value)
     except (TypeError, ValueError):

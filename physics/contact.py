@@ -196,7 +196,7 @@ class ContactLaw(NamedTuple):
     tangential_translation: float
 
     @classmethod
-    def from_params(cls, contact, wall: bool = False) -> "ContactLaw":
+    def from_params(cls, contact, wall: bool = False) -> ContactLaw:
         """The floe–floe law of ``contact`` (a
         :class:`~physics.params.ContactParams`), or with ``wall`` the law
         of a floe against a rigid wall (its stiffer E* and G*)."""

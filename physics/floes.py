@@ -142,12 +142,12 @@ class FloeField:
         """Ice concentration A = F / S in ``box`` [-]."""
         return self.total_area / box.area
 
-    def copy(self) -> "FloeField":
+    def copy(self) -> FloeField:
         return FloeField(self.positions.copy(), self.radii.copy(), self.thickness.copy(),
                          self.velocities.copy(), self.angular_velocities.copy(),
                          self.density, self.frozen.copy())
 
-    def take(self, order) -> "FloeField":
+    def take(self, order) -> FloeField:
         """A new field of the floes ``order`` (indices into this one), e.g. a
         renumbering by :func:`spatial_order`."""
         order = np.asarray(order)

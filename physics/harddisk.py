@@ -229,7 +229,7 @@ class HardDiskSimulation(FloeProperties):
     @classmethod
     def from_preset(cls, preset: PaperPreset, n: int | None = None,
                     concentration: float | None = None, *, seed: int | None = 0,
-                    forcing: bool | Forcing | None = True, **kwargs) -> "HardDiskSimulation":
+                    forcing: bool | Forcing | None = True, **kwargs) -> HardDiskSimulation:
         """A simulation of a paper preset's floes, contact and numerics.
 
         The floes come from ``preset.floe_field(n, concentration, seed=seed)``

@@ -225,7 +225,7 @@ class HertzSimulation(FloeProperties):
     @classmethod
     def from_preset(cls, preset: PaperPreset, n: int | None = None,
                     concentration: float | None = None, *, seed: int | None = 0,
-                    forcing: bool | Forcing | None = True, **kwargs) -> "HertzSimulation":
+                    forcing: bool | Forcing | None = True, **kwargs) -> HertzSimulation:
         """A simulation of a paper preset's floes, contact law and time step.
 
         The floes come from ``preset.floe_field(n, concentration, seed=seed)``

@@ -97,7 +97,7 @@ class Hull:
 
     # -- construction -------------------------------------------------------
     @classmethod
-    def box(cls, length: float, beam: float, name: str = "box") -> "Hull":
+    def box(cls, length: float, beam: float, name: str = "box") -> Hull:
         """A rectangle ``length`` × ``beam`` (a flat bow)."""
         _check_dimensions(length, beam)
         a, b = 0.5 * length, 0.5 * beam
@@ -106,7 +106,7 @@ class Hull:
     @classmethod
     def pointed(cls, length: float, beam: float, *, shoulder: float = 0.7,
                 knuckle: float = 0.85, knuckle_beam: float = 0.7,
-                name: str = "pointed") -> "Hull":
+                name: str = "pointed") -> Hull:
         """A flat stern, a parallel mid-body up to ``shoulder`` × length from
         the stern, and a bow narrowing to a stem, with one knuckle at
         ``knuckle`` × length where the half-beam is ``knuckle_beam`` × the

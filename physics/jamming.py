@@ -293,8 +293,8 @@ def relax_floes(positions, radii, box: PeriodicBox, *, max_iter: int = 200000,
     rs = r / scale
     lx, ly = box.lx / scale, box.ly / scale
     cell = choose_cell_size(rs, lx, ly, _SKIN)
-    status, it, e, nc, res, _ = fire_relax(p, rs, radius_rank(rs), lx, ly, cell, int(max_iter), float(energy_tol),
-                                           float(force_tol), 1.0)
+    status, it, e, nc, res, _ = fire_relax(p, rs, radius_rank(rs), lx, ly, cell, int(max_iter),
+                                           float(energy_tol), float(force_tol), 1.0)
     out = p * scale
     return RelaxResult(positions=out, status=_STATUS_NAMES[int(status)], iterations=int(it),
                        energy_per_floe=float(e), contacts_per_floe=2.0 * nc / r.size,

@@ -597,7 +597,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
     @velocities.setter
     def velocities(self, value):
         v = _checked_motion("velocities", value, (self.field.n, 2), self.field.frozen, "velocity")
-        self.lmp
+        _ = self.lmp                # reopens a restored simulation, refuses a closed one
         self._scatter("v", np.column_stack([v, np.zeros(self.field.n)]))
 
     @property
@@ -609,7 +609,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
     def angular_velocities(self, value):
         w = _checked_motion("angular_velocities", value, (self.field.n,), self.field.frozen,
                             "angular velocity")
-        self.lmp
+        _ = self.lmp                # reopens a restored simulation, refuses a closed one
         self._scatter("omega", np.column_stack([np.zeros((self.field.n, 2)), w]))
 
     @property

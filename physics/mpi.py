@@ -91,7 +91,7 @@ def abort(code: int = 1) -> None:
     if under_mpiexec():
         try:
             lib = _lib()
-        except Exception:
+        except Exception:  # noqa: BLE001  (no library to abort with: end this rank alone)
             os._exit(code)
         sys.stdout.flush()
         sys.stderr.flush()

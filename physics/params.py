@@ -208,7 +208,7 @@ class PaperPreset:
     def mean_radius(self) -> float:
         return 0.5 * self.mean_diameter
 
-    def replace(self, **changes) -> "PaperPreset":
+    def replace(self, **changes) -> PaperPreset:
         """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
 
@@ -518,7 +518,7 @@ class ItdPreset:
         check_range("h_raft", h_raft, 0.0, None)
         return {"r": self.r0, "h_raft": h_raft, "factor": self.raft_factor}
 
-    def replace(self, **changes) -> "ItdPreset":
+    def replace(self, **changes) -> ItdPreset:
         """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
 

@@ -1,7 +1,7 @@
 """Progress bars for long runs of the engines."""
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 __all__ = ["steps_with_bar"]
 

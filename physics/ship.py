@@ -96,7 +96,7 @@ class ShipHydrodynamics:
 
     @classmethod
     def fossen_supply(cls, mass: float, length: float, yaw_inertia: float, draft: float,
-                      water_density: float = _WATER_DENSITY) -> "ShipHydrodynamics":
+                      water_density: float = _WATER_DENSITY) -> ShipHydrodynamics:
         """The manoeuvring coefficients of Fossen's supply-vessel model
         (:data:`FOSSEN_SUPPLY`), scaled to a ship of this ``mass`` [kg] and
         ``length`` [m] in the bis system (they are the same numbers at model
@@ -214,7 +214,7 @@ class Ship:
         if self.mode == "prescribed" and abs(self.speed) > self.max_speed:
             raise ValueError(f"Ship.speed {self.speed} exceeds max_speed {self.max_speed}")
 
-    def replace(self, **changes) -> "Ship":
+    def replace(self, **changes) -> Ship:
         """A copy with some fields changed (``dataclasses.replace``)."""
         return dataclasses.replace(self, **changes)
 

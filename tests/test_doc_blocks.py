@@ -29,7 +29,7 @@ import pytest
 
 pytest.importorskip("markdown_it", reason="markdown-it-py comes with the docs extra")
 
-from doc_blocks import ROOT, Block, Page, load_pages, parse_page  # noqa: E402
+from doc_blocks import ROOT, Block, Page, load_pages, parse_page
 
 PAGES = load_pages()
 BLOCKS = [b for page in PAGES for b in page.blocks if b.kind in ("python", "shell")]

@@ -1,4 +1,6 @@
-import gymnasium as gym, numpy as np, iceenvs  # noqa: F401  (iceenvs registers the environments)
+import gymnasium as gym
+import numpy as np
+import iceenvs  # noqa: F401  (iceenvs registers the environments)
 from stable_baselines3 import PPO
 from stable_baselines3.common.env_util import make_vec_env
 

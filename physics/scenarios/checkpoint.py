@@ -57,7 +57,7 @@ class CheckpointError(ValueError):
     """A checkpoint file that cannot be read; the message says why."""
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _yaml():
     """(yaml, the writer's dumper, the reader's loader)."""
     import yaml
@@ -444,7 +444,7 @@ def load(path):
             return _Decoder(zf).decode(doc.get("data"))
     except CheckpointError:
         raise
-    except Exception as exc:            # anything a damaged file can raise
+    except Exception as exc:  # noqa: BLE001  (anything a damaged file can raise)
         raise CheckpointError(f"it is damaged ({type(exc).__name__}: {exc})") from None
 
 

@@ -67,7 +67,8 @@ def build_parser(prog: str = "ice-scenarios") -> argparse.ArgumentParser:
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="set a parameter (YAML value: 0.5, true, [0.6,0.8]); repeatable")
     r.add_argument("--out", help="run directory (default runs/NAME, runs/NAME-quick)")
-    r.add_argument("--quick", action="store_true", help="the reduced form: a small set-up that runs in seconds")
+    r.add_argument("--quick", action="store_true",
+                   help="the reduced form: a small set-up that runs in seconds")
     r.add_argument("--force", action="store_true", help="overwrite an existing run directory")
     r.add_argument("--resume", metavar="RUN_DIR", help="continue an interrupted run")
     r.add_argument("--workers", type=int, help="parallel processes (default: one per core)")

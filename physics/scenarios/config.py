@@ -233,9 +233,10 @@ def parse_set(items) -> dict[str, Any]:
         key = key.strip()
         if not key:
             raise ValueError(f"--set expects key=value, got {item!r}")
+        yaml = _yaml()
         try:
-            out[key] = _yaml().safe_load(text)
-        except Exception:
+            out[key] = yaml.safe_load(text)
+        except yaml.YAMLError:          # not YAML: the value is the text itself
             out[key] = text
     return out
 

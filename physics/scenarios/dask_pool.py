@@ -118,7 +118,7 @@ class _Reporter:
         self.sent = now
         try:
             self.worker.log_event(self.topic, [self.job_id, float(fraction)])
-        except Exception:      # the progress bar is not worth a failed run
+        except Exception:  # noqa: BLE001  (the progress bar is not worth a failed run)
             pass
 
 
@@ -152,7 +152,7 @@ def run_on_dask(args: list, update, dask: dict, log=print) -> None:
     except BaseException:
         try:
             client.cancel(futures)
-        except Exception:
+        except Exception:  # noqa: BLE001  (the error being raised matters, not this one)
             pass
         raise
     finally:

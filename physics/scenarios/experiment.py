@@ -93,7 +93,7 @@ def experiments() -> dict[str, type]:
     return dict(_REGISTRY)
 
 
-def get_experiment(name: str, engine: str = "numba") -> "Experiment":
+def get_experiment(name: str, engine: str = "numba") -> Experiment:
     """The experiment ``name``, running on ``engine`` (checked with
     :func:`~physics.scenarios.engines.check_engine`)."""
     found = experiments()

@@ -29,7 +29,7 @@ from ..domain import ChannelBox, DeformingPeriodicBox, PeriodicBox
 from ..engine import FloeEngine
 from ..floes import FloeField
 from ..forcing import Forcing, steady_drift
-from ..hertz import HertzSimulation, hertz_time_step, scaled_contact
+from ..hertz import hertz_time_step, scaled_contact
 from ..hertz_kernels import floe_drag
 from ..observables import fabric, stress
 from ..params import HERMAN2013

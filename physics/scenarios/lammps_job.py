@@ -120,7 +120,7 @@ def main(argv=None) -> int:
             print(f"{PROGRESS}{fraction:.6f}", flush=True)
     try:
         run_job(*args, on_progress=report, engine="lammps")
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001  (any failure must abort every rank, or they hang)
         print(f"rank {mpi.world_rank()}: {type(exc).__name__}: {exc}", file=sys.stderr,
               flush=True)
         mpi.abort(1)

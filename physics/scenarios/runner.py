@@ -27,6 +27,7 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
+from queue import Empty
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -307,7 +308,7 @@ def _run_pool(args, workers, update):
         while not stop.is_set():
             try:
                 k, f = queue.get(timeout=0.2)
-            except Exception:
+            except Empty:
                 continue
             update(k, f)
     reader = threading.Thread(target=pump, daemon=True)

@@ -10,15 +10,14 @@ import numpy as np
 import pytest
 import yaml
 
-import iceenvs
 from iceenvs import ENV_IDS
 
 pytest.importorskip("stable_baselines3")
 
-from agents import train  # noqa: E402
-from agents.baselines import baseline_names, make_baseline  # noqa: E402
-from iceenvs.facts import env_facts  # noqa: E402
-from small_envs import SMALL as ALL_SMALL  # noqa: E402
+from agents import train
+from agents.baselines import baseline_names, make_baseline
+from iceenvs.facts import env_facts
+from small_envs import SMALL as ALL_SMALL
 
 ROOT = Path(__file__).resolve().parents[2]
 CONVERGENCE = "iceenvs/Convergence-v0"

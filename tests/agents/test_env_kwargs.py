@@ -8,8 +8,8 @@ import yaml
 
 pytest.importorskip("stable_baselines3")
 
-from agents import train  # noqa: E402
-from agents.envs import check_env_kwargs, parse_key_values  # noqa: E402
+from agents import train
+from agents.envs import check_env_kwargs, parse_key_values
 
 CONVERGENCE = "iceenvs/Convergence-v0"
 ITD = "iceenvs/ThicknessDistribution-v0"

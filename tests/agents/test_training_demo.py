@@ -9,8 +9,8 @@ import yaml
 
 pytest.importorskip("stable_baselines3")
 
-from agents import demo  # noqa: E402
-from agents.train import read_hyperparams  # noqa: E402
+from agents import demo
+from agents.train import read_hyperparams
 
 
 def report(**changes):

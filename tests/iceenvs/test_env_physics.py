@@ -241,7 +241,7 @@ def test_convergence_failure_is_absorbing():
     try:
         env.reset(seed=1, options={"concentration": 0.84})
         base = env.unwrapped
-        for k in range(1, 401):
+        for k in range(1, 401):  # noqa: B007  (k counts the steps after the loop)
             _, reward, terminated, truncated, info = env.step(np.array([1.0], dtype=np.float32))
             assert "error" not in info
             if terminated:

@@ -9,7 +9,7 @@ from gymnasium.error import DependencyNotInstalled
 
 pygame = pytest.importorskip("pygame")
 
-from iceenvs.rendering import (  # noqa: E402
+from iceenvs.rendering import (
     ARROW_CIRCLE, ARROW_COLOURS, BACKGROUND, CHAIN, CLUSTER_LEGEND, CLUSTER_PALETTE, FROZEN,
     ITD_BACKGROUND, ITD_TARGET, LARGEST_CLUSTER, PANEL_BACKGROUND, SINGLE_FLOE, SPEED_SCALE,
     Window, annotate, draw_floes, draw_itd, season,

@@ -168,7 +168,7 @@ def test_a_weak_ship_is_beset_and_the_episode_fails():
     env = gym.make(BESET, concentration=0.7, thrust_fraction=0.001, speed=0.0, beset_time=20.0)
     try:
         env.reset(seed=0)
-        for k in range(100):
+        for k in range(100):  # noqa: B007  (k counts the steps after the loop)
             _, reward, terminated, truncated, info = env.step(np.array([1.0, 0.0], np.float32))
             if terminated or truncated:
                 break

@@ -102,7 +102,7 @@ def test_collision_log_grows_and_matches_the_count():
     assert len(sim.collision_log) == 0
     off = HardDiskSimulation(field, box)
     with pytest.raises(ValueError, match="log_collisions=True"):
-        off.collision_log
+        _ = off.collision_log
 
 
 # -- calendar and cells against brute force ----------------------------------------
@@ -201,7 +201,7 @@ def test_drag_relaxes_to_u_eq_within_the_derived_position_bound(dt_max):
     worst = np.zeros(d.size)
     t_total = 8 * tau.max()
     n_chunks = 200
-    for k in range(n_chunks):
+    for _ in range(n_chunks):
         sim.advance(t_total / n_chunks)
         x = sim.positions[:, 0]
         travelled += (x - last + 0.5 * box.lx) % box.lx - 0.5 * box.lx

@@ -35,15 +35,15 @@ from physics.lammps_library import lammps_available
 OK, WHY = lammps_available()
 pytestmark = pytest.mark.skipif(not OK, reason=WHY)
 
-from physics import HERMAN2013, HertzSimulation, PeriodicBox  # noqa: E402
-from physics.domain import ChannelBox, DeformingPeriodicBox, WalledBox  # noqa: E402
-from physics.engine import FailureReason, SimulationError  # noqa: E402
-from physics.floes import FloeField  # noqa: E402
-from physics.forcing import Forcing  # noqa: E402
-from physics.hertz import minimum_contact_time  # noqa: E402
-from physics.lammps_engine import LammpsHertzSimulation, rotation_drag_types  # noqa: E402
-from physics.observables import fabric, stress  # noqa: E402
-from physics.scenarios.lammps_job import mpiexec as mpiexec_launcher  # noqa: E402
+from physics import HERMAN2013, HertzSimulation, PeriodicBox
+from physics.domain import ChannelBox, DeformingPeriodicBox, WalledBox
+from physics.engine import FailureReason, SimulationError
+from physics.floes import FloeField
+from physics.forcing import Forcing
+from physics.hertz import minimum_contact_time
+from physics.lammps_engine import LammpsHertzSimulation, rotation_drag_types
+from physics.observables import fabric, stress
+from physics.scenarios.lammps_job import mpiexec as mpiexec_launcher
 
 ROOT = Path(__file__).resolve().parents[2]
 DT = 0.001

@@ -16,8 +16,8 @@ import pytest
 
 pytest.importorskip("yaml")
 
-from physics.scenarios import checkpoint as ck  # noqa: E402
-from physics.scenarios.recorder import Recorder, checkpoint_files  # noqa: E402
+from physics.scenarios import checkpoint as ck
+from physics.scenarios.recorder import Recorder, checkpoint_files
 
 # Classes standing for the physics package's own (engines, bundles, statuses):
 # they are registered below as the module physics._checkpoint_test_types.

@@ -5,7 +5,7 @@ import pytest
 
 pytest.importorskip("yaml")
 
-from physics.scenarios import cli  # noqa: E402
+from physics.scenarios import cli
 
 
 def test_unknown_scenario_lists_the_valid_ones(capsys):

@@ -10,8 +10,8 @@ import pytest
 pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-from physics.scenarios import cli, run_scenario  # noqa: E402
-from physics.scenarios.compare import Row, compare_runs  # noqa: E402
+from physics.scenarios import cli, run_scenario
+from physics.scenarios.compare import Row, compare_runs
 
 WIND = dict(floes=100, concentrations=[0.6, 0.8], duration=20.0, output_interval=2.0,
             snapshot_times=[10.0])

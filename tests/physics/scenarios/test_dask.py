@@ -12,8 +12,8 @@ distributed = pytest.importorskip("distributed")
 xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-from physics.scenarios import cli, run_scenario  # noqa: E402
-from physics.scenarios import jobs as jobs_module  # noqa: E402
+from physics.scenarios import cli, run_scenario
+from physics.scenarios import jobs as jobs_module
 
 # a two-member convergence ensemble of a few seconds
 TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.0,

@@ -9,11 +9,11 @@ import pytest
 pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-import xarray as xr  # noqa: E402
+import xarray as xr
 
-from physics.params import GODLOVITCH  # noqa: E402
-from physics.scenarios import find_config, get_experiment, resume_run, run_scenario  # noqa: E402
-from physics.scenarios.recorder import Recorder  # noqa: E402
+from physics.params import GODLOVITCH
+from physics.scenarios import find_config, get_experiment, resume_run, run_scenario
+from physics.scenarios.recorder import Recorder
 
 NAMES = ("godlovitch-kernels", "godlovitch-rafting", "godlovitch-thermo", "scm-analytic")
 

@@ -12,8 +12,8 @@ import pytest
 xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-from physics.scenarios import Recorder, get_experiment, run_scenario  # noqa: E402
-from physics.scenarios.runner import find_config, member_seeds  # noqa: E402
+from physics.scenarios import Recorder, get_experiment, run_scenario
+from physics.scenarios.runner import find_config, member_seeds
 
 NAME = "herman2011-clustering"
 # two concentrations, 500 floes, 600 model seconds: a few seconds of wall time

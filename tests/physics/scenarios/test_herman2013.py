@@ -10,8 +10,8 @@ import pytest
 xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-from physics.scenarios import run_scenario  # noqa: E402
-from physics.scenarios.herman2013 import first_crossing, jamming_from_pressure, shear_zone  # noqa: E402
+from physics.scenarios import run_scenario
+from physics.scenarios.herman2013 import first_crossing, jamming_from_pressure, shear_zone
 
 
 def _run(name, out, **overrides):

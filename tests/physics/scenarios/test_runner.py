@@ -15,12 +15,12 @@ import pytest
 xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 
-from physics.scenarios import get_experiment, load_config, resume_run, run_scenario  # noqa: E402
-from physics.scenarios import recorder as recorder_module  # noqa: E402
-from physics.scenarios.config import bundled_configs, parse_set  # noqa: E402
-from physics.scenarios.experiment import experiment_modules, experiments  # noqa: E402
-from physics.scenarios.recorder import checkpoint_files  # noqa: E402
-from physics.scenarios.runner import QUICK_NOTE, find_config, format_summary, member_seeds  # noqa: E402
+from physics.scenarios import get_experiment, load_config, resume_run, run_scenario
+from physics.scenarios import recorder as recorder_module
+from physics.scenarios.config import bundled_configs, parse_set
+from physics.scenarios.experiment import experiment_modules, experiments
+from physics.scenarios.recorder import checkpoint_files
+from physics.scenarios.runner import QUICK_NOTE, find_config, format_summary, member_seeds
 
 # a convergence run of a few seconds
 TINY = dict(floes=200, start_concentration=0.84, end_concentration=0.88, rate=2.0,

@@ -12,9 +12,9 @@ xr = pytest.importorskip("xarray")
 pytest.importorskip("yaml")
 pytest.importorskip("matplotlib")
 
-from physics.scenarios import run_scenario  # noqa: E402
-from physics.scenarios.runner import find_config  # noqa: E402
-from physics.scenarios.ship_transit import (beset_concentration, pack_ice,  # noqa: E402
+from physics.scenarios import run_scenario
+from physics.scenarios.runner import find_config
+from physics.scenarios.ship_transit import (beset_concentration, pack_ice,
                                             power_law_fit)
 
 # three (concentration, speed) pairs × two modes × with and without wind
