@@ -9,9 +9,7 @@ from physics.domain import Box
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .rewards import ship_beset_reward
-from .facts import EnvFacts
-from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_env import CONTROLS, FLOE_SIZES, METRICS, ShipEnv, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
 
 __all__ = ["ShipBesetEnv", "MAX_EPISODE_STEPS"]
 
@@ -149,16 +147,12 @@ class ShipBesetEnv(ShipEnv):
     drawn = ("concentration", "wind_speed")
     reward_task_keys = ("pressure_limit",)
     reward_fn = staticmethod(ship_beset_reward)
-    facts = EnvFacts(
+    facts = ship_facts(
         summary="keep a ship moving in pressured ice",
         metrics={"goal_distance": "goal_distance", "surge": "surge",
                  "hull_pressure": "hull_pressure", "pressure_limit": "pressure_limit",
                  "step_impulse": "step_impulse", "concentration": "concentration"},
         main_metric="hull_pressure",
-        episode_metrics=METRICS,
-        compared_metric=("impulse_per_metre", True),
-        controllers={"heuristic": ReactivePlanner, "straight": StraightLinePolicy,
-                     "reactive": ReactivePlanner},
         small={"concentration": 0.6})
 
     def __init__(self, preset=HERMAN2013, control_interval: float = 2.0, width: float = 200.0,

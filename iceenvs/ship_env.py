@@ -55,10 +55,13 @@ from physics.checks import check_range
 from physics.hertz import hull_contact_time
 
 from .base import HertzEnv
+from .facts import EnvFacts
 from .observations import Feature
+from .ship_controllers import ReactivePlanner, StraightLinePolicy
 from .ship_sensors import ice_lidar, occupancy_image
 
-__all__ = ["ShipEnv", "ship_features", "FLOE_SIZES", "CONTROLS", "OBS_TYPES", "METRICS"]
+__all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
+           "METRICS"]
 
 #: floe-size presets: (``sizes`` of :func:`physics.ship.transit_field`,
 #: log-normal (median diameter [m], σ of ln d))
@@ -81,6 +84,22 @@ OBS_TYPES = ("vector", "image", "dict")
 METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
            "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
            "energy_to_ice", "ice_resistance", "max_hull_pressure")
+
+
+
+def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
+               **more) -> EnvFacts:
+    """The facts of a ship environment: the task's own (``summary``,
+    ``metrics``, ``main_metric``, ``small`` and any other field of
+    :class:`~iceenvs.facts.EnvFacts`) with what every ship task shares: the
+    episode metrics of :data:`METRICS`, the ice impulse per metre compared
+    like the return (lower is better), and the planners of
+    :mod:`iceenvs.ship_controllers` (``"heuristic"`` is the reactive one)."""
+    return EnvFacts(summary=summary, metrics=metrics, main_metric=main_metric, small=small,
+                    episode_metrics=METRICS, compared_metric=("impulse_per_metre", True),
+                    controllers={"heuristic": ReactivePlanner, "straight": StraightLinePolicy,
+                                 "reactive": ReactivePlanner}, **more)
+
 
 #: below this concentration the floes are placed directly; above it they are
 #: placed at it and compressed (FIRE relaxation)

@@ -11,9 +11,7 @@ from physics.forcing import steady_drift
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
-from .facts import EnvFacts
-from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_env import CONTROLS, FLOE_SIZES, METRICS, ShipEnv, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
 
 __all__ = ["ShipNavigationEnv", "MAX_EPISODE_STEPS"]
 
@@ -177,16 +175,12 @@ class ShipNavigationEnv(ShipEnv):
     drawn = ("concentration", "wind_speed", "wind_direction", "current_speed",
              "current_direction")
     reward_fn = staticmethod(ship_navigation_reward)
-    facts = EnvFacts(
+    facts = ship_facts(
         summary="sail a ship through pack ice to a goal",
         metrics={"goal_distance": "goal_distance", "surge": "surge",
                  "step_impulse": "step_impulse", "hull_pressure": "hull_pressure",
                  "concentration": "concentration"},
         main_metric="step_impulse",
-        episode_metrics=METRICS,
-        compared_metric=("impulse_per_metre", True),
-        controllers={"heuristic": ReactivePlanner, "straight": StraightLinePolicy,
-                     "reactive": ReactivePlanner},
         small={"concentration": 0.3},
         # ten times BenchNPIN ship-ice-v0 on the same machine (about 10 steps/s)
         speed_target=100)
