@@ -191,10 +191,10 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
     if "hertz" in suites:
         import numba
 
-        from .hertz import _kernel_configs, prepared_cases
+        from .hertz import kernel_configs, prepared_cases
 
         labels = [f"{k}, {t} thread{'s' * (t > 1)}"
-                  for k, _, t in _kernel_configs(numba.config.NUMBA_NUM_THREADS)]
+                  for k, _, t in kernel_configs(numba.config.NUMBA_NUM_THREADS)]
         for name, path, dt in prepared_cases(sizes["floes"], seed, cache_dir, quiet):
             out.append(dict(name=f"Hertz, N = {sizes['floes']}, {name}", labels=labels,
                             unit="floe-steps/s", fn=_hertz_child,
@@ -223,9 +223,9 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
     if "environments" in suites:
         from iceenvs import ENV_IDS
 
-        from .environments import _resolve_ids
+        from .environments import resolve_ids
 
-        for env_id in (_resolve_ids(ids, ENV_IDS) if ids else ENV_IDS):
+        for env_id in (resolve_ids(ids, ENV_IDS) if ids else ENV_IDS):
             out.append(dict(name=env_id, labels=["one thread"], unit="steps/s",
                             fn=_environment_child,
                             args=(env_id, sizes["seconds"], sizes["runs"], 0, sizes["warmup"]),

@@ -263,7 +263,7 @@ def stiffness_table(rows: list[dict]) -> dict:
           f"{r['pressure']:.3g}", f"{r['largest_cluster']:.2f}"] for r in rows])
 
 
-def _resolve_ids(ids, known) -> list[str]:
+def resolve_ids(ids, known) -> list[str]:
     out = []
     for i in ids:
         full = i if "/" in i else f"iceenvs/{i}"
@@ -308,7 +308,7 @@ def main(argv=None, prog: str | None = None) -> int:
         args.no_json = args.no_json or not any(a.startswith("--json") for a in argv)
         harness.finish(args, record)
         return 0
-    ids = _resolve_ids(args.ids, ENV_IDS) if args.ids else list(ENV_IDS)
+    ids = resolve_ids(args.ids, ENV_IDS) if args.ids else list(ENV_IDS)
     result = run_benchmark(ids, settings["seconds"], settings["runs"], args.seed,
                            settings["warmup"], args.quiet)
     tables = [environments_table(result)]

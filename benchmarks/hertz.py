@@ -81,7 +81,7 @@ def _load_state(path: Path):
     return field, PeriodicBox(float(d["lx"]), float(d["ly"]))
 
 
-def _loose_state(n: int, seed: int, cache_dir: Path) -> Path:
+def loose_state(n: int, seed: int, cache_dir: Path) -> Path:
     """Path of the saved Ā = 0.7 field (random velocities of 3 cm/s per
     component), made on first use."""
     path = Path(cache_dir) / f"hertz_a070_n{n}_seed{seed}_v2.npz"
@@ -124,7 +124,7 @@ def _jammed_state(n: int, seed: int, cache_dir: Path, quiet: bool, target: float
 def prepared_cases(n: int, seed: int, cache_dir: Path, quiet: bool = True) -> list[tuple]:
     """The two cases, as (name, path of the saved field, Δt): Ā = 0.7 and
     jammed (prepared and saved on first use)."""
-    loose_path = _loose_state(n, seed, cache_dir)
+    loose_path = loose_state(n, seed, cache_dir)
     jam_path, prep = _jammed_state(n, seed, cache_dir, quiet)
     jam, jam_box = _load_state(jam_path)
     conc = jam.total_area / jam_box.area
@@ -134,7 +134,7 @@ def prepared_cases(n: int, seed: int, cache_dir: Path, quiet: bool = True) -> li
             (f"jammed, Ā = {conc:.2f}", jam_path, 1e-3)]
 
 
-def _kernel_configs(threads_all: int) -> list[tuple[str, bool, int]]:
+def kernel_configs(threads_all: int) -> list[tuple[str, bool, int]]:
     """(label, parallel kernels?, threads) of every timed configuration."""
     configs = [("serial", False, 1), ("parallel", True, 1)]
     if threads_all > 1:
@@ -142,7 +142,7 @@ def _kernel_configs(threads_all: int) -> list[tuple[str, bool, int]]:
     return configs
 
 
-def _warm_sim(path: str, dt: float, parallel: bool) -> HertzSimulation:
+def warm_sim(path: str, dt: float, parallel: bool) -> HertzSimulation:
     """A simulation of the saved state, its kernels compiled (or loaded from
     the cache) by a few warm-up steps."""
     field, box = _load_state(Path(path))
@@ -160,14 +160,14 @@ def _segment_rate(sim: HertzSimulation, steps: int) -> float:
 
 
 def warm_sims(path: str, dt: float) -> tuple[list, list]:
-    """Every configuration of :func:`_kernel_configs` (this process's thread
+    """Every configuration of :func:`kernel_configs` (this process's thread
     pool) and a warmed-up simulation of the saved state for each, on its
     own copy. Returns (configurations, simulations)."""
-    configs = _kernel_configs(numba.config.NUMBA_NUM_THREADS)
+    configs = kernel_configs(numba.config.NUMBA_NUM_THREADS)
     sims = []
     for _, parallel, threads in configs:
         numba.set_num_threads(threads)
-        sims.append(_warm_sim(path, dt, parallel))
+        sims.append(warm_sim(path, dt, parallel))
     return configs, sims
 
 
@@ -187,7 +187,7 @@ def time_configs(configs: list, sims: list, steps: int, rounds: int = REPEATS) -
 
 def _time_child(path: str, steps: int, dt: float) -> dict:
     """Run in a fresh process whose thread pool has all threads: time every
-    configuration of :func:`_kernel_configs` on its own copy of the saved
+    configuration of :func:`kernel_configs` on its own copy of the saved
     state, in ``REPEATS`` rounds of one segment of ``steps`` steps each,
     the configurations taking turns within a round (:func:`time_configs`).
     Returns the rates of every segment per configuration, contacts per
@@ -221,7 +221,7 @@ def peak_memory(n: int) -> int:
 def _pinned_child(path: str, steps: int, dt: float) -> dict:
     """The rates of ``REPEATS`` segments of ``steps`` steps of the serial
     kernels (in a process pinned to one core)."""
-    sim = _warm_sim(path, dt, parallel=False)
+    sim = warm_sim(path, dt, parallel=False)
     return dict(rates=[_segment_rate(sim, steps) for _ in range(REPEATS)])
 
 
@@ -260,7 +260,7 @@ def bench_hertz(n: int = 20000, steps: int = 2000, seed: int = 1, cache_dir: Pat
     ceilings = ceilings and threads_all > 1
     pinned = ceilings and hasattr(os, "sched_setaffinity") and len(os.sched_getaffinity(0)) > 1
     total = len(cases) * processes + 3 * pinned + 2 * processes * ceilings + bool(memory_floes)
-    configs = _kernel_configs(threads_all)
+    configs = kernel_configs(threads_all)
     with harness.Progress(total, "hertz", quiet) as bar:
         for name, path, dt in cases:
             # the same run differs by up to 1.7x between processes on a shared

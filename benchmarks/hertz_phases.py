@@ -19,7 +19,7 @@ from physics.params import HERMAN2013
 
 from . import harness
 from .harness import REPEATS
-from .hertz import _kernel_configs, _loose_state, _warm_sim
+from .hertz import kernel_configs, loose_state, warm_sim
 
 SUITE = "hertz_phases"
 TITLE = "Phases of a Hertz step"
@@ -93,9 +93,9 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
     time and the same-round speed-ups over the serial kernels."""
     threads_all = numba.config.NUMBA_NUM_THREADS
     cache_dir = Path(cache_dir) if cache_dir is not None else harness.CACHE_DIR
-    path = _loose_state(n, seed, cache_dir)
+    path = loose_state(n, seed, cache_dir)
     dt = HERMAN2013.time_step
-    sim = _warm_sim(str(path), dt, parallel=False)
+    sim = warm_sim(str(path), dt, parallel=False)
     box = sim.box.kernel_box(sim.time)
 
     def arrays(n_chunks):
@@ -105,7 +105,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
         return (K.pair_chunks(verlet, n_chunks), floes, sim._law, box, verlet,
                 K.force_buffers(n_chunks, sim.n_floes), verlet.ref, sim._drive())
 
-    configs = _kernel_configs(threads_all)
+    configs = kernel_configs(threads_all)
     data = [arrays(threads if parallel else 1) for _, parallel, threads in configs]
 
     def run(k, phase, count):

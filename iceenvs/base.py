@@ -317,6 +317,14 @@ class ControlEnv(gym.Env):
         return max(0.0, 1.0 - self._steps / self.horizon)
 
     # -- the loop -----------------------------------------------------------------------------
+    @property
+    def last_measurement(self) -> dict | None:
+        """The raw physical observables (SI units) of the last reset or step,
+        from which the observation and the reward were made; ``None`` before
+        the first reset. Controllers that read the physics instead of the
+        observation use it."""
+        return self._prev
+
     def _begin_episode(self):
         """Zero action, first measurement and observation of a new episode;
         returns what ``reset`` returns."""

@@ -50,7 +50,7 @@ class StraightLinePolicy(Controller):
         if isinstance(obs, dict):
             obs = obs["vector"]
         if self.unwrapped.obs_type == "image":
-            now = self.unwrapped._prev
+            now = self.unwrapped.last_measurement
             return lambda name: float(now[name])
         return lambda name: float(obs[self._index[name]]) * self._scale[name]
 
@@ -61,7 +61,7 @@ class StraightLinePolicy(Controller):
     def _steer(self, bearing: float, get) -> np.ndarray:
         u = self.unwrapped
         if u.control == "thrust":
-            ship = u._ship                # the episode's ship (set by reset)
+            ship = u.ship                 # the episode's ship (set by reset)
             w = self.FREQUENCY
             moment = ship.total_mass[2] * (w * w * bearing - 2.0 * w * get("yaw_rate"))
             return np.array([1.0, moment / ship.max_yaw_moment])

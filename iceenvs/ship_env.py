@@ -522,6 +522,12 @@ class ShipEnv(HertzEnv):
         return bool(now["reached"])
 
     @property
+    def ship(self):
+        """The :class:`~physics.ship.Ship` of the current episode (set by
+        ``reset``)."""
+        return self._ship
+
+    @property
     def reward_bounds(self) -> tuple[float, float]:
         """(lowest, highest) reward of one step (:func:`iceenvs.rewards.ship_reward_bounds`)."""
         from .rewards import ship_reward_bounds

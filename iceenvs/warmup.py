@@ -45,7 +45,7 @@ class _CompileCounter:
 
         class Listener(event.Listener):
             def on_start(self, ev):
-                if depth[0] == 0 and _jit_cache._is_package_kernel(ev.data.get("dispatcher")):
+                if depth[0] == 0 and _jit_cache.is_package_kernel(ev.data.get("dispatcher")):
                     counter.count += 1
                 depth[0] += 1
 

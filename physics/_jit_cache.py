@@ -122,7 +122,7 @@ def compile_notice(cache_dir: Path | None = None) -> str:
             f"later runs {where}; {QUIET_ENV}=1 hides this line)")
 
 
-def _is_package_kernel(dispatcher) -> bool:
+def is_package_kernel(dispatcher) -> bool:
     """A cached (``cache=True``) kernel of this project: its compilation is
     what a later run will load from the cache instead."""
     module = getattr(getattr(dispatcher, "py_func", None), "__module__", None) or ""
@@ -150,7 +150,7 @@ def _install_compile_notice() -> None:
             if self.done:
                 return
             data = ev.data if isinstance(ev.data, dict) else {}
-            if not _is_package_kernel(data.get("dispatcher")):
+            if not is_package_kernel(data.get("dispatcher")):
                 return
             self.done = True
             if not _quiet():

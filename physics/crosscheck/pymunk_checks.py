@@ -104,7 +104,7 @@ def _bar(iterable, progress: bool, desc: str, total: int | None = None):
     return tqdm(iterable, desc=desc, total=total, dynamic_ncols=True, leave=False)
 
 
-def _new_figure(size=(6.0, 4.0), ncols=1):
+def new_figure(size=(6.0, 4.0), ncols=1):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -357,7 +357,7 @@ def binary_frictionless(out_dir: Path | None = None, quick: bool = False, seed: 
     worst = rows[:, 1:].max(axis=0)
     figures = []
     if out_dir is not None:
-        fig, (ax,) = _new_figure((6.4, 4.2))
+        fig, (ax,) = new_figure((6.4, 4.2))
         floor = 1e-18
         ax.semilogy(rows[:, 0], np.maximum(rows[:, 1], floor), ".", ms=3, label="hard discs vs law")
         ax.semilogy(rows[:, 0], np.maximum(rows[:, 2], floor), ".", ms=3,
@@ -491,7 +491,7 @@ def binary_friction(out_dir: Path | None = None, quick: bool = False, seed: int 
     peak = herman[np.argmax(herman[:, 1])]
     figures = []
     if out_dir is not None:
-        fig, (ax, ax2) = _new_figure((11.0, 4.2), ncols=2)
+        fig, (ax, ax2) = new_figure((11.0, 4.2), ncols=2)
         grid = np.geomspace(psis[0], psis[-1], 400)
         ax.semilogx(grid, np.minimum(0.0, -1.0 + 3.0 / grid), "k-", lw=1.0,
                     label="rigid Coulomb (sticking: β = 0)")
@@ -656,7 +656,7 @@ def gas_cooling(out_dir: Path | None = None, quick: bool = False, seed: int = 0,
     err_pm = float(np.max(np.abs(mean_pm / haff - 1.0)))
     figures = []
     if out_dir is not None:
-        fig, (ax, ax2) = _new_figure((10.5, 4.0), ncols=2)
+        fig, (ax, ax2) = new_figure((10.5, 4.0), ncols=2)
         ax.semilogy(x, haff, "k-", lw=1.0, label="Haff 1/(1 + t/τ_H)²")
         ax.semilogy(x, mean_hd, "o", ms=4, mfc="none", label="hard discs (periodic)")
         ax.semilogy(x, mean_pm, "x", ms=5, label="pymunk (walls)")
@@ -759,7 +759,7 @@ def drag_relaxation(out_dir: Path | None = None, quick: bool = False, seed: int 
     run_pm = float(np.max(np.hypot(*(mean_pm - exact).T))) / scale
     figures = []
     if out_dir is not None:
-        fig, (ax,) = _new_figure((6.4, 4.2))
+        fig, (ax,) = new_figure((6.4, 4.2))
         ax.plot(times / tau, exact[:, 0], "k-", lw=1.0, label="ū_eq (1 − exp(−t/τ))")
         ax.plot(times / tau, mean_hd[:, 0], "o", ms=4, mfc="none", label="hard discs")
         ax.plot(times / tau, mean_pm[:, 0], "x", ms=5, label="pymunk")

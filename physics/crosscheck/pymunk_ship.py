@@ -618,9 +618,9 @@ def dilute_transit(out_dir: Path | None = None, quick: bool = False, seed: int =
 
 
 def _transit_figure(out_dir, values, p) -> str:
-    from .pymunk_checks import _new_figure
+    from .pymunk_checks import new_figure
 
-    fig, axes = _new_figure((10.0, 4.0), ncols=2)
+    fig, axes = new_figure((10.0, 4.0), ncols=2)
     for ax, (key, label) in zip(axes, (("collisions", "hull–floe collisions"),
                                        ("resistance", "mean resistance [kN]"))):
         a, b = values[key]

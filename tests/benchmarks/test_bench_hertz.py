@@ -18,9 +18,9 @@ from benchmarks.harness import render_table
 
 
 def test_timing_child_times_every_configuration_in_every_round(tmp_path):
-    path = bench._loose_state(400, 1, tmp_path)
+    path = bench.loose_state(400, 1, tmp_path)
     out = bench._timed_steps(path, 0.002, 20, threads=2)
-    configs = bench._kernel_configs(2)
+    configs = bench.kernel_configs(2)
     assert [label for label, _, _ in configs] == ["serial", "parallel", "parallel"]
     assert len(out["rates"]) == len(configs)
     for rates in out["rates"]:
@@ -54,7 +54,7 @@ def test_phase_benchmark_times_every_phase_and_configuration(tmp_path):
     and kernel configuration, positive times, the serial kernels' speed-up
     over themselves exactly 1, and a table that shows them."""
     result = phases.bench_phases(n=400, seed=1, passes=5, cache_dir=tmp_path, quiet=True)
-    configs = bench._kernel_configs(numba.config.NUMBA_NUM_THREADS)
+    configs = bench.kernel_configs(numba.config.NUMBA_NUM_THREADS)
     timed = result["rows"]
     assert len(timed) == len(phases.PHASES) * len(configs)
     assert [r["phase"] for r in timed[::len(configs)]] == [name for name, _, _ in phases.PHASES]
@@ -105,7 +105,7 @@ def test_quick_hertz_run_writes_a_valid_record(tmp_path):
 def test_ceilings_and_memory_are_measured(tmp_path):
     """The host ceiling (one pinned process per core), a control loop and
     the peak memory, each in fresh processes (about 20 s)."""
-    path = bench._loose_state(400, 1, tmp_path)
+    path = bench.loose_state(400, 1, tmp_path)
     speeds = bench.core_speeds(path, 0.002, 5)
     assert speeds["alone"] > 0.0
     assert len(speeds["together"]) == len(os.sched_getaffinity(0))
