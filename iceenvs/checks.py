@@ -1,6 +1,7 @@
 """The checks every environment of the package passes, for a new one too.
 
-    python -m iceenvs.checks ID [ID ...]      (default: every registered id)
+    python -m iceenvs.checks [ID ...]                 (default: every registered id)
+    python -m iceenvs.checks --fingerprint [ID ...]   (hashes of the behaviour)
 
 Each check builds the environment at its small size (its facts'
 :attr:`~iceenvs.facts.EnvFacts.small`) and raises ``AssertionError`` with
@@ -21,6 +22,14 @@ the reason when the environment breaks a convention:
 
 The test suite runs them on every registered id; the docs' Contributing
 page runs them on a new environment.
+
+:func:`fingerprint` hashes what an environment does (the observations,
+rewards and episode ends of 3 seeds × 20 seeded random actions at its
+default size): a change meant to leave the behaviour alone, such as a
+restructuring, keeps every fingerprint on one machine and one set of
+libraries. Floating-point results differ between processors (see
+"Reproducible" in the docs' environments page), so fingerprints are
+compared on one machine only.
 """
 from __future__ import annotations
 
@@ -36,7 +45,7 @@ from .base import REWARD_RANGE
 from .facts import env_facts
 
 __all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_facts",
-           "check_all", "CHECKS"]
+           "check_all", "CHECKS", "fingerprint"]
 
 
 def make_small(env_id: str, **kwargs) -> gym.Env:
@@ -178,13 +187,46 @@ def check_all(env_id: str) -> None:
         check(env_id)
 
 
+def fingerprint(env_id: str, seeds: int = 3, steps: int = 20) -> str:
+    """SHA-256 of the observations, rewards and episode ends of ``env_id``
+    (default size) over ``seeds`` episodes seeded 0, 1, … with ``steps``
+    random actions each (the action space seeded like the episode; an
+    episode that ends is reset)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for seed in range(seeds):
+        env = gym.make(env_id)
+        try:
+            obs, _ = env.reset(seed=seed)
+            env.action_space.seed(seed)
+            h.update(_flat(obs).tobytes())
+            for _ in range(steps):
+                obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+                h.update(_flat(obs).tobytes())
+                h.update(np.float64(reward).tobytes())
+                h.update(bytes([bool(terminated), bool(truncated)]))
+                if terminated or truncated:
+                    obs, _ = env.reset()
+                    h.update(_flat(obs).tobytes())
+        finally:
+            env.close()
+    return h.hexdigest()
+
+
 def main(argv: list[str] | None = None) -> int:
     from .facts import registered_ids
 
     p = argparse.ArgumentParser(prog="python -m iceenvs.checks",
                                 description=__doc__.splitlines()[0])
     p.add_argument("ids", nargs="*", help="environment ids (default: every registered id)")
+    p.add_argument("--fingerprint", action="store_true",
+                   help="print each id's behaviour hash (fingerprint) instead of checking it")
     args = p.parse_args(argv)
+    if args.fingerprint:
+        for env_id in args.ids or registered_ids():
+            print(env_id, fingerprint(env_id), flush=True)
+        return 0
     failed = 0
     for env_id in args.ids or registered_ids():
         for name, check in CHECKS.items():

@@ -271,3 +271,13 @@ def test_third_step_truncates(env_id):
     finally:
         env.close()
     assert flags == [(False, False), (False, False), (False, True)]
+
+
+def test_fingerprint_is_repeatable_and_sees_a_change():
+    """The behaviour hash of ``python -m iceenvs.checks --fingerprint``: the
+    same run hashes the same, a longer one differently."""
+    from iceenvs.checks import fingerprint
+
+    once = fingerprint(ITD, seeds=1, steps=2)
+    assert fingerprint(ITD, seeds=1, steps=2) == once
+    assert fingerprint(ITD, seeds=1, steps=3) != once
