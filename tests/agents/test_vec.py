@@ -1,0 +1,93 @@
+"""A Gymnasium vector environment seen through agents.vec.GymnasiumVecEnv
+gives SB3 what DummyVecEnv gives for the same sub-environments, step for
+step, across episode ends."""
+import gymnasium as gym
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+from stable_baselines3.common.vec_env import DummyVecEnv
+
+import iceenvs  # noqa: F401  (registers the ids)
+from agents.vec import GymnasiumVecEnv, unbatch_info
+from small_envs import SMALL
+
+ITD = "iceenvs/ThicknessDistribution-v0"
+CONVERGENCE = "iceenvs/Convergence-v0"
+
+
+def _assert_same(a: dict, b: dict):
+    assert a.keys() == b.keys()
+    for key in a:
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+def _factories(env_id, n):
+    kwargs = {**SMALL[env_id], "max_episode_steps": 3}
+    return [lambda: gym.make(env_id, **kwargs) for _ in range(n)]
+
+
+@pytest.mark.parametrize("env_id", [ITD, CONVERGENCE])
+def test_steps_match_dummy_vec_env_across_episode_ends(env_id):
+    n, steps = 2, 8
+    ours = GymnasiumVecEnv(SyncVectorEnv(_factories(env_id, n),
+                                         autoreset_mode=AutoresetMode.SAME_STEP))
+    theirs = DummyVecEnv(_factories(env_id, n))
+    rng = np.random.default_rng(7)
+    space = theirs.action_space
+    actions = rng.uniform(space.low, space.high, (steps, n) + space.shape).astype(space.dtype)
+    try:
+        ours.seed(11)
+        theirs.seed(11)
+        # the same code on the same seeds: exactly the same numbers
+        np.testing.assert_array_equal(ours.reset(), theirs.reset())
+        ends = 0
+        for a in actions:
+            o1, r1, d1, i1 = ours.step(a)
+            o2, r2, d2, i2 = theirs.step(a)
+            np.testing.assert_array_equal(o1, o2)
+            np.testing.assert_array_equal(r1, r2)
+            np.testing.assert_array_equal(d1, d2)
+            for k in range(n):
+                _assert_same(i1[k]["physics"], i2[k]["physics"])
+                if d2[k]:
+                    ends += 1
+                    np.testing.assert_array_equal(i1[k]["terminal_observation"],
+                                                  i2[k]["terminal_observation"])
+                    assert i1[k]["TimeLimit.truncated"] == i2[k]["TimeLimit.truncated"]
+            assert ours.reset_infos[0].keys() == theirs.reset_infos[0].keys()
+        assert ends == 2 * n          # episodes of 3 steps end at steps 3 and 6
+    finally:
+        ours.close()
+        theirs.close()
+
+
+def test_ppo_trains_on_it():
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    venv = GymnasiumVecEnv(SyncVectorEnv(_factories(ITD, 2),
+                                         autoreset_mode=AutoresetMode.SAME_STEP))
+    venv.seed(0)
+    env = VecNormalize(VecMonitor(venv))
+    model = PPO("MlpPolicy", env, n_steps=8, batch_size=8, n_epochs=1, seed=0, device="cpu")
+    model.learn(32)
+    assert model.num_timesteps == 32
+    assert env.get_attr("render_mode") == [None, None]
+    env.close()
+
+
+def test_another_autoreset_mode_is_refused_with_its_name():
+    venv = SyncVectorEnv(_factories(ITD, 1), autoreset_mode=AutoresetMode.NEXT_STEP)
+    with pytest.raises(ValueError, match="SAME_STEP.*NEXT_STEP"):
+        GymnasiumVecEnv(venv)
+    venv.close()
+
+
+def test_unbatch_info_keeps_only_the_entries_each_environment_set():
+    info = {"a": np.array([1.0, 2.0]), "_a": np.array([True, False]),
+            "nested": {"b": np.array([3, 4]), "_b": np.array([False, True])},
+            "_nested": np.array([True, True])}
+    assert unbatch_info(info, 2) == [{"a": 1.0, "nested": {}}, {"nested": {"b": 4}}]
