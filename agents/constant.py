@@ -251,11 +251,14 @@ def markdown_table(env_id: str, results: list[dict], *, grid: int, top: int = 10
 def build_parser() -> argparse.ArgumentParser:
     from iceenvs import ENV_IDS
 
+    from .envs import registered_env_id
+
     p = argparse.ArgumentParser(prog="python -m agents.constant",
                                 description="Search a grid of constant actions for the best "
                                             "one (a baseline for trained policies).")
-    p.add_argument("--env", required=True, choices=ENV_IDS, metavar="ID",
-                   help="environment id, one of: " + ", ".join(ENV_IDS))
+    p.add_argument("--env", required=True, type=registered_env_id, metavar="ID",
+                   help="a registered environment id: " + ", ".join(ENV_IDS)
+                        + ", or one registered by your own code")
     p.add_argument("--grid", type=int, default=GRID,
                    help=f"points per action dimension on [low, high] (default {GRID})")
     p.add_argument("--seeds", type=int, default=SEEDS,

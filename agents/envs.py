@@ -103,6 +103,33 @@ def make_checked_env(env_id: str, env_kwargs: dict | None = None, *, seed: int |
     return env
 
 
+def registered_env_id(value: str) -> str:
+    """``value`` if it is a registered environment id: the package's, or
+    ``module:id`` with a module that registers ``id`` when imported (as
+    :func:`gymnasium.make` reads it, so that worker processes import it
+    too); else ``argparse.ArgumentTypeError`` listing the package's ids.
+    The type of the commands' ``--env``."""
+    import argparse
+    import importlib
+
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    module, _, env_id = value.rpartition(":")
+    if module:
+        try:
+            importlib.import_module(module)
+        except ImportError as err:
+            raise argparse.ArgumentTypeError(f"{value!r}: cannot import {module!r} ({err})") \
+                from None
+    if env_id not in gym.registry:
+        raise argparse.ArgumentTypeError(
+            f"invalid choice: {value!r} (not a registered environment id; the package's ids: "
+            f"{', '.join(iceenvs.ENV_IDS)})")
+    return value
+
+
 def check_env_kwargs(env_id: str, env_kwargs: dict | None = None, *, seed: int | None = 0) -> None:
     """Build one environment with ``env_kwargs``, reset it once and close it
     (:func:`make_checked_env`); raises ``ValueError`` when it cannot."""

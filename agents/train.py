@@ -85,11 +85,14 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
     """The command-line parser (env ids and algorithms as choices)."""
     from iceenvs import ENV_IDS
 
+    from .envs import registered_env_id
+
     p = argparse.ArgumentParser(prog=prog,
                                 description="Train a stable-baselines3 agent on an iceenvs "
                                             "environment.")
-    p.add_argument("--env", required=True, choices=ENV_IDS, metavar="ID",
-                   help="environment id, one of: " + ", ".join(ENV_IDS))
+    p.add_argument("--env", required=True, type=registered_env_id, metavar="ID",
+                   help="a registered environment id: " + ", ".join(ENV_IDS)
+                        + ", or one registered by your own code")
     p.add_argument("--algo", required=True, choices=sorted(ALGOS),
                    help="algorithm: " + ", ".join(sorted(ALGOS)))
     p.add_argument("--timesteps", type=int, default=None,

@@ -128,12 +128,18 @@ def _finite(value) -> float:
 
 
 def _creator(env_id: str):
-    """The class (or function) that ``gymnasium.make(env_id)`` calls."""
+    """The class (or function) that ``gymnasium.make(env_id)`` calls
+    (``module:id`` imports the module first, as Gymnasium does)."""
+    import importlib
+
     import gymnasium as gym
     from gymnasium.envs.registration import load_env_creator
 
     import iceenvs
 
+    module, _, env_id = env_id.rpartition(":")
+    if module:
+        importlib.import_module(module)
     try:
         spec = gym.spec(env_id)
     except gym.error.Error as err:
