@@ -174,9 +174,38 @@ class EnvFactory:
         return env
 
 
+#: how the sub-environments of a run are stepped (``--vectorization``)
+VECTORIZATIONS = ("auto", "native", "subproc", "dummy")
+
+
+def native_vector_env(env_id: str, n_envs: int, env_kwargs: dict | None = None):
+    """The environment's own vector environment (``vector_entry_point`` of its
+    registration, built by ``gymnasium.make_vec``) as an SB3 ``VecEnv``
+    (:class:`agents.vec.GymnasiumVecEnv`).
+
+    Raises
+    ------
+    ValueError
+        When the registration has no vector entry point.
+    """
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    from .vec import GymnasiumVecEnv
+
+    spec = gym.spec(env_id.rpartition(":")[2])
+    if spec.vector_entry_point is None:
+        raise ValueError(f"{env_id} has no native vector environment (its registration has no "
+                         f"vector_entry_point); use vectorization 'subproc' or 'dummy'")
+    return GymnasiumVecEnv(gym.make_vec(env_id, num_envs=n_envs,
+                                        vectorization_mode="vector_entry_point",
+                                        **(env_kwargs or {})))
+
+
 def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None = None,
                  normalize: dict | None = None, training: bool = True,
-                 stats_path: str | Path | None = None):
+                 stats_path: str | Path | None = None, vectorization: str = "auto"):
     """The vectorised environment stack of a run.
 
     Parameters
@@ -197,16 +226,40 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         not normalised.
     stats_path : path, optional
         Load the normalisation statistics from this ``vecnormalize.pkl``.
+    vectorization : str
+        ``"native"``: the environment's own vector environment
+        (:func:`native_vector_env`); ``"subproc"``: one worker process per
+        environment; ``"dummy"``: all in this process, one after the other;
+        ``"auto"`` (default): native where the registration has a vector
+        entry point, else subproc for several environments and dummy for one.
 
     Returns
     -------
     VecEnv
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``vectorization``, or ``"native"`` without a vector
+        entry point.
     """
+    import gymnasium as gym
     from stable_baselines3.common.vec_env import (DummyVecEnv, SubprocVecEnv, VecMonitor,
                                                   VecNormalize)
 
-    fns = [EnvFactory(env_id, env_kwargs, seed + i) for i in range(n_envs)]
-    venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
+    if vectorization not in VECTORIZATIONS:
+        raise ValueError(f"unknown vectorization {vectorization!r}; valid: "
+                         f"{', '.join(VECTORIZATIONS)}")
+    if vectorization == "auto":
+        import iceenvs  # noqa: F401  (registers the ids)
+
+        native = gym.spec(env_id.rpartition(":")[2]).vector_entry_point is not None
+        vectorization = "native" if native else "subproc" if n_envs > 1 else "dummy"
+    if vectorization == "native":
+        venv = native_vector_env(env_id, n_envs, env_kwargs)
+    else:
+        fns = [EnvFactory(env_id, env_kwargs, seed + i) for i in range(n_envs)]
+        venv = SubprocVecEnv(fns) if vectorization == "subproc" else DummyVecEnv(fns)
     venv.seed(seed)
     venv = VecMonitor(venv)
     if stats_path is not None and Path(stats_path).exists():

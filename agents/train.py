@@ -85,7 +85,7 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
     """The command-line parser (env ids and algorithms as choices)."""
     from iceenvs import ENV_IDS
 
-    from .envs import registered_env_id
+    from .envs import VECTORIZATIONS, registered_env_id
 
     p = argparse.ArgumentParser(prog=prog,
                                 description="Train a stable-baselines3 agent on an iceenvs "
@@ -117,6 +117,11 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                    help="gymnasium.make arguments of the environment, set over the YAML's "
                         "env_kwargs and --hyperparams env_kwargs (VALUE is YAML, e.g. "
                         "n_floes=40); checked on one environment before the run starts")
+    p.add_argument("--vectorization", choices=VECTORIZATIONS, default="auto",
+                   help="how the environments are stepped: native (the environment's own "
+                        "vector environment), subproc (a process each), dummy (one after the "
+                        "other here); auto (default): native where the environment has one, "
+                        "else subproc for several and dummy for one")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p
@@ -134,6 +139,12 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
             parser.error(f"--{name.replace('_', '-')} must be >= 0")
     if args.eval_episodes < 1:
         parser.error("--eval-episodes must be >= 1")
+    if args.vectorization == "native":
+        import gymnasium as gym
+
+        if gym.spec(args.env.rpartition(":")[2]).vector_entry_point is None:
+            parser.error(f"--vectorization native: {args.env} has no native vector environment "
+                         f"(its registration has no vector_entry_point); use subproc or dummy")
     if args.out is None:
         args.out = default_run_dir(args.env, args.algo, args.seed)
     return args
@@ -338,7 +349,8 @@ def make_envs(args: argparse.Namespace, hp: dict):
 
     norm = normalize_kwargs(hp)
     env = make_vec_env(args.env, n_envs=hp["n_envs"], seed=args.seed,
-                       env_kwargs=hp["env_kwargs"], normalize=norm)
+                       env_kwargs=hp["env_kwargs"], normalize=norm,
+                       vectorization=args.vectorization)
     eval_env = None
     if args.eval_freq > 0:
         try:

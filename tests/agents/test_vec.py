@@ -91,3 +91,45 @@ def test_unbatch_info_keeps_only_the_entries_each_environment_set():
             "nested": {"b": np.array([3, 4]), "_b": np.array([False, True])},
             "_nested": np.array([True, True])}
     assert unbatch_info(info, 2) == [{"a": 1.0, "nested": {}}, {"nested": {"b": 4}}]
+
+
+def _sync_itd(num_envs, **kwargs):
+    """A vector entry point: the thickness environment in a SyncVectorEnv
+    that resets in the step that ends an episode."""
+    return SyncVectorEnv([lambda: gym.make(ITD, **kwargs) for _ in range(num_envs)],
+                         autoreset_mode=AutoresetMode.SAME_STEP)
+
+
+@pytest.fixture
+def vectorised_id():
+    env_id = "vectest/Thickness-v0"
+    gym.register(id=env_id, entry_point="iceenvs.thickness_distribution:ThicknessDistributionEnv",
+                 vector_entry_point=_sync_itd)
+    try:
+        yield env_id
+    finally:
+        del gym.registry[env_id]
+
+
+def test_make_vec_env_takes_the_native_vector_env_where_there_is_one(vectorised_id):
+    from agents.envs import make_vec_env
+
+    for how in ("auto", "native"):
+        env = make_vec_env(vectorised_id, n_envs=2, seed=3, env_kwargs=SMALL[ITD],
+                           vectorization=how)
+        assert isinstance(env.unwrapped, GymnasiumVecEnv), how
+        assert env.reset().shape == (2,) + env.observation_space.shape
+        env.close()
+    env = make_vec_env(vectorised_id, n_envs=2, seed=3, env_kwargs=SMALL[ITD],
+                       vectorization="dummy")
+    assert not isinstance(env.unwrapped, GymnasiumVecEnv)
+    env.close()
+
+
+def test_native_is_refused_without_a_vector_entry_point():
+    from agents.envs import make_vec_env
+
+    with pytest.raises(ValueError, match="no native vector environment"):
+        make_vec_env(ITD, n_envs=2, seed=0, env_kwargs=SMALL[ITD], vectorization="native")
+    with pytest.raises(ValueError, match="unknown vectorization 'threads'"):
+        make_vec_env(ITD, n_envs=2, seed=0, vectorization="threads")
