@@ -2,19 +2,16 @@
 
 Gymnasium (1.x) and Stable-Baselines3 batch environments differently:
 
-================================  ==========================================
-Gymnasium ``VectorEnv``           SB3 ``VecEnv``
-================================  ==========================================
-``step`` returns ``terminated``   ``step`` returns ``dones`` (either) and
-and ``truncated``                 ``info["TimeLimit.truncated"]``
-``info``: one dict of arrays,     ``infos``: one dict per sub-environment
-with a mask ``_key`` per key
-the reset observation of an       the reset observation, and the last
-ended episode in the same step    one in ``info["terminal_observation"]``
-(``AutoresetMode.SAME_STEP``),
-the last in ``info["final_obs"]``
-``reset(seed=[...])``             ``seed(s)`` then ``reset()``
-================================  ==========================================
+- a Gymnasium ``step`` returns ``terminated`` and ``truncated``; SB3's returns
+  ``dones`` (either) and ``info["TimeLimit.truncated"]``;
+- Gymnasium's ``info`` is one dict of arrays, with a mask ``_key`` per key;
+  SB3's ``infos`` are one dict per sub-environment;
+- with ``AutoresetMode.SAME_STEP``, Gymnasium returns the reset observation
+  of an ended episode in the step that ends it and the last one in
+  ``info["final_obs"]``; SB3 expects the reset observation and the last one
+  in ``info["terminal_observation"]``;
+- Gymnasium seeds with ``reset(seed=[...])``, SB3 with ``seed(s)`` then
+  ``reset()``.
 
 :class:`GymnasiumVecEnv` wraps a Gymnasium vector environment whose
 ``metadata["autoreset_mode"]`` is ``AutoresetMode.SAME_STEP`` and gives SB3
