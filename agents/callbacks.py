@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from .metrics import physics_metrics
+from iceenvs.facts import env_facts
 
 __all__ = ["PhysicsMetricsCallback", "TqdmCallback"]
 
@@ -20,7 +20,8 @@ class PhysicsMetricsCallback(BaseCallback):
     """Log the task's physics metrics per finished episode.
 
     For every finished episode of every sub-environment, the final value
-    and the episode mean of each metric of :func:`agents.metrics.physics_metrics`
+    and the episode mean of each metric of the environment's facts
+    (:meth:`iceenvs.facts.EnvFacts.logged_metrics`)
     are kept; at the end of each rollout the means over the last
     ``window`` episodes are recorded as ``physics/final_<name>`` and
     ``physics/mean_<name>`` (next to SB3's ``rollout/ep_rew_mean``). Each
@@ -41,6 +42,7 @@ class PhysicsMetricsCallback(BaseCallback):
     def __init__(self, env_id: str, csv_path: str | Path, window: int = 20, verbose: int = 0):
         super().__init__(verbose)
         self.env_id = env_id
+        self._logged_metrics = env_facts(env_id).logged_metrics
         self.csv_path = Path(csv_path)
         self.window = window
         self._file = None
@@ -61,7 +63,7 @@ class PhysicsMetricsCallback(BaseCallback):
         infos = self.locals.get("infos", ())
         dones = self.locals.get("dones", np.zeros(len(infos), dtype=bool))
         for i, info in enumerate(infos):
-            values = physics_metrics(self.env_id, info)
+            values = self._logged_metrics(info)
             sums = self._sums[i]
             for name, v in values.items():
                 sums[name] = sums.get(name, 0.0) + v

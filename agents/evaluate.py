@@ -286,13 +286,14 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
                                progress=not args.no_progress)
     finally:
         env.close()
+    facts = env_facts(env_id)
     summaries = {name: summarise(eps) for name, eps in results.items()}
     comparisons, metric_comparisons = {}, {}
     if args.baseline is None:
         first = next(iter(results))
         comparisons = {n: compare(results[first], results[n]) for n in names}
-        if env_facts(env_id).compared_metric is not None:
-            metric, lower = env_facts(env_id).compared_metric
+        if facts.compared_metric is not None:
+            metric, lower = facts.compared_metric
             metric_comparisons = {n: compare(results[first], results[n], metric, lower)
                                   for n in names}
     table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels,
@@ -303,7 +304,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
                   metric_comparisons=metric_comparisons,
-                  main_metric=env_facts(env_id).main_metric,
+                  main_metric=facts.main_metric,
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
                                             terminated=e["terminated"], final=e["final"],
                                             rewards=rounded(e["rewards"]),

@@ -12,17 +12,12 @@ from __future__ import annotations
 
 from iceenvs.facts import env_facts
 
-__all__ = ["env_name", "main_metric", "physics_metrics"]
+__all__ = ["env_name", "physics_metrics"]
 
 
 def env_name(env_id: str) -> str:
     """``"iceenvs/Convergence-v0"`` → ``"Convergence-v0"``."""
     return env_id.split("/")[-1]
-
-
-def main_metric(env_id: str) -> str:
-    """The logged name of the metric that says most about ``env_id``'s task."""
-    return env_facts(env_id).main_metric
 
 
 def physics_metrics(env_id: str, info: dict) -> dict[str, float]:

@@ -17,8 +17,6 @@ import yaml
 
 from iceenvs.facts import env_facts
 
-from .metrics import physics_metrics
-
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "rounded",
            "stats", "summarise", "compare"]
 
@@ -61,15 +59,16 @@ class TrainedPolicy:
 def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     """One episode from ``reset(seed=seed)``: return, length, final physics
     metrics and the per-step rewards and main metric."""
+    logged_metrics = env_facts(env.spec.id).logged_metrics
     obs, info = env.reset(seed=seed)
     policy.reset(seed)
     rewards, trace = [], []
-    final = physics_metrics(env.spec.id, info)
+    final = logged_metrics(info)
     while True:
         action, _ = policy.predict(obs, deterministic=True)
         obs, reward, terminated, truncated, info = env.step(action)
         rewards.append(float(reward))
-        metrics = physics_metrics(env.spec.id, info)
+        metrics = logged_metrics(info)
         final = metrics or final
         trace.append(metrics.get(main_metric, math.nan) if main_metric else math.nan)
         if terminated or truncated:
