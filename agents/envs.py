@@ -110,23 +110,13 @@ def registered_env_id(value: str) -> str:
     too); else ``argparse.ArgumentTypeError`` listing the package's ids.
     The type of the commands' ``--env``."""
     import argparse
-    import importlib
 
-    import gymnasium as gym
+    from iceenvs.facts import env_spec
 
-    import iceenvs  # noqa: F401  (registers the ids)
-
-    module, _, env_id = value.rpartition(":")
-    if module:
-        try:
-            importlib.import_module(module)
-        except ImportError as err:
-            raise argparse.ArgumentTypeError(f"{value!r}: cannot import {module!r} ({err})") \
-                from None
-    if env_id not in gym.registry:
-        raise argparse.ArgumentTypeError(
-            f"invalid choice: {value!r} (not a registered environment id; the package's ids: "
-            f"{', '.join(iceenvs.ENV_IDS)})")
+    try:
+        env_spec(value)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(f"invalid choice: {err}") from None
     return value
 
 
@@ -178,6 +168,13 @@ class EnvFactory:
 VECTORIZATIONS = ("auto", "native", "subproc", "dummy")
 
 
+def has_native_vector_env(env_id: str) -> bool:
+    """Whether the registration of ``env_id`` has a ``vector_entry_point``."""
+    from iceenvs.facts import env_spec
+
+    return env_spec(env_id).vector_entry_point is not None
+
+
 def native_vector_env(env_id: str, n_envs: int, env_kwargs: dict | None = None):
     """The environment's own vector environment (``vector_entry_point`` of its
     registration, built by ``gymnasium.make_vec``) as an SB3 ``VecEnv``
@@ -190,12 +187,9 @@ def native_vector_env(env_id: str, n_envs: int, env_kwargs: dict | None = None):
     """
     import gymnasium as gym
 
-    import iceenvs  # noqa: F401  (registers the ids)
-
     from .vec import GymnasiumVecEnv
 
-    spec = gym.spec(env_id.rpartition(":")[2])
-    if spec.vector_entry_point is None:
+    if not has_native_vector_env(env_id):
         raise ValueError(f"{env_id} has no native vector environment (its registration has no "
                          f"vector_entry_point); use vectorization 'subproc' or 'dummy'")
     return GymnasiumVecEnv(gym.make_vec(env_id, num_envs=n_envs,
@@ -243,7 +237,6 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         For an unknown ``vectorization``, or ``"native"`` without a vector
         entry point.
     """
-    import gymnasium as gym
     from stable_baselines3.common.vec_env import (DummyVecEnv, SubprocVecEnv, VecMonitor,
                                                   VecNormalize)
 
@@ -251,10 +244,8 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         raise ValueError(f"unknown vectorization {vectorization!r}; valid: "
                          f"{', '.join(VECTORIZATIONS)}")
     if vectorization == "auto":
-        import iceenvs  # noqa: F401  (registers the ids)
-
-        native = gym.spec(env_id.rpartition(":")[2]).vector_entry_point is not None
-        vectorization = "native" if native else "subproc" if n_envs > 1 else "dummy"
+        vectorization = ("native" if has_native_vector_env(env_id) else
+                         "subproc" if n_envs > 1 else "dummy")
     if vectorization == "native":
         venv = native_vector_env(env_id, n_envs, env_kwargs)
     else:

@@ -140,9 +140,9 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
     if args.eval_episodes < 1:
         parser.error("--eval-episodes must be >= 1")
     if args.vectorization == "native":
-        import gymnasium as gym
+        from .envs import has_native_vector_env
 
-        if gym.spec(args.env.rpartition(":")[2]).vector_entry_point is None:
+        if not has_native_vector_env(args.env):
             parser.error(f"--vectorization native: {args.env} has no native vector environment "
                          f"(its registration has no vector_entry_point); use subproc or dummy")
     if args.out is None:

@@ -28,7 +28,7 @@ from types import MappingProxyType
 from typing import Any
 from collections.abc import Mapping
 
-__all__ = ["EnvFacts", "env_facts", "registered_ids"]
+__all__ = ["EnvFacts", "env_facts", "env_spec", "registered_ids"]
 
 
 @dataclass(frozen=True)
@@ -127,25 +127,41 @@ def _finite(value) -> float:
     return value if math.isfinite(value) else float("nan")
 
 
-def _creator(env_id: str):
-    """The class (or function) that ``gymnasium.make(env_id)`` calls
-    (``module:id`` imports the module first, as Gymnasium does)."""
+def env_spec(env_id: str):
+    """The Gymnasium ``EnvSpec`` of ``env_id``, which may be ``module:id``
+    for an id that the module registers when imported (as
+    :func:`gymnasium.make` reads it).
+
+    Raises
+    ------
+    ValueError
+        When the module cannot be imported or the id is not registered (the
+        message lists the package's ids).
+    """
     import importlib
 
     import gymnasium as gym
-    from gymnasium.envs.registration import load_env_creator
 
     import iceenvs
 
-    module, _, env_id = env_id.rpartition(":")
+    module, _, name = env_id.rpartition(":")
     if module:
-        importlib.import_module(module)
+        try:
+            importlib.import_module(module)
+        except ImportError as err:
+            raise ValueError(f"{env_id!r}: cannot import {module!r} ({err})") from None
     try:
-        spec = gym.spec(env_id)
+        return gym.spec(name)
     except gym.error.Error as err:
         raise ValueError(f"{env_id!r} is not a registered environment id ({err}); the "
                          f"package's ids: {', '.join(iceenvs.ENV_IDS)}") from None
-    entry = spec.entry_point
+
+
+def _creator(env_id: str):
+    """The class (or function) that ``gymnasium.make(env_id)`` calls."""
+    from gymnasium.envs.registration import load_env_creator
+
+    entry = env_spec(env_id).entry_point
     return load_env_creator(entry) if isinstance(entry, str) else entry
 
 
