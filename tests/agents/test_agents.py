@@ -16,6 +16,7 @@ pytest.importorskip("stable_baselines3")
 
 from agents import train
 from agents.baselines import baseline_names, make_baseline
+from cli_checks import assert_refused
 from iceenvs.facts import env_facts
 from small_envs import SMALL as ALL_SMALL
 
@@ -302,13 +303,7 @@ def test_baseline_alone_from_the_command_line(tmp_path):
      ("n_steps", "batch_size", "env_kwargs")),
 ])
 def test_bad_input_lists_valid_choices(argv, expected, capsys, tmp_path):
-    with pytest.raises(SystemExit) as exc:
-        train.main([*argv, "--out", str(tmp_path / "run")])
-    assert exc.value.code == 2
-    err = capsys.readouterr().err
-    for word in expected:
-        assert word in err
-    assert not (tmp_path / "run").exists()
+    assert_refused(train.main, argv, expected, tmp_path / "run", capsys)
 
 
 def test_existing_run_directory_needs_force(tmp_path):

@@ -11,6 +11,7 @@ pytest.importorskip("stable_baselines3")
 
 from agents import demo
 from agents.train import read_hyperparams
+from cli_checks import assert_refused
 
 
 def report(**changes):
@@ -76,13 +77,7 @@ def test_demo_trains_evaluates_prints_and_records(tmp_path, capsys):
     (["--seed", "0", "--seeds", "1"], ["not allowed with"]),
 ])
 def test_bad_arguments_are_refused_before_training(args, words, tmp_path, capsys):
-    with pytest.raises(SystemExit) as exc:
-        demo.main([*args, "--out", str(tmp_path / "run")])
-    assert exc.value.code == 2
-    err = capsys.readouterr().err
-    for word in words:
-        assert word in err
-    assert not (tmp_path / "run").exists()
+    assert_refused(demo.main, args, words, tmp_path / "run", capsys)
 
 
 @pytest.mark.slow
