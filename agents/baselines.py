@@ -196,5 +196,5 @@ def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
     if name not in controllers:
         where = env_id or type(env).__name__
         raise ValueError(f"unknown baseline {name!r} for {where}; valid baselines: "
-                         f"{', '.join([*GENERIC, *controllers])}")
+                         f"{', '.join(baseline_names(env_id))}")
     return controllers[name](env, seed, **kwargs)

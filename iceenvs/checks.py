@@ -121,8 +121,9 @@ def check_determinism(env_id: str, steps: int = 5, seed: int = 123) -> None:
 
 def check_fuzz(env_id: str, steps: int = 12, seed: int = 0) -> None:
     """Seeded wild actions (NaN, ±inf, 1e30, in range) are sanitised: the
-    observations stay finite and inside the space, the rewards finite and in
-    :data:`~iceenvs.base.REWARD_RANGE`, and the physics does not fail."""
+    observations stay finite and inside the space, the rewards finite and
+    within the environment's ``reward_bounds`` (default
+    :data:`~iceenvs.base.REWARD_RANGE`), and the physics does not fail."""
     rng = np.random.default_rng(seed)
     env = make_small(env_id)
     try:
