@@ -335,41 +335,58 @@ class HertzSimulation(FloeProperties):
             If the state became non-finite, the integration unstable, or a
             deforming box reached its concentration limit.
         """
-        check_range("n", n, 0, None)
-        n = int(n)
+        n = self._steps_to_run(n)
         if n == 0:
             return
-        if self.forcing is not None:
-            self._set_drag_if_changed()
-        if self.ship is None:
-            status, _ = self._run(n, self._no_ship)
-        else:
-            # in pieces that bound the record buffer; the collision log is
-            # emptied whenever it fills
-            self.ship.set_current(self.forcing.current if self.forcing is not None else (0, 0))
-            self.ship.refresh()
-            left = n
-            while left > 0:
-                status, done = self._run(min(left, self._SHIP_CHUNK), self.ship.bundle(
-                    min(left, self._SHIP_CHUNK)))
-                left -= done
-                self.ship.drain()
-                if status not in (HertzStatus.OK, HertzStatus.SHIP_LOG_FULL):
-                    break
-        self._check_status(status)
+        left = n
+        while left > 0:
+            args = self._kernel_arguments(left)
+            done, status, nreb, self._verlet = K.run_steps(
+                args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
+                numba.get_num_threads(), args[6])
+            left = self._after_run(done, status, nreb, left)
+        self._check_status(HertzStatus(status))
 
     _SHIP_CHUNK = 50_000
 
-    def _run(self, n: int, ship_bundle) -> tuple:
+    def _steps_to_run(self, n) -> int:
+        """``n`` checked, and the forcing and the ship made ready for a run."""
+        check_range("n", n, 0, None)
+        n = int(n)
+        if n == 0:
+            return 0
+        if self.forcing is not None:
+            self._set_drag_if_changed()
+        if self.ship is not None:
+            self.ship.set_current(self.forcing.current if self.forcing is not None else (0, 0))
+            self.ship.refresh()
+        return n
+
+    def _kernel_arguments(self, left: int) -> tuple:
+        """(steps of the next kernel run, floes, law, wall law, drive, box,
+        ship bundle) for a run with ``left`` steps to go. With a ship the run
+        is cut into pieces that bound the record buffer."""
         box = self.box.kernel_box(self.time)
-        done, status, nreb, self._verlet = K.run_steps(
-            n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(), box,
-            self._verlet, self.parallel, numba.get_num_threads(), ship_bundle)
+        self._kernel_box = box
+        if self.ship is None:
+            return left, self._floes, self._law, self._wall_law, self._drive(), box, self._no_ship
+        k = min(left, self._SHIP_CHUNK)
+        return k, self._floes, self._law, self._wall_law, self._drive(), box, self.ship.bundle(k)
+
+    def _after_run(self, done: int, status: int, n_rebuilds: int, left: int) -> int:
+        """Count a kernel run of ``done`` steps that ended with ``status``;
+        the steps still to go (0 when the run must stop: done, or a failure
+        that :meth:`_check_status` reports). The ship's collision log is
+        emptied whenever it fills."""
         self.time += done * self.dt
         self.n_steps += done
-        self.n_rebuilds += nreb
-        self.box.update_from_kernel(box)
-        return HertzStatus(status), done
+        self.n_rebuilds += n_rebuilds
+        self.box.update_from_kernel(self._kernel_box)
+        left -= done
+        if self.ship is None:
+            return 0 if status != HertzStatus.OK else left
+        self.ship.drain()
+        return left if status in (HertzStatus.OK, HertzStatus.SHIP_LOG_FULL) else 0
 
     def _check_status(self, status: HertzStatus):
         if status is HertzStatus.CONCENTRATION_LIMIT:
@@ -538,3 +555,78 @@ class HertzSimulation(FloeProperties):
     def __repr__(self):
         return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "
                 f"time={self.time:.6g}, parallel={self.parallel})")
+
+
+def advance_together(sims, duration: float) -> list:
+    """Advance several independent simulations by ``duration`` model seconds
+    each (rounded to whole steps of each one's Δt) in compiled calls that
+    run the simulations in parallel over Numba's threads
+    (:func:`physics.hertz_kernels.run_many`), one simulation per thread at a
+    time. Each simulation does exactly what its own :meth:`HertzSimulation.advance`
+    would: the same arithmetic in the same order, so the same state.
+
+    Parameters
+    ----------
+    sims : sequence of HertzSimulation
+        Distinct serial simulations (``parallel=False``).
+    duration : float
+        Model seconds [s].
+
+    Returns
+    -------
+    list
+        Per simulation ``None``, or the :class:`~physics.engine.SimulationError`
+        its :meth:`~HertzSimulation.advance` would have raised (the others
+        are advanced all the same).
+
+    Raises
+    ------
+    TypeError, ValueError
+        A simulation that is not a serial :class:`HertzSimulation`, or one
+        given twice.
+    """
+    from numba.typed import List
+
+    sims = list(sims)
+    for k, sim in enumerate(sims):
+        if not isinstance(sim, HertzSimulation):
+            raise TypeError(f"sims[{k}] is a {type(sim).__name__}; advance_together takes "
+                            f"HertzSimulation objects")
+        if sim.parallel:
+            raise ValueError(f"sims[{k}] is a parallel simulation; advance_together runs the "
+                             f"simulations in parallel, each serial (parallel=False)")
+    if len({id(s) for s in sims}) != len(sims):
+        raise ValueError("advance_together got the same simulation twice")
+    check_range("duration", duration, 0.0, None)
+    left = [sim._steps_to_run(int(round(duration / sim.dt))) for sim in sims]
+    status = [HertzStatus.OK] * len(sims)
+    while True:
+        todo = [k for k, n in enumerate(left) if n > 0]
+        if not todo:
+            break
+        runs, verlets = List(), List()
+        n_steps = np.empty(len(todo), dtype=np.int64)
+        for m, k in enumerate(todo):
+            args = sims[k]._kernel_arguments(left[k])
+            n_steps[m] = args[0]
+            runs.append(args[1:])
+            verlets.append(sims[k]._verlet)
+        dt = np.array([sims[k].dt for k in todo])
+        time = np.array([sims[k].time for k in todo])
+        done = np.zeros(len(todo), dtype=np.int64)
+        stat = np.zeros(len(todo), dtype=np.int64)
+        nreb = np.zeros(len(todo), dtype=np.int64)
+        K.run_many(n_steps, dt, time, runs, verlets, done, stat, nreb)
+        for m, k in enumerate(todo):
+            sims[k]._verlet = verlets[m]
+            status[k] = HertzStatus(int(stat[m]))
+            left[k] = sims[k]._after_run(int(done[m]), status[k], int(nreb[m]), left[k])
+    errors = []
+    for sim, st in zip(sims, status):
+        try:
+            sim._check_status(st)
+        except SimulationError as err:
+            errors.append(err)
+        else:
+            errors.append(None)
+    return errors

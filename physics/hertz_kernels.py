@@ -1174,3 +1174,25 @@ def contact_list(floes, law, box, verlet):
                 data[k, 8] = res[4]
                 k += 1
     return ii[:k], jj[:k], data[:k]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def run_many(n_steps, dt, time, runs, verlets, done, status, n_rebuilds):
+    """:func:`run_steps` of several independent simulations in one call,
+    parallel over the simulations (each one's own step is serial).
+
+    ``runs[k]`` is (floes, law, wall law, drive, box, ship bundle) of
+    simulation k and ``verlets[k]`` its Verlet list (replaced by the list
+    after the run); ``n_steps``, ``dt`` and ``time`` hold the arguments of
+    :func:`run_steps` per simulation, and ``done``, ``status`` and
+    ``n_rebuilds`` receive its results. The simulations share no array, so
+    the iterations write disjoint memory."""
+    for m in prange(len(runs)):
+        k = np.int64(m)                     # typed lists take signed indices
+        floes, law, wall_law, drive, box, ship = runs[k]
+        d, s, r, verlet = run_steps(n_steps[k], dt[k], time[k], floes, law, wall_law, drive, box,
+                                    verlets[k], False, 1, ship)
+        done[k] = d
+        status[k] = s
+        n_rebuilds[k] = r
+        verlets[k] = verlet
