@@ -59,10 +59,13 @@ from .observations import FLOE_FEATURES, Feature, normalise
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "choice", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
-           "TIME_FEATURE", "task_table", "MAX_WIND"]
+           "TIME_FEATURE", "task_table", "MAX_WIND", "PHYSICS_ERRORS"]
 
 #: every per-step reward of the built-in tasks lies in this range
 REWARD_RANGE = (0.0, 1.0)
+#: the errors of a step that are physics failures: they end the episode
+#: (``info["error"]``) instead of reaching the caller
+PHYSICS_ERRORS = (FloatingPointError, RuntimeError, ValueError)
 #: default wind speed [m/s] of a full action of the wind-driven tasks (the
 #: ``max_wind`` task parameter)
 MAX_WIND = 20.0
@@ -339,21 +342,39 @@ class ControlEnv(gym.Env):
         return self._obs.copy(), self._info(now)
 
     def step(self, action):
+        a, replaced = self._take_action(action)
+        try:
+            self._apply_action(a)
+            self._advance()
+            now = self._measure()
+        except PHYSICS_ERRORS as err:
+            return self._failed_step(err, replaced)
+        return self._finish_step(a, replaced, now)
+
+    # the three parts of a step, which a vector environment
+    # (:mod:`iceenvs.vector`) also calls, with its engines advanced together
+    # between the first and the last
+    def _take_action(self, action) -> tuple[np.ndarray, int]:
+        """The sanitised action of a step and the number of its non-finite
+        entries (:func:`sanitise_action`); counts the step."""
         if not self._ready():
             raise RuntimeError("call reset() before step()")
         a, replaced = sanitise_action(action, self.action_space)
         self._last_action = a
         self._steps += 1
-        try:
-            self._apply_action(a)
-            self._advance()
-            now = self._measure()
-        except (FloatingPointError, RuntimeError, ValueError) as err:
-            # a physics failure ends the episode instead of crashing the caller
-            info = self._info(self._prev)
-            info["error"] = f"{type(err).__name__}: {err}"
-            info["nonfinite_action"] = replaced
-            return self._obs.copy(), float(self.failure_reward), True, False, info
+        return a, replaced
+
+    def _failed_step(self, err: BaseException, replaced: int) -> tuple:
+        """What ``step`` returns after a physics failure: the episode ends
+        instead of the caller crashing."""
+        info = self._info(self._prev)
+        info["error"] = f"{type(err).__name__}: {err}"
+        info["nonfinite_action"] = replaced
+        return self._obs.copy(), float(self.failure_reward), True, False, info
+
+    def _finish_step(self, a: np.ndarray, replaced: int, now: dict) -> tuple:
+        """Reward, end of episode, observation and info of a step that
+        measured ``now``."""
         reward = self._reward(a, now)
         info = self._info(now)
         info["nonfinite_action"] = replaced
@@ -492,6 +513,12 @@ class FloeEnv(ControlEnv):
 
     def _advance(self) -> None:
         self.sim.advance(self.control_interval)
+        self._advanced()
+
+    def _advanced(self) -> None:
+        """Read what the engine did in the control interval just run (after
+        ``sim.advance``, or the engines of a vector environment advanced
+        together)."""
 
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):

@@ -376,9 +376,8 @@ class ShipEnv(HertzEnv):
                     peak_hull_pressure=0.0, step_impulse=0.0, step_contact_impulse=0.0,
                     step_energy=0.0, step_effort=0.0, step_path=0.0, step_collisions=0)
 
-    def _advance(self):
+    def _advanced(self):
         sim = self.sim
-        sim.advance(self.control_interval)
         ship = sim.ship
         rec = ship.records()
         log = ship.collisions()
