@@ -25,19 +25,26 @@ __all__ = ["ENV_IDS"]
 # Every id is registered with its episode length: ``env.spec.max_episode_steps``
 # is set, Gymnasium's TimeLimit truncates the episodes, and
 # ``gymnasium.make(id, max_episode_steps=N)`` changes the length. The
-# environments never truncate on their own.
+# environments never truncate on their own. An environment with a native
+# vector environment (iceenvs.vector) names it third: the class beside the
+# environment's, and gymnasium.make_vec(id, num_envs=N,
+# vectorization_mode="vector_entry_point") builds it.
 _ENVS = {
-    "WindDrift-v0": ("iceenvs.wind_drift:WindDriftEnv", 200),
-    "Convergence-v0": ("iceenvs.convergence:ConvergenceEnv", 150),
-    "MarginalIceZone-v0": ("iceenvs.marginal_ice_zone:MarginalIceZoneEnv", 200),
-    "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400),
-    "ThicknessDistribution-v0": ("iceenvs.thickness_distribution:ThicknessDistributionEnv", 360),
-    "ShipNavigation-v0": ("iceenvs.ship_navigation:ShipNavigationEnv", 300),
-    "ShipBeset-v0": ("iceenvs.ship_beset:ShipBesetEnv", 300),
+    "WindDrift-v0": ("iceenvs.wind_drift:WindDriftEnv", 200, "WindDriftVectorEnv"),
+    "Convergence-v0": ("iceenvs.convergence:ConvergenceEnv", 150, "ConvergenceVectorEnv"),
+    "MarginalIceZone-v0": ("iceenvs.marginal_ice_zone:MarginalIceZoneEnv", 200,
+                           "MarginalIceZoneVectorEnv"),
+    "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400, None),
+    "ThicknessDistribution-v0": ("iceenvs.thickness_distribution:ThicknessDistributionEnv", 360,
+                                 None),
+    "ShipNavigation-v0": ("iceenvs.ship_navigation:ShipNavigationEnv", 300,
+                          "ShipNavigationVectorEnv"),
+    "ShipBeset-v0": ("iceenvs.ship_beset:ShipBesetEnv", 300, "ShipBesetVectorEnv"),
 }
 
 #: every registered id
 ENV_IDS = tuple(f"iceenvs/{name}" for name in _ENVS)
 
-for _name, (_entry, _steps) in _ENVS.items():
-    register(id=f"iceenvs/{_name}", entry_point=_entry, max_episode_steps=_steps)
+for _name, (_entry, _steps, _vector) in _ENVS.items():
+    register(id=f"iceenvs/{_name}", entry_point=_entry, max_episode_steps=_steps,
+             vector_entry_point=_vector and f"{_entry.partition(':')[0]}:{_vector}")

@@ -11,8 +11,9 @@ from .controllers import FloeController
 from .facts import EnvFacts
 from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import convergence_reward
+from .vector import vector_class
 
-__all__ = ["ConvergenceEnv", "ConvergenceController", "MAX_START"]
+__all__ = ["ConvergenceEnv", "ConvergenceVectorEnv", "ConvergenceController", "MAX_START"]
 
 MAX_EPISODE_STEPS = 150
 #: random placement of this floe-size distribution jams near 0.86
@@ -189,3 +190,7 @@ class ConvergenceEnv(HertzEnv):
         pressure = f"{p:.3g}" if abs(p) >= 1e-3 else "0"      # no "-0" for a slack pack
         return super()._frame_text() + [f"target A* = {self.episode['target']:.3f}",
                                         f"p = {pressure} N/m"]
+
+
+#: N :class:`ConvergenceEnv` whose engines advance together (:mod:`iceenvs.vector`)
+ConvergenceVectorEnv = vector_class(ConvergenceEnv)

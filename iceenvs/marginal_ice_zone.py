@@ -14,8 +14,9 @@ from .controllers import FloeController
 from .facts import EnvFacts
 from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import marginal_ice_zone_reward
+from .vector import vector_class
 
-__all__ = ["MarginalIceZoneEnv", "MarginalIceZoneController"]
+__all__ = ["MarginalIceZoneEnv", "MarginalIceZoneVectorEnv", "MarginalIceZoneController"]
 
 MAX_EPISODE_STEPS = 200
 
@@ -228,3 +229,7 @@ class MarginalIceZoneEnv(HertzEnv):
     def _frame_arrow(self):
         wind = np.asarray(self.forcing.wind, dtype=float)
         return [(wind / self.episode["max_wind"], f"wind {np.hypot(*wind):.1f} m/s")]
+
+
+#: N :class:`MarginalIceZoneEnv` whose engines advance together (:mod:`iceenvs.vector`)
+MarginalIceZoneVectorEnv = vector_class(MarginalIceZoneEnv)

@@ -10,8 +10,9 @@ from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .rewards import ship_beset_reward
 from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
+from .vector import vector_class
 
-__all__ = ["ShipBesetEnv", "MAX_EPISODE_STEPS"]
+__all__ = ["ShipBesetEnv", "ShipBesetVectorEnv", "MAX_EPISODE_STEPS"]
 
 MAX_EPISODE_STEPS = 300
 #: the hull must keep this far [m] from the coast and the far wall
@@ -207,3 +208,7 @@ class ShipBesetEnv(ShipEnv):
     def _frame_text(self):
         return super()._frame_text() + [
             f"limit {self.episode['pressure_limit'] / 1e3:.3g} kN/m"]
+
+
+#: N :class:`ShipBesetEnv` whose engines advance together (:mod:`iceenvs.vector`)
+ShipBesetVectorEnv = vector_class(ShipBesetEnv)

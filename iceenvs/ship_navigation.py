@@ -12,8 +12,9 @@ from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
 from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
+from .vector import vector_class
 
-__all__ = ["ShipNavigationEnv", "MAX_EPISODE_STEPS"]
+__all__ = ["ShipNavigationEnv", "ShipNavigationVectorEnv", "MAX_EPISODE_STEPS"]
 
 MAX_EPISODE_STEPS = 300
 
@@ -222,3 +223,7 @@ class ShipNavigationEnv(ShipEnv):
         if self.mode == "dynamic" and self._slow_time >= self.episode["beset_time"]:
             return True
         return self.episode["channel_exit"] == "terminate" and abs(now["channel_offset"]) > 1.0
+
+
+#: N :class:`ShipNavigationEnv` whose engines advance together (:mod:`iceenvs.vector`)
+ShipNavigationVectorEnv = vector_class(ShipNavigationEnv)

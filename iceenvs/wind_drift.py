@@ -13,8 +13,9 @@ from .controllers import FloeController
 from .facts import EnvFacts
 from .observations import FLOE_FEATURES, Feature, feature_table, log_stress
 from .rewards import wind_drift_reward
+from .vector import vector_class
 
-__all__ = ["WindDriftEnv", "WindDriftController"]
+__all__ = ["WindDriftEnv", "WindDriftVectorEnv", "WindDriftController"]
 
 MAX_EPISODE_STEPS = 200
 
@@ -211,3 +212,7 @@ class WindDriftEnv(HertzEnv):
         return [((math.cos(h), math.sin(h)), "heading"),
                 (wind / (self.episode["max_wind"] * math.sqrt(2.0)),
                  f"wind {np.hypot(*wind):.1f} m/s")]
+
+
+#: N :class:`WindDriftEnv` whose engines advance together (:mod:`iceenvs.vector`)
+WindDriftVectorEnv = vector_class(WindDriftEnv)

@@ -1,0 +1,235 @@
+"""Native vector environments: N sub-environments of a Hertz environment whose
+engines advance together, in one compiled call per step
+(:func:`physics.hertz.advance_together`), in parallel over the cores.
+
+``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")``
+builds one for every environment registered with a ``vector_entry_point``
+(:data:`iceenvs.ENV_IDS`; ``iceenvs.facts.env_spec(id).vector_entry_point``
+says which). It keeps Gymnasium's vector conventions:
+
+* ``metadata["autoreset_mode"]`` is ``AutoresetMode.SAME_STEP``: a sub-environment
+  whose episode ends is reset in the same step; the step returns the first
+  observation of the new episode, and ``info["final_obs"]`` and
+  ``info["final_info"]`` (with their masks ``_final_obs``, ``_final_info``)
+  hold the last observation and info of the one that ended;
+* ``info`` is one dict of arrays with a mask ``_key`` per key, as
+  :class:`gymnasium.vector.SyncVectorEnv` gives;
+* episodes are truncated after the registered ``max_episode_steps`` (or the
+  ``max_episode_steps`` given to ``make_vec``), as the single environment's
+  ``TimeLimit`` does;
+* ``reset(seed=s)`` seeds sub-environment k with ``s + k`` (a list gives each
+  its seed). Sub-environment k then runs the episode of the single
+  environment seeded ``s + k``, step for step: the engines do the same
+  arithmetic in the same order, so the observations and rewards are the
+  same numbers.
+
+Task parameters are keyword arguments (for every sub-environment and every
+episode) or reset options: one dict for all sub-environments, or a list of
+N dicts, one per sub-environment. ``render_env=k`` chooses the
+sub-environment that ``render()`` draws (``render_mode`` as in the single
+environment).
+
+The engine step runs in one compiled call; the measurements, observations
+and rewards are still made by each sub-environment's own code, one after the
+other (:class:`~iceenvs.base.ControlEnv`'s step in three parts).
+
+>>> import gymnasium as gym
+>>> import iceenvs  # noqa: F401
+>>> envs = gym.make_vec("iceenvs/ShipNavigation-v0", num_envs=2,
+...                     vectorization_mode="vector_entry_point")
+>>> obs, info = envs.reset(seed=0)
+>>> obs.shape
+(2, 34)
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
+
+from physics.hertz import advance_together
+
+from .base import PHYSICS_ERRORS, HertzEnv
+
+__all__ = ["HertzVectorEnv"]
+
+
+class HertzVectorEnv(VectorEnv):
+    """N sub-environments of one Hertz environment class, stepped together.
+
+    Subclasses set ``env_class`` (each environment module defines its own,
+    e.g. :class:`iceenvs.ship_navigation.ShipNavigationVectorEnv`).
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of sub-environments (>= 1).
+    max_episode_steps : int, optional
+        Episode length (``make_vec`` passes the registered one); ``None``:
+        never truncated.
+    render_mode : None, "rgb_array" or "human"
+        The render mode of the sub-environment ``render_env``.
+    render_env : int
+        The sub-environment that :meth:`render` draws.
+    **kwargs
+        Arguments of the environment (the same for every sub-environment).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad ``num_envs``, ``max_episode_steps`` or ``render_env``, or the
+        environment's own error for a bad argument.
+    """
+
+    env_class: type[HertzEnv] = HertzEnv
+    metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": ["rgb_array", "human"]}
+
+    def __init__(self, num_envs: int = 1, *, max_episode_steps: int | None = None,
+                 render_mode: str | None = None, render_env: int = 0, **kwargs):
+        for name, value, optional in (("num_envs", num_envs, False),
+                                      ("max_episode_steps", max_episode_steps, True)):
+            if value is None and optional:
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+        if (isinstance(render_env, bool) or not isinstance(render_env, (int, np.integer))
+                or not 0 <= render_env < num_envs):
+            raise ValueError(f"render_env must be the index of a sub-environment, 0 to "
+                             f"{num_envs - 1}, got {render_env!r}")
+        if self.env_class is HertzEnv:
+            raise TypeError("HertzVectorEnv is a base class; use the vector environment of an "
+                            "environment (its registration's vector_entry_point)")
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
+        self.render_env = int(render_env)
+        self.envs = [self.env_class(render_mode=render_mode if k == render_env else None,
+                                    **kwargs) for k in range(self.num_envs)]
+        first = self.envs[0]
+        self.render_mode = first.render_mode if render_env == 0 else self.envs[render_env].render_mode
+        self.metadata = {**type(self).metadata, "render_fps": first.metadata["render_fps"]}
+        self.single_observation_space = first.observation_space
+        self.single_action_space = first.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._obs = create_empty_array(self.single_observation_space, self.num_envs)
+        self._ready = False
+
+    # -- Gymnasium API -----------------------------------------------------------------
+    def reset(self, *, seed: int | Sequence[int | None] | None = None,
+              options: dict[str, Any] | Sequence[dict[str, Any]] | None = None):
+        """Reset every sub-environment: ``seed`` an int (sub-environment k gets
+        ``seed + k``), a list of N seeds or ``None``; ``options`` one dict for
+        all or a list of N dicts."""
+        seeds = self._per_env("seed", seed, (int, np.integer), lambda s, k: s + k)
+        opts = self._per_env("options", options, dict, lambda o, k: o)
+        super().reset(seed=None)
+        obs, infos = [], {}
+        for k, env in enumerate(self.envs):
+            o, info = env.reset(seed=seeds[k], options=opts[k])
+            obs.append(o)
+            infos = self._add_info(infos, info, k)
+        self._ready = True
+        return self._batch(obs), infos
+
+    def step(self, actions):
+        """One step of every sub-environment; the engines advance together."""
+        if not self._ready:
+            raise RuntimeError("call reset() before step()")
+        actions = self._checked_actions(actions)
+        taken, errors = [], [None] * self.num_envs
+        for k, env in enumerate(self.envs):
+            a, replaced = env._take_action(actions[k])
+            taken.append((a, replaced))
+            try:
+                env._apply_action(a)
+            except PHYSICS_ERRORS as err:
+                errors[k] = err
+        moving = [k for k in range(self.num_envs) if errors[k] is None]
+        for k, err in zip(moving, advance_together([self.envs[k].sim for k in moving],
+                                                   self.envs[0].control_interval)):
+            errors[k] = err
+        obs = []
+        rewards = np.zeros(self.num_envs)
+        terminated = np.zeros(self.num_envs, dtype=bool)
+        truncated = np.zeros(self.num_envs, dtype=bool)
+        infos: dict[str, Any] = {}
+        for k, env in enumerate(self.envs):
+            a, replaced = taken[k]
+            result = None
+            if errors[k] is None:
+                try:
+                    env._advanced()
+                    now = env._measure()
+                except PHYSICS_ERRORS as err:
+                    errors[k] = err
+                else:
+                    result = env._finish_step(a, replaced, now)
+            if result is None:
+                result = env._failed_step(errors[k], replaced)
+            o, rewards[k], terminated[k], _, info = result
+            truncated[k] = (self.max_episode_steps is not None
+                            and env._steps >= self.max_episode_steps)
+            if terminated[k] or truncated[k]:
+                infos = self._add_info(infos, {"final_obs": o, "final_info": info}, k)
+                o, info = env.reset()
+            obs.append(o)
+            infos = self._add_info(infos, info, k)
+        return self._batch(obs), rewards, terminated, truncated, infos
+
+    def render(self):
+        """The frame of sub-environment ``render_env`` (``render_mode``
+        "rgb_array"), or ``None``."""
+        if not self._ready:
+            raise RuntimeError("call reset() before render()")
+        return self.envs[self.render_env].render()
+
+    def close_extras(self, **kwargs):
+        for env in self.envs:
+            env.close()
+
+    # -- helpers -------------------------------------------------------------------------
+    def _per_env(self, name: str, value, kind, spread) -> list:
+        """``value`` for each sub-environment: ``None`` for all, one value of
+        type ``kind`` spread with ``spread(value, k)``, or a sequence of N."""
+        n = self.num_envs
+        if value is None:
+            return [None] * n
+        if isinstance(value, kind) and not isinstance(value, bool):
+            return [spread(value, k) for k in range(n)]
+        if isinstance(value, Sequence) and not isinstance(value, (str, bytes)):
+            if len(value) != n:
+                raise ValueError(f"{name} must have one entry per sub-environment "
+                                 f"(num_envs={n}), got {len(value)}")
+            return list(value)
+        raise TypeError(f"{name} must be None, one {getattr(kind, '__name__', 'int')} for every "
+                        f"sub-environment or a list of {n}, got {type(value).__name__}")
+
+    def _checked_actions(self, actions) -> np.ndarray:
+        a = np.asarray(actions, dtype=np.float64)
+        shape = (self.num_envs,) + self.single_action_space.shape
+        if a.shape != shape:
+            if a.shape == (self.num_envs,) and self.single_action_space.shape == (1,):
+                return a.reshape(shape)
+            raise ValueError(f"actions of shape {a.shape}; this vector environment takes "
+                             f"actions of shape {shape} (num_envs × the single action shape)")
+        return a
+
+    def _batch(self, obs: list):
+        self._obs = concatenate(self.single_observation_space, obs, self._obs)
+        return self._obs.copy() if not isinstance(self._obs, dict) else {
+            key: value.copy() for key, value in self._obs.items()}
+
+    def __repr__(self):
+        return f"{type(self).__name__}(num_envs={self.num_envs})"
+
+
+def vector_class(env_class: type[HertzEnv]) -> type[HertzVectorEnv]:
+    """The native vector environment of ``env_class`` (a subclass of
+    :class:`HertzVectorEnv` named after it)."""
+    name = env_class.__name__.removesuffix("Env") + "VectorEnv"
+    return type(name, (HertzVectorEnv,), {
+        "env_class": env_class, "__module__": env_class.__module__,
+        "__doc__": f"N :class:`{env_class.__name__}` stepped together (:mod:`iceenvs.vector`)."})

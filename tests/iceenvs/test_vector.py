@@ -1,0 +1,140 @@
+"""The native vector environments (iceenvs.vector): sub-environment k runs the
+episode of the single environment seeded the same way, episodes end and
+reset in the same step (AutoresetMode.SAME_STEP) with Gymnasium's info
+masks, task parameters and options reach each sub-environment, and bad input
+gets the single environment's clear errors."""
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.vector import AutoresetMode
+
+import iceenvs  # noqa: F401  (registers the ids)
+from iceenvs import ENV_IDS
+from iceenvs.facts import env_spec
+from small_envs import SMALL
+
+VECTOR_IDS = [i for i in ENV_IDS if env_spec(i).vector_entry_point is not None]
+SHIP = "iceenvs/ShipNavigation-v0"
+# the sub-environments' engines do the arithmetic of the single environment in
+# the same order (the same compiled step, called per engine); this bound only
+# absorbs a compiler's freedom between the two call sites
+RTOL, ATOL = 1e-12, 1e-12
+
+
+def make_vec(env_id, n, **kwargs):
+    return gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point",
+                        **{**SMALL[env_id], **kwargs})
+
+
+def test_the_hertz_environments_have_a_native_vector_env():
+    assert {i.split("/")[1] for i in VECTOR_IDS} == {
+        "WindDrift-v0", "Convergence-v0", "MarginalIceZone-v0", "ShipNavigation-v0",
+        "ShipBeset-v0"}
+    envs = make_vec(SHIP, 2)
+    assert envs.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    envs.close()
+
+
+@pytest.mark.parametrize("env_id", VECTOR_IDS)
+def test_sub_environment_k_runs_the_single_environment_seeded_the_same(env_id):
+    n, steps, seed = 2, 5, 3
+    envs = make_vec(env_id, n, max_episode_steps=3)
+    singles = [gym.make(env_id, **SMALL[env_id], max_episode_steps=3) for _ in range(n)]
+    obs, _ = envs.reset(seed=seed)
+    for k, env in enumerate(singles):
+        np.testing.assert_allclose(obs[k], env.reset(seed=seed + k)[0], rtol=RTOL, atol=ATOL)
+    actions = np.random.default_rng(5).uniform(-1, 1, (steps, n) + envs.single_action_space.shape)
+    ends = 0
+    for a in actions:
+        obs, reward, terminated, truncated, info = envs.step(a)
+        for k, env in enumerate(singles):
+            o, r, te, tr, inf = env.step(a[k])
+            assert (terminated[k], truncated[k]) == (te, tr)
+            np.testing.assert_allclose(reward[k], r, rtol=RTOL, atol=ATOL)
+            if te or tr:
+                ends += 1
+                assert info["_final_obs"][k] and info["_final_info"][k]
+                np.testing.assert_allclose(info["final_obs"][k], o, rtol=RTOL, atol=ATOL)
+                o = env.reset()[0]
+            else:
+                assert not info.get("_final_obs", np.zeros(n, bool))[k]
+            np.testing.assert_allclose(obs[k], o, rtol=RTOL, atol=ATOL)
+            # the step's info; for an ended episode it is the final one, and
+            # the info of the reset is in its place
+            step_info = info["final_info"] if te or tr else info
+            assert step_info["_physics"][k]
+            for key, value in inf["physics"].items():
+                np.testing.assert_allclose(step_info["physics"][key][k], value, rtol=RTOL,
+                                           atol=ATOL, err_msg=key)
+    # every sub-environment was truncated after 3 steps and reset
+    assert ends == n
+    envs.close()
+
+
+def test_an_episode_that_reaches_its_goal_ends_and_resets_in_the_same_step():
+    envs = make_vec(SHIP, 2, goal_distance=5.0)
+    envs.reset(seed=0)
+    _, _, terminated, truncated, info = envs.step(np.zeros((2, 1)))
+    # 2 s at the default 2.5 m/s does not reach a line 5 m ahead
+    assert not terminated.any() and "final_obs" not in info
+    for _ in range(3):
+        _, _, terminated, truncated, info = envs.step(np.zeros((2, 1)))
+        if terminated.any():
+            break
+    assert terminated.all() and not truncated.any()
+    assert info["final_info"]["success"].all()
+    # the first observation of the new episodes: the step counter starts again
+    assert (info["steps"] == 0).all()
+    envs.close()
+
+
+def test_task_parameters_as_keywords_and_per_sub_environment_options():
+    envs = make_vec(SHIP, 2, concentration=0.25)
+    _, info = envs.reset(seed=1)
+    assert (info["task"]["concentration"] == 0.25).all()
+    _, info = envs.reset(seed=1, options=[{"concentration": 0.2}, {"concentration": 0.35}])
+    np.testing.assert_array_equal(info["task"]["concentration"], [0.2, 0.35])
+    single = gym.make(SHIP, **{**SMALL[SHIP], "concentration": 0.25})
+    single_obs, _ = single.reset(seed=2, options={"concentration": 0.35})
+    obs, _ = envs.reset(seed=[None, 2], options={"concentration": 0.35})
+    np.testing.assert_allclose(obs[1], single_obs, rtol=RTOL, atol=ATOL)
+    envs.close()
+
+
+def test_bad_input_gets_clear_errors():
+    with pytest.raises(ValueError, match="num_envs must be an integer >= 1, got 0"):
+        make_vec(SHIP, 0)
+    with pytest.raises(ValueError, match="render_env must be the index of a sub-environment"):
+        make_vec(SHIP, 2, render_env=2)
+    with pytest.raises(TypeError, match="unknown arguments \\['bogus'\\]"):
+        make_vec(SHIP, 2, bogus=1)
+    with pytest.raises(ValueError, match="concentration"):
+        make_vec(SHIP, 2, concentration=1.5)
+    envs = make_vec(SHIP, 2)
+    with pytest.raises(RuntimeError, match="call reset\\(\\) before step\\(\\)"):
+        envs.step(np.zeros((2, 1)))
+    envs.reset(seed=0)
+    with pytest.raises(ValueError, match="actions of shape \\(3, 1\\); .* shape \\(2, 1\\)"):
+        envs.step(np.zeros((3, 1)))
+    with pytest.raises(ValueError, match="one entry per sub-environment"):
+        envs.reset(seed=[1, 2, 3])
+    with pytest.raises(ValueError, match="unknown reset options \\['bogus'\\]"):
+        envs.reset(options={"bogus": 1})
+    # a NaN action is a zero command, as in the single environment
+    _, _, _, _, info = envs.step(np.array([[np.nan], [0.0]]))
+    np.testing.assert_array_equal(info["nonfinite_action"], [1, 0])
+    envs.close()
+
+
+def test_render_draws_the_chosen_sub_environment():
+    envs = make_vec(SHIP, 2, render_mode="rgb_array", render_env=1)
+    single = gym.make(SHIP, **SMALL[SHIP], render_mode="rgb_array")
+    envs.reset(seed=4)
+    single.reset(seed=5)
+    envs.step(np.zeros((2, 1)))
+    single.step(np.zeros(1))
+    frame = envs.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3
+    # the same picture as the single environment seeded like sub-environment 1
+    assert np.mean(frame != single.render()) < 1e-3
+    envs.close()
