@@ -160,4 +160,6 @@ class GymnasiumVecEnv(VecEnv):
     def get_images(self):
         if self.render_mode != "rgb_array":
             return [None] * self.num_envs
-        return [env.render() for env in self._envs(None)]
+        # a native vector environment draws one chosen sub-environment
+        return [env.render() if getattr(env, "render_mode", None) == "rgb_array" else None
+                for env in self._envs(None)]
