@@ -1,0 +1,77 @@
+"""physics.hertz.advance_together: several simulations advanced in one
+compiled call end where each one's own advance would take it, a failure of
+one leaves the others going, and bad input is refused clearly."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from physics import ContactParams, HertzSimulation
+from physics.domain import Box, PeriodicBox
+from physics.engine import SimulationError
+from physics.floes import FloeField, place_floes
+from physics.hertz import advance_together, hull_contact_time
+from physics.hull import Hull
+from physics.ship import Ship
+
+PARAMS = ContactParams(elastic_modulus=1e7, restitution=0.5, friction=0.3)
+# the same compiled step on the same state, in the same order; the bound only
+# absorbs a compiler's freedom between two call sites
+TOL = 1e-12
+
+
+def transit(seed: int, speed: float = 2.0) -> HertzSimulation:
+    """A ship crossing 300 floes at rest in a periodic box."""
+    rng = np.random.default_rng(seed)
+    radii = rng.uniform(1.0, 2.5, 300)
+    pos = place_floes(radii, Box(70.0, 80.0, periodic=(False, True)), rng) + [40.0, 0.0]
+    field = FloeField(pos, radii, 1.0, np.zeros((300, 2)))
+    ship = Ship(Hull.pointed(20.0, 6.0), 3e5, position=(18.0, 40.0), speed=speed)
+    dt = 0.1 * hull_contact_time(radii, 1.0, field.density, PARAMS, 2.0 * speed)
+    return HertzSimulation(field, PeriodicBox(140.0, 80.0), PARAMS, None, dt,
+                           impact_speed=2.0 * speed, ship=ship)
+
+
+def test_together_ends_where_each_alone_ends():
+    alone = [transit(s) for s in (1, 2, 3)]
+    together = [transit(s) for s in (1, 2, 3)]
+    for _ in range(4):
+        for sim in alone:
+            sim.advance(2.0)
+        assert advance_together(together, 2.0) == [None, None, None]
+    for a, b in zip(alone, together):
+        assert b.n_steps == a.n_steps and b.n_rebuilds == a.n_rebuilds
+        np.testing.assert_allclose(b.positions, a.positions, rtol=0, atol=TOL)
+        np.testing.assert_allclose(b.velocities, a.velocities, rtol=0, atol=TOL)
+        np.testing.assert_allclose(b.ship.position, a.ship.position, rtol=0, atol=TOL)
+        la, lb = a.ship_loads(), b.ship_loads()
+        assert lb.collisions == la.collisions > 0
+        np.testing.assert_allclose(lb.resistance, la.resistance, rtol=1e-9)
+
+
+def test_a_failing_simulation_does_not_stop_the_others():
+    good, bad = transit(4), transit(5)
+    v = np.zeros((bad.n_floes, 2))
+    v[0] = 1e6                         # a floe that crosses the box in a step
+    bad.velocities = v
+    errors = advance_together([good, bad], 1.0)
+    assert errors[0] is None and isinstance(errors[1], SimulationError)
+    assert good.time == pytest.approx(1.0, abs=good.dt)
+    with pytest.raises(SimulationError):
+        bad.advance(1.0)
+
+
+def test_bad_input_is_refused():
+    sim = transit(6)
+    with pytest.raises(TypeError, match="sims\\[1\\] is a str"):
+        advance_together([sim, "x"], 1.0)
+    with pytest.raises(ValueError, match="the same simulation twice"):
+        advance_together([sim, sim], 1.0)
+    with pytest.raises(ValueError, match="duration"):
+        advance_together([sim], -1.0)
+    field = FloeField(np.array([[5.0, 5.0], [9.0, 5.0]]), np.array([1.0, 1.0]), 1.0,
+                      np.zeros((2, 2)))
+    par = HertzSimulation(field, PeriodicBox(20.0, 20.0), PARAMS, None, 1e-3, parallel=True)
+    with pytest.raises(ValueError, match="sims\\[0\\] is a parallel simulation"):
+        advance_together([par], 1.0)
+    assert advance_together([], 1.0) == []
