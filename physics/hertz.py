@@ -35,6 +35,7 @@ from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
 from .hertz_kernels import HertzStatus
+from .hertz_resting import run_steps_resting
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, PaperPreset
@@ -132,6 +133,17 @@ class HertzSimulation(FloeProperties):
         :class:`~physics.ship.ShipState` and :meth:`ship_loads` gives the
         statistics of its ice loads. The time-step check then also covers a
         floe hitting the hull at the ship's speed.
+    skip_resting : bool
+        Skip the floes at rest (default False): a floe with zero velocity,
+        angular velocity and force that touches nothing and has no wind or
+        current acting on it is not integrated (velocity Verlet would leave
+        it exactly where it is) until a contact with a moving floe or the
+        hull wakes it (:mod:`physics.hertz_resting`). The set is found
+        again at each :meth:`step`. The result is that of the full step (to
+        rounding in the list's expiry test), at the cost of the moving
+        floes: worth it when most floes lie still (a ship in calm ice). It
+        runs the serial step only: with ``parallel=True`` it is a
+        ``ValueError``, and ``parallel=None`` then means serial.
 
     Attributes
     ----------
@@ -139,6 +151,8 @@ class HertzSimulation(FloeProperties):
     positions, velocities, angular_velocities : read-only snapshots of the current state
     force, torque : read-only snapshots of the total force and torque of the last step
     n_steps, n_rebuilds : counters
+    n_awake : floes integrated at the end of the last :meth:`step` (all of
+        them unless ``skip_resting``)
 
     Examples
     --------
@@ -159,10 +173,16 @@ class HertzSimulation(FloeProperties):
                  forcing: Forcing | None = None, dt: float = 0.002, *,
                  impact_speed: float = 0.1, skin: float | None = None,
                  parallel: bool | None = None, allow_overlap: bool = False,
-                 ship: Ship | None = None):
+                 ship: Ship | None = None, skip_resting: bool = False):
         contact = checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed)
         if ship is not None and not isinstance(ship, Ship):
             raise TypeError(f"ship must be a physics.ship.Ship or None, got {type(ship).__name__}")
+        if not isinstance(skip_resting, (bool, np.bool_)):
+            raise TypeError(f"skip_resting must be True or False, got {skip_resting!r}")
+        if skip_resting and parallel:
+            raise ValueError("skip_resting=True runs the serial step only: pass parallel=False "
+                             "or None, not parallel=True")
+        self.skip_resting = bool(skip_resting)
         self.field = field.copy()
         self.box = box
         self.contact = contact
@@ -188,7 +208,7 @@ class HertzSimulation(FloeProperties):
         # neighbour-list sizing
         self.skin, self.max_cut = neighbour_cut(f.radii, box, skin)
         if parallel is None:
-            parallel = n >= 5000 and numba.get_num_threads() > 1
+            parallel = n >= 5000 and numba.get_num_threads() > 1 and not skip_resting
         self.parallel = bool(parallel)
 
         # positions inside the box; walls must not cut floes deeply
@@ -217,6 +237,7 @@ class HertzSimulation(FloeProperties):
         self.time = 0.0
         self.n_steps = 0
         self.n_rebuilds = 0
+        self.n_awake = n
         self._build_list()
         self._no_ship = HC.inactive_bundle(self._wall_law)
         self.ship = None if ship is None else self._place_ship(ship)
@@ -362,9 +383,14 @@ class HertzSimulation(FloeProperties):
 
     def _run(self, n: int, ship_bundle) -> tuple:
         box = self.box.kernel_box(self.time)
-        done, status, nreb, self._verlet = K.run_steps(
-            n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(), box,
-            self._verlet, self.parallel, numba.get_num_threads(), ship_bundle)
+        if self.skip_resting:
+            done, status, nreb, self._verlet, self.n_awake = run_steps_resting(
+                n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(), box,
+                self._verlet, ship_bundle)
+        else:
+            done, status, nreb, self._verlet = K.run_steps(
+                n, self.dt, self.time, self._floes, self._law, self._wall_law, self._drive(),
+                box, self._verlet, self.parallel, numba.get_num_threads(), ship_bundle)
         self.time += done * self.dt
         self.n_steps += done
         self.n_rebuilds += nreb
@@ -536,5 +562,6 @@ class HertzSimulation(FloeProperties):
                          self._omega.copy(), f.density, f.frozen.copy())
 
     def __repr__(self):
+        rest = ", skip_resting=True" if self.skip_resting else ""
         return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "
-                f"time={self.time:.6g}, parallel={self.parallel})")
+                f"time={self.time:.6g}, parallel={self.parallel}{rest})")
