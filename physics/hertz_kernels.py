@@ -1033,6 +1033,28 @@ def rebuild(floes, verlet, lx, ly, px, py, parallel, skins=None):
                       cell_size, verlet.max_cut, sk, skin_max, wide, wide_ref, wide_weight)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def begin_step(box, time, step, dt, centre, ship):
+    """The start of step ``step`` of a run: the box's lengths after it
+    (written to ``box.lengths``), the :class:`Kick` of the floes' pass
+    (centre: the list's displacement centre) and the ship's kick–drift.
+    Returns (status, kick): CONCENTRATION_LIMIT, with nothing changed, when
+    a deforming box reached its limit, else OK."""
+    lengths = box.lengths
+    lx_old, ly_old = lengths[0], lengths[1]
+    lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
+    dt_kick = 0.5 * dt if step == 0 else dt
+    kick = Kick(dt_kick, dt, lx, ly, box.periodic_x, box.periodic_y, lx / lx_old, ly / ly_old,
+                centre[0], centre[1])
+    if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
+        return _CONCENTRATION_LIMIT, kick
+    lengths[0] = lx
+    lengths[1] = ly
+    if ship.active:
+        ship_kick_drift(ship, dt_kick, dt)
+    return _OK, kick
+
+
 @njit(cache=True, error_model="numpy")
 def rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, deforming, dt):
     """The list rebuild of a run (:func:`rebuild`): with a ship in a rigid
@@ -1116,18 +1138,10 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             lx, ly = lengths[0], lengths[1]
             expired = True
         else:
-            lx_old, ly_old = lengths[0], lengths[1]
-            lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
-            if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
-                status = _CONCENTRATION_LIMIT
+            status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
+            if status != _OK:
                 break
-            lengths[0] = lx
-            lengths[1] = ly
-            dt_kick = 0.5 * dt if step == 0 else dt
-            kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, verlet.centre[0],
-                        verlet.centre[1])
-            if ship.active:
-                ship_kick_drift(ship, dt_kick, dt)
+            lx, ly = kick.lx, kick.ly
             if parallel:
                 worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
                                                            verlet.ref, drive, kick)

@@ -41,12 +41,12 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .domain import box_lengths_at, minimum_image
-from .hertz_kernels import (KICK_FASTMATH, Kick, _CONCENTRATION_LIMIT, _OK, _SHIP_LOG_FULL,
+from .domain import minimum_image
+from .hertz_kernels import (KICK_FASTMATH, _OK, _SHIP_LOG_FULL, begin_step,
                             floe_drag, floe_rows, floe_walls, force_buffers, from_order_key,
                             half_kick, kick_drift_floe, list_expired, listed_pair, max_keep_nan,
                             order_key, pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
-from .hull_contact import C_CAND, hull_forces, ship_closing_kick, ship_kick_drift
+from .hull_contact import C_CAND, hull_forces, ship_closing_kick
 
 __all__ = ["Awake", "LivePairs", "run_steps_resting"]
 
@@ -325,7 +325,6 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     px = box.periodic_x
     py = box.periodic_y
     walls = not (px and py)
-    lengths = box.lengths
     n = floes.pos.shape[0]
     buffers = force_buffers(1, n)
     buffers.force[0] = floes.force
@@ -340,18 +339,10 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     log_full = False
     step = 0
     while step < n_steps:
-        lx_old, ly_old = lengths[0], lengths[1]
-        lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
-        if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
-            status = _CONCENTRATION_LIMIT
+        status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
+        if status != _OK:
             break
-        lengths[0] = lx
-        lengths[1] = ly
-        dt_kick = 0.5 * dt if step == 0 else dt
-        kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, verlet.centre[0],
-                    verlet.centre[1])
-        if ship.active:
-            ship_kick_drift(ship, dt_kick, dt)
+        lx, ly = kick.lx, kick.ly
         worst, mx, my, vmax2 = first_half_awake(work, verlet.ref, drive, kick, awake)
         done += 1
         step += 1
