@@ -20,7 +20,6 @@ def test_transit_statistics_agree_on_and_off():
     assert off["collisions"] > 0, "the ship hit nothing: the test tests nothing"
     for key in bench.METRICS:
         assert on[key] == pytest.approx(off[key], rel=1e-9, abs=1e-12), key
-    assert 0 < on["awake"] < on["floes"]
 
 
 def test_quick_run_writes_a_record(tmp_path):
