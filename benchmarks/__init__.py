@@ -30,6 +30,8 @@ suite               what is timed
 ``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
                     N = 200000, its strong and weak scaling, and a projection
                     to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
+``resting``         ship transits with and without skipping the floes at rest,
+                    and env steps/s of a long channel (:mod:`benchmarks.resting`)
 ==================  ==============================================================
 
 Every suite writes one JSON record to ``docs/benchmarks/<suite>.json`` of
@@ -49,7 +51,7 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "ship",
-          "compare", "lammps_scaling")
+          "compare", "lammps_scaling", "resting")
 
 __all__ = ["SUITES", "main"]
 

@@ -566,7 +566,7 @@ class HertzEnv(FloeEnv):
                              self.preset.time_step,
                              self.stiffness_scale)
         return HertzSimulation(field, box, self.contact, forcing, dt=dt,
-                               impact_speed=self.impact_speed, parallel=False)
+                               impact_speed=self.impact_speed, parallel=False, skip_resting=True)
 
     def _contact_physics(self) -> dict:
         from physics.observables import stress

@@ -342,7 +342,7 @@ class ShipEnv(HertzEnv):
                  0.1 * hull_contact_time(field.radii, field.thickness, field.density,
                                          self.contact, impact))
         sim = HertzSimulation(field, box, self.contact, forcing, dt=dt, impact_speed=impact,
-                              parallel=False, ship=self._ship,
+                              parallel=False, ship=self._ship, skip_resting=True,
                               allow_overlap=self.episode["concentration"] > PLACEMENT_LIMIT)
         self.n_floes = field.n
         self.impact_speed = impact

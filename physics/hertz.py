@@ -35,6 +35,8 @@ from .engine import snapshot as _snapshot
 from .floes import FloeField
 from .forcing import Forcing
 from .hertz_kernels import HertzStatus
+from .hertz_batch import run_many
+from .hertz_resting import run_steps_resting
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, Stress, fabric, stress
 from .params import ContactParams, PaperPreset
@@ -132,6 +134,17 @@ class HertzSimulation(FloeProperties):
         :class:`~physics.ship.ShipState` and :meth:`ship_loads` gives the
         statistics of its ice loads. The time-step check then also covers a
         floe hitting the hull at the ship's speed.
+    skip_resting : bool
+        Skip the floes at rest (default False): a floe with zero velocity,
+        angular velocity and force that touches nothing and has no wind or
+        current acting on it is not integrated (velocity Verlet would leave
+        it exactly where it is) until a contact with a moving floe or the
+        hull wakes it (:mod:`physics.hertz_resting`). The set is found
+        again at each :meth:`step`. The result is that of the full step (to
+        rounding in the list's expiry test), at the cost of the moving
+        floes: worth it when most floes lie still (a ship in calm ice). It
+        runs the serial step only: with ``parallel=True`` it is a
+        ``ValueError``, and ``parallel=None`` then means serial.
 
     Attributes
     ----------
@@ -139,6 +152,8 @@ class HertzSimulation(FloeProperties):
     positions, velocities, angular_velocities : read-only snapshots of the current state
     force, torque : read-only snapshots of the total force and torque of the last step
     n_steps, n_rebuilds : counters
+    n_awake : floes integrated at the end of the last :meth:`step` (all of
+        them unless ``skip_resting``)
 
     Examples
     --------
@@ -159,10 +174,16 @@ class HertzSimulation(FloeProperties):
                  forcing: Forcing | None = None, dt: float = 0.002, *,
                  impact_speed: float = 0.1, skin: float | None = None,
                  parallel: bool | None = None, allow_overlap: bool = False,
-                 ship: Ship | None = None):
+                 ship: Ship | None = None, skip_resting: bool = False):
         contact = checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed)
         if ship is not None and not isinstance(ship, Ship):
             raise TypeError(f"ship must be a physics.ship.Ship or None, got {type(ship).__name__}")
+        if not isinstance(skip_resting, (bool, np.bool_)):
+            raise TypeError(f"skip_resting must be True or False, got {skip_resting!r}")
+        if skip_resting and parallel:
+            raise ValueError("skip_resting=True runs the serial step only: pass parallel=False "
+                             "or None, not parallel=True")
+        self.skip_resting = bool(skip_resting)
         self.field = field.copy()
         self.box = box
         self.contact = contact
@@ -188,7 +209,7 @@ class HertzSimulation(FloeProperties):
         # neighbour-list sizing
         self.skin, self.max_cut = neighbour_cut(f.radii, box, skin)
         if parallel is None:
-            parallel = n >= 5000 and numba.get_num_threads() > 1
+            parallel = n >= 5000 and numba.get_num_threads() > 1 and not skip_resting
         self.parallel = bool(parallel)
 
         # positions inside the box; walls must not cut floes deeply
@@ -217,6 +238,7 @@ class HertzSimulation(FloeProperties):
         self.time = 0.0
         self.n_steps = 0
         self.n_rebuilds = 0
+        self.n_awake = n
         self._build_list()
         self._no_ship = HC.inactive_bundle(self._wall_law)
         self.ship = None if ship is None else self._place_ship(ship)
@@ -341,9 +363,13 @@ class HertzSimulation(FloeProperties):
         left = n
         while left > 0:
             args = self._kernel_arguments(left)
-            done, status, nreb, self._verlet = K.run_steps(
-                args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
-                numba.get_num_threads(), args[6])
+            if self.skip_resting:
+                done, status, nreb, self._verlet, self.n_awake = run_steps_resting(
+                    args[0], self.dt, self.time, *args[1:6], self._verlet, args[6])
+            else:
+                done, status, nreb, self._verlet = K.run_steps(
+                    args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
+                    numba.get_num_threads(), args[6])
             left = self._after_run(done, status, nreb, left)
         self._check_status(HertzStatus(status))
 
@@ -553,15 +579,16 @@ class HertzSimulation(FloeProperties):
                          self._omega.copy(), f.density, f.frozen.copy())
 
     def __repr__(self):
+        rest = ", skip_resting=True" if self.skip_resting else ""
         return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "
-                f"time={self.time:.6g}, parallel={self.parallel})")
+                f"time={self.time:.6g}, parallel={self.parallel}{rest})")
 
 
 def advance_together(sims, duration: float) -> list:
     """Advance several independent simulations by ``duration`` model seconds
     each (rounded to whole steps of each one's Δt) in compiled calls that
     run the simulations in parallel over Numba's threads
-    (:func:`physics.hertz_kernels.run_many`), one simulation per thread at a
+    (:func:`physics.hertz_batch.run_many`), one simulation per thread at a
     time. Each simulation does exactly what its own :meth:`HertzSimulation.advance`
     would: the same arithmetic in the same order, so the same state.
 
@@ -613,12 +640,13 @@ def advance_together(sims, duration: float) -> list:
             verlets.append(sims[k]._verlet)
         dt = np.array([sims[k].dt for k in todo])
         time = np.array([sims[k].time for k in todo])
-        done = np.zeros(len(todo), dtype=np.int64)
-        stat = np.zeros(len(todo), dtype=np.int64)
-        nreb = np.zeros(len(todo), dtype=np.int64)
-        K.run_many(n_steps, dt, time, runs, verlets, done, stat, nreb)
+        resting = np.array([sims[k].skip_resting for k in todo])
+        done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
+        run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
         for m, k in enumerate(todo):
             sims[k]._verlet = verlets[m]
+            if sims[k].skip_resting:
+                sims[k].n_awake = int(awake[m])
             status[k] = HertzStatus(int(stat[m]))
             left[k] = sims[k]._after_run(int(done[m]), status[k], int(nreb[m]), left[k])
     errors = []

@@ -283,17 +283,24 @@ def pair_contact(dx, dy, ri, rj, vrx, vry, wi, wj, inv_mass_sum, spring, a_last,
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def wall_overlap(side, x, y, r, lx, ly):
+    """(overlap, nx, ny) of a disc of radius r at (x, y) with wall ``side``
+    (0..3 = wall at x=0, x=lx, y=0, y=ly; n points from the floe to the
+    wall); the disc touches it when the overlap is positive."""
+    if side == 0:
+        return r - x, -1.0, 0.0
+    if side == 1:
+        return r - (lx - x), 1.0, 0.0
+    if side == 2:
+        return r - y, 0.0, -1.0
+    return r - (ly - y), 0.0, 1.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def wall_contact(side, x, y, vx, vy, w, r, inv_mass, lx, ly, spring, a_last, dt_history, law):
     """Force of a rigid wall on a floe; ``side`` 0..3 = wall at x=0, x=lx,
     y=0, y=ly. Returns (fx, fy, torque, spring, a_last)."""
-    if side == 0:
-        delta, nx, ny = r - x, -1.0, 0.0
-    elif side == 1:
-        delta, nx, ny = r - (lx - x), 1.0, 0.0
-    elif side == 2:
-        delta, nx, ny = r - y, 0.0, -1.0
-    else:
-        delta, nx, ny = r - (ly - y), 0.0, 1.0
+    delta, nx, ny = wall_overlap(side, x, y, r, lx, ly)
     if delta <= 0.0 or inv_mass == 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0
     v_normal = vx * nx + vy * ny
@@ -362,24 +369,29 @@ def min_image_step(d, length, periodic):
 def wall_forces(i_lo, i_hi, floes, wall_law, box, dt_history, force, torque):
     """Add the forces of the rigid walls of non-periodic sides to floes
     i_lo..i_hi−1 (and advance their history ``floes.wall_hist``)."""
+    for i in range(i_lo, i_hi):
+        floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def floe_walls(i, floes, wall_law, box, dt_history, force, torque):
+    """Add the forces of the rigid walls of non-periodic sides to floe i
+    (and advance its history ``floes.wall_hist``)."""
     pos, vel, omega, radius = floes.pos, floes.vel, floes.omega, floes.radius
     inv_mass, wall_hist = floes.inv_mass, floes.wall_hist
     lx, ly = box.lengths[0], box.lengths[1]
-    walls_x = not box.periodic_x
-    walls_y = not box.periodic_y
-    for i in range(i_lo, i_hi):
-        for side in range(4):
-            if (side < 2 and not walls_x) or (side >= 2 and not walls_y):
-                continue
-            wfx, wfy, wtq, sp, al = wall_contact(side, pos[i, 0], pos[i, 1], vel[i, 0],
-                                                 vel[i, 1], omega[i], radius[i], inv_mass[i],
-                                                 lx, ly, wall_hist[i, side, 0],
-                                                 wall_hist[i, side, 1], dt_history, wall_law)
-            wall_hist[i, side, 0] = sp
-            wall_hist[i, side, 1] = al
-            force[i, 0] += wfx
-            force[i, 1] += wfy
-            torque[i] += wtq
+    for side in range(4):
+        if (side < 2 and box.periodic_x) or (side >= 2 and box.periodic_y):
+            continue
+        wfx, wfy, wtq, sp, al = wall_contact(side, pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1],
+                                             omega[i], radius[i], inv_mass[i], lx, ly,
+                                             wall_hist[i, side, 0], wall_hist[i, side, 1],
+                                             dt_history, wall_law)
+        wall_hist[i, side, 0] = sp
+        wall_hist[i, side, 1] = al
+        force[i, 0] += wfx
+        force[i, 1] += wfy
+        torque[i] += wtq
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -394,6 +406,24 @@ def drag_forces(i_lo, i_hi, floes, drive, force, torque):
         force[i, 0] = fx
         force[i, 1] = fy
         torque[i] = tq
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def listed_pair(p, j, xi, yi, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py, hist,
+                dt_history):
+    """:func:`pair_contact` of pair p of a Verlet list, owner i (its centre,
+    velocity, angular velocity, radius and inverse mass given) and partner
+    j, in a box of lengths (lx, ly), with the pair's history ``hist[p]``
+    advanced."""
+    pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
+                                         floes.inv_mass)
+    res = pair_contact(minimum_image(pos[j, 0] - xi, lx, px),
+                       minimum_image(pos[j, 1] - yi, ly, py), ri, radius[j], vxi - vel[j, 0],
+                       vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j], hist[p, 0], hist[p, 1],
+                       dt_history, law)
+    hist[p, 0] = res[5]
+    hist[p, 1] = res[6]
+    return res
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -422,12 +452,8 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
         tqi = 0.0
         for p in range(start[i], start[i + 1]):
             j = nbr[p]
-            res = pair_contact(minimum_image(pos[j, 0] - xi_, lx, px),
-                               minimum_image(pos[j, 1] - yi_, ly, py), ri, radius[j],
-                               vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j],
-                               hist[p, 0], hist[p, 1], dt_history, law)
-            hist[p, 0] = res[5]
-            hist[p, 1] = res[6]
+            res = listed_pair(p, j, xi_, yi_, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py,
+                              hist, dt_history)
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -629,17 +655,12 @@ def first_half(floes, ref, drive, kick):
     reassociated."""
     omega, torque = floes.omega, floes.torque
     inv_mass, inv_inertia = floes.inv_mass, floes.inv_inertia
-    dt_kick, dt = kick.dt_kick, kick.dt
-    lx, ly, px, py = kick.lx, kick.ly, kick.periodic_x, kick.periodic_y
-    sx, sy, cx, cy = kick.sx, kick.sy, kick.cx, kick.cy
+    sx, sy = kick.sx, kick.sy
     n = inv_mass.shape[0]
     if sx != 1.0 or sy != 1.0:
         for i in range(n):
             ref[i, 0] *= sx
             ref[i, 1] *= sy
-    uax, uay, uwx, uwy = drive.wind_x, drive.wind_y, drive.current_x, drive.current_y
-    wind_speed = drive.wind_speed
-    on = 1.0 if drive.active else 0.0
     p = floes.pos.reshape(-1)
     v = floes.vel.reshape(-1)
     f = floes.force.reshape(-1)
@@ -650,47 +671,64 @@ def first_half(floes, ref, drive, kick):
     sdx = 0.0
     sdy = 0.0
     for i in range(n):
-        im = inv_mass[i]
-        mobile = im != 0.0
-        x0 = p[2 * i]
-        y0 = p[2 * i + 1]
-        vx0 = v[2 * i]
-        vy0 = v[2 * i + 1]
-        w0 = omega[i]
-        vx = vx0 + dt_kick * f[2 * i] * im
-        vy = vy0 + dt_kick * f[2 * i + 1] * im
-        w = w0 + dt_kick * torque[i] * inv_inertia[i]
-        # one wrap is enough: a floe that crossed more than a box length
-        # also crossed half the skin, and the step stops as unstable
-        x = wrap_once((x0 + dt * vx) * sx, lx, px)
-        y = wrap_once((y0 + dt * vy) * sy, ly, py)
-        x = x if mobile else x0
-        y = y if mobile else y0
-        vx = vx if mobile else vx0
-        vy = vy if mobile else vy0
-        w = w if mobile else w0
-        p[2 * i] = x
-        p[2 * i + 1] = y
-        v[2 * i] = vx
-        v[2 * i + 1] = vy
-        omega[i] = w
-        key = order_key(vx * vx + vy * vy if mobile else 0.0)
+        v2, e2, dx, dy = kick_drift_floe(i, p, v, f, omega, torque, inv_mass, inv_inertia, r, k,
+                                         drive, kick)
+        key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
-        # frozen floes have zero drag coefficients: their force is cleared
-        fx, fy, tq = floe_drag(vx, vy, w, on * k[4 * i], on * k[4 * i + 1], on * k[4 * i + 2],
-                               on * k[4 * i + 3], uax, uay, uwx, uwy, wind_speed)
-        f[2 * i] = fx
-        f[2 * i + 1] = fy
-        torque[i] = tq
-        dx = min_image_step(x - r[2 * i], lx, px)
-        dy = min_image_step(y - r[2 * i + 1], ly, py)
-        ex = dx - cx
-        ey = dy - cy
-        key = order_key(ex * ex + ey * ey)
+        key = order_key(e2)
         worst = key if key > worst else worst
         sdx += dx
         sdy += dy
     return from_order_key(worst), sdx, sdy, from_order_key(vmax2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def kick_drift_floe(i, p, v, f, omega, torque, inv_mass, inv_inertia, r, k, drive, kick):
+    """The kick–drift of floe i of :func:`first_half` (``p``, ``v``, ``f``,
+    ``r``, ``k``: the positions, velocities, forces, positions at the build
+    and drag coefficients as flat arrays): its new state and drag force
+    written. Returns (squared speed, 0 for a frozen floe; squared distance
+    of its displacement since the build from (kick.cx, kick.cy); the
+    displacement along x, along y)."""
+    dt_kick, dt = kick.dt_kick, kick.dt
+    lx, ly, px, py = kick.lx, kick.ly, kick.periodic_x, kick.periodic_y
+    on = 1.0 if drive.active else 0.0
+    im = inv_mass[i]
+    mobile = im != 0.0
+    x0 = p[2 * i]
+    y0 = p[2 * i + 1]
+    vx0 = v[2 * i]
+    vy0 = v[2 * i + 1]
+    w0 = omega[i]
+    vx = vx0 + dt_kick * f[2 * i] * im
+    vy = vy0 + dt_kick * f[2 * i + 1] * im
+    w = w0 + dt_kick * torque[i] * inv_inertia[i]
+    # one wrap is enough: a floe that crossed more than a box length
+    # also crossed half the skin, and the step stops as unstable
+    x = wrap_once((x0 + dt * vx) * kick.sx, lx, px)
+    y = wrap_once((y0 + dt * vy) * kick.sy, ly, py)
+    x = x if mobile else x0
+    y = y if mobile else y0
+    vx = vx if mobile else vx0
+    vy = vy if mobile else vy0
+    w = w if mobile else w0
+    p[2 * i] = x
+    p[2 * i + 1] = y
+    v[2 * i] = vx
+    v[2 * i + 1] = vy
+    omega[i] = w
+    # frozen floes have zero drag coefficients: their force is cleared
+    fx, fy, tq = floe_drag(vx, vy, w, on * k[4 * i], on * k[4 * i + 1], on * k[4 * i + 2],
+                           on * k[4 * i + 3], drive.wind_x, drive.wind_y, drive.current_x,
+                           drive.current_y, drive.wind_speed)
+    f[2 * i] = fx
+    f[2 * i + 1] = fy
+    torque[i] = tq
+    dx = min_image_step(x - r[2 * i], lx, px)
+    dy = min_image_step(y - r[2 * i + 1], ly, py)
+    ex = dx - kick.cx
+    ey = dy - kick.cy
+    return vx * vx + vy * vy if mobile else 0.0, ex * ex + ey * ey, dx, dy
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -995,6 +1033,38 @@ def rebuild(floes, verlet, lx, ly, px, py, parallel, skins=None):
                       cell_size, verlet.max_cut, sk, skin_max, wide, wide_ref, wide_weight)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def begin_step(box, time, step, dt, centre, ship):
+    """The start of step ``step`` of a run: the box's lengths after it
+    (written to ``box.lengths``), the :class:`Kick` of the floes' pass
+    (centre: the list's displacement centre) and the ship's kick–drift.
+    Returns (status, kick): CONCENTRATION_LIMIT, with nothing changed, when
+    a deforming box reached its limit, else OK."""
+    lengths = box.lengths
+    lx_old, ly_old = lengths[0], lengths[1]
+    lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
+    dt_kick = 0.5 * dt if step == 0 else dt
+    kick = Kick(dt_kick, dt, lx, ly, box.periodic_x, box.periodic_y, lx / lx_old, ly / ly_old,
+                centre[0], centre[1])
+    if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
+        return _CONCENTRATION_LIMIT, kick
+    lengths[0] = lx
+    lengths[1] = ly
+    if ship.active:
+        ship_kick_drift(ship, dt_kick, dt)
+    return _OK, kick
+
+
+@njit(cache=True, error_model="numpy")
+def rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, deforming, dt):
+    """The list rebuild of a run (:func:`rebuild`): with a ship in a rigid
+    box, with the floes' skins of :func:`physics.hull_contact.ship_floe_skins`."""
+    if ship.active and not deforming:
+        return rebuild(floes, verlet, lx, ly, px, py, parallel,
+                       ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
+    return rebuild(floes, verlet, lx, ly, px, py, parallel)
+
+
 @njit(cache=True, error_model="numpy")
 def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair,
               ship):
@@ -1068,18 +1138,10 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             lx, ly = lengths[0], lengths[1]
             expired = True
         else:
-            lx_old, ly_old = lengths[0], lengths[1]
-            lx, ly, conc = box_lengths_at(box, time + (step + 1) * dt)
-            if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
-                status = _CONCENTRATION_LIMIT
+            status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
+            if status != _OK:
                 break
-            lengths[0] = lx
-            lengths[1] = ly
-            dt_kick = 0.5 * dt if step == 0 else dt
-            kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, verlet.centre[0],
-                        verlet.centre[1])
-            if ship.active:
-                ship_kick_drift(ship, dt_kick, dt)
+            lx, ly = kick.lx, kick.ly
             if parallel:
                 worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
                                                            verlet.ref, drive, kick)
@@ -1107,11 +1169,8 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             verlet.centre[1] = my / n
             expired = list_expired(worst, lx, ly, verlet)
         if expired:
-            if ship.active and not box.deforming:
-                verlet = rebuild(floes, verlet, lx, ly, px, py, parallel,
-                                 ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
-            else:
-                verlet = rebuild(floes, verlet, lx, ly, px, py, parallel)
+            verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, box.deforming,
+                                    dt)
             chunks = pair_chunks(verlet, n_pair)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces
@@ -1174,25 +1233,3 @@ def contact_list(floes, law, box, verlet):
                 data[k, 8] = res[4]
                 k += 1
     return ii[:k], jj[:k], data[:k]
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def run_many(n_steps, dt, time, runs, verlets, done, status, n_rebuilds):
-    """:func:`run_steps` of several independent simulations in one call,
-    parallel over the simulations (each one's own step is serial).
-
-    ``runs[k]`` is (floes, law, wall law, drive, box, ship bundle) of
-    simulation k and ``verlets[k]`` its Verlet list (replaced by the list
-    after the run); ``n_steps``, ``dt`` and ``time`` hold the arguments of
-    :func:`run_steps` per simulation, and ``done``, ``status`` and
-    ``n_rebuilds`` receive its results. The simulations share no array, so
-    the iterations write disjoint memory."""
-    for m in prange(len(runs)):
-        k = np.int64(m)                     # typed lists take signed indices
-        floes, law, wall_law, drive, box, ship = runs[k]
-        d, s, r, verlet = run_steps(n_steps[k], dt[k], time[k], floes, law, wall_law, drive, box,
-                                    verlets[k], False, 1, ship)
-        done[k] = d
-        status[k] = s
-        n_rebuilds[k] = r
-        verlets[k] = verlet

@@ -51,6 +51,7 @@ BENCH_SUITES = {
     "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "compare": "this tree against another revision, side by side",
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
+    "resting": "skipping the floes at rest: transit statistics on and off, env steps/s",
     "headline": "put the headline figures of the records into the README",
 }
 

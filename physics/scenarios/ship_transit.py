@@ -284,8 +284,10 @@ def open_water_thrust(ship, speed: float) -> float:
     return h.linear_damping[0] * speed + h.quadratic_damping[0] * speed * abs(speed)
 
 
-def build_simulation(p: dict, case: dict, seed: int):
-    """(simulation, geometry, constants) of one run."""
+def build_simulation(p: dict, case: dict, seed: int, *, skip_resting: bool = True):
+    """(simulation, geometry, constants) of one run; ``skip_resting``: the
+    engine skips the floes at rest (``HertzSimulation(skip_resting=...)``,
+    the same result)."""
     c, v = float(case["concentration"]), float(case["speed"])
     walls = bool(case.get("walls", 0))
     field, box, geo = pack_ice(p, c, seed, walls)
@@ -313,7 +315,8 @@ def build_simulation(p: dict, case: dict, seed: int):
         raise ValueError(f"speed {v:g} m/s needs a thrust of {thrust / 1e3:.0f} kN in open "
                          f"water, above the ship's {ship.max_thrust / 1e3:.0f} kN")
     sim = HertzSimulation(field, box, contact, forcing, dt=dt, impact_speed=impact,
-                          allow_overlap=c > p["placement_limit"], ship=ship)
+                          allow_overlap=c > p["placement_limit"], ship=ship,
+                          skip_resting=skip_resting)
     if dynamic:
         sim.ship.command(thrust=thrust, yaw_moment=0.0)
     constants = dict(thrust=thrust, open_water_speed=v, n_floes=field.n, band_start=geo["x0"],

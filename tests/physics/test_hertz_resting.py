@@ -1,0 +1,215 @@
+"""Floes at rest cost nothing (``HertzSimulation(skip_resting=True)``,
+:mod:`physics.hertz_resting`): the same run as the full step, with the
+resting floes woken by a floe, the hull and a wall, and nothing at rest
+under wind.
+
+The two paths do the same arithmetic on the awake floes; a resting floe
+would come out of the full step unchanged. Only the sums of the
+displacements in the Verlet list's expiry test are added in another order,
+so the bound of the comparisons is rounding: 1e-12 m, 1e-12 m/s (and
+relative 1e-12 for forces)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from physics import ContactParams, Forcing, HertzSimulation
+from physics.domain import ChannelBox, PeriodicBox, WalledBox
+from physics.floes import FloeField, make_floe_field
+from physics.hertz import hull_contact_time
+from physics.hull import Hull
+from physics.params import HERMAN2013
+from physics.ship import Ship
+
+# rounding of the same arithmetic (see the module docstring)
+TOL = 1e-12
+CONTACT = ContactParams(elastic_modulus=1.0e8, restitution=0.5, friction=0.5)
+
+
+def assert_same(a: HertzSimulation, b: HertzSimulation):
+    """Positions, velocities, spins, forces and torques of two runs agree
+    to rounding."""
+    assert a.n_steps == b.n_steps
+    np.testing.assert_allclose(a.positions, b.positions, rtol=0, atol=TOL)
+    np.testing.assert_allclose(a.velocities, b.velocities, rtol=0, atol=TOL)
+    np.testing.assert_allclose(a.angular_velocities, b.angular_velocities, rtol=0, atol=TOL)
+    scale = max(1.0, float(np.abs(b.force).max()), float(np.abs(b.torque).max()))
+    np.testing.assert_allclose(a.force, b.force, rtol=0, atol=TOL * scale)
+    np.testing.assert_allclose(a.torque, b.torque, rtol=0, atol=TOL * scale)
+
+
+def both(make, *steps):
+    """The simulation of ``make(skip_resting)`` with the option on and off,
+    each advanced by the numbers of steps ``steps`` (one call each)."""
+    out = []
+    for skip in (True, False):
+        sim = make(skip)
+        for n in steps:
+            sim.step(n)
+        out.append(sim)
+    return out
+
+
+def transit_field(n: int = 300, seed: int = 1):
+    """A calm field of ``n`` floes (A = 0.4) with a slot cleared for a
+    20 m × 6 m hull heading +x at a fifth of the box."""
+    field, box = make_floe_field(n, concentration=0.4, alpha=1.8, mean_diameter=4.0, seed=seed)
+    start = np.array([0.2 * box.lx, 0.5 * box.ly])
+    keep = np.hypot(*(field.positions - start).T) > field.radii + 12.0
+    field = FloeField(field.positions[keep], field.radii[keep], field.thickness[keep],
+                      density=field.density)
+    return field, box, start
+
+
+def transit(skip: bool, forcing=None, seed: int = 1, mode: str = "prescribed"):
+    field, box, start = transit_field(seed=seed)
+    speed = 2.0
+    impact = (1.0 + CONTACT.restitution) * speed
+    dt = 0.1 * hull_contact_time(field.radii, field.thickness, field.density, CONTACT, impact)
+    ship = Ship(Hull.pointed(20.0, 6.0), 2.0e5, mode=mode, position=tuple(start),
+                speed=speed)
+    sim = HertzSimulation(field, box, CONTACT, forcing, dt=dt, impact_speed=impact, ship=ship,
+                          skip_resting=skip)
+    if mode == "dynamic":
+        sim.ship.command(thrust=2.0e4)
+    return sim
+
+
+@pytest.mark.parametrize("mode", ["prescribed", "dynamic"])
+def test_ship_transit_same_as_full_step(mode):
+    """A ship pushing through a calm field for 10 s, in pieces of different
+    lengths: floes, forces and the ship's records agree with the full step
+    to rounding, and most floes were never integrated."""
+    pieces = []
+    on, off = None, None
+    for skip in (True, False):
+        sim = transit(skip, mode=mode)
+        n10 = int(round(10.0 / sim.dt))
+        pieces = (1, n10 // 3, n10 - n10 // 3 - 1)
+        for n in pieces:
+            sim.step(n)
+        on, off = (sim, off) if skip else (on, sim)
+    assert_same(on, off)
+    r_on, r_off = on.ship.records(), off.ship.records()
+    assert r_on["time"].size == sum(pieces)
+    for key in ("x", "y", "surge", "ice_surge", "ice_sway", "ice_moment", "ice_power",
+                "contacts", "normal_force"):
+        scale = max(1.0, float(np.abs(r_off[key]).max()))
+        np.testing.assert_allclose(r_on[key], r_off[key], rtol=0, atol=TOL * scale, err_msg=key)
+    c_on, c_off = on.ship.collisions(), off.ship.collisions()
+    assert c_on["floe"].tolist() == c_off["floe"].tolist()
+    assert c_off["floe"].size > 0, "the ship hit nothing: the test tests nothing"
+    # the floes the ship set moving, and only they, are awake at the end
+    moving = np.count_nonzero(np.any(off.velocities != 0.0, axis=1))
+    assert 0 < moving <= on.n_awake < 0.5 * on.n_floes
+    assert off.n_awake == off.n_floes
+
+
+def test_calm_field_only_a_few_floes_awake():
+    """After 10 s of a ship in calm ice few floes were integrated: the hull
+    sweeps 20 m × 6 m of a box of ~100 m × 100 m, so the floes it and the
+    floes it pushed can reach are a small part of the field (< 20 %)."""
+    sim = transit(True)
+    sim.advance(10.0)
+    assert 0 < sim.n_awake < 0.2 * sim.n_floes
+
+
+def pair_field(positions, velocities, radius=1.0):
+    pos = np.array(positions, dtype=float)
+    return FloeField(pos, np.full(len(pos), radius), 1.0, np.array(velocities, dtype=float))
+
+
+def test_woken_by_a_floe_and_by_an_assigned_velocity():
+    """A moving floe hits a resting one (which passes the push on to a
+    third); a fourth lies in contact with a fifth at rest (touching: both
+    awake from the start); between two calls the user sets a sixth moving.
+    Every floe ends as in the full step."""
+    positions = [(10.0, 10.0), (13.0, 10.0), (15.5, 10.0), (30.0, 30.0), (31.995, 30.0),
+                 (40.0, 10.0)]
+    velocities = [(0.5, 0.0)] + [(0.0, 0.0)] * 5
+    field = pair_field(positions, velocities)
+    dt = 1e-3
+
+    def make(skip):
+        return HertzSimulation(field, PeriodicBox(60.0), CONTACT, None, dt, impact_speed=1.0,
+                               skip_resting=skip)
+
+    on, off = both(make, 1, 4000)
+    assert_same(on, off)
+    assert np.all(on.velocities[:5, 0] != 0.0)
+    assert on.velocities[5, 0] == 0.0 and on.n_awake == 5
+    for sim in (on, off):
+        v = sim.velocities.copy()
+        v[5] = (0.0, 0.3)
+        sim.velocities = v
+        sim.step(1000)
+    assert_same(on, off)
+    assert on.n_awake == 6
+
+
+def test_woken_by_the_hull():
+    """A prescribed hull sails into a resting floe: it wakes and leaves as
+    in the full step (and was not integrated before)."""
+    field = pair_field([(40.0, 30.0)], [(0.0, 0.0)])
+    speed = 1.0
+    dt = 0.01 * hull_contact_time(field.radii, 1.0, field.density, CONTACT, 2.0 * speed)
+
+    def make(skip):
+        ship = Ship(Hull.box(10.0, 4.0), 1.0e5, position=(30.0, 30.0), speed=speed)
+        return HertzSimulation(field, PeriodicBox(60.0), CONTACT, None, dt, impact_speed=2.0,
+                               ship=ship, skip_resting=skip)
+
+    on, off = both(make, 10)
+    assert on.n_awake == 0
+    n = int(round(6.0 / speed / dt))
+    for sim in (on, off):
+        sim.step(n)
+    assert_same(on, off)
+    assert on.n_awake == 1 and on.velocities[0, 0] > speed
+    assert on.ship.collisions()["floe"].tolist() == off.ship.collisions()["floe"].tolist() == [0]
+
+
+@pytest.mark.parametrize("box_type", [ChannelBox, WalledBox])
+def test_walls(box_type):
+    """A resting floe that overlaps a wall is not at rest (the wall pushes
+    it off); a moving floe pushes a resting one into the wall ahead. Both
+    as in the full step."""
+    positions = [(0.995, 20.0), (20.0, 10.0), (36.0, 10.0)]
+    velocities = [(0.0, 0.0), (0.8, 0.0), (0.0, 0.0)]
+    if box_type is ChannelBox:          # walls at y = 0 and y = ly: turn the set-up
+        positions = [(y, x) for x, y in positions]
+        velocities = [(vy, vx) for vx, vy in velocities]
+    field = pair_field(positions, velocities)
+
+    def make(skip):
+        return HertzSimulation(field, box_type(40.0), CONTACT, None, 1e-3, impact_speed=2.0,
+                               skip_resting=skip)
+
+    on, off = both(make, 1, 30000)
+    assert_same(on, off)
+    assert on.n_awake == 3
+    # the first floe left the wall, the last one was pushed into it and back
+    assert np.all(np.abs(on.velocities).max(axis=1) > 0.0)
+
+
+def test_wind_nothing_rests():
+    """With wind every floe is pushed: all are awake and the run is the
+    full step's."""
+    forcing = Forcing(HERMAN2013.forcing)
+
+    def make(skip):
+        return transit(skip, forcing=forcing)
+
+    on, off = both(make, 2000)
+    assert on.n_awake == on.n_floes
+    assert_same(on, off)
+
+
+def test_bad_arguments():
+    field, box, _ = transit_field(n=50)
+    with pytest.raises(ValueError, match="serial step only"):
+        HertzSimulation(field, box, CONTACT, None, 1e-3, parallel=True, skip_resting=True)
+    with pytest.raises(TypeError, match="skip_resting must be True or False"):
+        HertzSimulation(field, box, CONTACT, None, 1e-3, skip_resting="yes")
+    sim = HertzSimulation(field, box, CONTACT, None, 1e-3, skip_resting=True)
+    assert not sim.parallel and "skip_resting=True" in repr(sim)
