@@ -61,7 +61,9 @@ bench: setup
 	$(PY) -m benchmarks.observables
 	$(PY) -m benchmarks.itd
 	$(PY) -m benchmarks.environments
+	$(PY) -m benchmarks.vector
 	$(PY) -m benchmarks.ship
+	$(PY) -m benchmarks.resting
 	$(PY) -m benchmarks.headline
 
 docs: setup

@@ -23,15 +23,18 @@ suite               what is timed
 ``itd``             the ice-thickness-distribution models (:mod:`benchmarks.itd`)
 ``environments``    sustained steps/s of every environment
                     (:mod:`benchmarks.environments`)
+``vector``          env steps/s of the native vector environments against the
+                    single environment, SyncVectorEnv and SubprocVecEnv, and
+                    PPO training steps/s with each (:mod:`benchmarks.vector`)
 ``ship``            floe-steps/s with and without a ship among the floes, and
                     the ship's share of a step (:mod:`benchmarks.ship`)
+``resting``         ship transits with and without skipping the floes at rest,
+                    and env steps/s of a long channel (:mod:`benchmarks.resting`)
 ``compare``         this tree against another revision, side by side
                     (:mod:`benchmarks.compare`)
 ``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
                     N = 200000, its strong and weak scaling, and a projection
                     to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
-``resting``         ship transits with and without skipping the floes at rest,
-                    and env steps/s of a long channel (:mod:`benchmarks.resting`)
 ==================  ==============================================================
 
 Every suite writes one JSON record to ``docs/benchmarks/<suite>.json`` of
@@ -50,8 +53,8 @@ from __future__ import annotations
 import importlib
 
 #: the suites, in the order the documentation shows them
-SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "ship",
-          "compare", "lammps_scaling", "resting")
+SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "vector",
+          "ship", "resting", "compare", "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

@@ -165,18 +165,20 @@ class ChildError(RuntimeError):
 
 
 class Child:
-    """A function running in a fresh spawned process (see :func:`start`)."""
+    """A function running in a fresh spawned process (see :func:`start`).
+    ``daemon=False`` lets the function start processes of its own (it is
+    then not stopped with its parent, only by :meth:`kill`)."""
 
     def __init__(self, fn: Callable, args: tuple = (), kwargs: dict | None = None, *,
                  threads: int | None = None, cpu: int | None = None,
-                 source: str | os.PathLike | None = None):
+                 source: str | os.PathLike | None = None, daemon: bool = True):
         if threads is not None and (int(threads) != threads or threads < 1):
             raise ValueError(f"threads must be a positive whole number, got {threads!r}")
         ctx = multiprocessing.get_context("spawn")
         self._recv, send = ctx.Pipe(duplex=False)
         self.target = _target_name(fn)
         self._process = ctx.Process(
-            target=_child_entry, daemon=True,
+            target=_child_entry, daemon=daemon,
             args=(send, self.target, tuple(args), dict(kwargs or {}), cpu,
                   None if source is None else str(source)))
         saved = os.environ.get("NUMBA_NUM_THREADS")
@@ -221,7 +223,7 @@ class Child:
 
 
 def spawn_call(fn: Callable, *args, threads: int | None = None, cpu: int | None = None,
-               source: str | os.PathLike | None = None, **kwargs):
+               source: str | os.PathLike | None = None, daemon: bool = True, **kwargs):
     """``fn(*args, **kwargs)`` in a fresh process, and its result.
 
     Parameters
@@ -238,13 +240,16 @@ def spawn_call(fn: Callable, *args, threads: int | None = None, cpu: int | None 
         A source tree put first on the child's module path, so that
         ``import physics`` and ``import iceenvs`` resolve there (the
         benchmark's own modules must not have imported them before).
+    daemon : bool
+        ``False`` for a function that starts processes of its own.
 
     Raises
     ------
     ChildError
         If ``fn`` raised in the child.
     """
-    return Child(fn, args, kwargs, threads=threads, cpu=cpu, source=source).result()
+    return Child(fn, args, kwargs, threads=threads, cpu=cpu, source=source,
+                 daemon=daemon).result()
 
 
 def spawn_together(fn: Callable, arg_lists: Sequence[tuple], *, threads: int | None = None,

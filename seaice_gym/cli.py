@@ -48,6 +48,7 @@ BENCH_SUITES = {
     "observables": "clusters, g_ffd, g_rdf, fabric and stress on many floes",
     "itd": "the ice-thickness-distribution models",
     "environments": "sustained steps/s of every environment",
+    "vector": "native vector environments against the others, and PPO steps/s with each",
     "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "compare": "this tree against another revision, side by side",
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
