@@ -148,14 +148,16 @@ def _kwargs(kwargs) -> str:
 
 def environments_table(envs) -> str:
     """One row per registered id, from its facts and its registration."""
-    rows = ["| id | task | actions | main metric | steps |", "|---|---|---|---|---|"]
+    rows = ["| id | task | actions | main metric | steps | native vector env |",
+            "|---|---|---|---|---|---|"]
     for env_id, spec in envs:
         cls = environment_class(spec)
         name = env_id.split("/")[-1]
         actions = ", ".join(f"`{a}`" for a in getattr(cls, "action_names", ()))
+        vector = "yes" if spec.vector_entry_point is not None else "no"
         rows.append(f"| {{doc}}`{env_id} </_generated/environments/{name}>` | "
                     f"{cls.facts.summary} | {actions} | `{cls.facts.main_metric}` | "
-                    f"{spec.max_episode_steps} |")
+                    f"{spec.max_episode_steps} | {vector} |")
     return "\n".join(rows + [""])
 
 
