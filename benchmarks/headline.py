@@ -5,7 +5,8 @@ Rewrites the block between ``<!-- headline:start -->`` and
 ``<!-- headline:end -->`` with one small table: the Hertz engine's
 floe-steps/s at Ā = 0.7 and jammed, each with its contacts per floe and a
 line on what the two regimes cost, the hard-disc engine's collisions/s and
-each environment's sustained steps/s, as far as records of full runs
+each environment's sustained steps/s, the native vector environments'
+steps/s and PPO's training steps/s on them, as far as records of full runs
 (not ``--quick``) exist, each with its date.
 """
 from __future__ import annotations
@@ -100,7 +101,30 @@ def _environment_rows(record: dict) -> list[list[str]]:
             for r in record["data"]["environments"] if "failed" not in r]
 
 
-_ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _environment_rows}
+def _vector_rows(record: dict) -> list[list[str]]:
+    """The native vector environment at its largest N against the single
+    environment of the same run, and PPO end to end with it."""
+    data = record["data"]
+    out = []
+    for env_id in data["settings"]["ids"]:
+        rows = [r for r in data["stepping"] if r["id"] == env_id and "failed" not in r]
+        single = [r for r in rows if r["mode"] == "single"]
+        native = [r for r in rows if r["mode"] == "native"]
+        if not single or not native:
+            continue
+        best = max(native, key=lambda r: r["mean"])
+        out.append([f"`{env_id}`, native vector environment, N = {best['n']}",
+                    f"{best['mean']:.0f} steps/s on {record['machine']['numba_threads']} "
+                    f"threads ({single[0]['mean']:.0f} single, one core)"])
+    for r in data.get("training", []):
+        if r["mode"] == "native" and "failed" not in r:
+            out.append([f"PPO on `{r['id']}`, native vector environment, N = {r['n']}",
+                        f"{r['mean']:.0f} training steps/s end to end"])
+    return out
+
+
+_ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _environment_rows,
+         "vector": _vector_rows}
 
 
 def headline_table(records: list[dict]) -> str:

@@ -129,7 +129,16 @@ def test_headline_block_is_rewritten_from_the_records(tmp_path):
     envs = _record("environments", data=dict(environments=[
         dict(id="iceenvs/WindDrift-v0", mean=162.3), dict(id="iceenvs/X-v0", failed="exit 1")]))
     quick = _record("harddisk", data=dict(quick=True, rows=[dict(case="elastic", rate=1.0)]))
-    for r in (hertz, envs, quick):
+    ship = "iceenvs/ShipNavigation-v0"
+    vector = _record("vector", data=dict(
+        settings=dict(ids=[ship]),
+        stepping=[dict(mode="single", id=ship, n=1, mean=380.0),
+                  dict(mode="native", id=ship, n=8, mean=700.0),
+                  dict(mode="native", id=ship, n=16, mean=900.4),
+                  dict(mode="sync", id=ship, n=16, mean=390.0)],
+        training=[dict(mode="native", id=ship, n=16, mean=640.0),
+                  dict(mode="subproc", id=ship, n=16, failed="exit 1")]))
+    for r in (hertz, envs, quick, vector):
         harness.write_record(r, tmp_path / f"{r['suite']}.json")
     readme = tmp_path / "README.md"
     readme.write_text("# x\n\nbefore\n<!-- headline:start -->\nold\n<!-- headline:end -->\nafter\n")
@@ -149,6 +158,12 @@ def test_headline_block_is_rewritten_from_the_records(tmp_path):
            "flight); in the jammed, Ā = 0.95 field, with 3.89 contacts per floe, a floe-step " \
            "costs 15 times as much on 2 threads." in text
     assert "| `iceenvs/WindDrift-v0` | 162 steps/s, one core |" in text
+    # the vector environment's fastest N beside the single environment of its run
+    threads = vector["machine"]["numba_threads"]
+    assert (f"| `{ship}`, native vector environment, N = 16 | 900 steps/s on {threads} threads "
+            f"(380 single, one core) |") in text
+    assert f"| PPO on `{ship}`, native vector environment, N = 16 | 640 training steps/s end " \
+           "to end |" in text
     assert "control" not in text and "X-v0" not in text and "elastic" not in text
     once = text
     assert headline.main(["--readme", str(readme), "--records", str(tmp_path)]) == 0
