@@ -58,7 +58,7 @@ from .base import HertzEnv
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_sensors import ice_lidar, occupancy_image
+from .ship_sensors import lidar_scan, occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
            "METRICS"]
@@ -213,6 +213,8 @@ class ShipEnv(HertzEnv):
         self.channel_width = float(channel_width)
         self.goal_distance = float(goal_distance)
         self.base_features = ship_features(self.lidar_sectors, self.lidar_range)
+        self._lidar_names = [(f"lidar_distance_{k}", f"lidar_concentration_{k}")
+                             for k in range(self.lidar_sectors)]
         super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
         self.failure_reward = -float(self.reward_params["failure_penalty"])
@@ -350,6 +352,8 @@ class ShipEnv(HertzEnv):
         self._metrics = dict.fromkeys(METRICS, 0.0)
         self._metrics["success"] = False
         self._impulses = []
+        self._impulse_total = 0.0
+        self._impulse_max = 0.0
         self._floes_hit = set()
         self._slow_time = 0.0
         self._resistance_sum = 0.0
@@ -415,7 +419,10 @@ class ShipEnv(HertzEnv):
             self._resistance_sum -= float(rec["ice_surge"].sum() * dt)
         impulses = np.hypot(log["impulse_surge"], log["impulse_sway"])
         loads["step_collisions"] = int(impulses.size)
-        self._impulses.extend(impulses.tolist())
+        if impulses.size:
+            self._impulses.extend(impulses.tolist())
+            self._impulse_total += float(impulses.sum())
+            self._impulse_max = max(self._impulse_max, float(impulses.max()))
         self._floes_hit.update(log["floe"].tolist())
         self._step_loads = loads
         if self.mode == "dynamic" and ship.surge < self.episode["beset_speed"]:
@@ -429,19 +436,18 @@ class ShipEnv(HertzEnv):
         x, y = ship.position
         heading = ship.heading
         box = sim.box
-        lengths = (box.lx, box.ly)
         now = {"goal_distance": float(self.goal_x - x), "goal_cos": math.cos(heading),
                "goal_sin": -math.sin(heading),
                "channel_offset": float((y - self.centre_y) / (0.5 * self.channel_width)),
                "surge": ship.surge, "sway": ship.sway, "yaw_rate": ship.yaw_rate}
         now.update(self._step_loads)
-        pos = sim.positions
-        dist, conc = ice_lidar((x, y), heading, pos, sim.radii, sectors=self.lidar_sectors,
-                               max_range=self.lidar_range, box_lengths=lengths,
-                               periodic=box.periodic)
-        for k in range(self.lidar_sectors):
-            now[f"lidar_distance_{k}"] = float(dist[k])
-            now[f"lidar_concentration_{k}"] = float(conc[k])
+        dist, conc = lidar_scan(float(x), float(y), heading, sim.positions, sim.radii,
+                                self.lidar_sectors, math.pi, self.lidar_range, box.lx, box.ly,
+                                box.periodic[0], box.periodic[1])
+        for (distance_name, concentration_name), d, c in zip(self._lidar_names, dist.tolist(),
+                                                             conc.tolist()):
+            now[distance_name] = d
+            now[concentration_name] = c
         now["concentration"] = self._field_concentration
         now.update(self._local_ice(x, y))
         now["time"] = float(sim.time)
@@ -450,28 +456,13 @@ class ShipEnv(HertzEnv):
 
     def _local_ice(self, x, y) -> dict:
         """Concentration, contacts per floe and contact pressure of the ice
-        within ``local_radius`` of the ship."""
-        sim = self.sim
-        big_r = self.local_radius
-        area = math.pi * big_r ** 2
-        d = sim.box.minimum_image(sim.positions - np.array([x, y]))
-        near = np.hypot(d[:, 0], d[:, 1]) < big_r
-        c = sim.contacts()
-        self._contacts = c
-        if len(c):
-            p = sim.box.minimum_image(c.contact_point - np.array([x, y]))
-            inside = np.hypot(p[:, 0], p[:, 1]) < big_r
-            arm = c.branch_i[inside] - c.branch_j[inside]
-            f = c.force[inside]
-            pressure = -0.5 * float(np.sum(arm * f)) / area
-            n_contacts = int(inside.sum())
-        else:
-            pressure, n_contacts = 0.0, 0
-        n_near = int(near.sum())
-        return {"local_concentration": min(1.0, float(np.pi * np.sum(sim.radii[near] ** 2))
-                                           / area),
-                "local_contacts": 2.0 * n_contacts / n_near if n_near else 0.0,
-                "local_pressure": pressure}
+        within ``local_radius`` of the ship
+        (:meth:`physics.HertzSimulation.local_ice`)."""
+        ice = self.sim.local_ice((x, y), self.local_radius)
+        n_near = ice.n_floes
+        return {"local_concentration": min(1.0, ice.floe_area / ice.area),
+                "local_contacts": 2.0 * ice.n_contacts / n_near if n_near else 0.0,
+                "local_pressure": ice.pressure if ice.n_contacts else 0.0}
 
     # -- observation, info, end --------------------------------------------------------
     def _vector(self, now: dict):
@@ -498,9 +489,9 @@ class ShipEnv(HertzEnv):
         m["energy_to_ice"] += self._step_loads["step_energy"]
         m["collisions"] = len(self._impulses)
         m["collided_floes"] = len(self._floes_hit)
-        total = float(np.sum(self._impulses)) if self._impulses else 0.0
+        total = self._impulse_total
         m["mean_impulse"] = total / len(self._impulses) if self._impulses else 0.0
-        m["max_impulse"] = float(np.max(self._impulses)) if self._impulses else 0.0
+        m["max_impulse"] = self._impulse_max
         m["impulse_per_metre"] = total / m["path_length"] if m["path_length"] > 0 else 0.0
         m["ice_resistance"] = self._resistance_sum / m["time"] if m["time"] > 0 else 0.0
         m["max_hull_pressure"] = max(m["max_hull_pressure"], now["peak_hull_pressure"])
@@ -544,7 +535,7 @@ class ShipEnv(HertzEnv):
         from .rendering import annotate, draw_floes, draw_ship
 
         sim = self.sim
-        c = self._contacts
+        c = sim.contacts()          # at the state the observation was made of
         box = (sim.box.lx, sim.box.ly)
         picture = draw_floes(sim.positions, sim.radii, box,
                              np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),
