@@ -386,9 +386,11 @@ class ShipEnv(HertzEnv):
         field, box, forcing = self._ice(rng)
         self.forcing = forcing
         self._ship = self._make_ship(rng)
+        # constants of the ship that every step reads
         h = self._ship.hydrodynamics
         self._damping = (tuple(float(v) for v in h.linear_damping),
                          tuple(float(v) for v in h.quadratic_damping))
+        self._hull_length = self._ship.hull.length
         drift = float(np.max(np.hypot(field.velocities[:, 0], field.velocities[:, 1]))) \
             if field.n else 0.0
         impact = (1.0 + self.contact.restitution) * max(self.max_speed, self._start_speed()) \
@@ -442,9 +444,10 @@ class ShipEnv(HertzEnv):
         log = ship.collision_rows()
         ship.clear()
         dt = sim.dt
-        loads = self._no_loads()
         n = rows.shape[0]
-        if n:
+        if not n:
+            loads = self._no_loads()
+        else:
             x0, y0 = self._track[-1]
             if self.mode == "dynamic":
                 c = ship.commands
@@ -454,11 +457,12 @@ class ShipEnv(HertzEnv):
             surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = \
                 step_sums(rows, float(x0), float(y0), self.mode == "dynamic", thrust, yaw_moment,
                           *self._damping)
-            length = self._ship.hull.length
-            loads.update(ice_surge=surge / n, ice_sway=sway / n, ice_moment=moment / n,
+            length = self._hull_length
+            loads = dict(ice_surge=surge / n, ice_sway=sway / n, ice_moment=moment / n,
                          hull_pressure=normal / n / length, peak_hull_pressure=peak / length,
                          step_impulse=force * dt, step_contact_impulse=magnitude * dt,
-                         step_energy=energy * dt, step_effort=effort * dt, step_path=path)
+                         step_energy=energy * dt, step_effort=effort * dt, step_path=path,
+                         step_collisions=0)
             self._track.append(np.array([rows[-1, _X], rows[-1, _Y]]))
             self._resistance_sum -= surge * dt
         if log.shape[0]:
