@@ -49,16 +49,18 @@ import math
 
 import gymnasium as gym
 import numpy as np
+from numba import njit
 
 from physics import FloeField, HERMAN2013
 from physics.checks import check_range
 from physics.hertz import hull_contact_time
+from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import HertzEnv
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_sensors import ice_lidar, occupancy_image
+from .ship_sensors import lidar_scan, occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
            "METRICS"]
@@ -85,6 +87,55 @@ METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions
            "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
            "energy_to_ice", "ice_resistance", "max_hull_pressure")
 
+
+
+# the columns of the ship's step records and collision log the step loads read
+(_X, _Y, _SURGE, _SWAY, _YAW_RATE, _ICE_SURGE, _ICE_SWAY, _ICE_MOMENT, _ICE_POWER, _NORMAL_FORCE,
+ _FORCE_MAGNITUDE_SUM) = (RECORD_COLUMNS.index(name) for name in (
+    "x", "y", "surge", "sway", "yaw_rate", "ice_surge", "ice_sway", "ice_moment", "ice_power",
+    "normal_force", "force_magnitude_sum"))
+_FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY = (LOG_COLUMNS.index(name) for name in (
+    "floe", "impulse_surge", "impulse_sway"))
+
+
+@njit(cache=True, error_model="numpy")
+def step_sums(rows, x0, y0, dynamic, thrust, yaw_moment, linear_damping, quadratic_damping):
+    """Sums over the ship's step records ``rows`` of one control interval
+    (one row per engine step, the columns of
+    :data:`physics.hull_contact.RECORD_COLUMNS`), the ship at (x0, y0)
+    before the first: of the ice surge force, sway force and moment, of the
+    hull's normal force (and its largest value), of the magnitude of the
+    resultant ice force, of the contacts' force magnitudes, of the power of
+    the hull on the ice, of the effort's power (a ``dynamic`` ship: the
+    thrust's and the yaw moment's, |T u| + |M r|; a prescribed one: the
+    power against ice and water, ice power + Σ (b v + a |v| v) v over surge,
+    sway and yaw rate with the linear and quadratic damping coefficients b,
+    a), and the path length."""
+    surge = sway = moment = normal = force = magnitude = energy = effort = path = 0.0
+    peak = -math.inf
+    px, py = x0, y0
+    for k in range(rows.shape[0]):
+        row = rows[k]
+        fx, fy, fn = row[_ICE_SURGE], row[_ICE_SWAY], row[_NORMAL_FORCE]
+        surge += fx
+        sway += fy
+        moment += row[_ICE_MOMENT]
+        normal += fn
+        peak = max(peak, fn)
+        force += math.hypot(fx, fy)
+        magnitude += row[_FORCE_MAGNITUDE_SUM]
+        energy += row[_ICE_POWER]
+        u, v, r = row[_SURGE], row[_SWAY], row[_YAW_RATE]
+        if dynamic:
+            effort += abs(thrust * u) + abs(yaw_moment * r)
+        else:
+            b, a = linear_damping, quadratic_damping
+            effort += row[_ICE_POWER] + ((b[0] * u + a[0] * abs(u) * u) * u
+                                         + (b[1] * v + a[1] * abs(v) * v) * v
+                                         + (b[2] * r + a[2] * abs(r) * r) * r)
+        path += math.hypot(row[_X] - px, row[_Y] - py)
+        px, py = row[_X], row[_Y]
+    return surge, sway, moment, normal, peak, force, magnitude, energy, effort, path
 
 
 def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
@@ -213,6 +264,8 @@ class ShipEnv(HertzEnv):
         self.channel_width = float(channel_width)
         self.goal_distance = float(goal_distance)
         self.base_features = ship_features(self.lidar_sectors, self.lidar_range)
+        self._lidar_names = [(f"lidar_distance_{k}", f"lidar_concentration_{k}")
+                             for k in range(self.lidar_sectors)]
         super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
         self.failure_reward = -float(self.reward_params["failure_penalty"])
@@ -333,6 +386,11 @@ class ShipEnv(HertzEnv):
         field, box, forcing = self._ice(rng)
         self.forcing = forcing
         self._ship = self._make_ship(rng)
+        # constants of the ship that every step reads
+        h = self._ship.hydrodynamics
+        self._damping = (tuple(float(v) for v in h.linear_damping),
+                         tuple(float(v) for v in h.quadratic_damping))
+        self._hull_length = self._ship.hull.length
         drift = float(np.max(np.hypot(field.velocities[:, 0], field.velocities[:, 1]))) \
             if field.n else 0.0
         impact = (1.0 + self.contact.restitution) * max(self.max_speed, self._start_speed()) \
@@ -350,6 +408,8 @@ class ShipEnv(HertzEnv):
         self._metrics = dict.fromkeys(METRICS, 0.0)
         self._metrics["success"] = False
         self._impulses = []
+        self._impulse_total = 0.0
+        self._impulse_max = 0.0
         self._floes_hit = set()
         self._slow_time = 0.0
         self._resistance_sum = 0.0
@@ -379,43 +439,38 @@ class ShipEnv(HertzEnv):
     def _advanced(self):
         sim = self.sim
         ship = sim.ship
-        rec = ship.records()
-        log = ship.collisions()
+        rows = ship.record_rows()
+        log = ship.collision_rows()
         ship.clear()
         dt = sim.dt
-        loads = self._no_loads()
-        if rec["time"].size:
-            xy = np.column_stack([rec["x"], rec["y"]])
-            path = np.diff(np.vstack([self._track[-1], xy]), axis=0)
-            force = np.hypot(rec["ice_surge"], rec["ice_sway"])
+        n = rows.shape[0]
+        if not n:
+            loads = self._no_loads()
+        else:
+            x0, y0 = self._track[-1]
             if self.mode == "dynamic":
                 c = ship.commands
-                power = np.abs(c["thrust"] * rec["surge"]) + np.abs(c["yaw_moment"]
-                                                                    * rec["yaw_rate"])
+                thrust, yaw_moment = c["thrust"], c["yaw_moment"]
             else:
-                h = self._ship.hydrodynamics
-                vel = np.column_stack([rec["surge"], rec["sway"], rec["yaw_rate"]])
-                drag = (np.asarray(h.linear_damping) * vel
-                        + np.asarray(h.quadratic_damping) * np.abs(vel) * vel)
-                power = rec["ice_power"] + np.sum(drag * vel, axis=1)
-            loads.update(ice_surge=float(rec["ice_surge"].mean()),
-                         ice_sway=float(rec["ice_sway"].mean()),
-                         ice_moment=float(rec["ice_moment"].mean()),
-                         hull_pressure=float(rec["normal_force"].mean()
-                                             / self._ship.hull.length),
-                         peak_hull_pressure=float(rec["normal_force"].max()
-                                                  / self._ship.hull.length),
-                         step_impulse=float(force.sum() * dt),
-                         step_contact_impulse=float(rec["force_magnitude_sum"].sum() * dt),
-                         step_energy=float(rec["ice_power"].sum() * dt),
-                         step_effort=float(power.sum() * dt),
-                         step_path=float(np.hypot(path[:, 0], path[:, 1]).sum()))
-            self._track.append(xy[-1].copy())
-            self._resistance_sum -= float(rec["ice_surge"].sum() * dt)
-        impulses = np.hypot(log["impulse_surge"], log["impulse_sway"])
-        loads["step_collisions"] = int(impulses.size)
-        self._impulses.extend(impulses.tolist())
-        self._floes_hit.update(log["floe"].tolist())
+                thrust = yaw_moment = 0.0
+            surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = \
+                step_sums(rows, float(x0), float(y0), self.mode == "dynamic", thrust, yaw_moment,
+                          *self._damping)
+            length = self._hull_length
+            loads = dict(ice_surge=surge / n, ice_sway=sway / n, ice_moment=moment / n,
+                         hull_pressure=normal / n / length, peak_hull_pressure=peak / length,
+                         step_impulse=force * dt, step_contact_impulse=magnitude * dt,
+                         step_energy=energy * dt, step_effort=effort * dt, step_path=path,
+                         step_collisions=0)
+            self._track.append(np.array([rows[-1, _X], rows[-1, _Y]]))
+            self._resistance_sum -= surge * dt
+        if log.shape[0]:
+            impulses = np.hypot(log[:, _IMPULSE_SURGE], log[:, _IMPULSE_SWAY])
+            self._impulses.extend(impulses.tolist())
+            self._impulse_total += float(impulses.sum())
+            self._impulse_max = max(self._impulse_max, float(impulses.max()))
+            self._floes_hit.update(log[:, _FLOE].astype(np.int64).tolist())
+        loads["step_collisions"] = int(log.shape[0])
         self._step_loads = loads
         if self.mode == "dynamic" and ship.surge < self.episode["beset_speed"]:
             self._slow_time += self.control_interval
@@ -428,19 +483,18 @@ class ShipEnv(HertzEnv):
         x, y = ship.position
         heading = ship.heading
         box = sim.box
-        lengths = (box.lx, box.ly)
         now = {"goal_distance": float(self.goal_x - x), "goal_cos": math.cos(heading),
                "goal_sin": -math.sin(heading),
                "channel_offset": float((y - self.centre_y) / (0.5 * self.channel_width)),
                "surge": ship.surge, "sway": ship.sway, "yaw_rate": ship.yaw_rate}
         now.update(self._step_loads)
-        pos = sim.positions
-        dist, conc = ice_lidar((x, y), heading, pos, sim.radii, sectors=self.lidar_sectors,
-                               max_range=self.lidar_range, box_lengths=lengths,
-                               periodic=box.periodic)
-        for k in range(self.lidar_sectors):
-            now[f"lidar_distance_{k}"] = float(dist[k])
-            now[f"lidar_concentration_{k}"] = float(conc[k])
+        dist, conc = lidar_scan(float(x), float(y), heading, sim.positions, sim.radii,
+                                self.lidar_sectors, math.pi, self.lidar_range, box.lx, box.ly,
+                                box.periodic[0], box.periodic[1])
+        for (distance_name, concentration_name), d, c in zip(self._lidar_names, dist.tolist(),
+                                                             conc.tolist()):
+            now[distance_name] = d
+            now[concentration_name] = c
         now["concentration"] = self._field_concentration
         now.update(self._local_ice(x, y))
         now["time"] = float(sim.time)
@@ -449,28 +503,13 @@ class ShipEnv(HertzEnv):
 
     def _local_ice(self, x, y) -> dict:
         """Concentration, contacts per floe and contact pressure of the ice
-        within ``local_radius`` of the ship."""
-        sim = self.sim
-        big_r = self.local_radius
-        area = math.pi * big_r ** 2
-        d = sim.box.minimum_image(sim.positions - np.array([x, y]))
-        near = np.hypot(d[:, 0], d[:, 1]) < big_r
-        c = sim.contacts()
-        self._contacts = c
-        if len(c):
-            p = sim.box.minimum_image(c.contact_point - np.array([x, y]))
-            inside = np.hypot(p[:, 0], p[:, 1]) < big_r
-            arm = c.branch_i[inside] - c.branch_j[inside]
-            f = c.force[inside]
-            pressure = -0.5 * float(np.sum(arm * f)) / area
-            n_contacts = int(inside.sum())
-        else:
-            pressure, n_contacts = 0.0, 0
-        n_near = int(near.sum())
-        return {"local_concentration": min(1.0, float(np.pi * np.sum(sim.radii[near] ** 2))
-                                           / area),
-                "local_contacts": 2.0 * n_contacts / n_near if n_near else 0.0,
-                "local_pressure": pressure}
+        within ``local_radius`` of the ship
+        (:meth:`physics.HertzSimulation.local_ice`)."""
+        ice = self.sim.local_ice((x, y), self.local_radius)
+        n_near = ice.n_floes
+        return {"local_concentration": min(1.0, ice.floe_area / ice.area),
+                "local_contacts": 2.0 * ice.n_contacts / n_near if n_near else 0.0,
+                "local_pressure": ice.pressure if ice.n_contacts else 0.0}
 
     # -- observation, info, end --------------------------------------------------------
     def _vector(self, now: dict):
@@ -497,9 +536,9 @@ class ShipEnv(HertzEnv):
         m["energy_to_ice"] += self._step_loads["step_energy"]
         m["collisions"] = len(self._impulses)
         m["collided_floes"] = len(self._floes_hit)
-        total = float(np.sum(self._impulses)) if self._impulses else 0.0
+        total = self._impulse_total
         m["mean_impulse"] = total / len(self._impulses) if self._impulses else 0.0
-        m["max_impulse"] = float(np.max(self._impulses)) if self._impulses else 0.0
+        m["max_impulse"] = self._impulse_max
         m["impulse_per_metre"] = total / m["path_length"] if m["path_length"] > 0 else 0.0
         m["ice_resistance"] = self._resistance_sum / m["time"] if m["time"] > 0 else 0.0
         m["max_hull_pressure"] = max(m["max_hull_pressure"], now["peak_hull_pressure"])
@@ -543,7 +582,7 @@ class ShipEnv(HertzEnv):
         from .rendering import annotate, draw_floes, draw_ship
 
         sim = self.sim
-        c = self._contacts
+        c = sim.contacts()          # at the state the observation was made of
         box = (sim.box.lx, sim.box.ly)
         picture = draw_floes(sim.positions, sim.radii, box,
                              np.hypot(sim.velocities[:, 0], sim.velocities[:, 1]),

@@ -4,8 +4,10 @@ occupancy image.
 Both sensors read one snapshot of the ice, floes as discs (centres
 ``positions`` (N, 2) [m], ``radii`` (N,) [m]), and the ship's pose
 (``ship_xy`` [m], ``heading`` [rad, anticlockwise from +x], as
-:class:`physics.ship.ShipState` gives it). They are plain NumPy functions
-of arrays, so an environment calls them on whatever engine it runs.
+:class:`physics.ship.ShipState` gives it). They are functions of arrays,
+so an environment calls them on whatever engine it runs; the lidar is
+compiled (:func:`lidar_scan`, the same without the checks of the
+arguments, is what an environment calls every step).
 
 Frames. The ship frame has x forward (along the heading) and y to port;
 angles are anticlockwise seen from above. Along a periodic axis of a box
@@ -48,8 +50,8 @@ an exact picture the sensor's reach should stay below half the box length.
     3. heading: the constant 255 (heading mod 2π) / 2π, rounded.
 
 Both sensors first keep the floes within reach of the ship by one
-vectorised distance test, so their cost grows with the number of floes
-with a small constant and otherwise with the ice near the ship.
+distance test, so their cost grows with the number of floes with a small
+constant and otherwise with the ice near the ship.
 
 Example
 -------
@@ -65,10 +67,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from physics.checks import check_range
+from physics.domain import minimum_image
 
-__all__ = ["ice_lidar", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
+__all__ = ["ice_lidar", "lidar_scan", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
 LIDAR_RINGS = 8
@@ -150,22 +154,6 @@ def _nearby(ship_xy, positions, radii, reach, lengths, periodic):
     return d[near], radii[near]
 
 
-def _angle_intervals(bearing, half, step, n):
-    """Grid angles within ``half`` of ``bearing`` (both [rad], bearings from
-    the start of the field of view, in [0, 2π)): for the grid angles
-    (j + 1/2) step, j = 0 … n − 1, the index ranges [lo, hi] as
-    (item, lo, hi), an item giving up to three ranges (the wrap at 2π)."""
-    items, lows, highs = [], [], []
-    for shift in (-_TWO_PI, 0.0, _TWO_PI):
-        lo = np.maximum(np.ceil((bearing - half + shift) / step - 0.5), 0.0)
-        hi = np.minimum(np.floor((bearing + half + shift) / step - 0.5), n - 1.0)
-        ok = np.nonzero(lo <= hi)[0]
-        items.append(ok)
-        lows.append(lo[ok].astype(np.intp))
-        highs.append(hi[ok].astype(np.intp))
-    return np.concatenate(items), np.concatenate(lows), np.concatenate(highs)
-
-
 def _expand(item, lo, hi):
     """Every (item, index) pair of the index ranges [lo, hi]."""
     count = hi - lo + 1
@@ -225,52 +213,95 @@ def ice_lidar(ship_xy, heading: float, positions, radii, *, sectors: int = 9,
     lengths, per = _check_box(box_lengths, periodic)
     fov, max_range = float(fov), float(max_range)
 
-    distance = np.full(k, max_range)
-    concentration = np.zeros(k)
-    d, r = _nearby(xy, p, r, max_range, lengths, per)
-    if r.size == 0:
-        return distance, concentration
-    inside = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] <= r * r
-    if np.any(inside):
+    lx, ly = (1.0, 1.0) if lengths is None else (float(lengths[0]), float(lengths[1]))
+    return lidar_scan(xy[0], xy[1], heading, p, r, k, fov, max_range, lx, ly, per[0], per[1])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _grid_range(low, high, step, n):
+    """The indices j of the grid angles (j + 1/2) step, j = 0 … n − 1, from
+    ``low`` to ``high`` [rad] as a float pair (lo, hi); empty when not
+    lo ≤ hi (a NaN bound included)."""
+    lo = np.ceil(low / step - 0.5)
+    hi = np.floor(high / step - 0.5)
+    if lo < 0.0:
+        lo = 0.0
+    if hi > n - 1.0:
+        hi = n - 1.0
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def lidar_scan(x, y, heading, positions, radii, sectors, fov, max_range, lx, ly, periodic_x,
+               periodic_y):
+    """:func:`ice_lidar` without the checks of its arguments: the ship at
+    (``x``, ``y``), the box of side lengths ``lx``, ``ly`` (used along the
+    periodic axes only). Returns (distance, concentration)."""
+    n_ang = sectors * LIDAR_RAYS
+    distance = np.full(sectors, max_range)
+    covered = np.zeros((LIDAR_RINGS, n_ang), dtype=np.bool_)
+    # the floes whose disc comes within range, as displacements from the ship
+    n = radii.shape[0]
+    near_x, near_y, near_r = np.empty(n), np.empty(n), np.empty(n)
+    m = 0
+    inside = False
+    for f in range(n):
+        dx = minimum_image(positions[f, 0] - x, lx, periodic_x)
+        dy = minimum_image(positions[f, 1] - y, ly, periodic_y)
+        r = radii[f]
+        limit = max_range + r
+        d2 = dx * dx + dy * dy
+        if d2 <= limit * limit:
+            near_x[m], near_y[m], near_r[m] = dx, dy, r
+            m += 1
+            inside = inside or d2 <= r * r
+    if inside:
         distance[:] = 0.0
     start = heading - 0.5 * fov
-    dist = np.hypot(d[:, 0], d[:, 1])
-    bearing = np.mod(np.arctan2(d[:, 1], d[:, 0]) - start, _TWO_PI)
-
-    # distance: a ray meets a disc outside the ship when its angle lies within
-    # asin(r / dist) of the disc's bearing; only those (ray, disc) pairs are solved
-    if not np.any(inside):
-        step = fov / k
-        floe, lo, hi = _angle_intervals(bearing, np.arcsin(r / dist), step, k)
-        floe, ray = _expand(floe, lo, hi)
-        if ray.size:
-            theta = start + (ray + 0.5) * step
-            dx, dy = d[floe, 0], d[floe, 1]
-            along = dx * np.cos(theta) + dy * np.sin(theta)
-            across = dx * np.sin(theta) - dy * np.cos(theta)
-            chord = np.sqrt(np.maximum(r[floe] ** 2 - across * across, 0.0))
-            np.minimum.at(distance, ray, along - chord)
-
-    # concentration: on ring i a disc covers the sample angles within an
-    # interval of half-width arccos((rho_i² + dist² − r²) / (2 rho_i dist))
-    # around its bearing, marked with a difference array
-    n_ang = k * LIDAR_RAYS
-    rho = max_range * np.sqrt((np.arange(LIDAR_RINGS) + 0.5) / LIDAR_RINGS)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cos_half = (rho[:, None] ** 2 + dist * dist - r * r) / (2.0 * rho[:, None] * dist)
-    at_centre = dist == 0.0
-    if np.any(at_centre):
-        cos_half[:, at_centre] = np.where(rho[:, None] <= r[at_centre], -2.0, 2.0)
-    ring, floe = np.nonzero(cos_half <= 1.0)
-    half = np.arccos(np.maximum(cos_half[ring, floe], -1.0))
-    pair, lo, hi = _angle_intervals(bearing[floe], half, fov / n_ang, n_ang)
-    base = ring[pair] * (n_ang + 1)
-    width = LIDAR_RINGS * (n_ang + 1)
-    marks = (np.bincount(base + lo, minlength=width)
-             - np.bincount(base + hi + 1, minlength=width))
-    covered = np.cumsum(marks.reshape(LIDAR_RINGS, n_ang + 1), axis=1)[:, :n_ang] > 0
-    concentration = covered.reshape(LIDAR_RINGS, k, LIDAR_RAYS).mean(axis=(0, 2))
-    return distance, concentration
+    step = fov / sectors
+    step_ang = fov / n_ang
+    ray_cos, ray_sin = np.empty(sectors), np.empty(sectors)
+    for ray in range(sectors):
+        theta = start + (ray + 0.5) * step
+        ray_cos[ray], ray_sin[ray] = math.cos(theta), math.sin(theta)
+    for f in range(m):
+        dx, dy, r = near_x[f], near_y[f], near_r[f]
+        dist = math.hypot(dx, dy)
+        bearing = (math.atan2(dy, dx) - start) % _TWO_PI
+        # distance: a ray meets a disc outside the ship when its angle lies
+        # within asin(r / dist) of the disc's bearing
+        if not inside:
+            half = math.asin(r / dist)
+            for shift in (-_TWO_PI, 0.0, _TWO_PI):
+                lo, hi = _grid_range(bearing - half + shift, bearing + half + shift, step, sectors)
+                if lo <= hi:
+                    for ray in range(int(lo), int(hi) + 1):
+                        c, s = ray_cos[ray], ray_sin[ray]
+                        across = dx * s - dy * c
+                        chord = math.sqrt(max(r * r - across * across, 0.0))
+                        distance[ray] = min(distance[ray], dx * c + dy * s - chord)
+        # concentration: on ring i a disc covers the sample angles within
+        # arccos((rho_i² + dist² − r²) / (2 rho_i dist)) of its bearing
+        for i in range(LIDAR_RINGS):
+            rho = max_range * math.sqrt((i + 0.5) / LIDAR_RINGS)
+            if dist == 0.0:
+                cos_half = -2.0 if rho <= r else 2.0
+            else:
+                cos_half = (rho * rho + dist * dist - r * r) / (2.0 * rho * dist)
+            if cos_half <= 1.0:
+                half = math.acos(max(cos_half, -1.0))
+                for shift in (-_TWO_PI, 0.0, _TWO_PI):
+                    lo, hi = _grid_range(bearing - half + shift, bearing + half + shift,
+                                         step_ang, n_ang)
+                    if lo <= hi:
+                        for j in range(int(lo), int(hi) + 1):
+                            covered[i, j] = True
+    concentration = np.zeros(sectors)
+    for i in range(LIDAR_RINGS):
+        for j in range(n_ang):
+            if covered[i, j]:
+                concentration[j // LIDAR_RAYS] += 1.0
+    return distance, concentration / (LIDAR_RINGS * LIDAR_RAYS)
 
 
 # -- occupancy image -------------------------------------------------------------------------

@@ -38,7 +38,7 @@ from .hertz_kernels import HertzStatus
 from .hertz_batch import run_many
 from .hertz_resting import run_steps_resting
 from .neighbors import choose_cell_size, radius_rank
-from .observables import Contacts, Fabric, Stress, fabric, stress
+from .observables import Contacts, Fabric, LocalIce, Stress, fabric, stress
 from .params import ContactParams, PaperPreset
 from .progress import steps_with_bar
 from .ship import Ship, ShipLoads, ShipState
@@ -547,6 +547,29 @@ class HertzSimulation(FloeProperties):
         return Contacts(i=i, j=j, normal=normal, overlap=delta, normal_force=d[:, 3].copy(),
                         tangential_force=d[:, 4].copy(), force=d[:, 5:7].copy(),
                         contact_point=point, branch_i=arm_i, branch_j=arm_j)
+
+    def local_ice(self, centre, radius: float) -> LocalIce:
+        """The ice within ``radius`` [m] of the point ``centre`` (x, y) [m]
+        (minimum-image distances) at the current state, in one compiled pass
+        over the floes and the Verlet list, without building a
+        :class:`Contacts` table: the floes whose centre lies in the disc and
+        the floe–floe contacts whose contact point does, with their
+        Love–Weber stress over the disc's area π radius² (see
+        :class:`~physics.observables.LocalIce`)."""
+        try:
+            cx, cy = (float(v) for v in centre)
+        except (TypeError, ValueError):
+            raise ValueError(f"centre must be a pair of finite numbers, got {centre!r}") from None
+        if not (math.isfinite(cx) and math.isfinite(cy)):
+            raise ValueError(f"centre must be a pair of finite numbers, got {centre!r}")
+        check_range("radius", radius, 0.0, None, low_open=True)
+        area = math.pi * float(radius) ** 2
+        f, v, box = self._floes, self._verlet, self.box
+        n_floes, r2, n_contacts, sxx, sxy, syx, syy = K.ice_within(
+            f.pos, f.vel, f.omega, f.radius, f.inv_mass, v.start, v.nbr, v.hist, self._law,
+            float(box.lx), float(box.ly), box.periodic[0], box.periodic[1], cx, cy, float(radius))
+        return LocalIce(n_floes, math.pi * r2, n_contacts,
+                        np.array([[-sxx / area, -sxy / area], [-syx / area, -syy / area]]), area)
 
     def fabric(self) -> Fabric:
         """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -47,7 +48,7 @@ from .checks import check_range
 from .domain import Box
 from .neighbors import choose_cell_size, pair_list, radius_rank
 
-__all__ = ["Contacts", "Fabric", "Stress", "fabric", "stress", "collision_stress",
+__all__ = ["Contacts", "Fabric", "Stress", "LocalIce", "fabric", "stress", "collision_stress",
            "near_pairs", "contacts_within", "check_positions"]
 
 
@@ -164,6 +165,33 @@ class Stress:
     direction: float
     per_floe: np.ndarray | None
     area: float
+
+
+class LocalIce(NamedTuple):
+    """The ice within a disc around a point (e.g. a ship), from
+    :meth:`physics.HertzSimulation.local_ice`.
+
+    Attributes
+    ----------
+    n_floes : int — floes whose centre lies in the disc
+    floe_area : float — their area π Σ r² [m²]
+    n_contacts : int — floe–floe contacts whose contact point lies in the disc
+    stress : (2, 2) — the Love–Weber stress of these contacts over the
+        disc's area, σ = −(1/S) Σ_c l_c ⊗ F_c as in :func:`stress`,
+        compression positive [N/m]
+    area : float — the disc's area S = π R² [m²]
+    """
+
+    n_floes: int
+    floe_area: float
+    n_contacts: int
+    stress: np.ndarray
+    area: float
+
+    @property
+    def pressure(self) -> float:
+        """p = (σ1 + σ2)/2 = tr σ / 2 [N/m]."""
+        return 0.5 * float(self.stress[0, 0] + self.stress[1, 1])
 
 
 # -- input checks ---------------------------------------------------------------

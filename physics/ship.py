@@ -578,6 +578,26 @@ class ShipState:
         return self.commands
 
     # -- loads ----------------------------------------------------------------
+    @staticmethod
+    def _rows(chunks: list, columns: int) -> np.ndarray:
+        if not chunks:
+            rows = np.zeros((0, columns))
+        else:
+            rows = chunks[0].view() if len(chunks) == 1 else np.concatenate(chunks)
+        rows.flags.writeable = False
+        return rows
+
+    def record_rows(self) -> np.ndarray:
+        """The step records of :meth:`records` as one read-only (steps,
+        len(RECORD_COLUMNS)) array, without a copy of each column (for a
+        caller that reduces them every step)."""
+        return self._rows(self._records, len(HC.RECORD_COLUMNS))
+
+    def collision_rows(self) -> np.ndarray:
+        """The finished collisions of :meth:`collisions` as one read-only
+        (collisions, len(LOG_COLUMNS)) array (the floe as a float)."""
+        return self._rows(self._log, len(HC.LOG_COLUMNS))
+
     def records(self) -> dict:
         """Every step since the start (or :meth:`clear`) as arrays, one per
         column of :data:`~physics.hull_contact.RECORD_COLUMNS`: time, pose,
@@ -587,8 +607,7 @@ class ShipState:
         also when the resultant cancels) and the sum of the magnitudes of
         their contact forces [N] (its time integral bounds the collisions'
         impulses: Σ_c |J_c| ≤ Σ_c ∫ |F_c| dt)."""
-        rows = (np.concatenate(self._records) if self._records
-                else np.zeros((0, len(HC.RECORD_COLUMNS))))
+        rows = self.record_rows()
         return {name: rows[:, k].copy() for k, name in enumerate(HC.RECORD_COLUMNS)}
 
     def collisions(self) -> dict:
@@ -596,8 +615,7 @@ class ShipState:
         :data:`~physics.hull_contact.LOG_COLUMNS`: start and end time, floe,
         impulse on the hull (surge, sway; ship frame) [N s], first contact
         point in the ship frame [m], floe mass [kg], peak force [N]."""
-        rows = (np.concatenate(self._log) if self._log
-                else np.zeros((0, len(HC.LOG_COLUMNS))))
+        rows = self.collision_rows()
         out = {name: rows[:, k].copy() for k, name in enumerate(HC.LOG_COLUMNS)}
         out["floe"] = out["floe"].astype(np.int64)
         return out

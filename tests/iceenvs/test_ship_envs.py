@@ -115,6 +115,40 @@ def test_collision_impulses_are_bounded_by_the_contact_impulses():
     assert resultant <= contact * (1.0 + 1e-9), (resultant, contact)
 
 
+@pytest.mark.parametrize("dynamic", [False, True])
+def test_step_sums_match_column_by_column_numpy(dynamic):
+    """The compiled sums behind the step loads equal NumPy over the record
+    columns: means, maxima, |resultant|, the effort's power (|T u| + |M r|,
+    or the ice power plus Σ (b v + a |v| v) v) and the path from (x0, y0)."""
+    from physics.hull_contact import RECORD_COLUMNS
+    from iceenvs.ship_env import step_sums
+
+    rng = np.random.default_rng(4)
+    rows = rng.normal(0.0, 1.0, (300, len(RECORD_COLUMNS))) * rng.uniform(0.1, 1e6,
+                                                                           len(RECORD_COLUMNS))
+    col = {name: rows[:, k] for k, name in enumerate(RECORD_COLUMNS)}
+    x0, y0, thrust, moment = 3.0, -2.0, 4e5, -2e6
+    b, a = (2e4, 5e4, 3e6), (1e3, 8e3, 1e7)
+    got = step_sums(rows, x0, y0, dynamic, thrust, moment, b, a)
+    vel = np.column_stack([col["surge"], col["sway"], col["yaw_rate"]])
+    if dynamic:
+        power = np.abs(thrust * col["surge"]) + np.abs(moment * col["yaw_rate"])
+    else:
+        power = col["ice_power"] + np.sum((np.array(b) * vel + np.array(a) * np.abs(vel) * vel)
+                                          * vel, axis=1)
+    path = np.diff(np.vstack([[x0, y0], np.column_stack([col["x"], col["y"]])]), axis=0)
+    terms = (col["ice_surge"], col["ice_sway"], col["ice_moment"], col["normal_force"], None,
+             np.hypot(col["ice_surge"], col["ice_sway"]), col["force_magnitude_sum"],
+             col["ice_power"], power, np.hypot(path[:, 0], path[:, 1]))
+    assert got[4] == col["normal_force"].max()          # the largest value, no arithmetic
+    for g, t, name in zip(got, terms, ("surge", "sway", "moment", "normal", "peak", "resultant",
+                                       "magnitudes", "ice power", "effort", "path")):
+        if t is not None:
+            # 1e-12 of the sum of magnitudes: 300 terms summed in another
+            # order, each addition rounding to ~1e-16 of the running sum
+            assert abs(g - t.sum()) <= 1e-12 * np.abs(t).sum(), name
+
+
 def test_episode_metrics_are_the_ones_agents_log():
     env = gym.make(NAV, concentration=0.3)
     try:

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from iceenvs.ship_sensors import LIDAR_RAYS, LIDAR_RINGS, ice_lidar, occupancy_image
+from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, ice_lidar, lidar_scan,
+                                  occupancy_image)
 
 TWO_PI = 2.0 * math.pi
 
@@ -137,6 +138,36 @@ def test_lidar_matches_ray_by_ray_and_sample_by_sample_evaluation():
                         max_range=120.0)
         want = lidar_by_hand(ship, heading, positions, radii, sectors, fov, 120.0)
         np.testing.assert_allclose(got[0], want[0], rtol=0.0, atol=1e-9)
+        np.testing.assert_allclose(got[1], want[1], rtol=0.0, atol=1e-12)
+
+
+def test_unchecked_lidar_matches_evaluation_of_the_nearest_images():
+    """lidar_scan (what an environment calls every step, without the checks)
+    in a box periodic along x, y or both equals the per-ray and per-sample
+    evaluation of each floe's nearest periodic image, found by trying the
+    nine images; the ship stands near a corner, so that the sensor looks
+    across the edges."""
+    rng = np.random.default_rng(8)
+    lx, ly = 300.0, 260.0
+    shifts = np.array([(i * lx, j * ly) for i in (-1, 0, 1) for j in (-1, 0, 1)])
+    for periodic, ship, heading in (((True, True), (290.0, 10.0), 0.3),
+                                    ((True, False), (5.0, 130.0), 3.0),
+                                    ((False, True), (150.0, 250.0), 1.4)):
+        positions = rng.uniform(0.0, 1.0, (80, 2)) * [lx, ly]
+        radii = rng.uniform(1.0, 10.0, 80)
+        allowed = shifts[[(periodic[0] or dx == 0.0) and (periodic[1] or dy == 0.0)
+                          for dx, dy in shifts]]
+        images = positions[:, None, :] + allowed[None, :, :]
+        gap = np.hypot(*(images - np.asarray(ship)).transpose(2, 0, 1))
+        nearest = images[np.arange(80), np.argmin(gap, axis=1)]
+        keep = np.min(gap, axis=1) > radii + 0.5                    # the ship in open water
+        got = lidar_scan(ship[0], ship[1], heading, positions[keep], radii[keep], 7, 2.5, 120.0,
+                         lx, ly, *periodic)
+        want = lidar_by_hand(np.asarray(ship), heading, nearest[keep], radii[keep], 7, 2.5, 120.0)
+        assert np.min(got[0]) < 120.0 and np.max(got[1]) > 0.0       # it sees ice
+        # 1e-9 m: the same ray-circle root in two algebraic forms
+        np.testing.assert_allclose(got[0], want[0], rtol=0.0, atol=1e-9)
+        # counts of sample points: any disagreement is at least 1/32
         np.testing.assert_allclose(got[1], want[1], rtol=0.0, atol=1e-12)
 
 

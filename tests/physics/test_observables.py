@@ -217,6 +217,93 @@ def test_branch_vectors_span_the_centres():
     assert len(g) == len(c)
 
 
+# -- the ice within a disc (HertzSimulation.local_ice) ---------------------------
+
+def _nearest_image(d, box):
+    """Displacements (K, 2) replaced by the shortest of their nine periodic
+    images (a search, not the floor formula of the engine)."""
+    shifts = np.array([(i * box.lx, j * box.ly) for i in (-1, 0, 1) for j in (-1, 0, 1)])
+    cand = d[:, None, :] + shifts[None, :, :]
+    best = np.argmin(np.hypot(cand[..., 0], cand[..., 1]), axis=1)
+    return cand[np.arange(len(d)), best]
+
+
+def test_local_ice_of_a_square_lattice():
+    """A disc of radius 1.3 a around a floe of the square lattice (cell a)
+    holds the floe, its 4 neighbours at a (the next ones lie at 1.41 a) and
+    the 12 contact points at a/2 and 1.12 a (the next at 1.5 a), 6 along x
+    and 6 along y: σ_xx = σ_yy = 6 F a / (π (1.3 a)²), σ_xy = 0. Around the
+    floe at a corner of the periodic box the neighbours are images across
+    its edges (stress to STRESS_RTOL, the counts exact)."""
+    pos, box, a = square_lattice()
+    sim, c = _hertz_lattice(pos, box)
+    f = float(c.normal_force.mean())
+    reach = 1.3 * a
+    want = 6.0 * f * a / (math.pi * reach ** 2)
+    for centre in (pos[14], pos[0]):
+        ice = sim.local_ice(centre, reach)
+        assert (ice.n_floes, ice.n_contacts) == (5, 12)
+        assert ice.floe_area == pytest.approx(5 * math.pi * R ** 2, rel=1e-12)
+        assert ice.area == pytest.approx(math.pi * reach ** 2, rel=1e-12)
+        assert ice.stress[0, 0] == pytest.approx(want, rel=STRESS_RTOL)
+        assert ice.stress[1, 1] == pytest.approx(want, rel=STRESS_RTOL)
+        assert abs(ice.stress[0, 1]) < STRESS_RTOL * want
+        assert abs(ice.stress[1, 0]) < STRESS_RTOL * want
+        assert ice.pressure == pytest.approx(want, rel=STRESS_RTOL)
+    # a disc between the floes, smaller than the gap to any contact point
+    ice = sim.local_ice(pos[14] + 0.5 * a, 0.2 * a)
+    assert (ice.n_floes, ice.n_contacts, ice.pressure) == (0, 0, 0.0)
+
+
+def test_local_ice_matches_the_contact_table():
+    """In a compressed, moving periodic field, the floes, contacts and
+    stress within discs at random points equal those picked from the
+    engine's Contacts table with NumPy: centres and contact points within
+    the radius (nearest periodic image) and −Σ l ⊗ F / (π R²) over them."""
+    rng = np.random.default_rng(5)
+    # a hexagonal lattice squeezed by 2 %, its floes of radii R ± 1 % shifted
+    # by ~0.01 R and moving: unequal normal forces and tangential ones
+    pos, box, a = hexagonal_lattice(12, 12)
+    pos = pos * 0.98 + rng.normal(0.0, 0.01 * R, pos.shape)
+    box = PeriodicBox(box.lx * 0.98, box.ly * 0.98)
+    n = len(pos)
+    field = FloeField(np.mod(pos, [box.lx, box.ly]), rng.uniform(0.99 * R, 1.01 * R, n),
+                      thickness=1.0, velocities=rng.normal(0.0, 0.01, (n, 2)))
+    sim = HertzSimulation(field, box, HERMAN2013.contact, None, dt=1e-4, allow_overlap=True)
+    sim.step(20)
+    c = sim.contacts()
+    assert len(c) > 2 * n and np.ptp(c.normal_force) > 0.1 * c.normal_force.max()
+    assert np.abs(c.tangential_force).max() > 0.0
+    r = sim.radii
+    for _ in range(6):
+        centre = rng.uniform(0.0, 1.0, 2) * [sim.box.lx, sim.box.ly]
+        reach = float(rng.uniform(0.1, 0.45) * min(sim.box.lx, sim.box.ly))
+        d = _nearest_image(sim.positions - centre, sim.box)
+        near = np.hypot(d[:, 0], d[:, 1]) < reach
+        q = _nearest_image(c.contact_point - centre, sim.box)
+        inside = np.hypot(q[:, 0], q[:, 1]) < reach
+        arm = (c.branch_i - c.branch_j)[inside]
+        tensor = -(arm.T @ c.force[inside]) / (math.pi * reach ** 2)
+        ice = sim.local_ice(centre, reach)
+        assert ice.n_floes == int(near.sum()) and ice.n_contacts == int(inside.sum())
+        assert ice.n_contacts > 0
+        # 1e-12: the same few hundred terms summed in another order
+        assert ice.floe_area == pytest.approx(math.pi * np.sum(r[near] ** 2), rel=1e-12)
+        np.testing.assert_allclose(ice.stress, tensor, rtol=0.0,
+                                   atol=1e-12 * np.abs(tensor).max())
+
+
+def test_local_ice_refuses_bad_input():
+    pos, box, _ = square_lattice(4)
+    sim, _ = _hertz_lattice(pos, box)
+    for centre in ((0.0, float("nan")), (1.0,), "xy", None):
+        with pytest.raises(ValueError, match="centre"):
+            sim.local_ice(centre, 1.0)
+    for radius in (0.0, -1.0, float("inf")):
+        with pytest.raises(ValueError, match="radius"):
+            sim.local_ice((1.0, 1.0), radius)
+
+
 # -- hard discs: geometric contacts and the collision virial ------------------------
 
 def _gas(seed=3, n=200, log=True):
