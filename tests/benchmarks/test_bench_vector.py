@@ -26,7 +26,12 @@ def test_quick_run_writes_every_configuration(tmp_path, capsys):
         assert r["min"] <= r["mean"] <= r["max"] and r["min"] > 0
     # the quick run trains without worker processes
     assert {r["mode"] for r in data["training"]} == {"sync", "native"}
-    assert "| N | single (1 core) | SyncVectorEnv (1 core) |" in harness.render_markdown(record)
+    phases = data["phases"]
+    for case in ("single", "empty", "native"):
+        assert phases[case]["engine_ms"] > 0 and phases[case]["rest_ms"] > 0
+    text = harness.render_markdown(record)
+    assert "| N | single (1 core) | SyncVectorEnv (1 core) |" in text
+    assert "where the time of a step goes" in text
 
 
 def test_an_environment_without_a_native_vector_env_is_refused(capsys):
