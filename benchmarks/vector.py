@@ -176,7 +176,9 @@ def measure_phases(env_id: str, seconds: float, seed: int, n: int,
 
     single_step(env)
     out["single"] = timed(lambda: single_step(env))
-    if "concentration" in {p.name for p in env.task_parameters}:
+    from iceenvs.ship_env import ShipEnv
+
+    if isinstance(env, ShipEnv):
         empty = gym.make(env_id, **{**(kwargs or {}), "concentration": 0.01}).unwrapped
         empty.reset(seed=seed)
         single_step(empty)
