@@ -42,8 +42,8 @@ import numpy as np
 from iceenvs.facts import env_facts
 
 from .metrics import env_name
-from .rollouts import (TrainedPolicy, compare, evaluate, evaluate_in_processes, rounded,
-                       run_episode, summarise)
+from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
+                       rounded, run_episode, summarise)
 
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
            "compare", "markdown_table", "plot_trajectories", "main"]
@@ -119,6 +119,9 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p = argparse.ArgumentParser(prog=prog,
                                 description="Compare a trained policy with baselines.")
     p.add_argument("run_dir", nargs="?", type=Path, help="run directory of agents.train")
+    p.add_argument("--checkpoint", type=int, metavar="STEPS",
+                   help="evaluate the run's checkpoint saved at STEPS steps instead of its "
+                        "final model (its results go to RUN_DIR/checkpoint_STEPS)")
     p.add_argument("--episodes", type=int, default=20, help="episodes per policy (default 20)")
     p.add_argument("--seed", type=int, default=10_000,
                    help="episode k is seeded SEED + k (default 10000, away from training)")
@@ -226,6 +229,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     if args.baseline is not None:
         if args.run_dir is not None:
             parser.error("give either RUN_DIR or --baseline, not both")
+        if args.checkpoint is not None:
+            parser.error("--checkpoint is a checkpoint of a RUN_DIR, not of a baseline")
         if args.env is None:
             parser.error(f"--baseline needs --env, one of: {', '.join(registered_ids())}")
         env_id, base_kwargs = args.env, {}
@@ -233,12 +238,15 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     else:
         if args.run_dir is None:
             parser.error("give a RUN_DIR, or --baseline NAME --env ID")
-        if not (args.run_dir / "model.zip").exists():
-            parser.error(f"{args.run_dir} holds no model.zip")
-        trained = TrainedPolicy(args.run_dir)
+        try:
+            checkpoint_files(args.run_dir, args.checkpoint)
+        except FileNotFoundError as err:
+            parser.error(str(err))
+        trained = TrainedPolicy(args.run_dir, args.checkpoint)
         env_id, base_kwargs = trained.env_id, trained.env_kwargs
         policies[f"{trained.args['algo']} policy"] = trained
-        out = args.out or args.run_dir
+        out = args.out or (args.run_dir if args.checkpoint is None
+                           else args.run_dir / f"checkpoint_{args.checkpoint}")
     valid = baseline_names(env_id)
     unknown = [n for n in names if n not in valid]
     if unknown:
@@ -261,7 +269,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         labels = {}
         recipes = {}
         if trained is not None:
-            recipes[next(iter(policies))] = ("trained", str(args.run_dir), {})
+            recipes[next(iter(policies))] = ("trained", str(args.run_dir),
+                                             dict(checkpoint=args.checkpoint))
         constant = None
         if "constant" in names:
             action, source = constant_action(parser, args, env_id, env_kwargs)

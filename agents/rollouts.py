@@ -21,6 +21,32 @@ __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", 
            "stats", "summarise", "compare"]
 
 
+def checkpoint_files(run_dir: Path, checkpoint: int | None = None) -> tuple[Path, Path]:
+    """(model, normalisation statistics) of a run of :mod:`agents.train`: the
+    final ones, or those its checkpoint callback saved at ``checkpoint``
+    steps (``checkpoints/model_<N>_steps.zip``).
+
+    Raises
+    ------
+    FileNotFoundError
+        When there is no such model; the message lists the run's checkpoints.
+    """
+    run_dir = Path(run_dir)
+    if checkpoint is None:
+        model, stats = run_dir / "model.zip", run_dir / "vecnormalize.pkl"
+    else:
+        folder = run_dir / "checkpoints"
+        model = folder / f"model_{checkpoint}_steps.zip"
+        stats = folder / f"model_vecnormalize_{checkpoint}_steps.pkl"
+    if not model.is_file():
+        saved = sorted(int(p.stem.split("_")[1]) for p in (run_dir / "checkpoints").glob(
+            "model_*_steps.zip"))
+        what = "no model.zip" if checkpoint is None else f"no checkpoint at {checkpoint} steps"
+        raise FileNotFoundError(f"{run_dir} holds {what}; its checkpoints: "
+                                f"{', '.join(map(str, saved)) or 'none'}")
+    return model, stats
+
+
 class TrainedPolicy:
     """A saved SB3 model with the ``predict`` interface of the baselines,
     normalising raw observations with the run's frozen statistics.
@@ -31,20 +57,20 @@ class TrainedPolicy:
         A run directory of :mod:`agents.train`.
     """
 
-    def __init__(self, run_dir: str | Path):
+    def __init__(self, run_dir: str | Path, checkpoint: int | None = None):
         from .envs import load_normalization
         from .train import algo_class
 
         run_dir = Path(run_dir)
+        model, stats = checkpoint_files(run_dir, checkpoint)
         with open(run_dir / "args.yaml") as fh:
             self.args = yaml.safe_load(fh)
         with open(run_dir / "hyperparams.yaml") as fh:
             self.hyperparams = yaml.safe_load(fh)
         self.env_id = self.args["env"]
         self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
-        self.model = algo_class(self.args["algo"]).load(run_dir / "model.zip", device="cpu")
-        self.normalization = load_normalization(run_dir / "vecnormalize.pkl", self.env_id,
-                                                self.env_kwargs)
+        self.model = algo_class(self.args["algo"]).load(model, device="cpu")
+        self.normalization = load_normalization(stats, self.env_id, self.env_kwargs)
 
     def reset(self, seed: int | None = None) -> None:
         """Nothing to reset: the policy is memoryless."""
@@ -123,7 +149,7 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     env = _WORKER["env"]
     if name not in _WORKER:
         kind, target, kwargs = recipe
-        _WORKER[name] = (TrainedPolicy(target) if kind == "trained" else
+        _WORKER[name] = (TrainedPolicy(target, **kwargs) if kind == "trained" else
                          make_baseline(target, env, seed=env_seed, **kwargs))
     return run_episode(env, _WORKER[name], episode_seed, env_facts(env_id).main_metric)
 

@@ -333,3 +333,20 @@ def test_learning_curve_from_progress_csv(tmp_path):
     assert (run / "learning_curve.png").stat().st_size > 1000
     with pytest.raises(SystemExit):
         curves_main([str(tmp_path / "missing")])
+
+
+def test_a_checkpoint_is_evaluated_on_its_own(ppo_runs, tmp_path, capsys):
+    from agents.evaluate import TrainedPolicy, main as evaluate_main
+
+    run = ppo_runs[CONVERGENCE]
+    # the run of 256 steps saves checkpoints every 128 steps
+    early = TrainedPolicy(run, checkpoint=128)
+    final = TrainedPolicy(run)
+    obs = observations(CONVERGENCE)
+    assert not np.array_equal(early.predict(obs)[0], final.predict(obs)[0])
+    evaluate_main([str(run), "--checkpoint", "128", "--episodes", "1", "--baselines", "zero",
+                   "--no-progress"])
+    assert (run / "checkpoint_128" / "evaluation.json").is_file()
+    with pytest.raises(SystemExit):
+        evaluate_main([str(run), "--checkpoint", "100", "--no-progress"])
+    assert "no checkpoint at 100 steps; its checkpoints: 128, 256" in capsys.readouterr().err
