@@ -315,29 +315,28 @@ def hull_wakes(ship, awake, force, torque):
             wake(i, awake)
 
 
-@njit(cache=True, error_model="numpy")
-def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship):
-    """:func:`physics.hertz_kernels.run_steps` on the serial path over the
-    awake floes and live pairs only (see the module docstring).
+@njit(cache=True, error_model="numpy", _nrt=False)
+def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
+                  awake, pairs, fbuf, tbuf):
+    """The steps of :func:`run_steps_resting` from ``step`` on, until the run
+    is done, fails, or the Verlet list expires (the caller rebuilds it and
+    finishes that step). Compiled without reference counting (it allocates
+    nothing): in a loop of this length Numba's counting of every array taken
+    from a bundle cost as much as the rest of a step of a ship among a few
+    floes.
 
-    Returns (steps done, status, number of list rebuilds, the Verlet list
-    now, number of floes awake at the end)."""
+    Returns (next step, steps done, status, whether the list expired, whether
+    the ship's log is full, box lengths of the last step)."""
     px = box.periodic_x
     py = box.periodic_y
     walls = not (px and py)
     n = floes.pos.shape[0]
-    buffers = force_buffers(1, n)
-    buffers.force[0] = floes.force
-    buffers.torque[0] = floes.torque
-    fbuf, tbuf = buffers.force[0], buffers.torque[0]
-    work = floe_rows(floes, 0, n, buffers)
-    awake = find_awake(floes, drive, box, verlet)
-    pairs = live_pairs(verlet, awake)
-    n_rebuilds = 0
     done = 0
     status = _OK
     log_full = False
-    step = 0
+    expired = False
+    lx = 0.0
+    ly = 0.0
     while step < n_steps:
         status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
         if status != _OK:
@@ -361,16 +360,56 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
         verlet.centre[0] = mx / n
         verlet.centre[1] = my / n
         if list_expired(worst, lx, ly, verlet):
-            verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, False, ship, box.deforming,
-                                    dt)
-            n_rebuilds += 1
-            # the new wide floes are integrated (their shadow positions must
-            # be in the kick-drift pass); the pending floes' pairs are live
-            for k in range(verlet.wide.shape[0]):
-                wake(verlet.wide[k], awake)
-            pairs = live_pairs(verlet, awake)
-            add_woken(awake, verlet, pairs)
+            expired = True
+            break
         # drag and wall forces are already in the buffer; add the pair forces
+        live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
+        if awake.count[1] > 0:
+            add_woken(awake, verlet, pairs)
+        if log_full:
+            status = _SHIP_LOG_FULL
+            break
+    return step, done, status, expired, log_full, lx, ly
+
+
+@njit(cache=True, error_model="numpy")
+def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship):
+    """:func:`physics.hertz_kernels.run_steps` on the serial path over the
+    awake floes and live pairs only (see the module docstring): the steps
+    run in :func:`resting_steps`, and here the list rebuilds (which
+    allocate) and the end of the step whose list expired.
+
+    Returns (steps done, status, number of list rebuilds, the Verlet list
+    now, number of floes awake at the end)."""
+    px = box.periodic_x
+    py = box.periodic_y
+    n = floes.pos.shape[0]
+    buffers = force_buffers(1, n)
+    buffers.force[0] = floes.force
+    buffers.torque[0] = floes.torque
+    fbuf, tbuf = buffers.force[0], buffers.torque[0]
+    work = floe_rows(floes, 0, n, buffers)
+    awake = find_awake(floes, drive, box, verlet)
+    pairs = live_pairs(verlet, awake)
+    n_rebuilds = 0
+    done = 0
+    status = _OK
+    step = 0
+    while step < n_steps:
+        step, d, status, expired, log_full, lx, ly = resting_steps(
+            step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work, awake,
+            pairs, fbuf, tbuf)
+        done += d
+        if not expired:
+            break
+        verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, False, ship, box.deforming, dt)
+        n_rebuilds += 1
+        # the new wide floes are integrated (their shadow positions must
+        # be in the kick-drift pass); the pending floes' pairs are live
+        for k in range(verlet.wide.shape[0]):
+            wake(verlet.wide[k], awake)
+        pairs = live_pairs(verlet, awake)
+        add_woken(awake, verlet, pairs)
         live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
         if awake.count[1] > 0:
             add_woken(awake, verlet, pairs)

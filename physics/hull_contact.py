@@ -237,7 +237,7 @@ def set_world_hull(ship):
         ship.world_y[k] = s * ship.hull_x[k] + c * ship.hull_y[k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def build_hull_list(ship, pos, radius, lx, ly, px, py):
     """The floes whose discs come within the skin of the hull (one linear
     pass); resets the travel counters."""
@@ -367,7 +367,7 @@ def floe_hull_contact(ship, dx, dy, vx, vy, w, r, inv_mass, spring, a_last, dt_h
             fx * hvx + fy * hvy)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
     """The hull's step after the floes' drift: the list check (and build),
     the contacts (their forces added to ``force``, ``torque`` of the floes),
