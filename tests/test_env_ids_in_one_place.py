@@ -20,9 +20,14 @@ PACKAGES = ("physics", "iceenvs", "agents", "seaice_gym", "benchmarks")
 SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: benchmark experiments about given environments by design: the timing
 #: against BenchNPIN's ship-ice-v0 (ShipNavigation-v0) and the study of the
-#: stiffness_scale option (WindDrift-v0, Convergence-v0)
+#: stiffness_scale option (WindDrift-v0, Convergence-v0); the vector
+#: environments timed on a ship task, the pressured ship task and a
+#: wind-driven one; the long ship channel of the resting-floe benchmark
 EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
-                                             "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"}}
+                                             "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
+               "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0",
+                                        "iceenvs/WindDrift-v0"},
+               "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"}}
 
 
 def _names() -> dict[str, str]:
