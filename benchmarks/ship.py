@@ -48,10 +48,11 @@ Four configurations take turns in one process, five rounds of one segment
 (5·10⁷ floe-steps) each: without and with the ship, on one thread (serial kernels) and on two
 threads (parallel kernels). Three such fresh processes are run; the table gives
 the median of all segments and their range, and the extra cost per step is
-the median of the same-round ratios. Without a ship the parallel step of a
-periodic box runs as a team of threads that stays in one parallel region
-between list rebuilds; with a ship the engine runs one parallel region per
-phase and step, so on two threads the extra cost includes losing the team.
+the median of the same-round ratios. The parallel step of a periodic box
+runs as a team of threads that stays in one parallel region between list
+rebuilds, with and without the ship; with the ship one thread does the hull's
+contacts between the floes' kick–drift pass and their pair loop while the
+other waits.
 
 The ship's share of the step time is measured two ways: the hull kernels timed
 on their own on the state of the run (the ship's kick–drift, the contacts of

@@ -64,7 +64,8 @@ from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
 from .domain import box_lengths_at, minimum_image
-from .hull_contact import hull_forces, ship_closing_kick, ship_floe_skins, ship_kick_drift
+from .hull_contact import (ShipBundle, hull_forces, ship_closing_kick, ship_floe_skins,
+                           ship_kick_drift)
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
                           wait_generation)
@@ -230,12 +231,17 @@ class Team(NamedTuple):
     n_threads: int
     #: tasks of the kick–drift phase
     n_kick: int
-    #: sync arrays of the two phases
+    #: sync arrays of the kick–drift and pair phases, and of the ship's
+    #: phase between them (one task, :func:`ship_after_kick`)
     sync_kick: np.ndarray
     sync_pair: np.ndarray
+    sync_ship: np.ndarray
     #: (n_kick, 4) partial results of the kick pass
     part: np.ndarray
-    #: (steps done, status, reason, centre x, centre y) of the run
+    #: (2,) results of the ship's phase: largest squared displacement,
+    #: 1 if the ship's collision log is full (else 0)
+    ship_out: np.ndarray
+    #: (steps done, status, reason, centre x, centre y, log full) of the run
     out: np.ndarray
 
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
@@ -857,20 +863,63 @@ def list_expired(worst, lx, ly, verlet):
 
 
 @njit(cache=True, error_model="numpy")
+def ship_after_kick(ship, floes, box, verlet, time, dt, vmax2, lx, ly, cx, cy, mx, my, worst,
+                    buffers):
+    """What a step does between the floes' kick–drift pass and the expiry
+    test of their list when there is a ship or a floe with a wider skin:
+    the hull's contacts (:func:`~physics.hull_contact.hull_forces` at
+    ``time``, the time after the step, with the pass's largest squared
+    speed ``vmax2``; its forces added to buffer 0 of ``buffers``), then
+    the pass over the wide-skinned floes (:func:`wide_floes_pass`, with the
+    old centre (cx, cy) and the pass's sums of the displacements (mx, my)).
+    Returns (the new largest squared displacement, whether the ship's
+    collision log is full)."""
+    log_full = False
+    if ship.active:
+        log_full = not hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), buffers.force[0],
+                                   buffers.torque[0])
+    if verlet.wide.shape[0] > 0:
+        n = floes.pos.shape[0]
+        worst = wide_floes_pass(floes.pos, verlet, lx, ly, box.periodic_x, box.periodic_y, cx, cy,
+                                mx / n, my / n, worst)
+    return worst, log_full
+
+
+# A named tuple inside a named tuple (the ship's contact law in its bundle)
+# cannot be an argument of a prange body (numba 0.68 raises "scalar type ...
+# given for non scalar argument"): team_steps takes the ship's bundle as the
+# fields before its law, the law and the fields after it, and each thread
+# puts it together again. (The slices must be written as literals: 15 = this.)
+SHIP_LAW_FIELD = ShipBundle._fields.index("law")
+assert SHIP_LAW_FIELD == 15, "change the slices of the ship's bundle in run_steps"
+
+
+@njit(cache=True, error_model="numpy")
 def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
-                chunks, buffers):
+                chunks, buffers, ship_head, ship_law, ship_tail):
     """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
     periodic box, each a kick–drift phase of ``team.n_kick`` tasks and a
     pair phase of ``team.n_threads`` tasks (the chunks of
     :func:`owner_chunks`, each with its private force buffer), with a
     ``sync`` array each (:mod:`physics.thread_team`).
 
+    With a ship (or floes with a wider skin, :func:`wide_floes_pass`) a
+    phase of one task lies between them: :func:`ship_after_kick`, done by
+    whichever thread claims it, while the others wait, since it adds the
+    hull's forces to the shared force buffer that the pair tasks write
+    too. Its results go to ``team.ship_out``. The ship's kick–drift is
+    done by the thread that claims kick task 0 (it reads and writes only
+    the ship's state, which no other task of the phase touches).
+
     Every thread makes the same decisions (stop, rebuild) from the same
-    partial results ``team.part`` of the kick pass. The thread that takes
-    the token writes (steps done, status, reason, centre x, centre y) to
-    ``team.out``."""
+    partial results ``team.part`` of the kick pass (and ``team.ship_out``).
+    The thread that takes the token writes (steps done, status, reason,
+    centre x, centre y, log full) to ``team.out``."""
     n_threads, n_kick = team.n_threads, team.n_kick
     sync_kick, sync_pair, part, out = team.sync_kick, team.sync_pair, team.part, team.out
+    sync_ship, ship_out = team.sync_ship, team.ship_out
+    ship = ShipBundle(*ship_head, ship_law, *ship_tail)
+    ship_phase = ship.active or verlet.wide.shape[0] > 0
     n = floes.pos.shape[0]
     px = box.periodic_x
     py = box.periodic_y
@@ -880,9 +929,11 @@ def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, 
     cy = verlet.centre[1]
     status = _OK
     reason = TEAM_ALL_DONE
+    log_full = False
     done = 0
-    gk = 0                                  # generation of the kick phase
-    gp = 0                                  # and of the pair phase
+    gk = 0                                  # generation of the kick phase,
+    gp = 0                                  # of the pair phase
+    gs = 0                                  # and of the ship's phase
     for s in range(n_steps):
         if deform:
             lx, ly, conc = box_lengths_at(box, time + (step0 + s + 1) * dt)
@@ -898,9 +949,11 @@ def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, 
             k = task_order(t, m, n_threads, n_kick)     # its own tasks first
             if claim(sync_kick, k, gk):
                 if k == 0:
-                    # only the pair phase reads the box lengths
+                    # only the ship's and the pair phase read the box lengths
                     box.lengths[0] = lx
                     box.lengths[1] = ly
+                    if ship.active:
+                        ship_kick_drift(ship, dt_kick, dt)
                 kick_task(k, n_kick, floes, buffers, chunks.shared, verlet.ref, drive, kick, part)
                 task_done(sync_kick, n_kick)
         wait_generation(sync_kick, n_kick, gk)
@@ -911,6 +964,19 @@ def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, 
         status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
         if status != _OK:
             break
+        if ship_phase:
+            gs += 1
+            if claim(sync_ship, 0, gs):
+                w, full = ship_after_kick(ship, floes, box, verlet, time + (step0 + s + 1) * dt,
+                                          dt, vmax2, lx, ly, cx, cy, mx, my, worst, buffers)
+                ship_out[0] = w
+                ship_out[1] = 1.0 if full else 0.0
+                task_done(sync_ship, 1)
+            wait_generation(sync_ship, 1, gs)
+            worst = ship_out[0]
+            log_full = ship_out[1] != 0.0
+            if overtaken(sync_ship, 1, gs):
+                return                      # ship_out may be the next step's
         cx = mx / n
         cy = my / n
         if list_expired(worst, lx, ly, verlet):
@@ -923,6 +989,10 @@ def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, 
                 pair_task(k, chunks, floes, law, box, verlet, dt, buffers)
                 task_done(sync_pair, n_threads)
         wait_generation(sync_pair, n_threads, gp)
+        if log_full:
+            # the step is finished; the caller empties the log
+            status = _SHIP_LOG_FULL
+            break
         lx_old, ly_old = lx, ly
     if take_token(sync_pair, n_threads):
         out[0] = done
@@ -930,21 +1000,24 @@ def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, 
         out[2] = reason
         out[3] = cx
         out[4] = cy
+        out[5] = 1.0 if log_full else 0.0
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
 def team_steps(team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet, chunks,
-               buffers):
+               buffers, ship_head, ship_law, ship_tail):
     """Steps of a periodic box by a team of threads that stays in one
     parallel region (:func:`team_member`; :mod:`physics.thread_team`) until
-    the run ends or the Verlet list must be rebuilt. Same arithmetic, in
-    the same order, as the step of :func:`run_steps` with
-    :func:`first_half_parallel` and :func:`pair_forces_parallel`: the new
-    state is the same bit for bit. (lx0, ly0) are the box lengths before
-    the first step (the team writes the new ones into ``box.lengths``)."""
+    the run ends, the Verlet list must be rebuilt or the ship's collision
+    log is full. Same arithmetic, in the same order, as the step of
+    :func:`run_steps` with :func:`first_half_parallel` and
+    :func:`pair_forces_parallel` (and the ship's step): the new state is
+    the same bit for bit. (lx0, ly0) are the box lengths before the first
+    step (the team writes the new ones into ``box.lengths``). The ship's
+    bundle comes in three parts (:data:`SHIP_LAW_FIELD`)."""
     for t in prange(team.n_threads):
         team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
-                    chunks, buffers)
+                    chunks, buffers, ship_head, ship_law, ship_tail)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -1067,7 +1140,7 @@ def rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, deforming, dt)
 
 @njit(cache=True, error_model="numpy")
 def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair,
-              ship):
+              ship, with_team=True):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
@@ -1086,7 +1159,12 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     ``ship`` is a :class:`~physics.hull_contact.ShipBundle` (inactive
     without a ship). With a ship every step also moves the ship before the
     floes' kick–drift pass and adds the hull contacts after it
-    (:mod:`physics.hull_contact`); the thread team is not used then.
+    (:mod:`physics.hull_contact`).
+
+    ``with_team``: whether the parallel step of a periodic box runs as a
+    thread team (:func:`team_steps`); with False it runs one parallel
+    region per phase and step, as in a box with walls (the same new state
+    bit for bit; for comparisons).
 
     Returns (steps done, status (a :class:`HertzStatus` value), number of
     list rebuilds, the Verlet list now). A status other than OK stops the
@@ -1113,28 +1191,31 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     # parallel region between list rebuilds; the serial path and boxes with
     # walls kick one step at a time. Both end a step whose list expired with
     # the same rebuild and pair loop.
-    use_team = parallel and not walls and not ship.active
+    use_team = parallel and not walls and with_team
     log_full = False
     team = Team(n_pair, n_kick, np.zeros(sync_size(n_kick), dtype=np.int64),
-                np.zeros(sync_size(n_pair), dtype=np.int64), np.empty((n_kick, 4)), np.empty(5))
+                np.zeros(sync_size(n_pair), dtype=np.int64), np.zeros(sync_size(1), dtype=np.int64),
+                np.empty((n_kick, 4)), np.empty(2), np.empty(6))
     step = 0
     while step < n_steps:
         if use_team:
             team.sync_kick[:] = 0
             team.sync_pair[:] = 0
+            team.sync_ship[:] = 0
             team_steps(team, n_steps - step, step, dt, time, lengths[0], lengths[1], floes, law,
-                       drive, box, verlet, chunks, buffers)
+                       drive, box, verlet, chunks, buffers, ship[:15], ship.law, ship[16:])
             out = team.out
             k = int(out[0])
             status = int(out[1])
             verlet.centre[0] = out[3]
             verlet.centre[1] = out[4]
+            log_full = out[5] != 0.0
             done += k
             step += k
             if status != _OK or int(out[2]) != TEAM_REBUILD:
                 break
-            # the team stopped after the kick of a step whose list expired:
-            # rebuild and finish that step below
+            # the team stopped after the kick (and the ship's phase) of a
+            # step whose list expired: rebuild and finish that step below
             lx, ly = lengths[0], lengths[1]
             expired = True
         else:
@@ -1159,12 +1240,10 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
                 else:
                     wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
                                 buffers.torque[0])
-            if ship.active:
-                log_full = not hull_forces(ship, floes, box, time + step * dt, dt,
-                                           math.sqrt(vmax2), buffers.force[0], buffers.torque[0])
-            if verlet.wide.shape[0] > 0:
-                worst = wide_floes_pass(floes.pos, verlet, lx, ly, px, py, kick.cx, kick.cy,
-                                        mx / n, my / n, worst)
+            if ship.active or verlet.wide.shape[0] > 0:
+                worst, log_full = ship_after_kick(ship, floes, box, verlet, time + step * dt, dt,
+                                                  vmax2, lx, ly, kick.cx, kick.cy, mx, my, worst,
+                                                  buffers)
             verlet.centre[0] = mx / n
             verlet.centre[1] = my / n
             expired = list_expired(worst, lx, ly, verlet)
