@@ -54,7 +54,7 @@ from physics.hertz import advance_together
 
 from .base import PHYSICS_ERRORS, HertzEnv
 
-__all__ = ["HertzVectorEnv"]
+__all__ = ["HertzVectorEnv", "batch_infos", "vector_class"]
 
 
 class HertzVectorEnv(VectorEnv):
@@ -126,13 +126,13 @@ class HertzVectorEnv(VectorEnv):
         seeds = self._per_env("seed", seed, (int, np.integer), lambda s, k: s + k)
         opts = self._per_env("options", options, dict, lambda o, k: o)
         super().reset(seed=None)
-        obs, infos = [], {}
+        obs, infos = [], []
         for k, env in enumerate(self.envs):
             o, info = env.reset(seed=seeds[k], options=opts[k])
             obs.append(o)
-            infos = self._add_info(infos, info, k)
+            infos.append(info)
         self._ready = True
-        return self._batch(obs), infos
+        return self._batch(obs), batch_infos(infos)
 
     def step(self, actions):
         """One step of every sub-environment; the engines advance together."""
@@ -151,11 +151,10 @@ class HertzVectorEnv(VectorEnv):
         for k, err in zip(moving, advance_together([self.envs[k].sim for k in moving],
                                                    self.envs[0].control_interval)):
             errors[k] = err
-        obs = []
+        obs, step_infos, ended = [], [], []
         rewards = np.zeros(self.num_envs)
         terminated = np.zeros(self.num_envs, dtype=bool)
         truncated = np.zeros(self.num_envs, dtype=bool)
-        infos: dict[str, Any] = {}
         for k, env in enumerate(self.envs):
             a, replaced = taken[k]
             result = None
@@ -173,10 +172,13 @@ class HertzVectorEnv(VectorEnv):
             truncated[k] = (self.max_episode_steps is not None
                             and env._steps >= self.max_episode_steps)
             if terminated[k] or truncated[k]:
-                infos = self._add_info(infos, {"final_obs": o, "final_info": info}, k)
+                ended.append((k, o, info))
                 o, info = env.reset()
             obs.append(o)
-            infos = self._add_info(infos, info, k)
+            step_infos.append(info)
+        infos = batch_infos(step_infos)
+        for k, o, info in ended:
+            infos = self._add_info(infos, {"final_obs": o, "final_info": info}, k)
         return self._batch(obs), rewards, terminated, truncated, infos
 
     def render(self):
@@ -224,6 +226,35 @@ class HertzVectorEnv(VectorEnv):
 
     def __repr__(self):
         return f"{type(self).__name__}(num_envs={self.num_envs})"
+
+
+def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
+    """The infos of the sub-environments as one Gymnasium vector info: what
+    :meth:`gymnasium.vector.VectorEnv._add_info` builds from them one by
+    one (a dict of arrays, each key with its mask ``_key`` of the
+    sub-environments that have it, nested dicts likewise; numbers in an
+    array of the first one's type, arrays stacked, anything else in an
+    object array), key by key over all of them at once."""
+    n = len(infos)
+    out: dict[str, Any] = {}
+    for key in dict.fromkeys(k for info in infos for k in info):
+        have = [k for k, info in enumerate(infos) if key in info]
+        first = infos[have[0]][key]
+        if isinstance(first, dict):
+            array = batch_infos([info.get(key, {}) for info in infos])
+        else:
+            if type(first) in (int, float, bool) or isinstance(first, np.number):
+                array = np.zeros(n, dtype=type(first))
+            elif isinstance(first, np.ndarray):
+                array = np.zeros((n,) + first.shape, dtype=first.dtype)
+            else:
+                array = np.full(n, None, dtype=object)
+            for k in have:
+                array[k] = infos[k][key]
+        mask = np.zeros(n, dtype=np.bool_)
+        mask[have] = True
+        out[key], out["_" + key] = array, mask
+    return out
 
 
 def vector_class(env_class: type[HertzEnv]) -> type[HertzVectorEnv]:

@@ -138,3 +138,30 @@ def test_render_draws_the_chosen_sub_environment():
     # the same picture as the single environment seeded like sub-environment 1
     assert np.mean(frame != single.render()) < 1e-3
     envs.close()
+
+
+def test_batched_infos_are_what_gymnasium_builds_one_by_one():
+    from gymnasium.vector import SyncVectorEnv
+
+    from iceenvs.vector import batch_infos
+
+    infos = [{"a": 1.5, "n": 2, "ok": True, "task": {"range": (0.2, 0.6), "x": 0.3},
+              "v": np.arange(3.0), "error": "boom"},
+             {"a": 2.5, "n": 3, "ok": False, "task": {"x": 0.4}, "v": np.ones(3)},
+             {"a": 0.5, "other": "s", "task": {"range": (0.1, 0.2)}, "v": np.zeros(3)}]
+    sync = SyncVectorEnv([lambda: gym.make("CartPole-v1")] * 3)
+    expected: dict = {}
+    for k, info in enumerate(infos):
+        expected = sync._add_info(expected, info, k)
+    got = batch_infos(infos)
+
+    def same(a, b):
+        assert a.keys() == b.keys()
+        for key in a:
+            if isinstance(a[key], dict):
+                same(a[key], b[key])
+            else:
+                assert a[key].dtype == b[key].dtype, key
+                np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    same(got, expected)
+    sync.close()
