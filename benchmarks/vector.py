@@ -179,7 +179,7 @@ def measure_phases(env_id: str, seconds: float, seed: int, n: int,
     from iceenvs.ship_env import ShipEnv
 
     if isinstance(env, ShipEnv):
-        empty = gym.make(env_id, **{**(kwargs or {}), "concentration": 0.01}).unwrapped
+        empty = gym.make(env_id, **{**(kwargs or {}), "concentration": 0.05}).unwrapped
         empty.reset(seed=seed)
         single_step(empty)
         out["empty"] = timed(lambda: single_step(empty))
@@ -312,7 +312,7 @@ def phases_table(result: dict) -> dict:
         return harness.table("Where the time goes", ["what", "failed"], [["", ph["failed"]]])
     rows = []
     labels = (("single", "single environment, its field (one core)"),
-              ("empty", "single environment, a nearly empty field (A = 0.01)"),
+              ("empty", "single environment, a sparse field (A = 0.05)"),
               ("native", f"native vector environment, N = {ph['n']}, per env step"))
     for key, label in labels:
         if key in ph:
@@ -325,7 +325,7 @@ def phases_table(result: dict) -> dict:
          "the rest of the step [ms/step]"], rows,
         "The engine is the compiled step over the control interval (about 1500 sub-steps of "
         "Δt); the rest is the action, the measurements, the observation and the reward, in "
-        "Python. The nearly empty field (two floes) gives the fixed cost of a sub-step: the "
+        "Python. The sparse field (a few floes) shows the fixed cost of a sub-step: the "
         "ship's kick–drift, its contact pass and step record, and the loop. In the native "
         "vector environment the engines of all sub-environments run in parallel and the rest "
         "one after the other.")
