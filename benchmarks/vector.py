@@ -299,7 +299,7 @@ def stepping_table(result: dict, env_id: str) -> dict:
         row.append(f"{native['mean'] / single['mean']:.1f}" if ok else "")
         rows.append(row)
     return harness.table(
-        f"`{env_id}`: environment steps per second (mean over the rounds, and their range)",
+        f"{env_id}: environment steps per second (mean over the rounds, and their range)",
         ["N", "single (1 core)", "SyncVectorEnv (1 core)", "SubprocVecEnv", "native",
          "native / single"], rows,
         "The single environment does not depend on N; it is timed once per round.")
@@ -320,7 +320,7 @@ def phases_table(result: dict) -> dict:
             rows.append([label, f"{r['engine_ms']:.3f}", f"{r['substep_ns']:.0f}",
                          f"{r['rest_ms']:.3f}"])
     return harness.table(
-        f"`{ph['id']}`: where the time of a step goes",
+        f"{ph['id']}: where the time of a step goes",
         ["case", "engine [ms/step]", "engine per sub-step [ns]",
          "the rest of the step [ms/step]"], rows,
         "The engine is the compiled step over the control interval (about 1500 sub-steps of "
@@ -335,7 +335,7 @@ def training_table(result: dict) -> dict:
     rows = [[r["mode"].replace("sync", "dummy"), r["n"], _rate(r)] for r in result["training"]]
     st = result["settings"]
     return harness.table(
-        f"`{st['ids'][0]}`: PPO training steps per second end to end ({st['ppo_steps']} "
+        f"{st['ids'][0]}: PPO training steps per second end to end ({st['ppo_steps']} "
         f"timed steps)", ["vectorization", "N", "training steps/s"], rows,
         "dummy: SB3's DummyVecEnv (one after the other in the training process).")
 
