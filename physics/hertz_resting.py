@@ -315,6 +315,15 @@ def hull_wakes(ship, awake, force, torque):
             wake(i, awake)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf):
+    """The end of a step: the forces of the live pairs added to the drag and
+    wall forces already in the buffer, and the floes they woke made live."""
+    live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
+    if awake.count[1] > 0:
+        add_woken(awake, verlet, pairs)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
                   awake, pairs, fbuf, tbuf):
@@ -362,10 +371,7 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
         if list_expired(worst, lx, ly, verlet):
             expired = True
             break
-        # drag and wall forces are already in the buffer; add the pair forces
-        live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
-        if awake.count[1] > 0:
-            add_woken(awake, verlet, pairs)
+        pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
         if log_full:
             status = _SHIP_LOG_FULL
             break
@@ -410,9 +416,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
             wake(verlet.wide[k], awake)
         pairs = live_pairs(verlet, awake)
         add_woken(awake, verlet, pairs)
-        live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
-        if awake.count[1] > 0:
-            add_woken(awake, verlet, pairs)
+        pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
         if log_full:
             status = _SHIP_LOG_FULL
             break
