@@ -108,7 +108,7 @@ class HertzVectorEnv(VectorEnv):
         self.envs = [self.env_class(render_mode=render_mode if k == render_env else None,
                                     **kwargs) for k in range(self.num_envs)]
         first = self.envs[0]
-        self.render_mode = first.render_mode if render_env == 0 else self.envs[render_env].render_mode
+        self.render_mode = self.envs[self.render_env].render_mode
         self.metadata = {**type(self).metadata, "render_fps": first.metadata["render_fps"]}
         self.single_observation_space = first.observation_space
         self.single_action_space = first.action_space

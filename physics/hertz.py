@@ -394,10 +394,9 @@ class HertzSimulation(FloeProperties):
         is cut into pieces that bound the record buffer."""
         box = self.box.kernel_box(self.time)
         self._kernel_box = box
-        if self.ship is None:
-            return left, self._floes, self._law, self._wall_law, self._drive(), box, self._no_ship
-        k = min(left, self._SHIP_CHUNK)
-        return k, self._floes, self._law, self._wall_law, self._drive(), box, self.ship.bundle(k)
+        k = left if self.ship is None else min(left, self._SHIP_CHUNK)
+        ship = self._no_ship if self.ship is None else self.ship.bundle(k)
+        return k, self._floes, self._law, self._wall_law, self._drive(), box, ship
 
     def _after_run(self, done: int, status: int, n_rebuilds: int, left: int) -> int:
         """Count a kernel run of ``done`` steps that ended with ``status``;
