@@ -407,7 +407,7 @@ class ShipEnv(HertzEnv):
         self._track = [sim.ship.position]
         self._metrics = dict.fromkeys(METRICS, 0.0)
         self._metrics["success"] = False
-        self._impulses = []
+        self._collisions = 0
         self._impulse_total = 0.0
         self._impulse_max = 0.0
         self._floes_hit = set()
@@ -466,7 +466,7 @@ class ShipEnv(HertzEnv):
             self._resistance_sum -= surge * dt
         if log.shape[0]:
             impulses = np.hypot(log[:, _IMPULSE_SURGE], log[:, _IMPULSE_SWAY])
-            self._impulses.extend(impulses.tolist())
+            self._collisions += int(impulses.size)
             self._impulse_total += float(impulses.sum())
             self._impulse_max = max(self._impulse_max, float(impulses.max()))
             self._floes_hit.update(log[:, _FLOE].astype(np.int64).tolist())
@@ -534,10 +534,10 @@ class ShipEnv(HertzEnv):
         m["path_length"] += self._step_loads["step_path"]
         m["effort"] += self._step_loads["step_effort"]
         m["energy_to_ice"] += self._step_loads["step_energy"]
-        m["collisions"] = len(self._impulses)
+        m["collisions"] = self._collisions
         m["collided_floes"] = len(self._floes_hit)
         total = self._impulse_total
-        m["mean_impulse"] = total / len(self._impulses) if self._impulses else 0.0
+        m["mean_impulse"] = total / self._collisions if self._collisions else 0.0
         m["max_impulse"] = self._impulse_max
         m["impulse_per_metre"] = total / m["path_length"] if m["path_length"] > 0 else 0.0
         m["ice_resistance"] = self._resistance_sum / m["time"] if m["time"] > 0 else 0.0
