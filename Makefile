@@ -43,9 +43,11 @@ lock:
 demo: setup
 	$(PY) -m seaice_gym demo
 
-# the linter and the import layers (pyproject.toml), then the tests
+# the linter and the import layers (pyproject.toml), then the tests, in
+# TEST_WORKERS processes (pytest-xdist; a test file's tests share a worker)
+TEST_WORKERS ?= 2
 test: setup lint
-	$(PY) -m pytest -q -m "not slow"
+	$(PY) -m pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadfile
 
 lint: setup
 	$(VENV)/bin/ruff check .
