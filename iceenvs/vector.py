@@ -50,7 +50,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
-from physics.hertz import advance_together
+from physics.hertz import KernelLists, advance_together
 
 from .base import PHYSICS_ERRORS, HertzEnv
 
@@ -115,6 +115,7 @@ class HertzVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._obs = create_empty_array(self.single_observation_space, self.num_envs)
+        self._lists = KernelLists()
         self._ready = False
 
     # -- Gymnasium API -----------------------------------------------------------------
@@ -149,7 +150,8 @@ class HertzVectorEnv(VectorEnv):
                 errors[k] = err
         moving = [k for k in range(self.num_envs) if errors[k] is None]
         for k, err in zip(moving, advance_together([self.envs[k].sim for k in moving],
-                                                   self.envs[0].control_interval)):
+                                                   self.envs[0].control_interval,
+                                                   lists=self._lists)):
             errors[k] = err
         obs, step_infos, ended = [], [], []
         rewards = np.zeros(self.num_envs)

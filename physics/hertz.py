@@ -606,7 +606,49 @@ class HertzSimulation(FloeProperties):
                 f"time={self.time:.6g}, parallel={self.parallel}{rest})")
 
 
-def advance_together(sims, duration: float) -> list:
+class KernelLists:
+    """The typed lists that carry several simulations' kernel arguments into
+    :func:`physics.hertz_batch.run_many`, kept from call to call.
+
+    Numba types a new list's first item in Python, which for the nested
+    bundles of a simulation costs about half a millisecond per simulation,
+    as much as a ship environment's engine step; replacing the items of a
+    list of that type costs some 20 µs each. One object per caller that
+    advances the same kind of simulations again and again (a native vector
+    environment) makes that saving; :func:`advance_together` makes a new
+    one when given none.
+    """
+
+    def __init__(self):
+        self._lists: dict[int, tuple] = {}
+
+    def filled(self, runs: list, verlets: list) -> tuple:
+        """Typed lists holding ``runs`` and ``verlets``: those of the last
+        call with as many items, with the items replaced, or new ones when
+        there are none or their item types differ."""
+        from numba import typeof
+        from numba.core.errors import NumbaError
+        from numba.typed import List
+
+        n = len(runs)
+        kept = self._lists.get(n)
+        if kept is not None:
+            try:
+                for k in range(n):
+                    kept[0][k] = runs[k]
+                    kept[1][k] = verlets[k]
+                return kept
+            except (NumbaError, TypeError, ValueError):
+                pass                        # items of another type: new lists
+        kept = (List.empty_list(typeof(runs[0])), List.empty_list(typeof(verlets[0])))
+        for run, verlet in zip(runs, verlets):
+            kept[0].append(run)
+            kept[1].append(verlet)
+        self._lists[n] = kept
+        return kept
+
+
+def advance_together(sims, duration: float, *, lists: KernelLists | None = None) -> list:
     """Advance several independent simulations by ``duration`` model seconds
     each (rounded to whole steps of each one's Δt) in compiled calls that
     run the simulations in parallel over Numba's threads
@@ -620,6 +662,9 @@ def advance_together(sims, duration: float) -> list:
         Distinct serial simulations (``parallel=False``).
     duration : float
         Model seconds [s].
+    lists : KernelLists, optional
+        The typed lists to reuse (see :class:`KernelLists`); a caller that
+        advances the same simulations step after step keeps one.
 
     Returns
     -------
@@ -634,8 +679,6 @@ def advance_together(sims, duration: float) -> list:
         A simulation that is not a serial :class:`HertzSimulation`, or one
         given twice.
     """
-    from numba.typed import List
-
     sims = list(sims)
     for k, sim in enumerate(sims):
         if not isinstance(sim, HertzSimulation):
@@ -653,13 +696,10 @@ def advance_together(sims, duration: float) -> list:
         todo = [k for k, n in enumerate(left) if n > 0]
         if not todo:
             break
-        runs, verlets = List(), List()
-        n_steps = np.empty(len(todo), dtype=np.int64)
-        for m, k in enumerate(todo):
-            args = sims[k]._kernel_arguments(left[k])
-            n_steps[m] = args[0]
-            runs.append(args[1:])
-            verlets.append(sims[k]._verlet)
+        args = [sims[k]._kernel_arguments(left[k]) for k in todo]
+        n_steps = np.array([a[0] for a in args], dtype=np.int64)
+        runs, verlets = (lists or KernelLists()).filled([a[1:] for a in args],
+                                                        [sims[k]._verlet for k in todo])
         dt = np.array([sims[k].dt for k in todo])
         time = np.array([sims[k].time for k in todo])
         resting = np.array([sims[k].skip_resting for k in todo])
