@@ -638,8 +638,8 @@ class KernelLists:
                     kept[0][k] = runs[k]
                     kept[1][k] = verlets[k]
                 return kept
-            except (NumbaError, TypeError, ValueError):
-                pass                        # items of another type: new lists
+            except (NumbaError, TypeError, ValueError, AssertionError):
+                pass     # items of another type (Numba fails to compile the cast): new lists
         kept = (List.empty_list(typeof(runs[0])), List.empty_list(typeof(verlets[0])))
         for run, verlet in zip(runs, verlets):
             kept[0].append(run)
@@ -706,7 +706,8 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
         run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
         for m, k in enumerate(todo):
-            sims[k]._verlet = verlets[m]
+            if nreb[m]:                     # a rebuilt list (reading an item costs 10 µs)
+                sims[k]._verlet = verlets[m]
             if sims[k].skip_resting:
                 sims[k].n_awake = int(awake[m])
             status[k] = HertzStatus(int(stat[m]))

@@ -435,8 +435,9 @@ class ShipState:
 
     # -- compiled step -------------------------------------------------------
     def bundle(self, n_steps: int) -> HC.ShipBundle:
-        """The bundle for a run of ``n_steps`` (a fresh record buffer)."""
-        self._bundle = self._bundle._replace(record=np.zeros((n_steps, len(HC.RECORD_COLUMNS))))
+        """The bundle for a run of ``n_steps`` (a fresh record buffer, whose
+        rows the run writes; :meth:`drain` keeps those it wrote)."""
+        self._bundle = self._bundle._replace(record=np.empty((n_steps, len(HC.RECORD_COLUMNS))))
         self._bundle.counts[HC.C_RECORD] = 0
         return self._bundle
 
@@ -463,7 +464,8 @@ class ShipState:
         b = self._bundle
         rows = int(b.counts[HC.C_RECORD])
         if rows:
-            self._records.append(b.record[:rows].copy())
+            # the buffer is the run's own (bundle): its rows are kept, not copied
+            self._records.append(b.record[:rows])
         n_log = int(b.counts[HC.C_LOG])
         if n_log:
             self._log.append(b.log[:n_log].copy())

@@ -10,7 +10,7 @@ from physics import ContactParams, HertzSimulation
 from physics.domain import Box, PeriodicBox
 from physics.engine import SimulationError
 from physics.floes import FloeField, place_floes
-from physics.hertz import advance_together, hull_contact_time
+from physics.hertz import KernelLists, advance_together, hull_contact_time
 from physics.hull import Hull
 from physics.ship import Ship
 
@@ -47,6 +47,26 @@ def test_together_ends_where_each_alone_ends():
         la, lb = a.ship_loads(), b.ship_loads()
         assert lb.collisions == la.collisions > 0
         np.testing.assert_allclose(lb.resistance, la.resistance, rtol=1e-9)
+
+
+def test_kept_lists_carry_new_simulations_and_new_item_types():
+    """Lists kept from call to call (a vector environment's) take the
+    simulations of each call, also others than the last call's."""
+    kept = KernelLists()
+    alone = [transit(s) for s in (7, 8)]
+    together = [transit(s) for s in (7, 8)]
+    for sim in alone:
+        sim.advance(2.0)
+    assert advance_together(together, 2.0, lists=kept) == [None, None]
+    first = kept._lists[2]
+    fresh, other = transit(9), transit(9)   # a new episode in the second slot
+    fresh.advance(1.0)
+    assert advance_together([together[0], other], 1.0, lists=kept) == [None, None]
+    alone[0].advance(1.0)
+    for a, b in ((alone[0], together[0]), (fresh, other)):
+        assert b.n_steps == a.n_steps
+        np.testing.assert_allclose(b.positions, a.positions, rtol=0, atol=TOL)
+    assert kept._lists[2] is first      # the second call refilled the first's lists
 
 
 def test_a_failing_simulation_does_not_stop_the_others():
