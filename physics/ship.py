@@ -464,8 +464,10 @@ class ShipState:
         b = self._bundle
         rows = int(b.counts[HC.C_RECORD])
         if rows:
-            # the buffer is the run's own (bundle): its rows are kept, not copied
-            self._records.append(b.record[:rows])
+            # the buffer is the run's own (bundle): its rows are kept without
+            # a copy, unless the run stopped early and used less than half of it
+            kept = b.record[:rows]
+            self._records.append(kept if 2 * rows >= b.record.shape[0] else kept.copy())
         n_log = int(b.counts[HC.C_LOG])
         if n_log:
             self._log.append(b.log[:n_log].copy())
