@@ -236,27 +236,73 @@ def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
     one (a dict of arrays, each key with its mask ``_key`` of the
     sub-environments that have it, nested dicts likewise; numbers in an
     array of the first one's type, arrays stacked, anything else in an
-    object array), key by key over all of them at once."""
+    object array), a column at a time."""
+    n = len(infos)
+    keys = list(infos[0]) if n else []
+    if not (n and all(list(info) == keys for info in infos)):
+        return _key_by_key(infos)
+    # the common case: every sub-environment has the same keys, in one order
+    out: dict[str, Any] = {}
+    for key, values in zip(keys, zip(*(info.values() for info in infos))):
+        first = values[0]
+        array = None
+        if isinstance(first, dict):
+            if all(isinstance(v, dict) for v in values):
+                array = batch_infos(values)
+        else:
+            array = _column(first, values, n)
+        if array is None:
+            array = _key_by_key([{key: v} for v in values])[key]
+        out[key], out["_" + key] = array, np.ones(n, dtype=np.bool_)
+    return out
+
+
+def _key_by_key(infos: Sequence[dict]) -> dict[str, Any]:
+    """:func:`batch_infos` for infos whose keys differ: key by key, each
+    sub-environment's value put in its row."""
     n = len(infos)
     out: dict[str, Any] = {}
     for key in dict.fromkeys(k for info in infos for k in info):
-        have = [k for k, info in enumerate(infos) if key in info]
-        first = infos[have[0]][key]
+        values = [info.get(key, _MISSING) for info in infos]
+        present = [v is not _MISSING for v in values]
+        first = next(v for v in values if v is not _MISSING)
         if isinstance(first, dict):
-            array = batch_infos([info.get(key, {}) for info in infos])
+            array = batch_infos([{} if v is _MISSING else v for v in values])
         else:
-            if type(first) in (int, float, bool) or isinstance(first, np.number):
-                array = np.zeros(n, dtype=type(first))
-            elif isinstance(first, np.ndarray):
-                array = np.zeros((n,) + first.shape, dtype=first.dtype)
-            else:
-                array = np.full(n, None, dtype=object)
-            for k in have:
-                array[k] = infos[k][key]
-        mask = np.zeros(n, dtype=np.bool_)
-        mask[have] = True
-        out[key], out["_" + key] = array, mask
+            array = _empty_column(first, n)
+            for k, v in enumerate(values):
+                if v is not _MISSING:
+                    array[k] = v
+        out[key], out["_" + key] = array, np.array(present, dtype=np.bool_)
     return out
+
+
+_MISSING = object()
+
+
+def _empty_column(first, n: int) -> np.ndarray:
+    """The array that ``_add_info`` starts a key with, from its first value."""
+    if type(first) in (int, float, bool) or isinstance(first, np.number):
+        return np.zeros(n, dtype=type(first))
+    if isinstance(first, np.ndarray):
+        return np.zeros((n,) + first.shape, dtype=first.dtype)
+    return np.full(n, None, dtype=object)
+
+
+def _column(first, values: Sequence, n: int) -> np.ndarray | None:
+    """The column of a key that every sub-environment has, in one call where
+    that gives what filling :func:`_empty_column` one by one gives (numbers
+    of the first one's type; arrays of one shape and dtype); else None."""
+    if type(first) in (int, float, bool) or isinstance(first, np.number):
+        if all(type(v) in (int, float, bool) or isinstance(v, np.number) for v in values):
+            return np.array(values, dtype=type(first))
+        return None
+    if isinstance(first, np.ndarray):
+        if all(isinstance(v, np.ndarray) and v.shape == first.shape and v.dtype == first.dtype
+               for v in values):
+            return np.stack(values) if n else _empty_column(first, n)
+        return None
+    return None
 
 
 def vector_class(env_class: type[HertzEnv]) -> type[HertzVectorEnv]:

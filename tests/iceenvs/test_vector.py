@@ -145,16 +145,6 @@ def test_batched_infos_are_what_gymnasium_builds_one_by_one():
 
     from iceenvs.vector import batch_infos
 
-    infos = [{"a": 1.5, "n": 2, "ok": True, "task": {"range": (0.2, 0.6), "x": 0.3},
-              "v": np.arange(3.0), "error": "boom"},
-             {"a": 2.5, "n": 3, "ok": False, "task": {"x": 0.4}, "v": np.ones(3)},
-             {"a": 0.5, "other": "s", "task": {"range": (0.1, 0.2)}, "v": np.zeros(3)}]
-    sync = SyncVectorEnv([lambda: gym.make("CartPole-v1")] * 3)
-    expected: dict = {}
-    for k, info in enumerate(infos):
-        expected = sync._add_info(expected, info, k)
-    got = batch_infos(infos)
-
     def same(a, b):
         assert a.keys() == b.keys()
         for key in a:
@@ -163,5 +153,41 @@ def test_batched_infos_are_what_gymnasium_builds_one_by_one():
             else:
                 assert a[key].dtype == b[key].dtype, key
                 np.testing.assert_array_equal(a[key], b[key], err_msg=key)
-    same(got, expected)
+
+    infos = [{"a": 1.5, "n": 2, "ok": True, "task": {"range": (0.2, 0.6), "x": 0.3},
+              "v": np.arange(3.0), "error": "boom"},
+             {"a": 2.5, "n": 3, "ok": False, "task": {"x": 0.4}, "v": np.ones(3)},
+             {"a": 0.5, "other": "s", "task": {"range": (0.1, 0.2)}, "v": np.zeros(3)}]
+    # keys that every info has: numbers of mixed types, arrays, strings
+    for k, (num, flag) in enumerate(((2, 1.0), (2.7, True), (np.float32(0.5), 0))):
+        infos[k].update(i=num, b=flag, m=np.full((2, 2), k, dtype=np.int32), s=str(k))
+    # infos with the same keys: numbers of mixed types, arrays, strings, a
+    # nested dict that two of them lack a key of
+    alike = [{"i": num, "b": flag, "m": np.full((2, 2), k, dtype=np.int32),
+              "s": str(k), "d": {"x": k} if k else {"x": 0, "y": 1.0}}
+             for k, (num, flag) in enumerate(((2, 1.0), (2.7, True), (np.float32(0.5), 0)))]
+    sync = SyncVectorEnv([lambda: gym.make("CartPole-v1")] * 3)
+    for case in (infos, alike):
+        expected: dict = {}
+        for k, info in enumerate(case):
+            expected = sync._add_info(expected, info, k)
+        same(batch_infos(case), expected)
     sync.close()
+
+
+def test_batched_infos_of_arrays_of_two_shapes_fail_as_gymnasiums():
+    from gymnasium.vector import SyncVectorEnv
+
+    from iceenvs.vector import batch_infos
+
+    infos = [{"w": np.zeros(k + 1)} for k in range(3)]
+    sync = SyncVectorEnv([lambda: gym.make("CartPole-v1")] * 3)
+    expected: dict = {}
+    with pytest.raises(ValueError):
+        for k, info in enumerate(infos):
+            expected = sync._add_info(expected, info, k)
+    sync.close()
+    with pytest.raises(ValueError):
+        batch_infos(infos)
+
+
