@@ -8,6 +8,8 @@
 """
 from __future__ import annotations
 
+import math
+
 import statistics
 import sys
 import time
@@ -159,20 +161,23 @@ def measure_phases(env_id: str, seconds: float, seed: int, n: int,
         t0 = time.perf_counter()
         e.sim.advance(e.control_interval)
         t1 = time.perf_counter()
+        floes = (e.sim.n_floes, e.sim.n_awake)
         e._advanced()
         _, _, term, _, _ = e._finish_step(a, replaced, e._measure())
         if term or e._steps >= 200:
             e.reset()
-        return t1 - t0, time.perf_counter() - t1, round(e.control_interval / e.sim.dt)
+        return t1 - t0, time.perf_counter() - t1, round(e.control_interval / e.sim.dt), floes
 
     def timed(step):
-        engine = rest = substeps = count = 0
+        engine = rest = substeps = count = floes = awake = 0
         t0 = time.perf_counter()
         while time.perf_counter() - t0 < seconds:
-            a, b, c = step()
+            a, b, c, (f, w) = step()
             engine, rest, substeps, count = engine + a, rest + b, substeps + c, count + 1
+            floes, awake = floes + f, awake + w
         return dict(engine_ms=1e3 * engine / count, rest_ms=1e3 * rest / count,
-                    substep_ns=1e9 * engine / substeps)
+                    substep_ns=1e9 * engine / substeps, floes=floes / count,
+                    awake=awake / count)
 
     single_step(env)
     out["single"] = timed(lambda: single_step(env))
@@ -197,13 +202,14 @@ def measure_phases(env_id: str, seconds: float, seed: int, n: int,
         t0 = time.perf_counter()
         advance_together([e.sim for e in subs], subs[0].control_interval)
         t1 = time.perf_counter()
+        floes = (sum(e.sim.n_floes for e in subs) / n, sum(e.sim.n_awake for e in subs) / n)
         for e, (a, replaced) in zip(subs, taken):
             e._advanced()
             _, _, term, _, _ = e._finish_step(a, replaced, e._measure())
             if term or e._steps >= 200:
                 e.reset()
         return (t1 - t0) / n, (time.perf_counter() - t1) / n, round(
-            subs[0].control_interval / subs[0].sim.dt)
+            subs[0].control_interval / subs[0].sim.dt), floes
 
     vector_step()
     out["native"] = timed(vector_step)
@@ -318,17 +324,20 @@ def phases_table(result: dict) -> dict:
         if key in ph:
             r = ph[key]
             rows.append([label, f"{r['engine_ms']:.3f}", f"{r['substep_ns']:.0f}",
-                         f"{r['rest_ms']:.3f}"])
+                         f"{r['rest_ms']:.3f}", f"{r.get('floes', math.nan):.0f}",
+                         f"{r.get('awake', math.nan):.0f}"])
     return harness.table(
         f"{ph['id']}: where the time of a step goes",
         ["case", "engine [ms/step]", "engine per sub-step [ns]",
-         "the rest of the step [ms/step]"], rows,
+         "the rest of the step [ms/step]", "floes", "awake floes"], rows,
         "The engine is the compiled step over the control interval (about 1500 sub-steps of "
         "Δt); the rest is the action, the measurements, the observation and the reward, in "
         "Python. The sparse field (a few floes) shows the fixed cost of a sub-step: the "
-        "ship's kick–drift, its contact pass and step record, and the loop. In the native "
-        "vector environment the engines of all sub-environments run in parallel and the rest "
-        "one after the other.")
+        "ship's kick–drift, its contact pass and step record, and the loop. Floes and awake "
+        "floes are means over the timed steps (per sub-environment); a floe at rest costs "
+        "nothing (skip_resting), an awake one its kick–drift and its pairs at every sub-step. "
+        "In the native vector environment the engines of all sub-environments run in "
+        "parallel and the rest one after the other.")
 
 
 def training_table(result: dict) -> dict:
