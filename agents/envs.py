@@ -224,8 +224,9 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         ``"native"``: the environment's own vector environment
         (:func:`native_vector_env`); ``"subproc"``: one worker process per
         environment; ``"dummy"``: all in this process, one after the other;
-        ``"auto"`` (default): native where the registration has a vector
-        entry point, else subproc for several environments and dummy for one.
+        ``"auto"`` (default): for several environments, native where the
+        registration has a vector entry point, else subproc; dummy for one
+        (one simulation runs faster without the batched call).
 
     Returns
     -------
@@ -244,8 +245,8 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         raise ValueError(f"unknown vectorization {vectorization!r}; valid: "
                          f"{', '.join(VECTORIZATIONS)}")
     if vectorization == "auto":
-        vectorization = ("native" if has_native_vector_env(env_id) else
-                         "subproc" if n_envs > 1 else "dummy")
+        vectorization = ("dummy" if n_envs == 1 else
+                         "native" if has_native_vector_env(env_id) else "subproc")
     if vectorization == "native":
         venv = native_vector_env(env_id, n_envs, env_kwargs)
     else:

@@ -120,8 +120,8 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
     p.add_argument("--vectorization", choices=VECTORIZATIONS, default="auto",
                    help="how the environments are stepped: native (the environment's own "
                         "vector environment), subproc (a process each), dummy (one after the "
-                        "other here); auto (default): native where the environment has one, "
-                        "else subproc for several and dummy for one")
+                        "other here); auto (default): for several, native where the environment "
+                        "has one, else subproc; dummy for one")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p

@@ -134,10 +134,11 @@ def test_make_vec_env_takes_the_native_vector_env_where_there_is_one(vectorised_
         assert isinstance(env.unwrapped, GymnasiumVecEnv), how
         assert env.reset().shape == (2,) + env.observation_space.shape
         env.close()
-    env = make_vec_env(vectorised_id, n_envs=2, seed=3, env_kwargs=SMALL[ITD],
-                       vectorization="dummy")
-    assert not isinstance(env.unwrapped, GymnasiumVecEnv)
-    env.close()
+    for n, how in ((2, "dummy"), (1, "auto")):     # auto steps one environment alone
+        env = make_vec_env(vectorised_id, n_envs=n, seed=3, env_kwargs=SMALL[ITD],
+                           vectorization=how)
+        assert not isinstance(env.unwrapped, GymnasiumVecEnv), (n, how)
+        env.close()
 
 
 def test_native_is_refused_without_a_vector_entry_point():
