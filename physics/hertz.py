@@ -610,10 +610,10 @@ class KernelLists:
     """The typed lists that carry several simulations' kernel arguments into
     :func:`physics.hertz_batch.run_many`, kept from call to call.
 
-    Numba types a new list's first item in Python, which for the nested
-    bundles of a simulation costs about half a millisecond per simulation,
-    as much as a ship environment's engine step; replacing the items of a
-    list of that type costs some 20 µs each. One object per caller that
+    Numba types a new list from its first item, in Python: for the nested
+    bundles of a simulation that costs about half a millisecond each time a
+    list is made, as much as a ship environment's engine step. Replacing
+    the items of a kept list costs some 20 µs each. One object per caller that
     advances the same kind of simulations again and again (a native vector
     environment) makes that saving; :func:`advance_together` makes a new
     one when given none.
