@@ -250,7 +250,7 @@ def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
             if all(isinstance(v, dict) for v in values):
                 array = batch_infos(values)
         else:
-            array = _column(first, values, n)
+            array = _column(first, values)
         if array is None:
             array = _key_by_key([{key: v} for v in values])[key]
         out[key], out["_" + key] = array, np.ones(n, dtype=np.bool_)
@@ -280,28 +280,30 @@ def _key_by_key(infos: Sequence[dict]) -> dict[str, Any]:
 _MISSING = object()
 
 
+def _is_number(value) -> bool:
+    """Whether ``_add_info`` keeps ``value`` in an array of its own type."""
+    return type(value) in (int, float, bool) or isinstance(value, np.number)
+
+
 def _empty_column(first, n: int) -> np.ndarray:
     """The array that ``_add_info`` starts a key with, from its first value."""
-    if type(first) in (int, float, bool) or isinstance(first, np.number):
+    if _is_number(first):
         return np.zeros(n, dtype=type(first))
     if isinstance(first, np.ndarray):
         return np.zeros((n,) + first.shape, dtype=first.dtype)
     return np.full(n, None, dtype=object)
 
 
-def _column(first, values: Sequence, n: int) -> np.ndarray | None:
+def _column(first, values: Sequence) -> np.ndarray | None:
     """The column of a key that every sub-environment has, in one call where
     that gives what filling :func:`_empty_column` one by one gives (numbers
     of the first one's type; arrays of one shape and dtype); else None."""
-    if type(first) in (int, float, bool) or isinstance(first, np.number):
-        if all(type(v) in (int, float, bool) or isinstance(v, np.number) for v in values):
-            return np.array(values, dtype=type(first))
-        return None
-    if isinstance(first, np.ndarray):
-        if all(isinstance(v, np.ndarray) and v.shape == first.shape and v.dtype == first.dtype
-               for v in values):
-            return np.stack(values) if n else _empty_column(first, n)
-        return None
+    if _is_number(first):
+        return np.array(values, dtype=type(first)) if all(map(_is_number, values)) else None
+    if isinstance(first, np.ndarray) and all(
+            isinstance(v, np.ndarray) and v.shape == first.shape and v.dtype == first.dtype
+            for v in values):
+        return np.stack(values)
     return None
 
 
