@@ -29,9 +29,18 @@ unchanged. Only the sums of the displacements in the list's expiry test
 are added in another order (the resting floes add zeros): they can differ
 in rounding, which could move a list rebuild by a step in a rare case.
 
-The cost of a step is that of the awake floes and their pairs; a run adds
-one pass over all floes and the list at its start, and the list rebuilds
-(which are over all floes in any case) rebuild the live pairs.
+A live pair found apart is not looked at again until its floes could have
+closed its gap: each awake floe's *path* (the sum of |v| Δt over its drifts
+in the run, plus a bound on their rounding) only grows, and two floes whose
+paths together grew by less than the gap cannot have met
+(:func:`apart_until`). Looking at such a pair gives no force and leaves its
+history at zero, so skipping it changes nothing; touching pairs and pairs
+whose gap is used up are looked at every step, as before.
+
+The cost of a step is that of the awake floes and of their pairs that are
+touching or close; a run adds one pass over all floes and the list at its
+start, and the list rebuilds (which are over all floes in any case) rebuild
+the live pairs.
 """
 from __future__ import annotations
 
@@ -44,8 +53,9 @@ from numba import njit
 from .domain import minimum_image
 from .hertz_kernels import (KICK_FASTMATH, _OK, _SHIP_LOG_FULL, begin_step,
                             floe_drag, floe_rows, floe_walls, force_buffers, from_order_key,
-                            half_kick, kick_drift_floe, list_expired, listed_pair, max_keep_nan,
-                            order_key, pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
+                            half_kick, kick_drift_floe, list_expired, max_keep_nan, order_key,
+                            pair_contact, pass_status, rebuild_in_run, wall_overlap,
+                            wide_floes_pass)
 from .hull_contact import C_CAND, hull_forces, ship_closing_kick
 
 __all__ = ["Awake", "LivePairs", "run_steps_resting"]
@@ -79,6 +89,9 @@ class LivePairs(NamedTuple):
     mark: np.ndarray
     #: (M,) scratch for the pairs of newly woken floes
     scratch: np.ndarray
+    #: (M,) a pair found apart is not looked at again while the sum of its
+    #: floes' paths (:func:`first_half_awake`) stays below this (−∞: every step)
+    due: np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
@@ -158,7 +171,8 @@ def live_pairs(verlet, awake):
             live[n_live] = p
             n_live += 1
     awake.count[2] = n_live
-    return LivePairs(owner, partner_start, as_partner, live, mark, np.empty(m, dtype=np.int64))
+    return LivePairs(owner, partner_start, as_partner, live, mark, np.empty(m, dtype=np.int64),
+                     np.full(m, -np.inf))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -217,12 +231,34 @@ def add_woken(awake, verlet, pairs):
     count[2] += n_new
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def path_slack(lx, ly):
+    """A bound on the rounding error of one drift of a floe's position in a
+    box of lengths (lx, ly) (a few units in the last place of the largest
+    coordinate)."""
+    return 2e-15 * (lx + ly)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def apart_until(dx, dy, rsum, paths):
+    """For a pair apart by (dx, dy) with radii summing to ``rsum``, whose
+    floes' paths sum to ``paths``: the sum of their paths below which they
+    cannot touch. Neither floe can have come closer by more than the length
+    it drifted, so while the sum grows by less than the gap they stay apart;
+    a nanometre and a relative 1e-12 are kept back for rounding."""
+    d = math.sqrt(dx * dx + dy * dy)
+    return paths + (d - rsum) - 1e-9 - 1e-12 * (d + rsum)
+
+
 @njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy", _nrt=False)
-def first_half_awake(floes, ref, drive, kick, awake):
+def first_half_awake(floes, ref, drive, kick, awake, path):
     """:func:`~physics.hertz_kernels.first_half` over the awake floes
     (:func:`~physics.hertz_kernels.kick_drift_floe`, the same arithmetic).
     The largest squared distance from the centre includes that of the
-    resting floes (displacement 0: |centre|²) when there are any."""
+    resting floes (displacement 0: |centre|²) when there are any.
+
+    Each awake floe's ``path`` grows by a bound on the length of its drift,
+    |v| Δt and the rounding of the new position (:func:`path_slack`)."""
     order, n_awake = awake.order, awake.count[0]
     n = floes.inv_mass.shape[0]
     if kick.sx != 1.0 or kick.sy != 1.0:
@@ -238,9 +274,13 @@ def first_half_awake(floes, ref, drive, kick, awake):
     worst = np.uint64(0)
     sdx = 0.0
     sdy = 0.0
+    step_length = kick.dt * (1.0 + 1e-12)
+    slack = path_slack(kick.lx, kick.ly)
     for q in range(n_awake):
-        v2, e2, dx, dy = kick_drift_floe(order[q], p, v, f, floes.omega, floes.torque,
-                                         floes.inv_mass, floes.inv_inertia, r, k, drive, kick)
+        i = order[q]
+        v2, e2, dx, dy = kick_drift_floe(i, p, v, f, floes.omega, floes.torque, floes.inv_mass,
+                                         floes.inv_inertia, r, k, drive, kick)
+        path[i] += math.sqrt(v2) * step_length + slack
         key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
         key = order_key(e2)
@@ -254,31 +294,48 @@ def first_half_awake(floes, ref, drive, kick, awake):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, force, torque):
+def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, path, force, torque):
     """The forces of the live pairs (the loop of
     :func:`~physics.hertz_kernels.owner_pairs` over them: each owner's
     pairs in list order, its sum added at the end), waking the resting
-    floes they touch."""
+    floes they touch.
+
+    A pair found apart is not looked at again until the paths of its two
+    floes have grown by its gap (:func:`apart_until`, ``pairs.due``): until
+    then it cannot touch, and looking would give no force and leave its
+    (zero) history as it is. Not in a deforming box, whose remap moves the
+    floes by more than they drift."""
     pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
                                          floes.inv_mass)
-    live, owner, nbr, hist = pairs.live, pairs.owner, verlet.nbr, verlet.hist
+    live, owner, nbr, hist, due = pairs.live, pairs.owner, verlet.nbr, verlet.hist, pairs.due
     lx, ly = box.lengths[0], box.lengths[1]
     px, py = box.periodic_x, box.periodic_y
+    skip = not box.deforming
     n_live = awake.count[2]
     q = 0
     while q < n_live:
         i = owner[live[q]]
         xi_, yi_ = pos[i, 0], pos[i, 1]
         vxi, vyi, wi, ri, imi = vel[i, 0], vel[i, 1], omega[i], radius[i], inv_mass[i]
+        path_i = path[i]
         fxi = 0.0
         fyi = 0.0
         tqi = 0.0
         touched = False
         while q < n_live and owner[live[q]] == i:
             p = live[q]
+            q += 1
             j = nbr[p]
-            res = listed_pair(p, j, xi_, yi_, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py,
-                              hist, dt_history)
+            paths = path_i + path[j]
+            if paths < due[p]:
+                continue
+            dx = minimum_image(pos[j, 0] - xi_, lx, px)
+            dy = minimum_image(pos[j, 1] - yi_, ly, py)
+            res = pair_contact(dx, dy, ri, radius[j], vxi - vel[j, 0], vyi - vel[j, 1], wi,
+                               omega[j], imi + inv_mass[j], hist[p, 0], hist[p, 1], dt_history,
+                               law)
+            hist[p, 0] = res[5]
+            hist[p, 1] = res[6]
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -288,7 +345,8 @@ def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, force, t
                 torque[j] += res[4]
                 touched = True
                 wake(j, awake)
-            q += 1
+            elif skip:
+                due[p] = apart_until(dx, dy, ri + radius[j], paths)
         if fxi != 0.0 or fyi != 0.0 or tqi != 0.0:
             force[i, 0] += fxi
             force[i, 1] += fyi
@@ -316,17 +374,17 @@ def hull_wakes(ship, awake, force, torque):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf):
+def pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf):
     """The end of a step: the forces of the live pairs added to the drag and
     wall forces already in the buffer, and the floes they woke made live."""
-    live_pair_forces(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
+    live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
     if awake.count[1] > 0:
         add_woken(awake, verlet, pairs)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
-                  awake, pairs, fbuf, tbuf):
+                  awake, pairs, path, fbuf, tbuf):
     """The steps of :func:`run_steps_resting` from ``step`` on, until the run
     is done, fails, or the Verlet list expires (the caller rebuilds it and
     finishes that step). Compiled without reference counting (it allocates
@@ -351,7 +409,7 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
         if status != _OK:
             break
         lx, ly = kick.lx, kick.ly
-        worst, mx, my, vmax2 = first_half_awake(work, verlet.ref, drive, kick, awake)
+        worst, mx, my, vmax2 = first_half_awake(work, verlet.ref, drive, kick, awake, path)
         done += 1
         step += 1
         status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
@@ -371,7 +429,7 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
         if list_expired(worst, lx, ly, verlet):
             expired = True
             break
-        pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
+        pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         if log_full:
             status = _SHIP_LOG_FULL
             break
@@ -397,6 +455,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     work = floe_rows(floes, 0, n, buffers)
     awake = find_awake(floes, drive, box, verlet)
     pairs = live_pairs(verlet, awake)
+    path = np.zeros(n)
     n_rebuilds = 0
     done = 0
     status = _OK
@@ -404,7 +463,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     while step < n_steps:
         step, d, status, expired, log_full, lx, ly = resting_steps(
             step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work, awake,
-            pairs, fbuf, tbuf)
+            pairs, path, fbuf, tbuf)
         done += d
         if not expired:
             break
@@ -416,7 +475,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
             wake(verlet.wide[k], awake)
         pairs = live_pairs(verlet, awake)
         add_woken(awake, verlet, pairs)
-        pair_phase(pairs, awake, floes, law, box, verlet, dt, fbuf, tbuf)
+        pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         if log_full:
             status = _SHIP_LOG_FULL
             break

@@ -213,3 +213,72 @@ def test_bad_arguments():
         HertzSimulation(field, box, CONTACT, None, 1e-3, skip_resting="yes")
     sim = HertzSimulation(field, box, CONTACT, None, 1e-3, skip_resting=True)
     assert not sim.parallel and "skip_resting=True" in repr(sim)
+
+
+def test_apart_until_is_a_bound_on_approach():
+    """The theorem the pair loop relies on (:func:`physics.hertz_resting.apart_until`):
+    two discs that each move by less than their path (sum of the paths
+    below the threshold) cannot touch. Random pairs, random moves of the
+    largest allowed lengths in random directions, in floating point."""
+    from physics.hertz_resting import apart_until
+
+    rng = np.random.default_rng(3)
+    checked = 0
+    for _ in range(20000):
+        ri, rj = rng.uniform(0.5, 30.0, 2)
+        gap = rng.choice([rng.uniform(1e-8, 1e-6), rng.uniform(1e-6, 2.0)])
+        angle = rng.uniform(0.0, 2.0 * np.pi)
+        d = ri + rj + gap
+        xi = rng.uniform(0.0, 1000.0, 2)
+        xj = xi + d * np.array([np.cos(angle), np.sin(angle)])
+        paths = rng.uniform(0.0, 10.0)
+        limit = apart_until(xj[0] - xi[0], xj[1] - xi[1], ri + rj, paths)
+        budget = limit - paths                      # what the two may drift together
+        if budget <= 0.0:
+            continue
+        share = rng.uniform(0.0, 1.0)
+        # each moves straight at the other: the closest approach its path allows
+        u = (xj - xi) / d
+        xi2 = xi + share * budget * u
+        xj2 = xj - (1.0 - share) * budget * u
+        dx, dy = xj2 - xi2
+        assert dx * dx + dy * dy >= (ri + rj) ** 2
+        checked += 1
+    assert checked > 15000
+
+
+def test_pairs_apart_are_not_looked_at_until_their_floes_drifted_their_gap():
+    """After one pass every listed pair that does not touch has a finite
+    threshold, and the pass skips it while the floes' paths stay below it
+    (a pass with the positions moved but the paths not grown gives no force
+    even where the discs now overlap: the skip is what the paths allow, so
+    the paths must bound the drift, which the kick–drift pass ensures). Once
+    the paths pass the threshold the pair is looked at again and pushes."""
+    from physics.hertz_resting import find_awake, live_pair_forces, live_pairs
+
+    positions = [(10.0, 10.0), (12.5, 10.0), (30.0, 30.0)]
+    field = pair_field(positions, [(0.1, 0.0), (0.0, 0.0), (0.0, 0.0)])
+    sim = HertzSimulation(field, PeriodicBox(60.0), CONTACT, None, 1e-3, impact_speed=1.0,
+                          skin=1.0, skip_resting=True)
+    args = sim._kernel_arguments(1)
+    floes, law, _, drive, box = args[1:6]
+    verlet = sim._verlet
+    awake = find_awake(floes, drive, box, verlet)
+    pairs = live_pairs(verlet, awake)
+    n_live = awake.count[2]
+    assert n_live == 1                              # floes 0 and 1, gap 0.5 m
+    p = pairs.live[0]
+    path = np.zeros(3)
+    force, torque = np.zeros((3, 2)), np.zeros(3)
+    live_pair_forces(pairs, awake, floes, law, box, verlet, 1e-3, path, force, torque)
+    assert np.all(force == 0.0)
+    assert pairs.due[p] == pytest.approx(0.5, abs=1e-8)
+    floes.pos[0, 0] = 10.6                          # overlapping by 0.1 m
+    live_pair_forces(pairs, awake, floes, law, box, verlet, 1e-3, path, force, torque)
+    assert np.all(force == 0.0)                     # skipped: the paths said 0
+    path[0] = 0.6                                   # the drift that took it there
+    live_pair_forces(pairs, awake, floes, law, box, verlet, 1e-3, path, force, torque)
+    assert force[0, 0] < 0.0 < force[1, 0]
+    # touching: the threshold stays where it was; the paths never shrink, so
+    # the pair is looked at in every step until it is apart again
+    assert pairs.due[p] <= path[0] + path[1]
