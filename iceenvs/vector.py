@@ -282,7 +282,12 @@ _MISSING = object()
 
 def _is_number(value) -> bool:
     """Whether ``_add_info`` keeps ``value`` in an array of its own type."""
-    return type(value) in (int, float, bool) or isinstance(value, np.number)
+    return _is_number_type(type(value))
+
+
+def _is_number_type(kind: type) -> bool:
+    """Whether values of type ``kind`` are numbers for :func:`_is_number`."""
+    return kind in (int, float, bool) or issubclass(kind, np.number)
 
 
 def _empty_column(first, n: int) -> np.ndarray:
@@ -299,7 +304,9 @@ def _column(first, values: Sequence) -> np.ndarray | None:
     that gives what filling :func:`_empty_column` one by one gives (numbers
     of the first one's type; arrays of one shape and dtype); else None."""
     if _is_number(first):
-        return np.array(values, dtype=type(first)) if all(map(_is_number, values)) else None
+        # the distinct types, each tested once: a column is mostly of one
+        return (np.array(values, dtype=type(first))
+                if all(_is_number_type(t) for t in set(map(type, values))) else None)
     if isinstance(first, np.ndarray) and all(
             isinstance(v, np.ndarray) and v.shape == first.shape and v.dtype == first.dtype
             for v in values):
