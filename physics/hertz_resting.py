@@ -35,7 +35,9 @@ in the run, plus a bound on their rounding) only grows, and two floes whose
 paths together grew by less than the gap cannot have met
 (:func:`apart_until`). Looking at such a pair gives no force and leaves its
 history at zero, so skipping it changes nothing; touching pairs and pairs
-whose gap is used up are looked at every step, as before.
+whose gap is used up are looked at every step, as before. The walls are
+skipped the same way: a floe found clear of every wall is looked at again
+once its path could have closed the smallest gap.
 
 The cost of a step is that of the awake floes and of their pairs that are
 touching or close; a run adds one pass over all floes and the list at its
@@ -356,11 +358,27 @@ def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, path, fo
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def awake_wall_forces(awake, floes, wall_law, box, dt_history, force, torque):
+def awake_wall_forces(awake, floes, wall_law, box, dt_history, path, wall_due, force, torque):
     """:func:`~physics.hertz_kernels.wall_forces` of the awake floes (a
-    resting floe touches no wall)."""
+    resting floe touches no wall). As with the pairs, a floe found clear of
+    every wall is not looked at again until its path (``wall_due``) could
+    have closed the smallest gap; not in a deforming box, whose walls move."""
+    lx, ly = box.lengths[0], box.lengths[1]
+    skip = not box.deforming
+    pos, radius = floes.pos, floes.radius
     for q in range(awake.count[0]):
-        floe_walls(awake.order[q], floes, wall_law, box, dt_history, force, torque)
+        i = awake.order[q]
+        if path[i] < wall_due[i]:
+            continue
+        floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+        if skip:
+            gap = math.inf
+            for side in range(4):
+                if (side < 2 and box.periodic_x) or (side >= 2 and box.periodic_y):
+                    continue
+                gap = min(gap, -wall_overlap(side, pos[i, 0], pos[i, 1], radius[i], lx, ly)[0])
+            if gap > 0.0:
+                wall_due[i] = path[i] + gap - 1e-9 - 1e-12 * (lx + ly)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -384,7 +402,7 @@ def pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf):
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
-                  awake, pairs, path, fbuf, tbuf):
+                  awake, pairs, path, wall_due, fbuf, tbuf):
     """The steps of :func:`run_steps_resting` from ``step`` on, until the run
     is done, fails, or the Verlet list expires (the caller rebuilds it and
     finishes that step). Compiled without reference counting (it allocates
@@ -416,7 +434,7 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
         if status != _OK:
             break
         if walls:
-            awake_wall_forces(awake, floes, wall_law, box, dt, fbuf, tbuf)
+            awake_wall_forces(awake, floes, wall_law, box, dt, path, wall_due, fbuf, tbuf)
         if ship.active:
             log_full = not hull_forces(ship, floes, box, time + step * dt, dt, math.sqrt(vmax2),
                                        fbuf, tbuf)
@@ -456,6 +474,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     awake = find_awake(floes, drive, box, verlet)
     pairs = live_pairs(verlet, awake)
     path = np.zeros(n)
+    wall_due = np.full(n, -np.inf)
     n_rebuilds = 0
     done = 0
     status = _OK
@@ -463,7 +482,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     while step < n_steps:
         step, d, status, expired, log_full, lx, ly = resting_steps(
             step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work, awake,
-            pairs, path, fbuf, tbuf)
+            pairs, path, wall_due, fbuf, tbuf)
         done += d
         if not expired:
             break

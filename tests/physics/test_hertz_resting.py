@@ -282,3 +282,27 @@ def test_pairs_apart_are_not_looked_at_until_their_floes_drifted_their_gap():
     # touching: the threshold stays where it was; the paths never shrink, so
     # the pair is looked at in every step until it is apart again
     assert pairs.due[p] <= path[0] + path[1]
+
+
+def test_walls_are_not_looked_at_until_a_floe_drifted_its_gap():
+    """A floe 0.5 m clear of the wall gets a threshold of its path plus
+    0.5 m; moved into the wall with its path not grown it is skipped (no
+    force), and once its path passes the threshold the wall pushes it."""
+    from physics.hertz_resting import awake_wall_forces, find_awake
+
+    field = pair_field([(1.5, 20.0)], [(-0.1, 0.0)])
+    sim = HertzSimulation(field, WalledBox(40.0), CONTACT, None, 1e-3, impact_speed=1.0,
+                          skip_resting=True)
+    args = sim._kernel_arguments(1)
+    floes, _, wall_law, drive, box = args[1:6]
+    awake = find_awake(floes, drive, box, sim._verlet)
+    path, due = np.zeros(1), np.full(1, -np.inf)
+    force, torque = np.zeros((1, 2)), np.zeros(1)
+    awake_wall_forces(awake, floes, wall_law, box, 1e-3, path, due, force, torque)
+    assert force[0, 0] == 0.0 and due[0] == pytest.approx(0.5, abs=1e-8)
+    floes.pos[0, 0] = 0.9                           # overlapping the wall at x = 0
+    awake_wall_forces(awake, floes, wall_law, box, 1e-3, path, due, force, torque)
+    assert force[0, 0] == 0.0                       # skipped: the path said 0
+    path[0] = 0.6                                   # the drift that took it there
+    awake_wall_forces(awake, floes, wall_law, box, 1e-3, path, due, force, torque)
+    assert force[0, 0] > 0.0
