@@ -278,11 +278,14 @@ def first_half_awake(floes, ref, drive, kick, awake, path):
     sdy = 0.0
     step_length = kick.dt * (1.0 + 1e-12)
     slack = path_slack(kick.lx, kick.ly)
+    # a deforming box moves the floes by more than they drift: no paths
+    track = kick.sx == 1.0 and kick.sy == 1.0
     for q in range(n_awake):
         i = order[q]
         v2, e2, dx, dy = kick_drift_floe(i, p, v, f, floes.omega, floes.torque, floes.inv_mass,
                                          floes.inv_inertia, r, k, drive, kick)
-        path[i] += math.sqrt(v2) * step_length + slack
+        if track:
+            path[i] += math.sqrt(v2) * step_length + slack
         key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
         key = order_key(e2)
@@ -328,9 +331,11 @@ def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, path, fo
             p = live[q]
             q += 1
             j = nbr[p]
-            paths = path_i + path[j]
-            if paths < due[p]:
-                continue
+            paths = 0.0
+            if skip:
+                paths = path_i + path[j]
+                if paths < due[p]:
+                    continue
             dx = minimum_image(pos[j, 0] - xi_, lx, px)
             dy = minimum_image(pos[j, 1] - yi_, ly, py)
             res = pair_contact(dx, dy, ri, radius[j], vxi - vel[j, 0], vyi - vel[j, 1], wi,
@@ -368,7 +373,7 @@ def awake_wall_forces(awake, floes, wall_law, box, dt_history, path, wall_due, f
     pos, radius = floes.pos, floes.radius
     for q in range(awake.count[0]):
         i = awake.order[q]
-        if path[i] < wall_due[i]:
+        if skip and path[i] < wall_due[i]:
             continue
         floe_walls(i, floes, wall_law, box, dt_history, force, torque)
         if skip:
