@@ -55,6 +55,15 @@ def _actions(space, rng, n):
     return rng.uniform(space.low, space.high, (n,) + space.shape).astype(space.dtype)
 
 
+def _warm_up(step, seconds: float):
+    """One ``step()`` (the kernels loaded, however long that takes), then
+    ``step()`` for up to a second more, before a timing starts."""
+    step()
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < min(1.0, seconds):
+        step()
+
+
 def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
                      kwargs: dict | None = None) -> dict:
     """Env steps/s of ``env_id`` stepped ``mode``-wise with ``n``
@@ -98,10 +107,7 @@ def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
         def step():
             env.step(_actions(space, rng, n))
             return n
-    step()                                   # the kernels loaded, then a second of steps
-    t0 = time.perf_counter()
-    while time.perf_counter() - t0 < min(1.0, seconds):
-        step()
+    _warm_up(step, seconds)
     steps = 0
     t0 = time.perf_counter()
     while True:
@@ -139,83 +145,103 @@ def measure_phases(env_id: str, seconds: float, seed: int, n: int,
                    kwargs: dict | None = None) -> dict:
     """Where a step's time goes, in this process: per env step, the engine
     (``sim.advance``; the native vector environment's ``advance_together``
-    over its ``n`` sub-environments) and the rest (action, measurements,
-    observation, reward), for the single environment on one thread and the
-    native vector environment; and the engine's time per engine sub-step in
-    the environment's field and in a nearly empty one (the fixed cost of a
-    sub-step: the ship's and the loop's)."""
+    over its ``n`` sub-environments) and the rest of the environment's own
+    ``step`` (action, measurements, observation, reward, info, resets), for
+    the single environment on one thread and the native vector environment;
+    and the engine's time per engine sub-step in the environment's field and
+    in a nearly empty one (the fixed cost of a sub-step: the ship's and the
+    loop's). The steps are the environments' real ones, random actions; the
+    engine calls are timed from inside them (:class:`_EngineClock`)."""
     import gymnasium as gym
     import numpy as np
 
     import iceenvs  # noqa: F401
-    from physics.hertz import advance_together
+    from iceenvs.ship_env import ShipEnv
 
     rng = np.random.default_rng(seed)
     out = {}
-    env = gym.make(env_id, **(kwargs or {})).unwrapped
+
+    def timed(env, per_env: int):
+        """Per env step: engine and rest [ms], engine per sub-step [ns], mean
+        floes and awake floes, over ``seconds`` of ``env.step``."""
+        def step():
+            _, _, terminated, truncated, _ = env.step(rng.uniform(-1, 1, env.action_space.shape))
+            if per_env == 1 and (terminated or truncated):
+                env.reset()
+
+        _warm_up(step, seconds)
+        with _EngineClock() as clock:
+            count = 0
+            t0 = time.perf_counter()
+            while time.perf_counter() - t0 < seconds:
+                step()
+                count += 1
+            total = time.perf_counter() - t0
+        steps = count * per_env
+        return dict(engine_ms=1e3 * clock.seconds / steps,
+                    rest_ms=1e3 * (total - clock.seconds) / steps,
+                    substep_ns=1e9 * clock.seconds / clock.substeps,
+                    floes=clock.floes / clock.sims, awake=clock.awake / clock.sims)
+
+    env = gym.make(env_id, **(kwargs or {}))
     env.reset(seed=seed)
-
-    def single_step(e):
-        a, replaced = e._take_action(rng.uniform(-1, 1, e.action_space.shape))
-        e._apply_action(a)
-        t0 = time.perf_counter()
-        e.sim.advance(e.control_interval)
-        t1 = time.perf_counter()
-        floes = (e.sim.n_floes, e.sim.n_awake)
-        e._advanced()
-        _, _, term, _, _ = e._finish_step(a, replaced, e._measure())
-        if term or e._steps >= 200:
-            e.reset()
-        return t1 - t0, time.perf_counter() - t1, round(e.control_interval / e.sim.dt), floes
-
-    def timed(step):
-        engine = rest = substeps = count = floes = awake = 0
-        t0 = time.perf_counter()
-        while time.perf_counter() - t0 < seconds:
-            a, b, c, (f, w) = step()
-            engine, rest, substeps, count = engine + a, rest + b, substeps + c, count + 1
-            floes, awake = floes + f, awake + w
-        return dict(engine_ms=1e3 * engine / count, rest_ms=1e3 * rest / count,
-                    substep_ns=1e9 * engine / substeps, floes=floes / count,
-                    awake=awake / count)
-
-    single_step(env)
-    out["single"] = timed(lambda: single_step(env))
-    from iceenvs.ship_env import ShipEnv
-
-    if isinstance(env, ShipEnv):
-        empty = gym.make(env_id, **{**(kwargs or {}), "concentration": 0.05}).unwrapped
+    out["single"] = timed(env, 1)
+    if isinstance(env.unwrapped, ShipEnv):
+        empty = gym.make(env_id, **{**(kwargs or {}), "concentration": 0.05})
         empty.reset(seed=seed)
-        single_step(empty)
-        out["empty"] = timed(lambda: single_step(empty))
+        out["empty"] = timed(empty, 1)
     envs = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point",
                         **(kwargs or {}))
     envs.reset(seed=seed)
-    subs = envs.unwrapped.envs
-    lists = envs.unwrapped._lists           # the typed lists the environment's own step keeps
-
-    def vector_step():
-        taken = []
-        for e in subs:
-            a, replaced = e._take_action(rng.uniform(-1, 1, e.action_space.shape))
-            e._apply_action(a)
-            taken.append((a, replaced))
-        t0 = time.perf_counter()
-        advance_together([e.sim for e in subs], subs[0].control_interval, lists=lists)
-        t1 = time.perf_counter()
-        floes = (sum(e.sim.n_floes for e in subs) / n, sum(e.sim.n_awake for e in subs) / n)
-        for e, (a, replaced) in zip(subs, taken):
-            e._advanced()
-            _, _, term, _, _ = e._finish_step(a, replaced, e._measure())
-            if term or e._steps >= 200:
-                e.reset()
-        return (t1 - t0) / n, (time.perf_counter() - t1) / n, round(
-            subs[0].control_interval / subs[0].sim.dt), floes
-
-    vector_step()
-    out["native"] = timed(vector_step)
+    out["native"] = timed(envs, n)
     envs.close()
     return dict(id=env_id, n=n, **out)
+
+
+class _EngineClock:
+    """Within its ``with`` block, times every engine call of the
+    environments (``HertzSimulation.advance`` and the native vector
+    environment's ``advance_together``) and counts their sub-steps and
+    floes; the calls themselves are unchanged."""
+
+    def __enter__(self):
+        import iceenvs.vector
+        from physics.hertz import HertzSimulation
+
+        self.seconds = 0.0
+        self.substeps = self.sims = self.floes = self.awake = 0
+        self._saved = [(HertzSimulation, "advance", HertzSimulation.advance),
+                       (iceenvs.vector, "advance_together", iceenvs.vector.advance_together)]
+        advance, together = (saved[2] for saved in self._saved)
+
+        def timed_advance(sim, duration):
+            t0 = time.perf_counter()
+            advance(sim, duration)
+            self.seconds += time.perf_counter() - t0
+            self._count([sim], duration)
+
+        def timed_together(sims, duration, **kwargs):
+            t0 = time.perf_counter()
+            errors = together(sims, duration, **kwargs)
+            self.seconds += time.perf_counter() - t0
+            self._count(sims, duration)
+            return errors
+
+        HertzSimulation.advance = timed_advance
+        iceenvs.vector.advance_together = timed_together
+        return self
+
+    def _count(self, sims, duration):
+        for sim in sims:
+            self.substeps += round(duration / sim.dt)
+            self.sims += 1
+            self.floes += sim.n_floes
+            self.awake += sim.n_awake
+
+    def __exit__(self, *exc):
+        for owner, name, value in self._saved:
+            setattr(owner, name, value)
+        return False
 
 
 def lambda_phases(mode: str, *args) -> dict:
@@ -331,9 +357,11 @@ def phases_table(result: dict) -> dict:
         f"{ph['id']}: where the time of a step goes",
         ["case", "engine [ms/step]", "engine per sub-step [ns]",
          "the rest of the step [ms/step]", "floes", "awake floes"], rows,
-        "The engine is the compiled step over the control interval (about 1500 sub-steps of "
-        "Δt); the rest is the action, the measurements, the observation and the reward, in "
-        "Python. The sparse field (a few floes) shows the fixed cost of a sub-step: the "
+        "The environments' own steps are timed, with their engine calls timed from inside "
+        "them. The engine is the compiled step over the control interval (about 1500 "
+        "sub-steps of Δt) with the Python that prepares and reads it; the rest is the action, "
+        "the measurements, the observation, the reward, the info and the resets of ended "
+        "episodes, in Python. The sparse field (a few floes) shows the fixed cost of a sub-step: the "
         "ship's kick–drift, its contact pass and step record, and the loop. Floes and awake "
         "floes are means over the timed steps (per sub-environment); a floe at rest costs "
         "nothing (skip_resting), an awake one its kick–drift and its pairs at every sub-step. "

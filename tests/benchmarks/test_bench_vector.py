@@ -38,3 +38,31 @@ def test_an_environment_without_a_native_vector_env_is_refused(capsys):
     with pytest.raises(SystemExit):
         vector.main(["--ids", "ThicknessDistribution-v0", "--no-json"])
     assert "has no native vector environment" in capsys.readouterr().err
+
+
+def test_engine_clock_times_the_engine_calls_and_puts_them_back():
+    """The phase timing counts each engine call of a real step (the single
+    environment's ``advance`` and the vector environment's
+    ``advance_together``) and leaves both as they were."""
+    import gymnasium as gym
+
+    import iceenvs.vector
+    from physics.hertz import HertzSimulation
+
+    advance, together = HertzSimulation.advance, iceenvs.vector.advance_together
+    env = gym.make("iceenvs/ShipNavigation-v0", concentration=0.05)
+    env.reset(seed=0)
+    envs = gym.make_vec("iceenvs/ShipNavigation-v0", num_envs=2,
+                        vectorization_mode="vector_entry_point", concentration=0.05)
+    envs.reset(seed=0)
+    with vector._EngineClock() as clock:
+        env.step(env.action_space.sample())
+        envs.step(envs.action_space.sample())
+    sim = env.unwrapped.sim
+    per_step = round(env.unwrapped.control_interval / sim.dt)
+    assert clock.sims == 3
+    assert clock.substeps == per_step + sum(
+        round(e.control_interval / e.sim.dt) for e in envs.unwrapped.envs)
+    assert clock.seconds > 0.0 and clock.floes >= sim.n_floes
+    assert HertzSimulation.advance is advance
+    assert iceenvs.vector.advance_together is together
