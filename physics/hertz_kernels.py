@@ -327,6 +327,41 @@ def floe_drag(vx, vy, w, a, b, c, g, uax, uay, uwx, uwy, wind_speed):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def path_slack(lx, ly):
+    """A bound on the rounding error of one drift of a floe's position in a
+    box of lengths (lx, ly) (a few units in the last place of the largest
+    coordinate)."""
+    return 2e-15 * (lx + ly)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def apart_until(dx, dy, rsum, paths):
+    """For a pair apart by (dx, dy) with radii summing to ``rsum``, whose
+    floes' paths sum to ``paths``: the sum of their paths below which they
+    cannot touch. Neither floe can have come closer by more than the length
+    it drifted, so while the sum grows by less than the gap they stay apart;
+    a nanometre and a relative 1e-12 are kept back for rounding."""
+    d = math.sqrt(dx * dx + dy * dy)
+    return paths + (d - rsum) - 1e-9 - 1e-12 * (d + rsum)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def walls_apart_until(i, floes, box, path_i):
+    """For floe i, whose path is ``path_i``: the path below which it cannot
+    touch a wall of the box (−∞ when it touches one now)."""
+    pos, radius = floes.pos, floes.radius
+    lx, ly = box.lengths[0], box.lengths[1]
+    gap = math.inf
+    for side in range(4):
+        if (side < 2 and box.periodic_x) or (side >= 2 and box.periodic_y):
+            continue
+        gap = min(gap, -wall_overlap(side, pos[i, 0], pos[i, 1], radius[i], lx, ly)[0])
+    if gap > 0.0:
+        return path_i + gap - 1e-9 - 1e-12 * (lx + ly)
+    return -math.inf
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def wrap_once(x, length, periodic):
     """Wrap a coordinate that moved by less than one box length in a step
     into [0, length) (compares and selects only: no branch, no division,
@@ -372,11 +407,20 @@ def min_image_step(d, length, periodic):
 # ---------------------------------------------------------------------------
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def wall_forces(i_lo, i_hi, floes, wall_law, box, dt_history, force, torque):
+def wall_forces(i_lo, i_hi, floes, wall_law, box, dt_history, force, torque, path=None,
+                wall_due=None):
     """Add the forces of the rigid walls of non-periodic sides to floes
-    i_lo..i_hi−1 (and advance their history ``floes.wall_hist``)."""
+    i_lo..i_hi−1 (and advance their history ``floes.wall_hist``). With the
+    floes' ``path`` and ``wall_due`` (the serial step in a rigid box), a
+    floe found clear of the walls is not looked at again until its path
+    passes :func:`walls_apart_until`: such a look gives no force and leaves
+    the (zero) history as it is."""
     for i in range(i_lo, i_hi):
-        floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+        if wall_due is None:
+            floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+        elif path[i] >= wall_due[i]:
+            floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+            wall_due[i] = walls_apart_until(i, floes, box, path[i])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -434,7 +478,7 @@ def listed_pair(p, j, xi, yi, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py,
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, torque, j_lo, j_hi,
-                force_out, torque_out):
+                force_out, torque_out, path=None, due=None):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
     both floes of its pair at once (a scatter into ``force``, ``torque``;
     for a partner j outside j_lo ≤ j < j_hi into ``force_out``,
@@ -443,7 +487,12 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
     Only floes that touch are written: in loose ice most listed pairs are
     apart, and a write of zero would still claim the cache line for this
     thread, so that the thread doing the kick of that floe would have to
-    fetch it back (see :func:`first_half_parallel`)."""
+    fetch it back (see :func:`first_half_parallel`).
+
+    With the floes' ``path`` and the pairs' ``due`` (the serial step in a
+    rigid box), a pair found apart is not looked at again until the paths
+    of its floes pass :func:`apart_until` (as in
+    :func:`physics.hertz_resting.live_pair_forces`)."""
     pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
                                          floes.inv_mass)
     start, nbr, hist = verlet.start, verlet.nbr, verlet.hist
@@ -458,8 +507,17 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
         tqi = 0.0
         for p in range(start[i], start[i + 1]):
             j = nbr[p]
+            paths = 0.0
+            if due is not None:
+                paths = path[i] + path[j]
+                if paths < due[p]:
+                    continue
             res = listed_pair(p, j, xi_, yi_, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py,
                               hist, dt_history)
+            if due is not None and not res[0]:
+                due[p] = apart_until(minimum_image(pos[j, 0] - xi_, lx, px),
+                                     minimum_image(pos[j, 1] - yi_, ly, py), ri + radius[j],
+                                     paths)
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -633,7 +691,7 @@ KICK_FASTMATH = {"reassoc"}
 
 
 @njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy", _nrt=False)
-def first_half(floes, ref, drive, kick):
+def first_half(floes, ref, drive, kick, path=None):
     """Kick–drift of the floes ``floes`` (all of them, or the views of a
     run of them) with their forces ``floes.force``, ``floes.torque``, their
     displacement since the list build, and their new drag forces.
@@ -658,7 +716,12 @@ def first_half(floes, ref, drive, kick):
     ``python -m benchmarks.hertz_phases``). Its per-floe arithmetic is the
     same in the vector body and in the scalar remainder, so the new state
     does not depend on how the floes are cut into chunks; only the sums are
-    reassociated."""
+    reassociated.
+
+    With ``path`` (the serial step), each floe's path grows by a bound on
+    the length of its drift, |v| Δt and the rounding of the new position
+    (:func:`path_slack`), in a rigid box (a deforming one remaps the floes
+    by more than they drift)."""
     omega, torque = floes.omega, floes.torque
     inv_mass, inv_inertia = floes.inv_mass, floes.inv_inertia
     sx, sy = kick.sx, kick.sy
@@ -676,9 +739,14 @@ def first_half(floes, ref, drive, kick):
     worst = np.uint64(0)
     sdx = 0.0
     sdy = 0.0
+    rigid = sx == 1.0 and sy == 1.0
+    step_length = kick.dt * (1.0 + 1e-12) if rigid else 0.0
+    slack = path_slack(kick.lx, kick.ly) if rigid else 0.0
     for i in range(n):
         v2, e2, dx, dy = kick_drift_floe(i, p, v, f, omega, torque, inv_mass, inv_inertia, r, k,
                                          drive, kick)
+        if path is not None:
+            path[i] += math.sqrt(v2) * step_length + slack
         key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
         key = order_key(e2)
@@ -1185,6 +1253,12 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     work = floe_rows(floes, 0, n, buffers)
     n_rebuilds = 0
     chunks = pair_chunks(verlet, n_pair)
+    # the serial step skips the looks at pairs and walls that cannot touch
+    # (the paths of owner_pairs, wall_forces); the parallel one looks at all
+    path = np.zeros(n)
+    due = np.full(verlet.nbr.shape[0], -np.inf)
+    wall_due = np.full(n, -np.inf)
+    skip = not (parallel or box.deforming)
     done = 0
     status = _OK
     # parallel path in a periodic box: a team of threads that stays in one
@@ -1227,7 +1301,7 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
                 worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
                                                            verlet.ref, drive, kick)
             else:
-                worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick)
+                worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
             done += 1
             step += 1
             status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
@@ -1237,6 +1311,9 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
                 if parallel:
                     wall_forces_parallel(floes, wall_law, box, dt, buffers.force[0],
                                          buffers.torque[0])
+                elif skip:
+                    wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
+                                buffers.torque[0], path, wall_due)
                 else:
                     wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
                                 buffers.torque[0])
@@ -1251,10 +1328,16 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, box.deforming,
                                     dt)
             chunks = pair_chunks(verlet, n_pair)
+            due = np.full(verlet.nbr.shape[0], -np.inf)
             n_rebuilds += 1
         # drag and wall forces are already in buffer 0; add the pair forces
         if parallel:
             pair_forces_parallel(chunks, floes, law, box, verlet, dt, buffers)
+        elif skip:
+            owners = chunks.owners
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,
+                        buffers.force[0], buffers.torque[0], 0, n, buffers.force[0],
+                        buffers.torque[0], path, due)
         else:
             owners = chunks.owners
             owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,

@@ -216,11 +216,11 @@ def test_bad_arguments():
 
 
 def test_apart_until_is_a_bound_on_approach():
-    """The theorem the pair loop relies on (:func:`physics.hertz_resting.apart_until`):
+    """The theorem the pair loops rely on (:func:`physics.hertz_kernels.apart_until`):
     two discs that each move by less than their path (sum of the paths
     below the threshold) cannot touch. Random pairs, random moves of the
     largest allowed lengths in random directions, in floating point."""
-    from physics.hertz_resting import apart_until
+    from physics.hertz_kernels import apart_until
 
     rng = np.random.default_rng(3)
     checked = 0
