@@ -335,6 +335,17 @@ def path_slack(lx, ly):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def drift_bound(kick):
+    """(length per unit speed, constant) of the bound on one drift that a
+    floe's path grows by: Δt (1 + 1e-12) and :func:`path_slack`; zeros for
+    a deforming box, which remaps the floes by more than they drift (there
+    the paths are not used)."""
+    if kick.sx != 1.0 or kick.sy != 1.0:
+        return 0.0, 0.0
+    return kick.dt * (1.0 + 1e-12), path_slack(kick.lx, kick.ly)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def apart_until(dx, dy, rsum, paths):
     """For a pair apart by (dx, dy) with radii summing to ``rsum``, whose
     floes' paths sum to ``paths``: the sum of their paths below which they
@@ -418,9 +429,18 @@ def wall_forces(i_lo, i_hi, floes, wall_law, box, dt_history, force, torque, pat
     for i in range(i_lo, i_hi):
         if wall_due is None:
             floe_walls(i, floes, wall_law, box, dt_history, force, torque)
-        elif path[i] >= wall_due[i]:
-            floe_walls(i, floes, wall_law, box, dt_history, force, torque)
-            wall_due[i] = walls_apart_until(i, floes, box, path[i])
+        else:
+            floe_walls_skipping(i, floes, wall_law, box, dt_history, force, torque, path,
+                                wall_due)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def floe_walls_skipping(i, floes, wall_law, box, dt_history, force, torque, path, wall_due):
+    """:func:`floe_walls` of floe i once its path has passed ``wall_due[i]``
+    (then the next threshold, :func:`walls_apart_until`); nothing before."""
+    if path[i] >= wall_due[i]:
+        floe_walls(i, floes, wall_law, box, dt_history, force, torque)
+        wall_due[i] = walls_apart_until(i, floes, box, path[i])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -459,18 +479,14 @@ def drag_forces(i_lo, i_hi, floes, drive, force, torque):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def listed_pair(p, j, xi, yi, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py, hist,
-                dt_history):
-    """:func:`pair_contact` of pair p of a Verlet list, owner i (its centre,
+def listed_pair(p, j, dx, dy, vxi, vyi, wi, ri, imi, floes, law, hist, dt_history):
+    """:func:`pair_contact` of pair p of a Verlet list, owner i (its
     velocity, angular velocity, radius and inverse mass given) and partner
-    j, in a box of lengths (lx, ly), with the pair's history ``hist[p]``
-    advanced."""
-    pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
-                                         floes.inv_mass)
-    res = pair_contact(minimum_image(pos[j, 0] - xi, lx, px),
-                       minimum_image(pos[j, 1] - yi, ly, py), ri, radius[j], vxi - vel[j, 0],
-                       vyi - vel[j, 1], wi, omega[j], imi + inv_mass[j], hist[p, 0], hist[p, 1],
-                       dt_history, law)
+    j, their minimum-image separation (dx, dy) = x_j − x_i given, with the
+    pair's history ``hist[p]`` advanced."""
+    vel, omega, radius, inv_mass = floes.vel, floes.omega, floes.radius, floes.inv_mass
+    res = pair_contact(dx, dy, ri, radius[j], vxi - vel[j, 0], vyi - vel[j, 1], wi, omega[j],
+                       imi + inv_mass[j], hist[p, 0], hist[p, 1], dt_history, law)
     hist[p, 0] = res[5]
     hist[p, 1] = res[6]
     return res
@@ -512,12 +528,11 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
                 paths = path[i] + path[j]
                 if paths < due[p]:
                     continue
-            res = listed_pair(p, j, xi_, yi_, vxi, vyi, wi, ri, imi, floes, law, lx, ly, px, py,
-                              hist, dt_history)
+            dx = minimum_image(pos[j, 0] - xi_, lx, px)
+            dy = minimum_image(pos[j, 1] - yi_, ly, py)
+            res = listed_pair(p, j, dx, dy, vxi, vyi, wi, ri, imi, floes, law, hist, dt_history)
             if due is not None and not res[0]:
-                due[p] = apart_until(minimum_image(pos[j, 0] - xi_, lx, px),
-                                     minimum_image(pos[j, 1] - yi_, ly, py), ri + radius[j],
-                                     paths)
+                due[p] = apart_until(dx, dy, ri + radius[j], paths)
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -739,9 +754,7 @@ def first_half(floes, ref, drive, kick, path=None):
     worst = np.uint64(0)
     sdx = 0.0
     sdy = 0.0
-    rigid = sx == 1.0 and sy == 1.0
-    step_length = kick.dt * (1.0 + 1e-12) if rigid else 0.0
-    slack = path_slack(kick.lx, kick.ly) if rigid else 0.0
+    step_length, slack = drift_bound(kick)
     for i in range(n):
         v2, e2, dx, dy = kick_drift_floe(i, p, v, f, omega, torque, inv_mass, inv_inertia, r, k,
                                          drive, kick)

@@ -56,10 +56,10 @@ from numba import njit
 
 from .domain import minimum_image
 from .hertz_kernels import (KICK_FASTMATH, _OK, _SHIP_LOG_FULL, apart_until, begin_step,
-                            first_half, floe_drag, floe_rows, floe_walls, force_buffers,
-                            from_order_key, half_kick, kick_drift_floe, list_expired,
-                            max_keep_nan, order_key, pair_contact, pass_status, path_slack,
-                            rebuild_in_run, wall_overlap, walls_apart_until, wide_floes_pass)
+                            drift_bound, first_half, floe_drag, floe_rows, floe_walls,
+                            floe_walls_skipping, force_buffers, from_order_key, half_kick,
+                            kick_drift_floe, list_expired, listed_pair, max_keep_nan, order_key,
+                            pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
 from .hull_contact import C_CAND, hull_forces, ship_closing_kick
 
 __all__ = ["Awake", "LivePairs", "run_steps_resting"]
@@ -244,7 +244,7 @@ def first_half_awake(floes, ref, drive, kick, awake, path):
 
     Each awake floe's ``path`` grows by a bound on the length of its drift,
     |v| Δt and the rounding of the new position
-    (:func:`~physics.hertz_kernels.path_slack`).
+    (:func:`~physics.hertz_kernels.drift_bound`).
 
     With half the floes or more awake, the pass runs over all of them
     instead, in :func:`~physics.hertz_kernels.first_half`, whose loop
@@ -269,16 +269,12 @@ def first_half_awake(floes, ref, drive, kick, awake, path):
     worst = np.uint64(0)
     sdx = 0.0
     sdy = 0.0
-    step_length = kick.dt * (1.0 + 1e-12)
-    slack = path_slack(kick.lx, kick.ly)
-    # a deforming box moves the floes by more than they drift: no paths
-    track = kick.sx == 1.0 and kick.sy == 1.0
+    step_length, slack = drift_bound(kick)
     for q in range(n_awake):
         i = order[q]
         v2, e2, dx, dy = kick_drift_floe(i, p, v, f, floes.omega, floes.torque, floes.inv_mass,
                                          floes.inv_inertia, r, k, drive, kick)
-        if track:
-            path[i] += math.sqrt(v2) * step_length + slack
+        path[i] += math.sqrt(v2) * step_length + slack
         key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
         key = order_key(e2)
@@ -332,11 +328,7 @@ def live_pair_forces(pairs, awake, floes, law, box, verlet, dt_history, path, fo
                     continue
             dx = minimum_image(pos[j, 0] - xi_, lx, px)
             dy = minimum_image(pos[j, 1] - yi_, ly, py)
-            res = pair_contact(dx, dy, ri, radius[j], vxi - vel[j, 0], vyi - vel[j, 1], wi,
-                               omega[j], imi + inv_mass[j], hist[p, 0], hist[p, 1], dt_history,
-                               law)
-            hist[p, 0] = res[5]
-            hist[p, 1] = res[6]
+            res = listed_pair(p, j, dx, dy, vxi, vyi, wi, ri, imi, floes, law, hist, dt_history)
             if res[0]:
                 fxi += res[1]
                 fyi += res[2]
@@ -366,11 +358,11 @@ def awake_wall_forces(awake, floes, wall_law, box, dt_history, path, wall_due, f
     skip = not box.deforming
     for q in range(awake.count[0]):
         i = awake.order[q]
-        if skip and path[i] < wall_due[i]:
-            continue
-        floe_walls(i, floes, wall_law, box, dt_history, force, torque)
         if skip:
-            wall_due[i] = walls_apart_until(i, floes, box, path[i])
+            floe_walls_skipping(i, floes, wall_law, box, dt_history, force, torque, path,
+                                wall_due)
+        else:
+            floe_walls(i, floes, wall_law, box, dt_history, force, torque)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
