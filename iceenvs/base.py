@@ -58,8 +58,8 @@ from physics.markdown import table_row
 from .observations import FLOE_FEATURES, Feature, normalise
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
-           "sanitise_action", "choice", "scaled_contact", "hertz_time_step", "REWARD_RANGE",
-           "TIME_FEATURE", "task_table", "MAX_WIND", "PHYSICS_ERRORS"]
+           "sanitise_action", "sanitise_actions", "choice", "scaled_contact", "hertz_time_step",
+           "REWARD_RANGE", "TIME_FEATURE", "task_table", "MAX_WIND", "PHYSICS_ERRORS"]
 
 #: every per-step reward of the built-in tasks lies in this range
 REWARD_RANGE = (0.0, 1.0)
@@ -90,8 +90,18 @@ def sanitise_action(action, space: gym.spaces.Box) -> tuple[np.ndarray, int]:
         else:
             raise ValueError(f"an action of shape {a.shape}; this environment takes actions "
                              f"of shape {space.shape} (its action_space is {space})")
-    replaced = int(np.count_nonzero(~np.isfinite(a)))
-    if replaced:
+    a, replaced = sanitise_actions(a[None], space)
+    return a[0], int(replaced[0])
+
+
+def sanitise_actions(actions: np.ndarray, space: gym.spaces.Box) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sanitise_action` of a batch: ``actions`` (M,) + the space's
+    shape, float64; returns the sanitised copy and the number of non-finite
+    entries of each action (M,)."""
+    a = np.array(actions, dtype=np.float64)
+    bad = ~np.isfinite(a)
+    replaced = np.count_nonzero(bad.reshape(a.shape[0], -1), axis=1)
+    if replaced.any():
         a[np.isnan(a)] = 0.0
     return np.clip(a, space.low, space.high), replaced
 
@@ -558,6 +568,9 @@ class HertzEnv(FloeEnv):
     """
 
     impact_speed = 1.0
+    #: the class its native vector environment derives from (:func:`iceenvs.vector.vector_class`);
+    #: None: :class:`iceenvs.vector.HertzVectorEnv`
+    vector_base = None
 
     def _hertz_sim(self, field, box, forcing):
         from physics import HertzSimulation

@@ -27,14 +27,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
+from numba import njit
 
 from physics import cluster_statistics, find_clusters
 from physics.markdown import table_row
 
-__all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "log_stress",
-           "feature_table"]
+__all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "normalise_rows",
+           "log_stress", "feature_table"]
 
 STRESS_REF = 1.0          # N/m
 TEMPERATURE_REF = 1e-6    # m²/s²
@@ -55,41 +57,8 @@ class Feature:
 
 def log_stress(s):
     """sign(s) log10(1 + |s| / 1 N/m)."""
-    return math.copysign(math.log10(1.0 + abs(s) / STRESS_REF), s)
+    return float(_scaled(1, float(s)))
 
-
-def _identity(x):
-    return x
-
-
-def _velocity(x):
-    return x / 1.0
-
-
-def _temperature(x):
-    return math.log10(1.0 + max(x, 0.0) / TEMPERATURE_REF)
-
-
-def _rate(x):
-    return math.log10(1.0 + max(x, 0.0) / RATE_REF)
-
-
-def _exponent(x):
-    return 0.0 if not math.isfinite(x) else x
-
-
-def _distance(x):
-    return x / 100.0
-
-
-def _yaw_rate(x):
-    return x / 0.1
-
-
-_SCALERS = {"none": _identity, "log stress": log_stress, "/ 1 m/s": _velocity,
-            "log temperature": _temperature, "log rate": _rate,
-            "exponent": _exponent, "log force": log_stress, "/ 100 m": _distance,
-            "/ 0.1 rad/s": _yaw_rate}
 
 FLOE_FEATURES: tuple[Feature, ...] = (
     Feature("concentration", "ice concentration A = floe area / box area", "-", "none", 0.0, 1.0),
@@ -169,13 +138,70 @@ def floe_physics(positions, velocities, masses, radii, box, contacts, stress_ten
 
 def normalise(raw: dict, features) -> np.ndarray:
     """The float32 vector of ``features`` from a raw dict, scaled and clipped
-    into each feature's bounds; a non-finite value becomes 0."""
-    out = np.empty(len(features), dtype=np.float32)
-    for k, f in enumerate(features):
-        x = _SCALERS[f.scaling](float(raw[f.name]))
-        if not math.isfinite(x):
-            x = 0.0
-        out[k] = min(max(x, f.low), f.high)
+    into each feature's bounds; a non-finite value becomes 0
+    (:func:`normalise_rows` of one row)."""
+    row = np.array([[float(raw[f.name]) for f in features]])
+    return normalise_rows(row, features)[0]
+
+
+def normalise_rows(raw: np.ndarray, features) -> np.ndarray:
+    """:func:`normalise` of many raw measurements at once: ``raw`` (M,
+    len(features)) holds one measurement per row, its columns the raw
+    values of ``features``; returns the (M, len(features)) float32 array of
+    their vectors, in one compiled call. A single environment calls it with
+    one row, a vector environment with one row per sub-environment: the
+    same arithmetic, so the same numbers."""
+    codes, low, high = _feature_arrays(tuple(features))
+    raw = np.ascontiguousarray(raw, dtype=np.float64)
+    if raw.ndim != 2 or raw.shape[1] != codes.size:
+        raise ValueError(f"raw must be an (M, {codes.size}) array (one column per feature), "
+                         f"got shape {raw.shape}")
+    return _normalise_rows(raw, codes, low, high)
+
+
+#: the scalings (the names of the module docstring) as the codes of :func:`_scaled`
+_SCALING_CODES = {"none": 0, "log stress": 1, "log force": 1, "/ 1 m/s": 2,
+                  "log temperature": 3, "log rate": 4, "exponent": 5, "/ 100 m": 6,
+                  "/ 0.1 rad/s": 7}
+
+
+@lru_cache(maxsize=64)
+def _feature_arrays(features: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The scaling codes and the bounds of ``features``, as arrays."""
+    return (np.array([_SCALING_CODES[f.scaling] for f in features], dtype=np.int64),
+            np.array([f.low for f in features], dtype=np.float64),
+            np.array([f.high for f in features], dtype=np.float64))
+
+
+@njit(cache=True, error_model="numpy")
+def _scaled(code, x):
+    """The scaling ``code`` of :data:`_SCALING_CODES` applied to ``x``."""
+    if code == 1:
+        return math.copysign(math.log10(1.0 + abs(x) / STRESS_REF), x)
+    if code == 2:
+        return x / 1.0
+    if code == 3:
+        return math.log10(1.0 + max(x, 0.0) / TEMPERATURE_REF)
+    if code == 4:
+        return math.log10(1.0 + max(x, 0.0) / RATE_REF)
+    if code == 5:
+        return x if math.isfinite(x) else 0.0
+    if code == 6:
+        return x / 100.0
+    if code == 7:
+        return x / 0.1
+    return x
+
+
+@njit(cache=True, error_model="numpy")
+def _normalise_rows(raw, codes, low, high):
+    out = np.empty(raw.shape, dtype=np.float32)
+    for m in range(raw.shape[0]):
+        for k in range(raw.shape[1]):
+            x = _scaled(codes[k], raw[m, k])
+            if not math.isfinite(x):
+                x = 0.0
+            out[m, k] = min(max(x, low[k]), high[k])
     return out
 
 

@@ -24,7 +24,9 @@ the channel), plus a bonus on the step that reaches the goal. A failure
 (beset, a physics failure, leaving a walled channel) ends the episode
 with −``failure_penalty``, below any sum of penalties a step can carry, so
 that ending early never pays there either. :func:`ship_reward_bounds`
-gives the bounds of one step.
+gives the bounds of one step. Their functions also take columns, dicts of
+arrays with one entry per sub-environment, as the native vector
+environments pass them (:class:`iceenvs.ship_measures.ShipVectorEnv`).
 """
 from __future__ import annotations
 
@@ -39,8 +41,9 @@ __all__ = ["excess", "safety", "closeness", "wind_drift_reward", "convergence_re
 
 
 def excess(value: float, threshold: float) -> float:
-    """How far ``value`` is above ``threshold``, relative to it (0 below)."""
-    return max(0.0, value / threshold - 1.0)
+    """How far ``value`` is above ``threshold``, relative to it (0 below);
+    elementwise for arrays."""
+    return np.maximum(0.0, value / threshold - 1.0)
 
 
 def safety(value: float, threshold: float, weight: float = 1.0) -> float:
@@ -121,7 +124,7 @@ def ship_progress(prev, now, step_length: float) -> float:
     """Distance gained towards the goal line over the step,
     (d_prev − d_now) / ``step_length`` [m], clipped to [−1, 1]."""
     gained = (prev["goal_distance"] - now["goal_distance"]) / step_length
-    return min(1.0, max(-1.0, gained))
+    return np.minimum(1.0, np.maximum(-1.0, gained))
 
 
 def ship_navigation_reward(prev, action, now, *, step_length: float,
@@ -138,8 +141,8 @@ def ship_navigation_reward(prev, action, now, *, step_length: float,
     2 m/s. ``step_length`` [m] is the distance the fastest ship of the
     action set-up sails in a step. ``failure_penalty`` is the environment's
     (a failed step's reward is −failure_penalty)."""
-    impact = min(now["step_impulse"] / impulse_scale, 2.0)
-    outside = abs(now["channel_offset"]) > 1.0
+    impact = np.minimum(now["step_impulse"] / impulse_scale, 2.0)
+    outside = np.abs(now["channel_offset"]) > 1.0
     return (ship_progress(prev, now, step_length) - impulse_weight * impact - time_weight
             - exit_weight * outside + goal_bonus * now["reached"])
 
@@ -153,7 +156,7 @@ def ship_beset_reward(prev, action, now, *, step_length: float, pressure_limit: 
     (``now["hull_pressure"]``) is the sum of the normal contact forces on the
     hull over its length, mean over the step; the penalty grows from 0
     at the limit to its full weight at twice the limit."""
-    over = min(excess(now["hull_pressure"], pressure_limit), 1.0)
+    over = np.minimum(excess(now["hull_pressure"], pressure_limit), 1.0)
     return (ship_progress(prev, now, step_length) - pressure_weight * over - time_weight
             + goal_bonus * now["reached"])
 

@@ -3,6 +3,8 @@ that an onshore wind presses against a coast, with the ice pressure on the hull
 below a limit."""
 from __future__ import annotations
 
+import numpy as np
+
 from physics import HERMAN2013
 from physics.domain import Box
 
@@ -194,15 +196,19 @@ class ShipBesetEnv(ShipEnv):
                                  floe_sizes=e["floe_sizes"], band=e["ice_edge"])
         return field, box, forcing
 
-    def _measure(self) -> dict:
-        now = super()._measure()
-        now["pressure_limit"] = self.episode["pressure_limit"]
-        y = self.sim.ship.vertices[:, 1]
-        now["wall_clearance"] = float(min(y.min(), self.width - y.max()))
-        return now
+    extra_measures = ("pressure_limit", "wall_clearance")
+
+    def _extra_measures(self, envs) -> np.ndarray:
+        """The episode's pressure limit and the hull's clearance [m] from the
+        nearer wall."""
+        out = np.empty((len(envs), 2))
+        for k, env in enumerate(envs):
+            y = env.sim.ship.vertices[:, 1]
+            out[k] = env.episode["pressure_limit"], min(y.min(), env.width - y.max())
+        return out
 
     def _terminated(self, now):
-        return (self._slow_time >= self.episode["beset_time"]
+        return (self.slow_time >= self.episode["beset_time"]
                 or now["wall_clearance"] < WALL_MARGIN)
 
     def _frame_text(self):

@@ -12,6 +12,7 @@ Data flow of one step::
 
     action → NaN → 0, ±inf → bound, clip → ship commands → engine.advance(control interval)
       → step loads (records, collision log) + sensors + local ice → SI dict
+        (:func:`iceenvs.ship_measures.measure_ships`, for one environment or many)
       → reward(prev, action, now) and the observation (vector, image or both)
 
 Subclasses say what the task is:
@@ -49,18 +50,18 @@ import math
 
 import gymnasium as gym
 import numpy as np
-from numba import njit
 
 from physics import FloeField, HERMAN2013
 from physics.checks import check_range
 from physics.hertz import hull_contact_time
-from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import HertzEnv
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_sensors import lidar_scan, occupancy_image
+from .ship_measures import (METRICS, SUM_COLUMNS, ShipVectorEnv, as_measurement, measure_names,
+                            measure_ships, metric_values, update_metrics)
+from .ship_sensors import occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
            "METRICS"]
@@ -81,62 +82,6 @@ CONTROLS = {
 }
 
 OBS_TYPES = ("vector", "image", "dict")
-
-#: the episode metrics in ``info``
-METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
-           "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
-           "energy_to_ice", "ice_resistance", "max_hull_pressure")
-
-
-
-# the columns of the ship's step records and collision log the step loads read
-(_X, _Y, _SURGE, _SWAY, _YAW_RATE, _ICE_SURGE, _ICE_SWAY, _ICE_MOMENT, _ICE_POWER, _NORMAL_FORCE,
- _FORCE_MAGNITUDE_SUM) = (RECORD_COLUMNS.index(name) for name in (
-    "x", "y", "surge", "sway", "yaw_rate", "ice_surge", "ice_sway", "ice_moment", "ice_power",
-    "normal_force", "force_magnitude_sum"))
-_FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY = (LOG_COLUMNS.index(name) for name in (
-    "floe", "impulse_surge", "impulse_sway"))
-
-
-@njit(cache=True, error_model="numpy")
-def step_sums(rows, x0, y0, dynamic, thrust, yaw_moment, linear_damping, quadratic_damping):
-    """Sums over the ship's step records ``rows`` of one control interval
-    (one row per engine step, the columns of
-    :data:`physics.hull_contact.RECORD_COLUMNS`), the ship at (x0, y0)
-    before the first: of the ice surge force, sway force and moment, of the
-    hull's normal force (and its largest value), of the magnitude of the
-    resultant ice force, of the contacts' force magnitudes, of the power of
-    the hull on the ice, of the effort's power (a ``dynamic`` ship: the
-    thrust's and the yaw moment's, |T u| + |M r|; a prescribed one: the
-    power against ice and water, ice power + Σ (b v + a |v| v) v over surge,
-    sway and yaw rate with the linear and quadratic damping coefficients b,
-    a), and the path length."""
-    surge = sway = moment = normal = force = magnitude = energy = effort = path = 0.0
-    peak = -math.inf
-    px, py = x0, y0
-    for k in range(rows.shape[0]):
-        row = rows[k]
-        fx, fy, fn = row[_ICE_SURGE], row[_ICE_SWAY], row[_NORMAL_FORCE]
-        surge += fx
-        sway += fy
-        moment += row[_ICE_MOMENT]
-        normal += fn
-        peak = max(peak, fn)
-        force += math.hypot(fx, fy)
-        magnitude += row[_FORCE_MAGNITUDE_SUM]
-        energy += row[_ICE_POWER]
-        u, v, r = row[_SURGE], row[_SWAY], row[_YAW_RATE]
-        if dynamic:
-            effort += abs(thrust * u) + abs(yaw_moment * r)
-        else:
-            b, a = linear_damping, quadratic_damping
-            effort += row[_ICE_POWER] + ((b[0] * u + a[0] * abs(u) * u) * u
-                                         + (b[1] * v + a[1] * abs(v) * v) * v
-                                         + (b[2] * r + a[2] * abs(r) * r) * r)
-        path += math.hypot(row[_X] - px, row[_Y] - py)
-        px, py = row[_X], row[_Y]
-    return surge, sway, moment, normal, peak, force, magnitude, energy, effort, path
-
 
 def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
                **more) -> EnvFacts:
@@ -222,6 +167,7 @@ class ShipEnv(HertzEnv):
     """
 
     controls: tuple[str, ...] = tuple(CONTROLS)
+    vector_base = ShipVectorEnv
     #: the goal line lies ahead along +x; the channel is centred on the box
     start_x = 50.0
 
@@ -264,8 +210,12 @@ class ShipEnv(HertzEnv):
         self.channel_width = float(channel_width)
         self.goal_distance = float(goal_distance)
         self.base_features = ship_features(self.lidar_sectors, self.lidar_range)
-        self._lidar_names = [(f"lidar_distance_{k}", f"lidar_concentration_{k}")
-                             for k in range(self.lidar_sectors)]
+        #: the raw measurements of a step, in the order of :func:`measure_ships`' columns
+        self.measure_names = measure_names(self.lidar_sectors, self.extra_measures)
+        #: the episode's sums and metrics (:data:`~iceenvs.ship_measures.SUM_COLUMNS`);
+        #: a native vector environment makes it a row of its table
+        self._sums = np.zeros(len(SUM_COLUMNS))
+        self._records_pending = False
         super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
         self.failure_reward = -float(self.reward_params["failure_penalty"])
@@ -405,15 +355,10 @@ class ShipEnv(HertzEnv):
         self.n_floes = field.n
         self.impact_speed = impact
         self._track = [sim.ship.position]
-        self._metrics = dict.fromkeys(METRICS, 0.0)
-        self._metrics["success"] = False
-        self._collisions = 0
-        self._impulse_total = 0.0
-        self._impulse_max = 0.0
+        self._sums[:] = 0.0
+        self._sums[[SUM_COLUMNS.index("x"), SUM_COLUMNS.index("y")]] = self._track[0]
         self._floes_hit = set()
-        self._slow_time = 0.0
-        self._resistance_sum = 0.0
-        self._step_loads = self._no_loads()
+        self._records_pending = False
         return sim
 
     # -- actions ---------------------------------------------------------------------
@@ -430,86 +375,28 @@ class ShipEnv(HertzEnv):
                          yaw_moment=float(action[1]) * self._ship.max_yaw_moment)
 
     # -- one step ----------------------------------------------------------------------
-    @staticmethod
-    def _no_loads() -> dict:
-        return dict(ice_surge=0.0, ice_sway=0.0, ice_moment=0.0, hull_pressure=0.0,
-                    peak_hull_pressure=0.0, step_impulse=0.0, step_contact_impulse=0.0,
-                    step_energy=0.0, step_effort=0.0, step_path=0.0, step_collisions=0)
+    #: the environment's own measurements, after those of every ship environment
+    extra_measures: tuple[str, ...] = ()
+
+    def _extra_measures(self, envs) -> np.ndarray:
+        """(M, len(extra_measures)) values of :attr:`extra_measures` for the
+        environments ``envs`` of this class (a measurement's last columns)."""
+        return np.zeros((len(envs), 0))
 
     def _advanced(self):
-        sim = self.sim
-        ship = sim.ship
-        rows = ship.record_rows()
-        log = ship.collision_rows()
-        ship.clear()
-        dt = sim.dt
-        n = rows.shape[0]
-        if not n:
-            loads = self._no_loads()
-        else:
-            x0, y0 = self._track[-1]
-            if self.mode == "dynamic":
-                c = ship.commands
-                thrust, yaw_moment = c["thrust"], c["yaw_moment"]
-            else:
-                thrust = yaw_moment = 0.0
-            surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = \
-                step_sums(rows, float(x0), float(y0), self.mode == "dynamic", thrust, yaw_moment,
-                          *self._damping)
-            length = self._hull_length
-            loads = dict(ice_surge=surge / n, ice_sway=sway / n, ice_moment=moment / n,
-                         hull_pressure=normal / n / length, peak_hull_pressure=peak / length,
-                         step_impulse=force * dt, step_contact_impulse=magnitude * dt,
-                         step_energy=energy * dt, step_effort=effort * dt, step_path=path,
-                         step_collisions=0)
-            self._track.append(np.array([rows[-1, _X], rows[-1, _Y]]))
-            self._resistance_sum -= surge * dt
-        if log.shape[0]:
-            impulses = np.hypot(log[:, _IMPULSE_SURGE], log[:, _IMPULSE_SWAY])
-            self._collisions += int(impulses.size)
-            self._impulse_total += float(impulses.sum())
-            self._impulse_max = max(self._impulse_max, float(impulses.max()))
-            self._floes_hit.update(log[:, _FLOE].astype(np.int64).tolist())
-        loads["step_collisions"] = int(log.shape[0])
-        self._step_loads = loads
-        if self.mode == "dynamic" and ship.surge < self.episode["beset_speed"]:
-            self._slow_time += self.control_interval
-        else:
-            self._slow_time = 0.0
+        # the step records are read with the measurement (measure_ships)
+        self._records_pending = True
 
     def _measure(self) -> dict:
-        sim = self.sim
-        ship = sim.ship
-        x, y = ship.position
-        heading = ship.heading
-        box = sim.box
-        now = {"goal_distance": float(self.goal_x - x), "goal_cos": math.cos(heading),
-               "goal_sin": -math.sin(heading),
-               "channel_offset": float((y - self.centre_y) / (0.5 * self.channel_width)),
-               "surge": ship.surge, "sway": ship.sway, "yaw_rate": ship.yaw_rate}
-        now.update(self._step_loads)
-        dist, conc = lidar_scan(float(x), float(y), heading, sim.positions, sim.radii,
-                                self.lidar_sectors, math.pi, self.lidar_range, box.lx, box.ly,
-                                box.periodic[0], box.periodic[1])
-        for (distance_name, concentration_name), d, c in zip(self._lidar_names, dist.tolist(),
-                                                             conc.tolist()):
-            now[distance_name] = d
-            now[concentration_name] = c
-        now["concentration"] = self._field_concentration
-        now.update(self._local_ice(x, y))
-        now["time"] = float(sim.time)
-        now["reached"] = float(x >= self.goal_x)
-        return now
+        raw = measure_ships([self], self._sums[None, :], advanced=self._records_pending)
+        self._records_pending = False
+        return as_measurement(self.measure_names, raw[0])
 
-    def _local_ice(self, x, y) -> dict:
-        """Concentration, contacts per floe and contact pressure of the ice
-        within ``local_radius`` of the ship
-        (:meth:`physics.HertzSimulation.local_ice`)."""
-        ice = self.sim.local_ice((x, y), self.local_radius)
-        n_near = ice.n_floes
-        return {"local_concentration": min(1.0, ice.floe_area / ice.area),
-                "local_contacts": 2.0 * ice.n_contacts / n_near if n_near else 0.0,
-                "local_pressure": ice.pressure if ice.n_contacts else 0.0}
+    @property
+    def slow_time(self) -> float:
+        """Time [s] the ship has spent below the beset speed since it last
+        sailed faster (a dynamic ship; 0 for a prescribed one)."""
+        return float(self._sums[SUM_COLUMNS.index("slow_time")])
 
     # -- observation, info, end --------------------------------------------------------
     def _vector(self, now: dict):
@@ -528,32 +415,16 @@ class ShipEnv(HertzEnv):
                                extent=self.image_extent,
                                box_lengths=(sim.box.lx, sim.box.ly), periodic=sim.box.periodic)
 
-    def _update_metrics(self, now: dict) -> dict:
-        m = self._metrics
-        m["time"] = float(self.sim.time)
-        m["path_length"] += self._step_loads["step_path"]
-        m["effort"] += self._step_loads["step_effort"]
-        m["energy_to_ice"] += self._step_loads["step_energy"]
-        m["collisions"] = self._collisions
-        m["collided_floes"] = len(self._floes_hit)
-        total = self._impulse_total
-        m["mean_impulse"] = total / self._collisions if self._collisions else 0.0
-        m["max_impulse"] = self._impulse_max
-        m["impulse_per_metre"] = total / m["path_length"] if m["path_length"] > 0 else 0.0
-        m["ice_resistance"] = self._resistance_sum / m["time"] if m["time"] > 0 else 0.0
-        m["max_hull_pressure"] = max(m["max_hull_pressure"], now["peak_hull_pressure"])
-        m["success"] = bool(now["reached"])
-        m["efficiency"] = (self.goal_distance / m["path_length"]
-                           if m["success"] and m["path_length"] > 0 else 0.0)
-        return m
+    @property
+    def _metrics(self) -> dict:
+        """The episode metrics so far (:data:`METRICS`)."""
+        return metric_values(self._sums)
 
     def _info(self, now: dict) -> dict:
         info = super()._info(now)
-        if now is self._prev or self._steps == 0:
-            metrics = dict(self._metrics)
-        else:
-            metrics = dict(self._update_metrics(now))
-        info.update(metrics)
+        if not (now is self._prev or self._steps == 0):
+            update_metrics(self._sums[None, :], now, self.goal_distance)
+        info.update(self._metrics)
         return info
 
     def _succeeded(self, now: dict) -> bool:

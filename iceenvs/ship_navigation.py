@@ -220,7 +220,7 @@ class ShipNavigationEnv(ShipEnv):
         return field, box, forcing
 
     def _terminated(self, now):
-        if self.mode == "dynamic" and self._slow_time >= self.episode["beset_time"]:
+        if self.mode == "dynamic" and self.slow_time >= self.episode["beset_time"]:
             return True
         return self.episode["channel_exit"] == "terminate" and abs(now["channel_offset"]) > 1.0
 

@@ -29,9 +29,14 @@ N dicts, one per sub-environment. ``render_env=k`` chooses the
 sub-environment that ``render()`` draws (``render_mode`` as in the single
 environment).
 
-The engine step runs in one compiled call; the measurements, observations
-and rewards are still made by each sub-environment's own code, one after the
-other (:class:`~iceenvs.base.ControlEnv`'s step in three parts).
+The engine step runs in one compiled call. The end of the step is the
+environment's: :class:`HertzVectorEnv` has each sub-environment measure,
+score and observe with its own code, one after the other
+(:class:`~iceenvs.base.ControlEnv`'s step in three parts), and an
+environment whose ``vector_base`` is a subclass makes it in batch (the ship
+environments: :class:`iceenvs.ship_measures.ShipVectorEnv`, measurements,
+rewards, observations, metrics and info as arrays over the
+sub-environments).
 
 >>> import gymnasium as gym
 >>> import iceenvs  # noqa: F401
@@ -52,9 +57,9 @@ from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
 from physics.hertz import KernelLists, advance_together
 
-from .base import PHYSICS_ERRORS, HertzEnv
+from .base import PHYSICS_ERRORS, HertzEnv, sanitise_actions
 
-__all__ = ["HertzVectorEnv", "batch_infos", "vector_class"]
+__all__ = ["HertzVectorEnv", "batch_infos", "row_info", "set_row", "vector_class"]
 
 
 class HertzVectorEnv(VectorEnv):
@@ -139,13 +144,14 @@ class HertzVectorEnv(VectorEnv):
         """One step of every sub-environment; the engines advance together."""
         if not self._ready:
             raise RuntimeError("call reset() before step()")
-        actions = self._checked_actions(actions)
-        taken, errors = [], [None] * self.num_envs
+        actions, replaced = sanitise_actions(self._checked_actions(actions),
+                                             self.single_action_space)
+        errors: list[BaseException | None] = [None] * self.num_envs
         for k, env in enumerate(self.envs):
-            a, replaced = env._take_action(actions[k])
-            taken.append((a, replaced))
+            env._last_action = actions[k]
+            env._steps += 1
             try:
-                env._apply_action(a)
+                env._apply_action(actions[k])
             except PHYSICS_ERRORS as err:
                 errors[k] = err
         moving = [k for k in range(self.num_envs) if errors[k] is None]
@@ -153,12 +159,34 @@ class HertzVectorEnv(VectorEnv):
                                                    self.envs[0].control_interval,
                                                    lists=self._lists)):
             errors[k] = err
-        obs, step_infos, ended = [], [], []
+        obs, rewards, terminated, infos = self._results(actions, replaced, errors)
+        truncated = np.zeros(self.num_envs, dtype=bool)
+        if self.max_episode_steps is not None:
+            truncated[:] = [env._steps >= self.max_episode_steps for env in self.envs]
+        for k in np.flatnonzero(terminated | truncated):
+            final = ({key: value[k] for key, value in obs.items()} if isinstance(obs, dict)
+                     else obs[k].copy())
+            final_info = row_info(infos, k)
+            o, info = self.envs[k].reset()
+            self._reset_row(k)
+            if isinstance(obs, dict):
+                for key in obs:
+                    obs[key][k] = o[key]
+            else:
+                obs[k] = o
+            infos = set_row(self, infos, info, k)
+            infos = self._add_info(infos, {"final_obs": final, "final_info": final_info}, k)
+        return obs, rewards, terminated, truncated, infos
+
+    def _results(self, actions, replaced, errors) -> tuple:
+        """(observations, rewards, terminated, info) of a step whose engines
+        ran (``errors[k]``: the physics failure of sub-environment k, or
+        None): each sub-environment measures, rewards and observes with its
+        own code, one after the other."""
+        obs, infos = [], []
         rewards = np.zeros(self.num_envs)
         terminated = np.zeros(self.num_envs, dtype=bool)
-        truncated = np.zeros(self.num_envs, dtype=bool)
         for k, env in enumerate(self.envs):
-            a, replaced = taken[k]
             result = None
             if errors[k] is None:
                 try:
@@ -167,21 +195,17 @@ class HertzVectorEnv(VectorEnv):
                 except PHYSICS_ERRORS as err:
                     errors[k] = err
                 else:
-                    result = env._finish_step(a, replaced, now)
+                    result = env._finish_step(actions[k], int(replaced[k]), now)
             if result is None:
-                result = env._failed_step(errors[k], replaced)
+                result = env._failed_step(errors[k], int(replaced[k]))
             o, rewards[k], terminated[k], _, info = result
-            truncated[k] = (self.max_episode_steps is not None
-                            and env._steps >= self.max_episode_steps)
-            if terminated[k] or truncated[k]:
-                ended.append((k, o, info))
-                o, info = env.reset()
             obs.append(o)
-            step_infos.append(info)
-        infos = batch_infos(step_infos)
-        for k, o, info in ended:
-            infos = self._add_info(infos, {"final_obs": o, "final_info": info}, k)
-        return self._batch(obs), rewards, terminated, truncated, infos
+            infos.append(info)
+        return self._batch(obs), rewards, terminated, batch_infos(infos)
+
+    def _reset_row(self, k: int) -> None:
+        """After sub-environment k started a new episode (a subclass that
+        keeps per-episode rows updates them)."""
 
     def render(self):
         """The frame of sub-environment ``render_env`` (``render_mode``
@@ -257,6 +281,43 @@ def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
     return out
 
 
+def row_info(infos: dict[str, Any], k: int) -> dict[str, Any]:
+    """Sub-environment k's info out of a vector info: the keys whose mask
+    is set for k, numbers as Python numbers (the inverse of
+    :func:`batch_infos` for one row)."""
+    out = {}
+    for key, value in infos.items():
+        if key.startswith("_") or not infos.get("_" + key, np.zeros(k + 1, bool))[k]:
+            continue
+        if isinstance(value, dict):
+            out[key] = row_info(value, k)
+        elif value.dtype == object:
+            out[key] = value[k]
+        elif value.ndim == 1:
+            out[key] = value[k].item()
+        else:
+            out[key] = value[k].copy()
+    return out
+
+
+def set_row(vector_env: VectorEnv, infos: dict[str, Any], info: dict[str, Any],
+            k: int) -> dict[str, Any]:
+    """``infos`` with sub-environment k's entries replaced by ``info``:
+    its keys set (Gymnasium's ``_add_info``), the others' masks cleared
+    for k."""
+    for key, value in infos.items():
+        if key.startswith("_") or key in info:
+            continue
+        infos["_" + key][k] = False
+        if isinstance(value, dict):
+            set_row(vector_env, value, {}, k)
+        elif value.dtype != object:
+            value[k] = 0
+        else:
+            value[k] = None
+    return vector_env._add_info(infos, info, k)
+
+
 def _key_by_key(infos: Sequence[dict]) -> dict[str, Any]:
     """:func:`batch_infos` for infos whose keys differ: key by key, each
     sub-environment's value put in its row."""
@@ -315,9 +376,9 @@ def _column(first, values: Sequence) -> np.ndarray | None:
 
 
 def vector_class(env_class: type[HertzEnv]) -> type[HertzVectorEnv]:
-    """The native vector environment of ``env_class`` (a subclass of
-    :class:`HertzVectorEnv` named after it)."""
+    """The native vector environment of ``env_class``: a subclass, named after
+    it, of its ``vector_base`` (``None``: :class:`HertzVectorEnv`)."""
     name = env_class.__name__.removesuffix("Env") + "VectorEnv"
-    return type(name, (HertzVectorEnv,), {
+    return type(name, (env_class.vector_base or HertzVectorEnv,), {
         "env_class": env_class, "__module__": env_class.__module__,
         "__doc__": f"N :class:`{env_class.__name__}` stepped together (:mod:`iceenvs.vector`)."})

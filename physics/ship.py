@@ -484,6 +484,15 @@ class ShipState:
         return self._bundle.state[[HC.S_X, HC.S_Y]].copy()
 
     @property
+    def motion(self) -> np.ndarray:
+        """(x, y, heading, Vx, Vy, yaw rate) [m, m, rad, m/s, m/s, rad/s] as
+        one read-only array, a view of the state the compiled step moves
+        (for a caller that reads the pose of many ships every step)."""
+        view = self._bundle.state[:6]
+        view.flags.writeable = False
+        return view
+
+    @property
     def heading(self) -> float:
         """Heading [rad, anticlockwise from +x]."""
         return float(self._bundle.state[HC.S_PSI])

@@ -13,6 +13,7 @@ import iceenvs  # noqa: F401  (registers the ids)
 from agents.metrics import physics_metrics
 from iceenvs.facts import env_facts
 from iceenvs.ship_env import METRICS
+from iceenvs.ship_measures import SUM_COLUMNS
 
 NAV = "iceenvs/ShipNavigation-v0"
 BESET = "iceenvs/ShipBeset-v0"
@@ -104,7 +105,7 @@ def test_collision_impulses_are_bounded_by_the_contact_impulses():
             contact += loads["step_contact_impulse"]
             if terminated or truncated:
                 break
-        impulses = u._impulse_total
+        impulses = u._sums[SUM_COLUMNS.index("impulse_total")]
     finally:
         env.close()
     assert info["collisions"] >= 5 and u.n_floes > 50
@@ -121,7 +122,7 @@ def test_step_sums_match_column_by_column_numpy(dynamic):
     columns: means, maxima, |resultant|, the effort's power (|T u| + |M r|,
     or the ice power plus Σ (b v + a |v| v) v) and the path from (x0, y0)."""
     from physics.hull_contact import RECORD_COLUMNS
-    from iceenvs.ship_env import step_sums
+    from iceenvs.ship_measures import step_sums
 
     rng = np.random.default_rng(4)
     rows = rng.normal(0.0, 1.0, (300, len(RECORD_COLUMNS))) * rng.uniform(0.1, 1e6,

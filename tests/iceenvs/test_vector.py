@@ -10,7 +10,7 @@ from gymnasium.vector import AutoresetMode
 
 import iceenvs  # noqa: F401  (registers the ids)
 from iceenvs import ENV_IDS
-from iceenvs.facts import env_spec
+from iceenvs.facts import env_facts, env_spec
 from small_envs import SMALL
 
 VECTOR_IDS = [i for i in ENV_IDS if env_spec(i).vector_entry_point is not None]
@@ -66,6 +66,11 @@ def test_sub_environment_k_runs_the_single_environment_seeded_the_same(env_id):
             for key, value in inf["physics"].items():
                 np.testing.assert_allclose(step_info["physics"][key][k], value, rtol=RTOL,
                                            atol=ATOL, err_msg=key)
+            # the episode metrics, of the same types
+            for key in env_facts(env_id).episode_metrics:
+                assert type(step_info[key][k].item()) is type(inf[key]), key
+                np.testing.assert_allclose(step_info[key][k], inf[key], rtol=RTOL, atol=ATOL,
+                                           err_msg=key)
     # every sub-environment was truncated after 3 steps and reset
     assert ends == n
     envs.close()
@@ -191,3 +196,63 @@ def test_batched_infos_of_arrays_of_two_shapes_fail_as_gymnasiums():
         batch_infos(infos)
 
 
+
+
+def _ship_reward(prev, action, now, **params):
+    """A reward of one's own: the native vector environment calls it per
+    sub-environment, with that sub-environment's measurement."""
+    return float(now["surge"] - 1e-7 * now["step_impulse"])
+
+
+@pytest.mark.parametrize("kwargs", [{"obs_type": "dict"}, {"reward_fn": _ship_reward}],
+                         ids=["image observations", "own reward"])
+def test_the_ship_paths_run_per_sub_environment_give_the_single_environment(kwargs):
+    n = 2
+    envs = make_vec(SHIP, n, **kwargs)
+    singles = [gym.make(SHIP, **SMALL[SHIP], **kwargs) for _ in range(n)]
+    obs, _ = envs.reset(seed=7)
+    for k, env in enumerate(singles):
+        env.reset(seed=7 + k)
+    for a in np.random.default_rng(2).uniform(-1, 1, (3, n, 1)):
+        obs, reward, _, _, _ = envs.step(a)
+        for k, env in enumerate(singles):
+            o, r, _, _, _ = env.step(a[k])
+            np.testing.assert_allclose(reward[k], r, rtol=RTOL, atol=ATOL)
+            for key in ("vector", "image") if isinstance(o, dict) else ():
+                np.testing.assert_allclose(obs[key][k], o[key], rtol=RTOL, atol=ATOL)
+    envs.close()
+
+
+def test_a_sub_environment_that_fails_ends_alone_and_the_others_run_on():
+    """A physics failure of one sub-environment ends its episode with the
+    failure reward and ``info["error"]``, as in the single environment; the
+    others are measured in batch as if it were not there."""
+    n = 3
+    envs = make_vec(SHIP, n)
+    single = gym.make(SHIP, **SMALL[SHIP])
+    envs.reset(seed=11)
+    single.reset(seed=11 + 2)
+    broken = envs.unwrapped.envs[1]
+    apply = broken._apply_action
+
+    def fail(action):                  # once: the new episode's start applies an action too
+        broken._apply_action = apply
+        raise FloatingPointError("overflow in a test")
+
+    broken._apply_action = fail
+    actions = np.array([[0.3], [0.0], [-0.2]])
+    obs, reward, terminated, _, info = envs.step(actions)
+    o, r, te, _, inf = single.step(actions[2])
+    assert terminated[1] and reward[1] == -broken.reward_params["failure_penalty"]
+    assert info["final_info"]["_error"][1] and "overflow in a test" in info["final_info"]["error"][1]
+    assert not info["final_info"]["_error"][[0, 2]].any()
+    assert info["_final_info"].tolist() == [False, True, False]
+    # sub-environment 2 is the single environment seeded alike
+    assert te == terminated[2]
+    np.testing.assert_allclose(obs[2], o, rtol=RTOL, atol=ATOL)
+    np.testing.assert_allclose(reward[2], r, rtol=RTOL, atol=ATOL)
+    np.testing.assert_allclose(info["impulse_per_metre"][2], inf["impulse_per_metre"], rtol=RTOL,
+                               atol=ATOL)
+    # the failed one started a new episode: its info is the new episode's first
+    assert info["steps"][1] == 0 and info["_nonfinite_action"].tolist() == [True, False, True]
+    envs.close()

@@ -1,0 +1,536 @@
+"""What a ship environment measures after each step, for one environment or
+for many at once.
+
+Every ship environment ends a step with the same work:
+
+1. read the ship's step records and collision log of the control interval
+   into the *step loads* (forces, impulses, energy, effort, path);
+2. add them to the episode's running sums (collisions, impulses, the floes
+   hit, the time spent below the beset speed);
+3. measure the pose, sense the ice ahead with the lidar
+   (:func:`iceenvs.ship_sensors.lidar_scan`) and the ice around the hull
+   (:meth:`physics.HertzSimulation.local_ice`);
+4. after the reward, update the episode metrics (:func:`update_metrics`).
+
+:func:`measure_ships` does steps 1-3 for a list of environments of one class
+and configuration: the records and the lidar of all of them in one compiled
+call (:func:`measure_many`, parallel over the environments), the loads and
+sums in numpy over the environments. The result is one matrix, a row per
+environment and a column per raw measurement (:func:`measure_names`). A
+single environment is a list of one; the native vector environment
+(:class:`ShipVectorEnv`) passes its sub-environments, so a sub-environment and
+the single environment seeded alike compute the same numbers with the same
+code. Per environment, Python only collects references to its engine's
+arrays and calls the compiled local-ice measure.
+
+Each environment keeps its episode's sums in one row of floats (columns
+:data:`SUM_COLUMNS`): its own array, or a row of the vector environment's
+table, so that the vector environment updates them all at once.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from gymnasium.vector.utils import create_empty_array
+from numba import njit, prange, types
+from numba.typed import List
+
+from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
+
+from .base import PHYSICS_ERRORS
+from .observations import normalise_rows
+from .ship_sensors import lidar_scan
+from .vector import HertzVectorEnv, set_row
+
+__all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
+           "measure_names", "measure_ships", "measure_many", "step_sums", "update_metrics",
+           "metric_values", "metric_columns", "as_measurement", "ShipVectorEnv"]
+
+#: the pose entries of a measurement (ship frame; the goal lies along +x)
+POSE = ("goal_distance", "goal_cos", "goal_sin", "channel_offset", "surge", "sway", "yaw_rate")
+#: the step loads (see :mod:`iceenvs.ship_env`)
+LOADS = ("ice_surge", "ice_sway", "ice_moment", "hull_pressure", "peak_hull_pressure",
+         "step_impulse", "step_contact_impulse", "step_energy", "step_effort", "step_path",
+         "step_collisions")
+#: after the lidar: the episode's concentration, the ice around the hull, the
+#: model time and whether the goal line is reached (1) or not (0)
+LOCAL = ("concentration", "local_concentration", "local_contacts", "local_pressure", "time",
+         "reached")
+#: the measurements whose values are counts
+INTEGER_MEASURES = ("step_collisions",)
+
+#: the episode metrics in ``info``
+METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
+           "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
+           "energy_to_ice", "ice_resistance", "max_hull_pressure")
+#: the metrics that are counts, and the one that is a flag
+_INTEGER_METRICS = ("collisions", "collided_floes")
+#: a row of episode sums: the metrics, then the running sums behind them
+#: (collisions and impulses of the finished collisions, distinct floes hit,
+#: time below the beset speed, ∫ ice surge force dt, the ship's last
+#: recorded position)
+SUM_COLUMNS = METRICS + ("n_collisions", "impulse_total", "impulse_max", "n_floes_hit",
+                         "slow_time", "resistance_sum", "x", "y")
+_C = {name: k for k, name in enumerate(SUM_COLUMNS)}
+
+# the columns of the ship's step records and collision log read here
+(_X, _Y, _SURGE, _SWAY, _YAW_RATE, _ICE_SURGE, _ICE_SWAY, _ICE_MOMENT, _ICE_POWER, _NORMAL_FORCE,
+ _FORCE_MAGNITUDE_SUM) = (RECORD_COLUMNS.index(name) for name in (
+    "x", "y", "surge", "sway", "yaw_rate", "ice_surge", "ice_sway", "ice_moment", "ice_power",
+    "normal_force", "force_magnitude_sum"))
+_FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY = (LOG_COLUMNS.index(name) for name in (
+    "floe", "impulse_surge", "impulse_sway"))
+_N_SUMS = 10
+
+
+def measure_names(sectors: int, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The raw measurements of a ship environment with a lidar of
+    ``sectors`` sectors, in the order of :func:`measure_ships`' columns
+    (``extra``: the environment's own, last)."""
+    lidar = tuple(name for k in range(sectors)
+                  for name in (f"lidar_distance_{k}", f"lidar_concentration_{k}"))
+    return POSE + LOADS + lidar + LOCAL + tuple(extra)
+
+
+@njit(cache=True, error_model="numpy")
+def step_sums(rows, x0, y0, dynamic, thrust, yaw_moment, linear_damping, quadratic_damping):
+    """Sums over the ship's step records ``rows`` of one control interval
+    (one row per engine step, the columns of
+    :data:`physics.hull_contact.RECORD_COLUMNS`), the ship at (x0, y0)
+    before the first: of the ice surge force, sway force and moment, of the
+    hull's normal force (and its largest value), of the magnitude of the
+    resultant ice force, of the contacts' force magnitudes, of the power of
+    the hull on the ice, of the effort's power (a ``dynamic`` ship: the
+    thrust's and the yaw moment's, |T u| + |M r|; a prescribed one: the
+    power against ice and water, ice power + Σ (b v + a |v| v) v over surge,
+    sway and yaw rate with the linear and quadratic damping coefficients b,
+    a), and the path length."""
+    surge = sway = moment = normal = force = magnitude = energy = effort = path = 0.0
+    peak = -math.inf
+    px, py = x0, y0
+    b, a = linear_damping, quadratic_damping
+    for k in range(rows.shape[0]):
+        row = rows[k]
+        fx, fy, fn = row[_ICE_SURGE], row[_ICE_SWAY], row[_NORMAL_FORCE]
+        surge += fx
+        sway += fy
+        moment += row[_ICE_MOMENT]
+        normal += fn
+        peak = max(peak, fn)
+        force += math.hypot(fx, fy)
+        magnitude += row[_FORCE_MAGNITUDE_SUM]
+        energy += row[_ICE_POWER]
+        u, v, r = row[_SURGE], row[_SWAY], row[_YAW_RATE]
+        if dynamic:
+            effort += abs(thrust * u) + abs(yaw_moment * r)
+        else:
+            effort += row[_ICE_POWER] + ((b[0] * u + a[0] * abs(u) * u) * u
+                                         + (b[1] * v + a[1] * abs(v) * v) * v
+                                         + (b[2] * r + a[2] * abs(r) * r) * r)
+        path += math.hypot(row[_X] - px, row[_Y] - py)
+        px, py = row[_X], row[_Y]
+    return surge, sway, moment, normal, peak, force, magnitude, energy, effort, path
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def measure_many(rows, start_xy, dynamic, commands, damping, positions, radii,
+                 floe_start, motion, sectors, max_range, lx, ly, periodic_x, periodic_y, goal_x,
+                 centre_y, half_channel, pose, sums, distance, concentration):
+    """The compiled part of :func:`measure_ships` for M ships, parallel over
+    them: ship k's step records are ``rows[k]`` (a typed list of arrays),
+    its last recorded position ``start_xy[k]``, its thrust and yaw moment
+    ``commands[k]`` (read when ``dynamic``), its damping coefficients
+    ``damping[k]`` (linear, quadratic), its floes
+    ``positions[floe_start[k]:floe_start[k + 1]]`` and ``radii`` (likewise)
+    and its (x, y, heading, Vx, Vy, yaw rate) ``motion[k]``. Writes the
+    pose entries (:data:`POSE`) into ``pose[k]``, the step sums of
+    :func:`step_sums` into ``sums[k]`` and the lidar (a field of view of π
+    cut into ``sectors`` sectors) into ``distance[k]`` and
+    ``concentration[k]``."""
+    for i in prange(motion.shape[0]):
+        m = np.int64(i)                     # typed lists take signed indices
+        x, y, psi, vx, vy, r = (motion[m, 0], motion[m, 1], motion[m, 2], motion[m, 3],
+                                motion[m, 4], motion[m, 5])
+        c, s = math.cos(psi), math.sin(psi)
+        pose[m, 0] = goal_x - x
+        pose[m, 1] = c
+        pose[m, 2] = -s
+        pose[m, 3] = (y - centre_y) / half_channel
+        pose[m, 4] = c * vx + s * vy
+        pose[m, 5] = -s * vx + c * vy
+        pose[m, 6] = r
+        out = step_sums(rows[m], start_xy[m, 0], start_xy[m, 1],
+                        dynamic, commands[m, 0], commands[m, 1], damping[m, 0], damping[m, 1])
+        for j in range(_N_SUMS):
+            sums[m, j] = out[j]
+        f0, f1 = floe_start[m], floe_start[m + 1]
+        d, a = lidar_scan(x, y, psi, positions[f0:f1], radii[f0:f1], sectors, math.pi, max_range,
+                          lx, ly, periodic_x, periodic_y)
+        distance[m, :] = d
+        concentration[m, :] = a
+
+
+def _starts(counts) -> np.ndarray:
+    return np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+
+
+_RECORDS_TYPE = types.Array(types.float64, 2, "C", readonly=True)
+
+
+def _record_list(arrays: list) -> List:
+    """The ships' step records as the typed list :func:`measure_many`
+    takes (a reference to each array: a copy of the records of many
+    ships costs ten times as much)."""
+    out = List.empty_list(_RECORDS_TYPE)
+    for a in arrays:
+        if a.flags.writeable or not a.flags.c_contiguous:
+            a = np.ascontiguousarray(a).view()
+            a.flags.writeable = False
+        out.append(a)
+    return out
+
+
+def _stacked(arrays: list, columns: int) -> np.ndarray:
+    """The arrays of (k, columns) rows one after the other."""
+    full = [a for a in arrays if a.shape[0]]
+    if not full:
+        return np.zeros((0, columns))
+    return full[0] if len(full) == 1 else np.concatenate(full)
+
+
+def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
+    """The raw measurements of the ship environments ``envs`` (of one class
+    and configuration, each with its episode running), one row each, the
+    columns of ``envs[0].measure_names``.
+
+    ``advanced``: their engines have just run a control interval, whose step
+    records and collisions are read (and cleared) into the step loads and
+    added to the episode sums in ``table`` (M, len(:data:`SUM_COLUMNS`)),
+    one row per environment, updated in place. Otherwise (the first
+    measurement of an episode) the step loads are zero.
+    """
+    e0 = envs[0]
+    n = len(envs)
+    sims = [env.sim for env in envs]
+    ships = [sim.ship for sim in sims]
+    motion = np.stack([ship.motion for ship in ships])
+    floe_xy = [sim.positions for sim in sims]
+    floe_r = [sim.radii for sim in sims]
+    floe_start = _starts([r.size for r in floe_r])
+    if advanced:
+        rows = [ship.record_rows() for ship in ships]
+        logs = [ship.collision_rows() for ship in ships]
+        for ship in ships:
+            ship.clear()
+    else:
+        rows = logs = [np.zeros((0, len(RECORD_COLUMNS)))] * n
+    dynamic = e0.mode == "dynamic"
+    commands = np.zeros((n, 2))
+    if dynamic:
+        for k, ship in enumerate(ships):
+            c = ship.commands
+            commands[k] = c["thrust"], c["yaw_moment"]
+    box = sims[0].box
+    pose = np.empty((n, len(POSE)))
+    sums = np.empty((n, _N_SUMS))
+    distance = np.empty((n, e0.lidar_sectors))
+    concentration = np.empty((n, e0.lidar_sectors))
+    measure_many(_record_list(rows), np.ascontiguousarray(table[:, [_C["x"], _C["y"]]]), dynamic, commands,
+                 np.array([env._damping for env in envs]), _stacked(floe_xy, 2),
+                 np.concatenate(floe_r), floe_start, motion, e0.lidar_sectors, e0.lidar_range,
+                 float(box.lx), float(box.ly), box.periodic[0], box.periodic[1], e0.goal_x,
+                 e0.centre_y, 0.5 * e0.channel_width, pose, sums, distance, concentration)
+
+    loads = np.zeros((n, len(LOADS)))
+    dt = np.array([sim.dt for sim in sims])
+    if advanced:
+        _add_loads(envs, table, loads, rows, sums, dt)
+        _add_collisions(envs, table, loads, logs)
+        if dynamic:
+            beset = np.array([env.episode["beset_speed"] for env in envs])
+            slow = table[:, _C["slow_time"]]
+            table[:, _C["slow_time"]] = np.where(pose[:, 4] < beset, slow + e0.control_interval,
+                                                 0.0)
+    lidar = np.empty((n, 2 * e0.lidar_sectors))
+    lidar[:, 0::2] = distance
+    lidar[:, 1::2] = concentration
+    local = np.empty((n, len(LOCAL)))
+    for k, (env, sim) in enumerate(zip(envs, sims)):
+        ice = sim.local_ice((motion[k, 0], motion[k, 1]), env.local_radius)
+        local[k, :4] = (env._field_concentration, min(1.0, ice.floe_area / ice.area),
+                        2.0 * ice.n_contacts / ice.n_floes if ice.n_floes else 0.0,
+                        ice.pressure if ice.n_contacts else 0.0)
+        local[k, 4] = sim.time
+    local[:, 5] = motion[:, 0] >= e0.goal_x
+    return np.concatenate([pose, loads, lidar, local, e0._extra_measures(envs)], axis=1)
+
+
+def _add_loads(envs, table, loads, rows, sums, dt):
+    """The step loads from the step sums, and the ice resistance's sum and
+    the last position into the episode sums (ships with step records)."""
+    counts = np.array([r.shape[0] for r in rows])
+    has = counts > 0
+    if not has.any():
+        return
+    k = np.flatnonzero(has)
+    n = counts[k]
+    length = np.array([envs[i]._hull_length for i in k])
+    surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = sums[k].T
+    loads[k, :10] = np.column_stack((
+        surge / n, sway / n, moment / n, normal / n / length, peak / length, force * dt[k],
+        magnitude * dt[k], energy * dt[k], effort * dt[k], path))
+    last = np.array([rows[i][-1] for i in k])
+    table[k, _C["x"]] = last[:, _X]
+    table[k, _C["y"]] = last[:, _Y]
+    table[k, _C["resistance_sum"]] -= surge * dt[k]
+    for i in k:
+        if envs[i].render_mode is not None:       # the path drawn on the frames
+            envs[i]._track.append(table[i, [_C["x"], _C["y"]]].copy())
+
+
+def _add_collisions(envs, table, loads, logs):
+    """The collisions that ended in the step into the step loads and the
+    episode sums."""
+    counts = np.array([log.shape[0] for log in logs])
+    loads[:, -1] = counts
+    if not counts.any():
+        return
+    log = _stacked(logs, len(LOG_COLUMNS))
+    owner = np.repeat(np.arange(len(logs)), counts)
+    impulses = np.hypot(log[:, _IMPULSE_SURGE], log[:, _IMPULSE_SWAY])
+    table[:, _C["n_collisions"]] += counts
+    table[:, _C["impulse_total"]] += np.bincount(owner, impulses, minlength=len(logs))
+    top = table[:, _C["impulse_max"]].copy()
+    np.maximum.at(top, owner, impulses)
+    table[:, _C["impulse_max"]] = top
+    for k in np.flatnonzero(counts):
+        hit = envs[k]._floes_hit
+        hit.update(log[owner == k, _FLOE].astype(np.int64).tolist())
+        table[k, _C["n_floes_hit"]] = len(hit)
+
+
+def _ratio(top, bottom, where) -> np.ndarray:
+    """top / bottom where ``where``, else 0."""
+    top, bottom, where = np.broadcast_arrays(np.asarray(top, float), np.asarray(bottom, float),
+                                             where)
+    return np.divide(top, bottom, out=np.zeros(top.shape), where=where)
+
+
+def update_metrics(table: np.ndarray, now, goal_distance: float) -> None:
+    """The episode metrics of ``table``'s rows after a step that measured
+    ``now`` (a measurement dict of floats for one row, or of columns, one
+    entry per row), in place; ``goal_distance`` [m] is the straight-line
+    distance from the start to the goal line."""
+    c = _C
+    t = table
+    time = np.broadcast_to(np.asarray(now["time"], dtype=float), t.shape[:1])
+    t[:, c["time"]] = time
+    t[:, c["path_length"]] += now["step_path"]
+    t[:, c["effort"]] += now["step_effort"]
+    t[:, c["energy_to_ice"]] += now["step_energy"]
+    n = t[:, c["n_collisions"]]
+    total = t[:, c["impulse_total"]]
+    path = t[:, c["path_length"]]
+    t[:, c["collisions"]] = n
+    t[:, c["collided_floes"]] = t[:, c["n_floes_hit"]]
+    t[:, c["mean_impulse"]] = _ratio(total, n, n > 0)
+    t[:, c["max_impulse"]] = t[:, c["impulse_max"]]
+    t[:, c["impulse_per_metre"]] = _ratio(total, path, path > 0)
+    t[:, c["ice_resistance"]] = _ratio(t[:, c["resistance_sum"]], time, time > 0)
+    t[:, c["max_hull_pressure"]] = np.maximum(t[:, c["max_hull_pressure"]],
+                                              now["peak_hull_pressure"])
+    success = np.broadcast_to(np.asarray(now["reached"], dtype=float), t.shape[:1]) > 0
+    t[:, c["success"]] = success
+    t[:, c["efficiency"]] = _ratio(goal_distance, path, success & (path > 0))
+
+
+def metric_values(row: np.ndarray) -> dict:
+    """The episode metrics of one row of sums, as ``info`` holds them."""
+    out = {name: float(row[k]) for k, name in enumerate(METRICS)}
+    out["success"] = bool(row[_C["success"]])
+    for name in _INTEGER_METRICS:
+        out[name] = int(row[_C[name]])
+    return out
+
+
+def metric_columns(table: np.ndarray) -> dict:
+    """The episode metrics of every row of sums, as columns of the types of
+    :func:`metric_values`."""
+    out = {name: table[:, k].copy() for k, name in enumerate(METRICS)}
+    out["success"] = out["success"] > 0
+    for name in _INTEGER_METRICS:
+        out[name] = out[name].astype(np.int64)
+    return out
+
+
+def as_measurement(names, row: np.ndarray) -> dict:
+    """One row of :func:`measure_ships` as a measurement dict (counts as
+    ints)."""
+    now = dict(zip(names, row.tolist()))
+    for name in INTEGER_MEASURES:
+        now[name] = int(now[name])
+    return now
+
+
+class ShipVectorEnv(HertzVectorEnv):
+    """The native vector environment of a ship environment
+    (:class:`~iceenvs.vector.HertzVectorEnv` with the step's end made in
+    batch): after the engines advanced together, :func:`measure_ships`
+    measures every sub-environment at once, and the rewards (a built-in
+    reward is evaluated on columns), observations (one
+    :func:`~iceenvs.observations.normalise_rows` call), episode metrics
+    (:func:`update_metrics` on the table of sums) and the info (columns) of
+    all of them are made as arrays over the sub-environments. Only the
+    image observation, a reward function of one's own and the end-of-episode
+    tests run per sub-environment."""
+
+    def __init__(self, num_envs: int = 1, **kwargs):
+        super().__init__(num_envs, **kwargs)
+        e0 = self.envs[0]
+        self._table = np.zeros((self.num_envs, len(SUM_COLUMNS)))
+        for k, env in enumerate(self.envs):
+            env._sums = self._table[k]
+        self._names = e0.measure_names
+        self._column = {name: j for j, name in enumerate(self._names)}
+        # the observation's features as columns of a measurement (time_left: computed)
+        self._feature_index = np.array([self._column.get(f.name, 0) for f in e0.features])
+        self._time_left = [j for j, f in enumerate(e0.features) if f.name not in self._column]
+        self._prev_raw = np.zeros((self.num_envs, len(self._names)))
+        self._reward_kw: dict[str, np.ndarray] = {}
+        self._task: dict = {}
+        self._batch_reward = all(env.reward_fn is type(env).reward_fn for env in self.envs)
+
+    def reset(self, *, seed=None, options=None):
+        obs, info = super().reset(seed=seed, options=options)
+        self._task = _copied(info["task"])
+        for k in range(self.num_envs):
+            self._reset_row(k)
+        return obs, info
+
+    def _reset_row(self, k: int) -> None:
+        env = self.envs[k]
+        self._prev_raw[k] = [env._prev[name] for name in self._names]
+        for key, value in env._reward_kwargs().items():
+            self._reward_kw.setdefault(key, np.zeros(self.num_envs))[k] = value
+        if self._task:
+            self._task = set_row(self, self._task, dict(env.episode), k)
+
+    def _results(self, actions, replaced, errors) -> tuple:
+        n = self.num_envs
+        ok = np.array([k for k in range(n) if errors[k] is None], dtype=np.int64)
+        obs = create_empty_array(self.single_observation_space, n)
+        rewards = np.zeros(n)
+        terminated = np.zeros(n, dtype=bool)
+        infos: dict = {}
+        if ok.size:
+            table = self._table if ok.size == n else self._table[ok]
+            group = [self.envs[k] for k in ok]
+            try:
+                raw = measure_ships(group, table, advanced=True)
+            except PHYSICS_ERRORS as err:          # every measured one fails with it
+                for k in ok:
+                    errors[k] = err
+                ok = ok[:0]
+            else:
+                infos = self._measured(group, ok, raw, table, actions, replaced, obs, rewards,
+                                       terminated)
+                if ok.size < n:
+                    self._table[ok] = table
+        for k in range(n):
+            if errors[k] is not None:
+                o, rewards[k], terminated[k], _, info = self.envs[k]._failed_step(
+                    errors[k], int(replaced[k]))
+                _put(obs, k, o)
+                infos = set_row(self, infos, info, k)
+        return obs, rewards, terminated, infos
+
+    def _measured(self, group, ok, raw, table, actions, replaced, obs, rewards, terminated):
+        """Rewards, ends, observations and the info of the sub-environments
+        ``ok`` (``group``) measured ``raw``; fills their rows of ``obs``,
+        ``rewards`` and ``terminated`` and returns the info."""
+        e0 = group[0]
+        n = self.num_envs
+        cols = {name: raw[:, j] for j, name in enumerate(self._names)}
+        prev_raw = self._prev_raw[ok]
+        prev = {name: prev_raw[:, j] for j, name in enumerate(self._names)}
+        nows = [as_measurement(self._names, row) for row in raw]
+        if self._batch_reward:
+            kw = {key: value[ok] for key, value in self._reward_kw.items()}
+            reward = np.asarray(e0.reward_fn(prev, actions[ok], cols, **kw), dtype=float)
+            reward = np.broadcast_to(reward, ok.shape).copy()
+        else:
+            reward = np.array([env._reward(actions[k], now)
+                               for env, k, now in zip(group, ok, nows)])
+        bad = ~np.isfinite(reward)
+        failed = np.array([env._terminated(now) for env, now in zip(group, nows)],
+                          dtype=bool) | bad
+        rewards[ok] = np.where(failed, e0.failure_reward, reward)
+        terminated[ok] = (cols["reached"] > 0) | failed
+        update_metrics(table, cols, e0.goal_distance)
+        self._prev_raw[ok] = raw
+        # observations
+        if e0.obs_type == "vector":
+            features = raw[:, self._feature_index]
+            for j in self._time_left:
+                features[:, j] = [env._time_left() for env in group]
+            vectors = np.concatenate([normalise_rows(features, e0.features),
+                                      actions[ok].astype(np.float32)], axis=1)
+            obs[ok] = vectors
+            for env, now, vector in zip(group, nows, vectors):
+                env._prev = now
+                env._obs = vector.copy()
+        else:
+            for env, k, now in zip(group, ok, nows):
+                env._prev = now
+                env._obs = env._vector(now)
+                _put(obs, k, env._obs)
+        for env in group:
+            if env.render_mode == "human":
+                env.render()
+        # info: what each sub-environment's info holds, as columns
+        physics = {name: raw[:, j].copy() for j, name in enumerate(self._names)}
+        for name in INTEGER_MEASURES:
+            physics[name] = physics[name].astype(np.int64)
+        metrics = metric_columns(table)
+        columns = {"physics": physics, "time": metrics["time"],
+                   "steps": np.array([env._steps for env in group]),
+                   "task": {key: value[ok] for key, value in self._task.items()
+                            if not key.startswith("_")},
+                   **metrics, "nonfinite_action": replaced[ok]}
+        infos = _spread(columns, ok, n)
+        for i in np.flatnonzero(bad):
+            infos = self._add_info(infos, {"error": f"non-finite reward {reward[i]}"}, ok[i])
+        return infos
+
+
+def _copied(info: dict) -> dict:
+    return {key: _copied(value) if isinstance(value, dict) else value.copy()
+            for key, value in info.items()}
+
+
+def _put(obs, k: int, value) -> None:
+    if isinstance(obs, dict):
+        for key in obs:
+            obs[key][k] = value[key]
+    else:
+        obs[k] = value
+
+
+def _spread(columns: dict, rows: np.ndarray, n: int) -> dict:
+    """A vector info of ``n`` sub-environments from the ``columns`` of the
+    sub-environments ``rows`` (each key with its mask ``_key``)."""
+    out = {}
+    full = rows.size == n
+    mask = np.zeros(n, dtype=bool)
+    mask[rows] = True
+    for key, value in columns.items():
+        if isinstance(value, dict):
+            array = _spread(value, rows, n)
+        elif full:
+            array = value
+        else:
+            array = np.zeros((n,) + value.shape[1:], dtype=value.dtype)
+            array[rows] = value
+        out[key], out["_" + key] = array, mask.copy()
+    return out
