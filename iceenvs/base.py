@@ -100,10 +100,10 @@ def sanitise_actions(actions: np.ndarray, space: gym.spaces.Box) -> tuple[np.nda
     entries of each action (M,)."""
     a = np.array(actions, dtype=np.float64)
     bad = ~np.isfinite(a)
-    replaced = np.count_nonzero(bad.reshape(a.shape[0], -1), axis=1)
-    if replaced.any():
-        a[np.isnan(a)] = 0.0
-    return np.clip(a, space.low, space.high), replaced
+    if not bad.any():
+        return np.clip(a, space.low, space.high), np.zeros(a.shape[0], dtype=np.int64)
+    a[np.isnan(a)] = 0.0
+    return np.clip(a, space.low, space.high), bad.reshape(a.shape[0], -1).sum(axis=1)
 
 
 # -- task parameters ---------------------------------------------------------------------------

@@ -73,6 +73,12 @@ _INTEGER_METRICS = ("collisions", "collided_floes")
 SUM_COLUMNS = METRICS + ("n_collisions", "impulse_total", "impulse_max", "n_floes_hit",
                          "slow_time", "resistance_sum", "x", "y")
 _C = {name: k for k, name in enumerate(SUM_COLUMNS)}
+# the columns as constants of the compiled code
+(_M_SUCCESS, _M_TIME, _M_PATH, _M_EFFICIENCY, _M_EFFORT, _M_COLLISIONS, _M_FLOES,
+ _M_MEAN_IMPULSE, _M_MAX_IMPULSE, _M_IMPULSE_PER_METRE, _M_ENERGY, _M_RESISTANCE,
+ _M_MAX_PRESSURE) = (_C[name] for name in METRICS)
+(_SUM_COLLISIONS, _SUM_IMPULSE, _SUM_IMPULSE_MAX, _SUM_FLOES_HIT, _SUM_SLOW, _SUM_RESISTANCE,
+ _SUM_X, _SUM_Y) = (_C[name] for name in SUM_COLUMNS[len(METRICS):])
 
 # the columns of the ship's step records and collision log read here
 (_X, _Y, _SURGE, _SWAY, _YAW_RATE, _ICE_SURGE, _ICE_SWAY, _ICE_MOMENT, _ICE_POWER, _NORMAL_FORCE,
@@ -81,7 +87,6 @@ _C = {name: k for k, name in enumerate(SUM_COLUMNS)}
     "normal_force", "force_magnitude_sum"))
 _FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY = (LOG_COLUMNS.index(name) for name in (
     "floe", "impulse_surge", "impulse_sway"))
-_N_SUMS = 10
 
 
 def measure_names(sectors: int, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
@@ -134,20 +139,26 @@ def step_sums(rows, x0, y0, dynamic, thrust, yaw_moment, linear_damping, quadrat
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def measure_many(rows, start_xy, dynamic, commands, damping, positions, radii,
-                 floe_start, motion, sectors, max_range, lx, ly, periodic_x, periodic_y, goal_x,
-                 centre_y, half_channel, pose, sums, distance, concentration):
+def measure_many(rows, advanced, dynamic, commands, damping, dt, hull_length, beset_speed,
+                 control_interval, positions, radii, floe_start, motion, sectors, max_range, lx,
+                 ly, periodic_x, periodic_y, goal_x, centre_y, half_channel, table, pose, loads,
+                 distance, concentration):
     """The compiled part of :func:`measure_ships` for M ships, parallel over
-    them: ship k's step records are ``rows[k]`` (a typed list of arrays),
-    its last recorded position ``start_xy[k]``, its thrust and yaw moment
-    ``commands[k]`` (read when ``dynamic``), its damping coefficients
-    ``damping[k]`` (linear, quadratic), its floes
-    ``positions[floe_start[k]:floe_start[k + 1]]`` and ``radii`` (likewise)
-    and its (x, y, heading, Vx, Vy, yaw rate) ``motion[k]``. Writes the
-    pose entries (:data:`POSE`) into ``pose[k]``, the step sums of
-    :func:`step_sums` into ``sums[k]`` and the lidar (a field of view of π
-    cut into ``sectors`` sectors) into ``distance[k]`` and
-    ``concentration[k]``."""
+    them (each writes only its own rows).
+
+    Ship k has the step records ``rows[k]`` (a typed list of arrays), the
+    thrust and yaw moment ``commands[k]`` (read when ``dynamic``), the
+    damping coefficients ``damping[k]`` (linear, quadratic), the engine
+    step ``dt[k]``, the hull length ``hull_length[k]``, the beset speed
+    ``beset_speed[k]``, the floes ``positions[floe_start[k]:floe_start[k +
+    1]]`` and ``radii`` (likewise) and the (x, y, heading, Vx, Vy, yaw
+    rate) ``motion[k]``; ``table[k]`` is its row of episode sums. Writes
+    the pose entries (:data:`POSE`) into ``pose[k]``, the lidar (a field of
+    view of π cut into ``sectors`` sectors) into ``distance[k]`` and
+    ``concentration[k]`` and, when ``advanced``, the step loads
+    (:data:`LOADS` but the collisions) into ``loads[k]``, and adds the step
+    to the sums: the ship's last position, ∫ ice surge force dt and the
+    time below the beset speed (a dynamic ship)."""
     for i in prange(motion.shape[0]):
         m = np.int64(i)                     # typed lists take signed indices
         x, y, psi, vx, vy, r = (motion[m, 0], motion[m, 1], motion[m, 2], motion[m, 3],
@@ -160,15 +171,42 @@ def measure_many(rows, start_xy, dynamic, commands, damping, positions, radii,
         pose[m, 4] = c * vx + s * vy
         pose[m, 5] = -s * vx + c * vy
         pose[m, 6] = r
-        out = step_sums(rows[m], start_xy[m, 0], start_xy[m, 1],
-                        dynamic, commands[m, 0], commands[m, 1], damping[m, 0], damping[m, 1])
-        for j in range(_N_SUMS):
-            sums[m, j] = out[j]
         f0, f1 = floe_start[m], floe_start[m + 1]
         d, a = lidar_scan(x, y, psi, positions[f0:f1], radii[f0:f1], sectors, math.pi, max_range,
                           lx, ly, periodic_x, periodic_y)
         distance[m, :] = d
         concentration[m, :] = a
+        loads[m, :] = 0.0
+        rec = rows[m]
+        n = rec.shape[0]
+        if advanced and n > 0:
+            surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = step_sums(
+                rec, table[m, _SUM_X], table[m, _SUM_Y], dynamic, commands[m, 0],
+                commands[m, 1], damping[m, 0], damping[m, 1])
+            h = dt[m]
+            loads[m, 0] = surge / n
+            loads[m, 1] = sway / n
+            loads[m, 2] = moment / n
+            loads[m, 3] = normal / n / hull_length[m]
+            loads[m, 4] = peak / hull_length[m]
+            loads[m, 5] = force * h
+            loads[m, 6] = magnitude * h
+            loads[m, 7] = energy * h
+            loads[m, 8] = effort * h
+            loads[m, 9] = path
+            table[m, _SUM_X] = rec[n - 1, _X]
+            table[m, _SUM_Y] = rec[n - 1, _Y]
+            table[m, _SUM_RESISTANCE] -= surge * h
+        if advanced and dynamic:
+            if pose[m, 4] < beset_speed[m]:
+                table[m, _SUM_SLOW] += control_interval
+            else:
+                table[m, _SUM_SLOW] = 0.0
+
+
+#: :func:`measure_many` compiled without threads, for one ship: the same
+#: arithmetic without the cost of starting the parallel loop
+measure_one = njit(cache=True, error_model="numpy")(measure_many.py_func)
 
 
 def _starts(counts) -> np.ndarray:
@@ -176,18 +214,30 @@ def _starts(counts) -> np.ndarray:
 
 
 _RECORDS_TYPE = types.Array(types.float64, 2, "C", readonly=True)
+#: kept typed lists of records, by length: a list's items are replaced (a few
+#: µs each), where making a list costs some 70 µs
+_RECORD_LISTS: dict[int, List] = {}
+_NO_RECORDS = np.zeros((0, len(RECORD_COLUMNS)))
+_NO_RECORDS.flags.writeable = False
 
 
 def _record_list(arrays: list) -> List:
     """The ships' step records as the typed list :func:`measure_many`
     takes (a reference to each array: a copy of the records of many
     ships costs ten times as much)."""
-    out = List.empty_list(_RECORDS_TYPE)
-    for a in arrays:
+    out = _RECORD_LISTS.get(len(arrays))
+    fresh = out is None
+    if fresh:
+        out = List.empty_list(_RECORDS_TYPE)
+    for k, a in enumerate(arrays):
         if a.flags.writeable or not a.flags.c_contiguous:
             a = np.ascontiguousarray(a).view()
             a.flags.writeable = False
-        out.append(a)
+        if fresh:
+            out.append(a)
+        else:
+            out[k] = a
+    _RECORD_LISTS[len(arrays)] = out
     return out
 
 
@@ -217,76 +267,58 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
     motion = np.stack([ship.motion for ship in ships])
     floe_xy = [sim.positions for sim in sims]
     floe_r = [sim.radii for sim in sims]
-    floe_start = _starts([r.size for r in floe_r])
     if advanced:
         rows = [ship.record_rows() for ship in ships]
         logs = [ship.collision_rows() for ship in ships]
         for ship in ships:
             ship.clear()
     else:
-        rows = logs = [np.zeros((0, len(RECORD_COLUMNS)))] * n
+        rows = [_NO_RECORDS] * n
     dynamic = e0.mode == "dynamic"
     commands = np.zeros((n, 2))
-    if dynamic:
-        for k, ship in enumerate(ships):
+    beset = np.zeros(n)
+    if dynamic and advanced:
+        for k, (env, ship) in enumerate(zip(envs, ships)):
             c = ship.commands
             commands[k] = c["thrust"], c["yaw_moment"]
+            beset[k] = env.episode["beset_speed"]
     box = sims[0].box
-    pose = np.empty((n, len(POSE)))
-    sums = np.empty((n, _N_SUMS))
-    distance = np.empty((n, e0.lidar_sectors))
-    concentration = np.empty((n, e0.lidar_sectors))
-    measure_many(_record_list(rows), np.ascontiguousarray(table[:, [_C["x"], _C["y"]]]), dynamic, commands,
-                 np.array([env._damping for env in envs]), _stacked(floe_xy, 2),
-                 np.concatenate(floe_r), floe_start, motion, e0.lidar_sectors, e0.lidar_range,
-                 float(box.lx), float(box.ly), box.periodic[0], box.periodic[1], e0.goal_x,
-                 e0.centre_y, 0.5 * e0.channel_width, pose, sums, distance, concentration)
-
-    loads = np.zeros((n, len(LOADS)))
-    dt = np.array([sim.dt for sim in sims])
+    # the measurement's columns, written in place: pose, loads, lidar (distance
+    # and concentration interleaved), local ice, the environment's own
+    k = 2 * e0.lidar_sectors
+    lid = len(POSE) + len(LOADS)
+    loc = lid + k
+    raw = np.empty((n, len(e0.measure_names)))
+    loads = raw[:, len(POSE):lid]
+    kernel = measure_one if n == 1 else measure_many
+    kernel(_record_list(rows), advanced, dynamic, commands, _per_env(envs, "_damping"),
+           np.array([sim.dt for sim in sims]), _per_env(envs, "_hull_length"), beset,
+           e0.control_interval, _stacked(floe_xy, 2), np.concatenate(floe_r),
+           _starts([r.size for r in floe_r]), motion, e0.lidar_sectors, e0.lidar_range,
+           float(box.lx), float(box.ly), box.periodic[0], box.periodic[1], e0.goal_x,
+           e0.centre_y, 0.5 * e0.channel_width, table, raw[:, :len(POSE)], loads,
+           raw[:, lid:loc:2], raw[:, lid + 1:loc:2])
     if advanced:
-        _add_loads(envs, table, loads, rows, sums, dt)
+        for m, env in enumerate(envs):
+            if env.render_mode is not None and rows[m].shape[0]:   # the path on the frames
+                env._track.append(table[m, [_SUM_X, _SUM_Y]].copy())
         _add_collisions(envs, table, loads, logs)
-        if dynamic:
-            beset = np.array([env.episode["beset_speed"] for env in envs])
-            slow = table[:, _C["slow_time"]]
-            table[:, _C["slow_time"]] = np.where(pose[:, 4] < beset, slow + e0.control_interval,
-                                                 0.0)
-    lidar = np.empty((n, 2 * e0.lidar_sectors))
-    lidar[:, 0::2] = distance
-    lidar[:, 1::2] = concentration
-    local = np.empty((n, len(LOCAL)))
-    for k, (env, sim) in enumerate(zip(envs, sims)):
-        ice = sim.local_ice((motion[k, 0], motion[k, 1]), env.local_radius)
-        local[k, :4] = (env._field_concentration, min(1.0, ice.floe_area / ice.area),
-                        2.0 * ice.n_contacts / ice.n_floes if ice.n_floes else 0.0,
-                        ice.pressure if ice.n_contacts else 0.0)
-        local[k, 4] = sim.time
-    local[:, 5] = motion[:, 0] >= e0.goal_x
-    return np.concatenate([pose, loads, lidar, local, e0._extra_measures(envs)], axis=1)
+    for m, (env, sim) in enumerate(zip(envs, sims)):
+        ice = sim.local_ice((motion[m, 0], motion[m, 1]), env.local_radius)
+        raw[m, loc:loc + 5] = (env._field_concentration, min(1.0, ice.floe_area / ice.area),
+                               2.0 * ice.n_contacts / ice.n_floes if ice.n_floes else 0.0,
+                               ice.pressure if ice.n_contacts else 0.0, sim.time)
+    raw[:, loc + 5] = motion[:, 0] >= e0.goal_x
+    if e0.extra_measures:
+        raw[:, loc + len(LOCAL):] = e0._extra_measures(envs)
+    return raw
 
 
-def _add_loads(envs, table, loads, rows, sums, dt):
-    """The step loads from the step sums, and the ice resistance's sum and
-    the last position into the episode sums (ships with step records)."""
-    counts = np.array([r.shape[0] for r in rows])
-    has = counts > 0
-    if not has.any():
-        return
-    k = np.flatnonzero(has)
-    n = counts[k]
-    length = np.array([envs[i]._hull_length for i in k])
-    surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = sums[k].T
-    loads[k, :10] = np.column_stack((
-        surge / n, sway / n, moment / n, normal / n / length, peak / length, force * dt[k],
-        magnitude * dt[k], energy * dt[k], effort * dt[k], path))
-    last = np.array([rows[i][-1] for i in k])
-    table[k, _C["x"]] = last[:, _X]
-    table[k, _C["y"]] = last[:, _Y]
-    table[k, _C["resistance_sum"]] -= surge * dt[k]
-    for i in k:
-        if envs[i].render_mode is not None:       # the path drawn on the frames
-            envs[i]._track.append(table[i, [_C["x"], _C["y"]]].copy())
+def _per_env(envs, name: str) -> np.ndarray:
+    """The attribute ``name`` of every environment, stacked."""
+    if len(envs) == 1:
+        return np.asarray(getattr(envs[0], name), dtype=float)[None]
+    return np.array([getattr(env, name) for env in envs], dtype=float)
 
 
 def _add_collisions(envs, table, loads, logs):
@@ -310,39 +342,44 @@ def _add_collisions(envs, table, loads, logs):
         table[k, _C["n_floes_hit"]] = len(hit)
 
 
-def _ratio(top, bottom, where) -> np.ndarray:
-    """top / bottom where ``where``, else 0."""
-    top, bottom, where = np.broadcast_arrays(np.asarray(top, float), np.asarray(bottom, float),
-                                             where)
-    return np.divide(top, bottom, out=np.zeros(top.shape), where=where)
-
-
 def update_metrics(table: np.ndarray, now, goal_distance: float) -> None:
     """The episode metrics of ``table``'s rows after a step that measured
     ``now`` (a measurement dict of floats for one row, or of columns, one
     entry per row), in place; ``goal_distance`` [m] is the straight-line
     distance from the start to the goal line."""
-    c = _C
-    t = table
-    time = np.broadcast_to(np.asarray(now["time"], dtype=float), t.shape[:1])
-    t[:, c["time"]] = time
-    t[:, c["path_length"]] += now["step_path"]
-    t[:, c["effort"]] += now["step_effort"]
-    t[:, c["energy_to_ice"]] += now["step_energy"]
-    n = t[:, c["n_collisions"]]
-    total = t[:, c["impulse_total"]]
-    path = t[:, c["path_length"]]
-    t[:, c["collisions"]] = n
-    t[:, c["collided_floes"]] = t[:, c["n_floes_hit"]]
-    t[:, c["mean_impulse"]] = _ratio(total, n, n > 0)
-    t[:, c["max_impulse"]] = t[:, c["impulse_max"]]
-    t[:, c["impulse_per_metre"]] = _ratio(total, path, path > 0)
-    t[:, c["ice_resistance"]] = _ratio(t[:, c["resistance_sum"]], time, time > 0)
-    t[:, c["max_hull_pressure"]] = np.maximum(t[:, c["max_hull_pressure"]],
-                                              now["peak_hull_pressure"])
-    success = np.broadcast_to(np.asarray(now["reached"], dtype=float), t.shape[:1]) > 0
-    t[:, c["success"]] = success
-    t[:, c["efficiency"]] = _ratio(goal_distance, path, success & (path > 0))
+    values = np.array([now[name] for name in _METRIC_INPUTS], dtype=float)
+    if values.ndim == 1:                     # one measurement, for every row
+        values = np.repeat(values[:, None], table.shape[0], axis=1)
+    _update_metrics(table, values, float(goal_distance))
+
+
+#: the measurements the metrics read, in the order of :func:`_update_metrics`' arguments
+_METRIC_INPUTS = ("time", "step_path", "step_effort", "step_energy", "peak_hull_pressure",
+                  "reached")
+
+
+@njit(cache=True, error_model="numpy")
+def _update_metrics(t, values, goal_distance):
+    time, path, effort, energy, peak, reached = (values[0], values[1], values[2], values[3],
+                                                 values[4], values[5])
+    for m in range(t.shape[0]):
+        t[m, _M_TIME] = time[m]
+        t[m, _M_PATH] += path[m]
+        t[m, _M_EFFORT] += effort[m]
+        t[m, _M_ENERGY] += energy[m]
+        n = t[m, _SUM_COLLISIONS]
+        total = t[m, _SUM_IMPULSE]
+        length = t[m, _M_PATH]
+        t[m, _M_COLLISIONS] = n
+        t[m, _M_FLOES] = t[m, _SUM_FLOES_HIT]
+        t[m, _M_MEAN_IMPULSE] = total / n if n > 0 else 0.0
+        t[m, _M_MAX_IMPULSE] = t[m, _SUM_IMPULSE_MAX]
+        t[m, _M_IMPULSE_PER_METRE] = total / length if length > 0 else 0.0
+        t[m, _M_RESISTANCE] = t[m, _SUM_RESISTANCE] / time[m] if time[m] > 0 else 0.0
+        t[m, _M_MAX_PRESSURE] = max(t[m, _M_MAX_PRESSURE], peak[m])
+        success = reached[m] > 0
+        t[m, _M_SUCCESS] = 1.0 if success else 0.0
+        t[m, _M_EFFICIENCY] = goal_distance / length if success and length > 0 else 0.0
 
 
 def metric_values(row: np.ndarray) -> dict:
