@@ -72,6 +72,7 @@ FLOE_SIZES = {
     "pack": ("lognormal", (20.0, 0.5)),
     "brash": ("lognormal", (6.0, 0.5)),
     "herman2013": ("power", (1.0, 0.5)),
+    "auto_icenav": ("auto_icenav", None),
 }
 
 #: the action set-ups: name → (ship mode, action names)

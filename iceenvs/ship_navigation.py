@@ -29,7 +29,9 @@ _TASK = (
                   interval(0.0, 0.9, low_open=True)),
     TaskParameter("floe_sizes", "pack", f"floe-size preset: one of {sorted(FLOE_SIZES)} "
                   "(pack: log-normal, median diameter 20 m; brash: median 6 m; "
-                  "herman2013: the preset's power law, mean 8 m)", choice(*FLOE_SIZES)),
+                  "herman2013: the preset's power law, mean 8 m; auto_icenav: the floe "
+                  "areas of AUTO-IceNav's ice fields, median 64 m², physics.ice_fields)",
+                  choice(*FLOE_SIZES)),
     TaskParameter("wind_speed", None, "wind speed [m/s] that drives the ice; None: drawn "
                   "from `wind_speed_range`", number(0.0, 40.0, optional=True)),
     TaskParameter("wind_speed_range", (0.0, 0.0), "range of the drawn wind speeds [m/s] "

@@ -281,6 +281,10 @@ class TransitBox(Box):
         return f"TransitBox({self.lx:g}, {self.ly:g}, band={self.band})"
 
 
+#: the floe-size laws of :func:`transit_field` and :func:`covering_diameters`
+FLOE_SIZE_LAWS = ("power", "lognormal", "auto_icenav")
+
+
 def transit_field(preset, *, concentration: float, band: tuple, length: float, width: float,
                   seed: int | None = 0, sizes: str = "power", lognormal=(1.0, 0.5),
                   thickness: float | None = None, box_type=TransitBox):
@@ -297,11 +301,12 @@ def transit_field(preset, *, concentration: float, band: tuple, length: float, w
         The ice band along the channel [m].
     length, width : float
         The channel [m].
-    sizes : {"power", "lognormal"}
+    sizes : {"power", "lognormal", "auto_icenav"}
         Power-law diameters of the preset (random draws between its
-        cut-offs), or log-normal diameters (as the ice fields of
-        AUTO-IceNav) with ``lognormal = (median diameter [m], σ of ln d)``,
-        clipped to 0.2–5 times the median.
+        cut-offs), log-normal diameters with ``lognormal = (median
+        diameter [m], σ of ln d)``, clipped to 0.2–5 times the median, or
+        the floe areas of AUTO-IceNav's ice fields
+        (:data:`physics.ice_fields.AUTO_ICENAV_SIZES`), each floe a disc.
     box_type : class
         :class:`TransitBox` (default) or any box class taking
         ``(lx, ly)``, e.g. :class:`~physics.domain.ChannelBox`.
@@ -313,8 +318,8 @@ def transit_field(preset, *, concentration: float, band: tuple, length: float, w
     check_range("concentration", concentration, 0.0, 0.9, low_open=True)
     check_range("length", length, 0.0, None, low_open=True)
     check_range("width", width, 0.0, None, low_open=True)
-    if sizes not in ("power", "lognormal"):
-        raise ValueError(f"sizes must be 'power' or 'lognormal', got {sizes!r}")
+    if sizes not in FLOE_SIZE_LAWS:
+        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
     box = box_type(length, width, band=band) if box_type is TransitBox else box_type(length, width)
     x0, x1 = (box.band if isinstance(box, TransitBox) else tuple(float(b) for b in band))
     if not 0.0 <= x0 < x1 <= length:
@@ -337,6 +342,12 @@ def covering_diameters(preset, sizes: str, lognormal, target_area: float,
     ``preset`` a :class:`~physics.params.PaperPreset`), drawn from ``rng``.
     The draw is repeated until it covers the area, and cut after the first
     floe that reaches it."""
+    if sizes not in FLOE_SIZE_LAWS:
+        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
+    if sizes == "auto_icenav":
+        from .ice_fields import AUTO_ICENAV_SIZES, covering_areas
+
+        return 2.0 * np.sqrt(covering_areas(AUTO_ICENAV_SIZES, target_area, rng) / math.pi)
     if sizes == "power":
         mean_d = preset.mean_diameter
         alpha = preset.fsd_exponent

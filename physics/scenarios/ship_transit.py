@@ -6,8 +6,9 @@ The full-scale platform supply vessel (:func:`physics.ship.psv_ship`, 76.2 m
 across) through a band of floes at rest with open water before and after
 it. Floes of the Herman (2013) material (h = 1.5 m, its contact law) have
 power-law diameters (exponent 1.8, mean ``mean_diameter``, largest over
-smallest ``size_ratio``) or, as the ice fields of AUTO-IceNav, log-normal
-ones. One run per (concentration, speed, mode, wind):
+smallest ``size_ratio``) or log-normal ones (a log-normal law of the
+diameter, not AUTO-IceNav's law of the log-mass: see
+:mod:`physics.ice_fields`). One run per (concentration, speed, mode, wind):
 
 * a concentration sweep at ``reference_speed`` and a speed sweep at
   ``reference_concentration``;
