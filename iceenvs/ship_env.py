@@ -41,8 +41,10 @@ reached, else 0), ``effort`` [J], ``collisions``, ``collided_floes``,
 ``mean_impulse`` and ``max_impulse`` [N s] (of the finished collisions),
 ``impulse_per_metre`` [N s/m] (their total over the path length),
 ``energy_to_ice`` [J], ``ice_resistance`` [N] (mean ice force against
-surge) and ``max_hull_pressure`` [N/m] (the largest sum of the normal
-contact forces on the hull over its length in any engine step).
+surge), ``max_hull_pressure`` [N/m] (the largest sum of the normal
+contact forces on the hull over its length in any engine step) and
+``mean_mass_hit`` [kg] (the mean mass of the mobile floes hit, each
+counted once: AUTO-IceNav's mean collided obstacle mass).
 """
 from __future__ import annotations
 

@@ -63,30 +63,31 @@ INTEGER_MEASURES = ("step_collisions",)
 #: the episode metrics in ``info``
 METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
            "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
-           "energy_to_ice", "ice_resistance", "max_hull_pressure")
+           "energy_to_ice", "ice_resistance", "max_hull_pressure", "mean_mass_hit")
 #: the metrics that are counts, and the one that is a flag
 _INTEGER_METRICS = ("collisions", "collided_floes")
 #: a row of episode sums: the metrics, then the running sums behind them
 #: (collisions and impulses of the finished collisions, distinct floes hit,
-#: time below the beset speed, ∫ ice surge force dt, the ship's last
-#: recorded position)
+#: the mass and number of the mobile ones, time below the beset speed,
+#: ∫ ice surge force dt, the ship's last recorded position)
 SUM_COLUMNS = METRICS + ("n_collisions", "impulse_total", "impulse_max", "n_floes_hit",
-                         "slow_time", "resistance_sum", "x", "y")
+                         "mass_hit", "n_mobile_hit", "slow_time", "resistance_sum", "x", "y")
 _C = {name: k for k, name in enumerate(SUM_COLUMNS)}
 # the columns as constants of the compiled code
 (_M_SUCCESS, _M_TIME, _M_PATH, _M_EFFICIENCY, _M_EFFORT, _M_COLLISIONS, _M_FLOES,
  _M_MEAN_IMPULSE, _M_MAX_IMPULSE, _M_IMPULSE_PER_METRE, _M_ENERGY, _M_RESISTANCE,
- _M_MAX_PRESSURE) = (_C[name] for name in METRICS)
-(_SUM_COLLISIONS, _SUM_IMPULSE, _SUM_IMPULSE_MAX, _SUM_FLOES_HIT, _SUM_SLOW, _SUM_RESISTANCE,
- _SUM_X, _SUM_Y) = (_C[name] for name in SUM_COLUMNS[len(METRICS):])
+ _M_MAX_PRESSURE, _M_MEAN_MASS) = (_C[name] for name in METRICS)
+(_SUM_COLLISIONS, _SUM_IMPULSE, _SUM_IMPULSE_MAX, _SUM_FLOES_HIT, _SUM_MASS_HIT,
+ _SUM_MOBILE_HIT, _SUM_SLOW, _SUM_RESISTANCE, _SUM_X, _SUM_Y) = (
+    _C[name] for name in SUM_COLUMNS[len(METRICS):])
 
 # the columns of the ship's step records and collision log read here
 (_X, _Y, _SURGE, _SWAY, _YAW_RATE, _ICE_SURGE, _ICE_SWAY, _ICE_MOMENT, _ICE_POWER, _NORMAL_FORCE,
  _FORCE_MAGNITUDE_SUM) = (RECORD_COLUMNS.index(name) for name in (
     "x", "y", "surge", "sway", "yaw_rate", "ice_surge", "ice_sway", "ice_moment", "ice_power",
     "normal_force", "force_magnitude_sum"))
-_FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY = (LOG_COLUMNS.index(name) for name in (
-    "floe", "impulse_surge", "impulse_sway"))
+_FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY, _FLOE_MASS = (LOG_COLUMNS.index(name) for name in (
+    "floe", "impulse_surge", "impulse_sway", "floe_mass"))
 
 
 def measure_names(sectors: int, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
@@ -338,8 +339,15 @@ def _add_collisions(envs, table, loads, logs):
     table[:, _C["impulse_max"]] = top
     for k in np.flatnonzero(counts):
         hit = envs[k]._floes_hit
-        hit.update(log[owner == k, _FLOE].astype(np.int64).tolist())
-        table[k, _C["n_floes_hit"]] = len(hit)
+        mine = log[owner == k]
+        for floe, mass in zip(mine[:, _FLOE].astype(np.int64).tolist(),
+                              mine[:, _FLOE_MASS].tolist()):
+            if floe not in hit:
+                hit.add(floe)
+                if math.isfinite(mass):         # a frozen floe has no mass to count
+                    table[k, _SUM_MASS_HIT] += mass
+                    table[k, _SUM_MOBILE_HIT] += 1.0
+        table[k, _SUM_FLOES_HIT] = len(hit)
 
 
 def update_metrics(table: np.ndarray, now, goal_distance: float) -> None:
@@ -377,6 +385,8 @@ def _update_metrics(t, values, goal_distance):
         t[m, _M_IMPULSE_PER_METRE] = total / length if length > 0 else 0.0
         t[m, _M_RESISTANCE] = t[m, _SUM_RESISTANCE] / time[m] if time[m] > 0 else 0.0
         t[m, _M_MAX_PRESSURE] = max(t[m, _M_MAX_PRESSURE], peak[m])
+        mobile = t[m, _SUM_MOBILE_HIT]
+        t[m, _M_MEAN_MASS] = t[m, _SUM_MASS_HIT] / mobile if mobile > 0 else 0.0
         success = reached[m] > 0
         t[m, _M_SUCCESS] = 1.0 if success else 0.0
         t[m, _M_EFFICIENCY] = goal_distance / length if success and length > 0 else 0.0

@@ -157,7 +157,7 @@ class ShipNavigationEnv(ShipEnv):
     `info` holds, for the episode so far: `success`, `time`, `path_length`,
     `efficiency`, `effort`, `collisions`, `collided_floes`, `mean_impulse`,
     `max_impulse`, `impulse_per_metre`, `energy_to_ice`, `ice_resistance`,
-    `max_hull_pressure` (see :mod:`iceenvs.ship_env`), with `physics` (the
+    `max_hull_pressure`, `mean_mass_hit` (see :mod:`iceenvs.ship_env`), with `physics` (the
     raw observation) and `task`.
 
     ## Arguments
