@@ -55,7 +55,7 @@ from physics.engine import FloeEngine
 from physics.hertz import hertz_time_step, scaled_contact
 from physics.markdown import table_row
 
-from .observations import FLOE_FEATURES, Feature, normalise
+from .observations import FLOE_FEATURES, Feature, observation_vectors
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "sanitise_actions", "choice", "scaled_contact", "hertz_time_step",
@@ -370,9 +370,14 @@ class ControlEnv(gym.Env):
         if not self._ready():
             raise RuntimeError("call reset() before step()")
         a, replaced = sanitise_action(action, self.action_space)
+        self._took_action(a)
+        return a, replaced
+
+    def _took_action(self, a: np.ndarray) -> None:
+        """Keep the sanitised action ``a`` of a step and count the step (a
+        vector environment, which sanitises its batch at once, calls this)."""
         self._last_action = a
         self._steps += 1
-        return a, replaced
 
     def _failed_step(self, err: BaseException, replaced: int) -> tuple:
         """What ``step`` returns after a physics failure: the episode ends
@@ -540,8 +545,8 @@ class FloeEnv(ControlEnv):
     def _vector(self, now: dict) -> np.ndarray:
         if self.horizon is not None:
             now = {**now, "time_left": self._time_left()}
-        vec = normalise(now, self.features)
-        return np.concatenate([vec, self._last_action.astype(np.float32)])
+        row = np.array([[float(now[f.name]) for f in self.features]])
+        return observation_vectors(row, self.features, self._last_action[None])[0]
 
     def _info(self, now: dict) -> dict:
         return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps,

@@ -36,7 +36,7 @@ from physics import cluster_statistics, find_clusters
 from physics.markdown import table_row
 
 __all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "normalise_rows",
-           "log_stress", "feature_table"]
+           "observation_vectors", "log_stress", "feature_table"]
 
 STRESS_REF = 1.0          # N/m
 TEMPERATURE_REF = 1e-6    # m²/s²
@@ -157,6 +157,13 @@ def normalise_rows(raw: np.ndarray, features) -> np.ndarray:
         raise ValueError(f"raw must be an (M, {codes.size}) array (one column per feature), "
                          f"got shape {raw.shape}")
     return _normalise_rows(raw, codes, low, high)
+
+
+def observation_vectors(raw: np.ndarray, features, actions: np.ndarray) -> np.ndarray:
+    """The vector observations of an environment family: the scaled
+    ``features`` of each row of ``raw`` (:func:`normalise_rows`), then that
+    row's last action ``actions`` (M, n_actions) as float32."""
+    return np.concatenate([normalise_rows(raw, features), actions.astype(np.float32)], axis=1)
 
 
 #: the scalings (the names of the module docstring) as the codes of :func:`_scaled`

@@ -39,9 +39,9 @@ from numba.typed import List
 from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import PHYSICS_ERRORS
-from .observations import normalise_rows
+from .observations import observation_vectors
 from .ship_sensors import lidar_scan
-from .vector import HertzVectorEnv, set_row
+from .vector import HertzVectorEnv, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
            "measure_names", "measure_ships", "measure_many", "step_sums", "update_metrics",
@@ -332,11 +332,11 @@ def _add_collisions(envs, table, loads, logs):
     log = _stacked(logs, len(LOG_COLUMNS))
     owner = np.repeat(np.arange(len(logs)), counts)
     impulses = np.hypot(log[:, _IMPULSE_SURGE], log[:, _IMPULSE_SWAY])
-    table[:, _C["n_collisions"]] += counts
-    table[:, _C["impulse_total"]] += np.bincount(owner, impulses, minlength=len(logs))
-    top = table[:, _C["impulse_max"]].copy()
+    table[:, _SUM_COLLISIONS] += counts
+    table[:, _SUM_IMPULSE] += np.bincount(owner, impulses, minlength=len(logs))
+    top = table[:, _SUM_IMPULSE_MAX].copy()
     np.maximum.at(top, owner, impulses)
-    table[:, _C["impulse_max"]] = top
+    table[:, _SUM_IMPULSE_MAX] = top
     for k in np.flatnonzero(counts):
         hit = envs[k]._floes_hit
         mine = log[owner == k]
@@ -426,7 +426,7 @@ class ShipVectorEnv(HertzVectorEnv):
     batch): after the engines advanced together, :func:`measure_ships`
     measures every sub-environment at once, and the rewards (a built-in
     reward is evaluated on columns), observations (one
-    :func:`~iceenvs.observations.normalise_rows` call), episode metrics
+    :func:`~iceenvs.observations.observation_vectors` call), episode metrics
     (:func:`update_metrics` on the table of sums) and the info (columns) of
     all of them are made as arrays over the sub-environments. Only the
     image observation, a reward function of one's own and the end-of-episode
@@ -488,7 +488,7 @@ class ShipVectorEnv(HertzVectorEnv):
             if errors[k] is not None:
                 o, rewards[k], terminated[k], _, info = self.envs[k]._failed_step(
                     errors[k], int(replaced[k]))
-                _put(obs, k, o)
+                put_row(obs, k, o)
                 infos = set_row(self, infos, info, k)
         return obs, rewards, terminated, infos
 
@@ -512,8 +512,9 @@ class ShipVectorEnv(HertzVectorEnv):
         bad = ~np.isfinite(reward)
         failed = np.array([env._terminated(now) for env, now in zip(group, nows)],
                           dtype=bool) | bad
+        succeeded = np.array([env._succeeded(now) for env, now in zip(group, nows)], dtype=bool)
         rewards[ok] = np.where(failed, e0.failure_reward, reward)
-        terminated[ok] = (cols["reached"] > 0) | failed
+        terminated[ok] = succeeded | failed
         update_metrics(table, cols, e0.goal_distance)
         self._prev_raw[ok] = raw
         # observations
@@ -521,8 +522,7 @@ class ShipVectorEnv(HertzVectorEnv):
             features = raw[:, self._feature_index]
             for j in self._time_left:
                 features[:, j] = [env._time_left() for env in group]
-            vectors = np.concatenate([normalise_rows(features, e0.features),
-                                      actions[ok].astype(np.float32)], axis=1)
+            vectors = observation_vectors(features, e0.features, actions[ok])
             obs[ok] = vectors
             for env, now, vector in zip(group, nows, vectors):
                 env._prev = now
@@ -531,7 +531,7 @@ class ShipVectorEnv(HertzVectorEnv):
             for env, k, now in zip(group, ok, nows):
                 env._prev = now
                 env._obs = env._vector(now)
-                _put(obs, k, env._obs)
+                put_row(obs, k, env._obs)
         for env in group:
             if env.render_mode == "human":
                 env.render()
@@ -554,14 +554,6 @@ class ShipVectorEnv(HertzVectorEnv):
 def _copied(info: dict) -> dict:
     return {key: _copied(value) if isinstance(value, dict) else value.copy()
             for key, value in info.items()}
-
-
-def _put(obs, k: int, value) -> None:
-    if isinstance(obs, dict):
-        for key in obs:
-            obs[key][k] = value[key]
-    else:
-        obs[k] = value
 
 
 def _spread(columns: dict, rows: np.ndarray, n: int) -> dict:

@@ -59,7 +59,7 @@ from physics.hertz import KernelLists, advance_together
 
 from .base import PHYSICS_ERRORS, HertzEnv, sanitise_actions
 
-__all__ = ["HertzVectorEnv", "batch_infos", "row_info", "set_row", "vector_class"]
+__all__ = ["HertzVectorEnv", "batch_infos", "row_info", "set_row", "put_row", "vector_class"]
 
 
 class HertzVectorEnv(VectorEnv):
@@ -148,8 +148,7 @@ class HertzVectorEnv(VectorEnv):
                                              self.single_action_space)
         errors: list[BaseException | None] = [None] * self.num_envs
         for k, env in enumerate(self.envs):
-            env._last_action = actions[k]
-            env._steps += 1
+            env._took_action(actions[k])
             try:
                 env._apply_action(actions[k])
             except PHYSICS_ERRORS as err:
@@ -169,11 +168,7 @@ class HertzVectorEnv(VectorEnv):
             final_info = row_info(infos, k)
             o, info = self.envs[k].reset()
             self._reset_row(k)
-            if isinstance(obs, dict):
-                for key in obs:
-                    obs[key][k] = o[key]
-            else:
-                obs[k] = o
+            put_row(obs, k, o)
             infos = set_row(self, infos, info, k)
             infos = self._add_info(infos, {"final_obs": final, "final_info": final_info}, k)
         return obs, rewards, terminated, truncated, infos
@@ -279,6 +274,16 @@ def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
             array = _key_by_key([{key: v} for v in values])[key]
         out[key], out["_" + key] = array, np.ones(n, dtype=np.bool_)
     return out
+
+
+def put_row(obs, k: int, value) -> None:
+    """Sub-environment k's observation ``value`` into the batched ``obs``
+    (an array, or a dict of arrays for a Dict space)."""
+    if isinstance(obs, dict):
+        for key in obs:
+            obs[key][k] = value[key]
+    else:
+        obs[k] = value
 
 
 def row_info(infos: dict[str, Any], k: int) -> dict[str, Any]:
