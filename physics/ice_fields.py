@@ -42,7 +42,8 @@ import numpy as np
 from .checks import check_range
 
 __all__ = ["LogMassSizes", "AUTO_ICENAV_SIZES", "floe_area_quantile", "draw_floe_areas",
-           "covering_areas"]
+           "covering_areas", "Lead", "field_keep_probability", "navigation_field",
+           "MAX_PLACED_CONCENTRATION"]
 
 
 @dataclass(frozen=True)
@@ -113,3 +114,170 @@ def covering_areas(sizes: LogMassSizes, target_area: float,
         more = max(16, int(2.0 * (target_area - areas.sum()) / median))
         areas = np.concatenate([areas, draw_floe_areas(sizes, more, rng)])
     return areas[: int(np.searchsorted(np.cumsum(areas), target_area)) + 1]
+
+
+# ---------------------------------------------------------------------------
+# Heterogeneous navigation fields: thickness classes, leads, a gradient
+# ---------------------------------------------------------------------------
+
+#: highest concentration at which the floes of a field are placed before
+#: leads and the gradient thin them (random sequential placement with growth,
+#: :func:`physics.floes.place_floes`)
+MAX_PLACED_CONCENTRATION = 0.8
+
+
+@dataclass(frozen=True)
+class Lead:
+    """A straight lead (a band of open water) ``width`` [m] wide whose
+    centre line runs through the point (``x``, ``y``) [m] at ``angle`` [rad]
+    to the route (+x; 0: along the route, ±π/2: across it), ``length`` [m]
+    long, centred on that point (default: without end). In a field periodic
+    across (y) the lead wraps round."""
+
+    x: float
+    y: float
+    angle: float
+    width: float
+    length: float = math.inf
+
+    def distance(self, points: np.ndarray, period: float | None = None) -> np.ndarray:
+        """Distance [m] of ``points`` (N, 2) from the lead's centre line
+        (``period``: the field's width when y is periodic; the nearest
+        periodic image counts)."""
+        p = np.asarray(points, dtype=float)
+        c, s = math.cos(self.angle), math.sin(self.angle)
+        if not math.isfinite(self.length):
+            if abs(c) < 1e-9:
+                return np.abs(p[:, 0] - self.x)
+            dy = p[:, 1] - (self.y + (s / c) * (p[:, 0] - self.x))
+            if period is not None:
+                dy = np.mod(dy + 0.5 * period, period) - 0.5 * period
+            return np.abs(dy) * abs(c)
+        half = 0.5 * self.length
+        images = 0 if period is None else int(math.ceil(half * abs(s) / period)) + 1
+        best = np.full(p.shape[0], np.inf)
+        for k in range(-images, images + 1):
+            dx = p[:, 0] - self.x
+            dy = p[:, 1] + (k * period if period is not None else 0.0) - self.y
+            along = np.clip(dx * c + dy * s, -half, half)
+            best = np.minimum(best, np.hypot(dx - along * c, dy - along * s))
+        return best
+
+
+def field_keep_probability(points, radii, *, width: float, gradient: float = 0.0,
+                           leads: tuple = (), periodic: bool = True) -> np.ndarray:
+    """The probability that a floe placed at ``points`` (N, 2) with
+    ``radii`` stays in a field of :func:`navigation_field`: 0 where the floe
+    reaches into a lead, else (1 + ``gradient`` η) / (1 + |``gradient``|)
+    with η = 2y/``width`` − 1 ∈ [−1, 1] the position across the field."""
+    p = np.asarray(points, dtype=float)
+    eta = 2.0 * p[:, 1] / width - 1.0
+    keep = (1.0 + gradient * eta) / (1.0 + abs(gradient))
+    for lead in leads:
+        keep[lead.distance(p, width if periodic else None)
+             < 0.5 * lead.width + np.asarray(radii, dtype=float)] = 0.0
+    return keep
+
+
+def navigation_field(sizes: LogMassSizes, *, concentration: float, band: tuple, width: float,
+                     rng: np.random.Generator, thickness: float | None = None,
+                     density: float | None = None, thick_fraction: float = 0.0,
+                     thick_thickness: float = 3.0, leads: tuple = (), gradient: float = 0.0,
+                     periodic: bool = True):
+    """The floes of a heterogeneous ice field for ship navigation.
+
+    Floes of the areas of ``sizes`` (each a disc) cover ``concentration``
+    of the band x0 ≤ x < x1 (``band``) across the ``width`` [m] of the
+    field, at rest. Three options make the field heterogeneous:
+
+    * ``thick_fraction``: each floe is, with this probability, of the
+      thicker class ``thick_thickness`` [m] (multi-year or ridged ice
+      among first-year floes of ``thickness``);
+    * ``leads``: :class:`Lead` bands of open water; no floe reaches into one;
+    * ``gradient`` in [−1, 1]: the concentration varies linearly across the
+      field, A(y) = A (1 + ``gradient`` η), η = 2y/``width`` − 1.
+
+    Floes are placed somewhat above the concentration the leads and the
+    gradient need where the ice is densest, then thinned: floe i stays when
+    u_i / p_i < t, with u_i uniform in [0, 1), p_i its keep probability
+    (:func:`field_keep_probability`) and t the one threshold at which the
+    floes left cover ``concentration`` of the band (to one floe). Each floe
+    so stays with probability t p_i, proportional to p_i; a placement too
+    sparse for that (t p_i > 1 somewhere) is repeated denser.
+
+    Parameters
+    ----------
+    sizes : LogMassSizes
+        The floe-size law (e.g. :data:`AUTO_ICENAV_SIZES`).
+    thickness, density : float, optional
+        Of the floes [m], [kg/m³]; default those of ``sizes``.
+    periodic : bool
+        Whether the field is periodic across (y) (leads wrap round).
+
+    Returns
+    -------
+    (FloeField, float)
+        The floes (positions in the band's frame: x from x0) and the
+        concentration they cover of the band.
+
+    Raises
+    ------
+    ValueError
+        For options out of range, or when the leads and the gradient need
+        the floes placed above :data:`MAX_PLACED_CONCENTRATION`.
+    """
+    from .domain import Box
+    from .floes import FloeField, place_floes
+
+    check_range("concentration", concentration, 0.0, MAX_PLACED_CONCENTRATION, low_open=True)
+    check_range("width", width, 0.0, None, low_open=True)
+    check_range("thick_fraction", thick_fraction, 0.0, 1.0)
+    check_range("thick_thickness", thick_thickness, 0.0, None, low_open=True)
+    check_range("gradient", gradient, -1.0, 1.0)
+    x0, x1 = (float(b) for b in band)
+    if not (math.isfinite(x0) and math.isfinite(x1) and x1 > x0):
+        raise ValueError(f"band must be (x0, x1) with x0 < x1, got {band!r}")
+    leads = tuple(leads)
+    for lead in leads:
+        if not isinstance(lead, Lead):
+            raise TypeError(f"leads must be Lead objects, got {type(lead).__name__}")
+        check_range("lead width", lead.width, 0.0, None, low_open=True)
+        if not lead.length > 0:
+            raise ValueError(f"lead length must be > 0, got {lead.length!r}")
+    h = sizes.thickness if thickness is None else float(thickness)
+    rho = sizes.density if density is None else float(density)
+    check_range("thickness", h, 0.0, None, low_open=True)
+    region = Box(x1 - x0, width, periodic=(False, bool(periodic)))
+    shifted = tuple(Lead(lead.x - x0, lead.y, lead.angle, lead.width, lead.length)
+                    for lead in leads)
+    placed = 1.1 * concentration * (1.0 + abs(gradient))
+    target = concentration * region.area
+    while True:
+        if placed > MAX_PLACED_CONCENTRATION:
+            raise ValueError(
+                f"concentration {concentration:g} with these leads and gradient {gradient:g} "
+                f"needs the floes placed above {MAX_PLACED_CONCENTRATION} where the ice is "
+                f"densest: fewer or narrower leads, a smaller gradient or a lower "
+                f"concentration")
+        r = np.sqrt(covering_areas(sizes, placed * region.area, rng) / math.pi)
+        # floes too large for the box (minimum images) are left out
+        r = r[r < 0.999 * min(0.5 * region.lx, region.ly / (4.0 if periodic else 2.0))]
+        pos = place_floes(r, region, rng)
+        p = field_keep_probability(pos, r, width=width, gradient=gradient, leads=shifted,
+                                   periodic=periodic)
+        with np.errstate(divide="ignore"):
+            key = np.where(p > 0.0, rng.random(r.size) / p, np.inf)
+        order = np.argsort(key, kind="stable")
+        area = np.cumsum(math.pi * r[order] ** 2)
+        cut = int(np.searchsorted(area, target))
+        if cut < r.size and key[order[cut]] * float(np.max(p)) <= 1.0:
+            break
+        placed = min(1.25 * placed, MAX_PLACED_CONCENTRATION + 1e-9) \
+            if placed < MAX_PLACED_CONCENTRATION else 2.0
+    kept = np.sort(order[: cut + 1])
+    pos, r = pos[kept], r[kept]
+    covered = math.pi * float(np.sum(r ** 2)) / region.area
+    h_floe = np.where(rng.random(r.size) < thick_fraction, float(thick_thickness), h)
+    pos[:, 0] += x0
+    field = FloeField(pos, r, h_floe, np.zeros((r.size, 2)), density=rho)
+    return field, covered
