@@ -28,7 +28,7 @@ from types import MappingProxyType
 from typing import Any
 from collections.abc import Mapping
 
-__all__ = ["EnvFacts", "env_facts", "env_spec", "registered_ids"]
+__all__ = ["EnvFacts", "env_facts", "env_spec", "env_creator", "registered_ids"]
 
 
 @dataclass(frozen=True)
@@ -157,7 +157,7 @@ def env_spec(env_id: str):
                          f"package's ids: {', '.join(iceenvs.ENV_IDS)}") from None
 
 
-def _creator(env_id: str):
+def env_creator(env_id: str):
     """The class (or function) that ``gymnasium.make(env_id)`` calls."""
     from gymnasium.envs.registration import load_env_creator
 
@@ -173,7 +173,7 @@ def env_facts(env_id: str) -> EnvFacts:
     ValueError
         For an unknown id, or an environment whose class declares no facts.
     """
-    creator = _creator(env_id)
+    creator = env_creator(env_id)
     facts = getattr(creator, "facts", None)
     if not isinstance(facts, EnvFacts):
         raise ValueError(f"{env_id} declares no facts: its class "

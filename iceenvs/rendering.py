@@ -340,10 +340,11 @@ HULL = (235, 90, 40)            # orange
 TRACK = (250, 250, 250)         # white
 GOAL = (60, 220, 90)            # green
 CHANNEL = (120, 160, 200)       # light blue
+ROUTE = (255, 60, 200)          # magenta: a planner's route and swath
 
 
 def draw_ship(picture, box_size, hull_vertices, track=None, *, goal_x=None,
-              channel=None) -> np.ndarray:
+              channel=None, route=None) -> np.ndarray:
     """The picture of :func:`draw_floes` with a ship drawn over it.
 
     Parameters
@@ -362,6 +363,10 @@ def draw_ship(picture, box_size, hull_vertices, track=None, *, goal_x=None,
         The goal line x = goal_x [m], drawn green across the box.
     channel : (y0, y1), optional
         The channel's edges [m], drawn as light-blue lines.
+    route : ((K, 2) array, float), optional
+        A planned route [m] and the half-width [m] of its swath: the route
+        drawn as a magenta line, the swath's edges as thin ones (wrapped
+        into the box like the track).
 
     Returns
     -------
@@ -391,12 +396,26 @@ def draw_ship(picture, box_size, hull_vertices, track=None, *, goal_x=None,
     if goal_x is not None:
         x = float(goal_x) % box[0]
         pygame.draw.line(surf, GOAL, screen((x, 0.0)), screen((x, box[1])), 3)
-    if track is not None:
-        t = np.asarray(track, dtype=float).reshape(-1, 2)
+    def polyline(points, colour, width):
+        t = np.asarray(points, dtype=float).reshape(-1, 2)
         wrapped = np.mod(t, box)
         for a, b, ra, rb in zip(wrapped[:-1], wrapped[1:], t[:-1], t[1:]):
             if np.allclose(b - a, rb - ra):
-                pygame.draw.line(surf, TRACK, screen(a), screen(b), 2)
+                pygame.draw.line(surf, colour, screen(a), screen(b), width)
+
+    if route is not None:
+        points, half = route
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        half = _check_number("route half-width", half)
+        if points.shape[0] >= 2 and np.all(np.isfinite(points)):
+            d = np.gradient(points, axis=0)
+            normal = np.column_stack([-d[:, 1], d[:, 0]])
+            normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-12)[:, None]
+            for side in (-1.0, 1.0):
+                polyline(points + side * half * normal, ROUTE, 1)
+            polyline(points, ROUTE, 2)
+    if track is not None:
+        polyline(track, TRACK, 2)
     centre = hull.mean(axis=0)
     shift = np.mod(centre, box) - centre
     points = [screen(p) for p in hull + shift]

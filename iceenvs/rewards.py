@@ -130,10 +130,11 @@ def ship_progress(prev, now, step_length: float) -> float:
 def ship_navigation_reward(prev, action, now, *, step_length: float,
                            impulse_weight: float = 1.0, impulse_scale: float = 1.0e6,
                            time_weight: float = 0.05, exit_weight: float = 1.0,
-                           goal_bonus: float = 10.0, failure_penalty: float = 10.0) -> float:
-    """:func:`ship_progress` − ``impulse_weight`` × min(J / ``impulse_scale``, 2)
-    − ``time_weight`` − ``exit_weight`` (outside the channel) + ``goal_bonus``
-    (goal line reached).
+                           goal_bonus: float = 10.0, failure_penalty: float = 10.0,
+                           impulse_cap: float = 2.0) -> float:
+    """:func:`ship_progress` − ``impulse_weight`` × min(J / ``impulse_scale``,
+    ``impulse_cap``) − ``time_weight`` − ``exit_weight`` (outside the
+    channel) + ``goal_bonus`` (goal line reached).
 
     J [N s] is the impulse of the ice on the hull over the step
     (``now["step_impulse"]``, the time integral of the ice force's
@@ -141,7 +142,7 @@ def ship_navigation_reward(prev, action, now, *, step_length: float,
     2 m/s. ``step_length`` [m] is the distance the fastest ship of the
     action set-up sails in a step. ``failure_penalty`` is the environment's
     (a failed step's reward is −failure_penalty)."""
-    impact = np.minimum(now["step_impulse"] / impulse_scale, 2.0)
+    impact = np.minimum(now["step_impulse"] / impulse_scale, impulse_cap)
     outside = np.abs(now["channel_offset"]) > 1.0
     return (ship_progress(prev, now, step_length) - impulse_weight * impact - time_weight
             - exit_weight * outside + goal_bonus * now["reached"])
@@ -164,6 +165,7 @@ def ship_beset_reward(prev, action, now, *, step_length: float, pressure_limit: 
 def ship_reward_bounds(params: dict) -> tuple[float, float]:
     """(lowest, highest) reward of one step of a ship task with these reward
     parameters (its ``env.reward_params``), a failure included."""
-    low = -1.0 - params.get("time_weight", 0.0) - 2.0 * params.get("impulse_weight", 0.0) \
+    low = -1.0 - params.get("time_weight", 0.0) \
+        - params.get("impulse_cap", 2.0) * params.get("impulse_weight", 0.0) \
         - params.get("exit_weight", 0.0) - params.get("pressure_weight", 0.0)
     return (min(low, -params["failure_penalty"]), 1.0 + params.get("goal_bonus", 0.0))

@@ -44,7 +44,16 @@ reached, else 0), ``effort`` [J], ``collisions``, ``collided_floes``,
 surge), ``max_hull_pressure`` [N/m] (the largest sum of the normal
 contact forces on the hull over its length in any engine step) and
 ``mean_mass_hit`` [kg] (the mean mass of the mobile floes hit, each
-counted once: AUTO-IceNav's mean collided obstacle mass).
+counted once: AUTO-IceNav's mean collided obstacle mass),
+``ice_energy_gain`` [J] (the kinetic energy of all the ice now less at the
+start, translation and rotation) and ``energy_dissipated`` [J]
+(``energy_to_ice`` − ``ice_energy_gain``: what the contacts and the
+water took). AUTO-IceNav's three kinetic-energy metrics map onto these:
+its ship's kinetic-energy loss is ``energy_to_ice`` (the work of the ice
+on the hull, which a prescribed ship's motion makes good), the ice's gain
+is ``ice_energy_gain`` and the system's loss ``energy_dissipated``. For a
+head-on hit at speed v on a floe of mass m at rest that leaves at
+(1 + e) v, they are v m (1 + e) v, ½ m (1 + e)² v² and ½ m v² (1 − e²).
 """
 from __future__ import annotations
 
@@ -362,6 +371,7 @@ class ShipEnv(HertzEnv):
         self._sums[[SUM_COLUMNS.index("x"), SUM_COLUMNS.index("y")]] = self._track[0]
         self._floes_hit = set()
         self._records_pending = False
+        self.plan_overlay = None
         return sim
 
     # -- actions ---------------------------------------------------------------------
@@ -451,6 +461,29 @@ class ShipEnv(HertzEnv):
         kwargs["step_length"] = self.max_speed * self.control_interval
         return kwargs
 
+    # -- privileged sensing (planners) -----------------------------------------------
+    def ice_near(self, distance: float) -> dict:
+        """The floes whose centres lie within ``distance`` [m] of the ship's
+        centroid, as the engine holds them now: ``positions`` (K, 2) [m]
+        (the periodic image nearest the ship), ``velocities`` (K, 2) [m/s],
+        ``radii`` (K,) [m], ``masses`` (K,) [kg] and ``index`` (K,) (the
+        engine's floe indices).
+
+        This is *privileged* information: a planner may read it (as
+        AUTO-IceNav's planners read the floe polygons from their simulator),
+        a policy sees only its observation."""
+        check_range("distance", distance, 0.0, None, low_open=True)
+        sim = self.sim
+        centre = np.asarray(sim.ship.position, dtype=float)
+        gap = sim.box.minimum_image(sim.positions - centre)
+        near = np.nonzero(gap[:, 0] ** 2 + gap[:, 1] ** 2 <= distance * distance)[0]
+        return {"positions": centre + gap[near], "velocities": sim.velocities[near].copy(),
+                "radii": sim.radii[near].copy(), "masses": sim.masses[near].copy(),
+                "index": near}
+
+    #: a planned route to draw on the frames: ((K, 2) points [m], swath half-width [m]) or None
+    plan_overlay = None
+
     # -- frames ------------------------------------------------------------------------
     def _frame(self) -> np.ndarray:
         from .rendering import annotate, draw_floes, draw_ship
@@ -464,7 +497,8 @@ class ShipEnv(HertzEnv):
                              speed_scale=self.colour_scale)
         y0 = self.centre_y - 0.5 * self.channel_width
         picture = draw_ship(picture, box, sim.ship.vertices, np.array(self._track),
-                            goal_x=self.goal_x, channel=(y0, y0 + self.channel_width))
+                            goal_x=self.goal_x, channel=(y0, y0 + self.channel_width),
+                            route=self.plan_overlay)
         return annotate(picture, colour_bar=(self.colour_label, 0.0, self.colour_scale),
                         arrow=self._frame_arrow(), text=self._frame_text())
 

@@ -44,8 +44,8 @@ from .ship_sensors import lidar_scan
 from .vector import HertzVectorEnv, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
-           "measure_names", "measure_ships", "measure_many", "step_sums", "update_metrics",
-           "metric_values", "metric_columns", "as_measurement", "ShipVectorEnv"]
+           "measure_names", "measure_ships", "ice_kinetic_energy", "measure_many", "step_sums",
+           "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipVectorEnv"]
 
 #: the pose entries of a measurement (ship frame; the goal lies along +x)
 POSE = ("goal_distance", "goal_cos", "goal_sin", "channel_offset", "surge", "sway", "yaw_rate")
@@ -54,31 +54,35 @@ LOADS = ("ice_surge", "ice_sway", "ice_moment", "hull_pressure", "peak_hull_pres
          "step_impulse", "step_contact_impulse", "step_energy", "step_effort", "step_path",
          "step_collisions")
 #: after the lidar: the episode's concentration, the ice around the hull, the
-#: model time and whether the goal line is reached (1) or not (0)
+#: model time, whether the goal line is reached (1) or not (0) and the kinetic
+#: energy of all the ice [J] (translation and rotation)
 LOCAL = ("concentration", "local_concentration", "local_contacts", "local_pressure", "time",
-         "reached")
+         "reached", "ice_kinetic_energy")
 #: the measurements whose values are counts
 INTEGER_MEASURES = ("step_collisions",)
 
 #: the episode metrics in ``info``
 METRICS = ("success", "time", "path_length", "efficiency", "effort", "collisions",
            "collided_floes", "mean_impulse", "max_impulse", "impulse_per_metre",
-           "energy_to_ice", "ice_resistance", "max_hull_pressure", "mean_mass_hit")
+           "energy_to_ice", "ice_resistance", "max_hull_pressure", "mean_mass_hit",
+           "ice_energy_gain", "energy_dissipated")
 #: the metrics that are counts, and the one that is a flag
 _INTEGER_METRICS = ("collisions", "collided_floes")
 #: a row of episode sums: the metrics, then the running sums behind them
 #: (collisions and impulses of the finished collisions, distinct floes hit,
 #: the mass and number of the mobile ones, time below the beset speed,
-#: ∫ ice surge force dt, the ship's last recorded position)
+#: ∫ ice surge force dt, the ship's last recorded position, the ice's kinetic
+#: energy at the start)
 SUM_COLUMNS = METRICS + ("n_collisions", "impulse_total", "impulse_max", "n_floes_hit",
-                         "mass_hit", "n_mobile_hit", "slow_time", "resistance_sum", "x", "y")
+                         "mass_hit", "n_mobile_hit", "slow_time", "resistance_sum", "x", "y",
+                         "ice_energy_start")
 _C = {name: k for k, name in enumerate(SUM_COLUMNS)}
 # the columns as constants of the compiled code
 (_M_SUCCESS, _M_TIME, _M_PATH, _M_EFFICIENCY, _M_EFFORT, _M_COLLISIONS, _M_FLOES,
  _M_MEAN_IMPULSE, _M_MAX_IMPULSE, _M_IMPULSE_PER_METRE, _M_ENERGY, _M_RESISTANCE,
- _M_MAX_PRESSURE, _M_MEAN_MASS) = (_C[name] for name in METRICS)
+ _M_MAX_PRESSURE, _M_MEAN_MASS, _M_ICE_GAIN, _M_DISSIPATED) = (_C[name] for name in METRICS)
 (_SUM_COLLISIONS, _SUM_IMPULSE, _SUM_IMPULSE_MAX, _SUM_FLOES_HIT, _SUM_MASS_HIT,
- _SUM_MOBILE_HIT, _SUM_SLOW, _SUM_RESISTANCE, _SUM_X, _SUM_Y) = (
+ _SUM_MOBILE_HIT, _SUM_SLOW, _SUM_RESISTANCE, _SUM_X, _SUM_Y, _SUM_ICE_START) = (
     _C[name] for name in SUM_COLUMNS[len(METRICS):])
 
 # the columns of the ship's step records and collision log read here
@@ -309,10 +313,24 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
         raw[m, loc:loc + 5] = (env._field_concentration, min(1.0, ice.floe_area / ice.area),
                                2.0 * ice.n_contacts / ice.n_floes if ice.n_floes else 0.0,
                                ice.pressure if ice.n_contacts else 0.0, sim.time)
+        raw[m, loc + 6] = ice_kinetic_energy(sim)
     raw[:, loc + 5] = motion[:, 0] >= e0.goal_x
+    if not advanced:
+        table[:, _SUM_ICE_START] = raw[:, loc + 6]
     if e0.extra_measures:
         raw[:, loc + len(LOCAL):] = e0._extra_measures(envs)
     return raw
+
+
+def ice_kinetic_energy(sim) -> float:
+    """Kinetic energy [J] of all the floes of ``sim``: Σ ½ m |v|² + ½ I ω²,
+    I = ½ m r² (a disc); frozen floes (infinite mass) do not move and count
+    nothing."""
+    m, v, r = sim.masses, sim.velocities, sim.radii
+    m = np.where(np.isfinite(m), m, 0.0)
+    w = sim.angular_velocities
+    return 0.5 * float(np.dot(m, v[:, 0] ** 2 + v[:, 1] ** 2)) \
+        + 0.25 * float(np.dot(m * r * r, w * w))
 
 
 def _per_env(envs, name: str) -> np.ndarray:
@@ -363,13 +381,14 @@ def update_metrics(table: np.ndarray, now, goal_distance: float) -> None:
 
 #: the measurements the metrics read, in the order of :func:`_update_metrics`' arguments
 _METRIC_INPUTS = ("time", "step_path", "step_effort", "step_energy", "peak_hull_pressure",
-                  "reached")
+                  "reached", "ice_kinetic_energy")
 
 
 @njit(cache=True, error_model="numpy")
 def _update_metrics(t, values, goal_distance):
-    time, path, effort, energy, peak, reached = (values[0], values[1], values[2], values[3],
-                                                 values[4], values[5])
+    time, path, effort, energy, peak, reached, ice = (values[0], values[1], values[2],
+                                                      values[3], values[4], values[5],
+                                                      values[6])
     for m in range(t.shape[0]):
         t[m, _M_TIME] = time[m]
         t[m, _M_PATH] += path[m]
@@ -390,6 +409,8 @@ def _update_metrics(t, values, goal_distance):
         success = reached[m] > 0
         t[m, _M_SUCCESS] = 1.0 if success else 0.0
         t[m, _M_EFFICIENCY] = goal_distance / length if success and length > 0 else 0.0
+        t[m, _M_ICE_GAIN] = ice[m] - t[m, _SUM_ICE_START]
+        t[m, _M_DISSIPATED] = t[m, _M_ENERGY] - t[m, _M_ICE_GAIN]
 
 
 def metric_values(row: np.ndarray) -> dict:

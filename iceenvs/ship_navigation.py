@@ -157,7 +157,8 @@ class ShipNavigationEnv(ShipEnv):
     `info` holds, for the episode so far: `success`, `time`, `path_length`,
     `efficiency`, `effort`, `collisions`, `collided_floes`, `mean_impulse`,
     `max_impulse`, `impulse_per_metre`, `energy_to_ice`, `ice_resistance`,
-    `max_hull_pressure`, `mean_mass_hit` (see :mod:`iceenvs.ship_env`), with `physics` (the
+    `max_hull_pressure`, `mean_mass_hit`, `ice_energy_gain`, `energy_dissipated`
+    (see :mod:`iceenvs.ship_env`), with `physics` (the
     raw observation) and `task`.
 
     ## Arguments
@@ -203,16 +204,21 @@ class ShipNavigationEnv(ShipEnv):
                 task[name] = value
         return task
 
-    def _ice(self, rng):
+    def _forcing(self):
+        """The episode's wind and current forcing."""
         e = self.episode
-        box = Box(self.length, self.width)
 
         def vector(speed, angle):
             return (speed * math.cos(angle), speed * math.sin(angle))
 
-        forcing = self.preset.make_forcing(wind=vector(e["wind_speed"], e["wind_direction"]),
-                                           current=vector(e["current_speed"],
-                                                          e["current_direction"]))
+        return self.preset.make_forcing(wind=vector(e["wind_speed"], e["wind_direction"]),
+                                        current=vector(e["current_speed"],
+                                                       e["current_direction"]))
+
+    def _ice(self, rng):
+        e = self.episode
+        box = Box(self.length, self.width)
+        forcing = self._forcing()
         field = self._floe_field(box, rng, concentration=e["concentration"],
                                  floe_sizes=e["floe_sizes"])
         if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
