@@ -12,6 +12,7 @@ id                                     task
 ``iceenvs/ThicknessDistribution-v0``   steer the ice thickness distribution
 ``iceenvs/ShipNavigation-v0``          sail a ship through pack ice to a goal
 ``iceenvs/ShipBeset-v0``               keep a ship moving in pressured ice
+``iceenvs/ShipNavigation-v1``          cross a kilometre of pack ice (AUTO-IceNav's fields)
 =====================================  =========================================
 
 >>> import gymnasium as gym
@@ -40,6 +41,8 @@ _ENVS = {
     "ShipNavigation-v0": ("iceenvs.ship_navigation:ShipNavigationEnv", 300,
                           "ShipNavigationVectorEnv"),
     "ShipBeset-v0": ("iceenvs.ship_beset:ShipBesetEnv", 300, "ShipBesetVectorEnv"),
+    "ShipNavigation-v1": ("iceenvs.ship_navigation_v1:ShipNavigationV1Env", 550,
+                          "ShipNavigationV1VectorEnv"),
 }
 
 #: every registered id

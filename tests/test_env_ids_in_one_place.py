@@ -27,7 +27,8 @@ EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
                "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0",
                                         "iceenvs/WindDrift-v0"},
-               "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"}}
+               "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"},
+               "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 
 
 def _names() -> dict[str, str]:

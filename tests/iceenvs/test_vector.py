@@ -29,7 +29,7 @@ def make_vec(env_id, n, **kwargs):
 def test_the_hertz_environments_have_a_native_vector_env():
     assert {i.split("/")[1] for i in VECTOR_IDS} == {
         "WindDrift-v0", "Convergence-v0", "MarginalIceZone-v0", "ShipNavigation-v0",
-        "ShipBeset-v0"}
+        "ShipBeset-v0", "ShipNavigation-v1"}
     envs = make_vec(SHIP, 2)
     assert envs.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
     envs.close()
