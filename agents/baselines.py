@@ -18,6 +18,7 @@ name              policy
 ``heuristic``     the hand-written controller of the environment
 ``straight``      ship environments: full speed straight to the goal line
 ``reactive``      ship environments: steer for the least obstructed lidar sector
+``lattice``       ship environments: the lattice planner of :mod:`agents.planners`
 ================  ==========================================================
 
 >>> env = gymnasium.make("iceenvs/Convergence-v0")
@@ -170,12 +171,27 @@ def _env_id(env: gym.Env) -> str | None:
     return env.spec.id if getattr(env, "spec", None) is not None else None
 
 
+def _planners(env_id: str | None) -> dict:
+    """The planners of :mod:`agents.planners` that apply to ``env_id``: all
+    of them for a ship environment (one that offers ``ice_near``), none
+    otherwise."""
+    if env_id is None:
+        return {}
+    from iceenvs.facts import env_creator
+
+    from .planners import PLANNERS
+
+    return dict(PLANNERS) if hasattr(env_creator(env_id), "ice_near") else {}
+
+
 def baseline_names(env_id: str | None = None) -> list[str]:
-    """The baselines of ``env_id``: the generic ones and the environment's
-    own controllers (every generic one without an id)."""
+    """The baselines of ``env_id``: the generic ones, the environment's own
+    controllers and, for a ship environment, the planners of
+    :mod:`agents.planners` (every generic one without an id)."""
     names = list(GENERIC)
     if env_id is not None:
         names += [n for n in env_facts(env_id).controllers if n not in names]
+        names += [n for n in _planners(env_id) if n not in names]
     return names
 
 
@@ -192,7 +208,8 @@ def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
     if name in GENERIC:
         return GENERIC[name](env, seed, **kwargs)
     env_id = _env_id(env)
-    controllers = env_facts(env_id).controllers if env_id is not None else {}
+    controllers = {**env_facts(env_id).controllers, **_planners(env_id)} \
+        if env_id is not None else {}
     if name not in controllers:
         where = env_id or type(env).__name__
         raise ValueError(f"unknown baseline {name!r} for {where}; valid baselines: "

@@ -10,6 +10,7 @@ saved model the ``predict`` interface of the baselines.
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -90,8 +91,11 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     policy.reset(seed)
     rewards, trace = [], []
     final = logged_metrics(info)
+    thinking = 0.0
     while True:
+        t0 = time.perf_counter()
         action, _ = policy.predict(obs, deterministic=True)
+        thinking += time.perf_counter() - t0
         obs, reward, terminated, truncated, info = env.step(action)
         rewards.append(float(reward))
         metrics = logged_metrics(info)
@@ -99,8 +103,14 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
         trace.append(metrics.get(main_metric, math.nan) if main_metric else math.nan)
         if terminated or truncated:
             break
-    return dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
-                terminated=bool(terminated), final=final, rewards=rewards, trace=trace)
+    out = dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
+               terminated=bool(terminated), final=final, rewards=rewards, trace=trace,
+               decision_ms=1e3 * thinking / max(len(rewards), 1))
+    plans = getattr(policy, "decision_times", None)
+    if plans:
+        out["plan_ms"] = 1e3 * float(np.mean(plans))
+        out["plans"] = len(plans)
+    return out
 
 
 def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = True) -> dict:

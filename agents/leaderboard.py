@@ -1,0 +1,324 @@
+"""The ship-navigation leaderboard: ``python -m agents.leaderboard``.
+
+Every policy sails the same seeded ice fields at each concentration
+(episode k of every policy and every concentration seeded ``--seed`` + k:
+the same draws, so paired), and the table gives per policy and
+concentration the mean and standard error of the return and of
+AUTO-IceNav's metrics, and the metrics normalised by the straight line's
+on the same field (the mean over the fields of the per-field ratio).
+
+Route choice *pays* at a concentration when the best planner meets at
+most 0.7 times the straight line's ice impulse per metre (the ratio of
+the means over the fields), sailing at most 10 % further.
+
+Output in ``--out`` (default ``docs/agents/leaderboard``):
+``leaderboard.md`` (the tables, with command, machine and date),
+``leaderboard.json`` (every episode) and ``leaderboard.png`` (impulse per
+metre and return against concentration)::
+
+    python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
+        [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
+        [--policies straight,reactive,lattice] [--trained NAME=RUN_DIR ...]
+        [--env-kwargs key=value ...] [--processes 2] [--out DIR]
+    python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import platform
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["run_leaderboard", "summarise_board", "board_markdown", "plot_board", "main",
+           "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
+
+DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
+DEFAULT_OUT = Path("docs/agents/leaderboard")
+#: the metrics normalised by the straight line's on the same field
+NORMALISED = ("impulse_per_metre", "energy_to_ice", "mean_impulse", "max_impulse", "path_length")
+#: the metrics of the main table: (logged name, header, scale, unit)
+SHOWN = (("impulse_per_metre", "ice impulse per metre", 1e3, "kN s/m"),
+         ("energy_to_ice", "energy to the ice", 1e6, "MJ"),
+         ("path_length", "path", 1.0, "m"),
+         ("collisions", "collisions", 1.0, ""),
+         ("collided_floes", "floes hit", 1.0, ""),
+         ("mean_impulse", "mean impulse", 1e3, "kN s"),
+         ("max_impulse", "max impulse", 1e6, "MN s"),
+         ("mean_mass_hit", "mean mass hit", 1e3, "t"))
+#: route choice pays when the best planner's impulse per metre is at most this
+#: times the straight line's ...
+ROUTE_CHOICE_RATIO = 0.7
+#: ... sailing at most this times its path
+DETOUR_LIMIT = 1.1
+
+
+def run_leaderboard(env_id: str, concentrations, recipes: dict, *, episodes: int, seed: int,
+                    processes: int, env_kwargs: dict | None = None,
+                    progress: bool = True) -> dict:
+    """``{concentration (str): {policy: [episode dicts]}}`` of
+    :func:`agents.rollouts.evaluate_in_processes` at each concentration."""
+    from .rollouts import evaluate_in_processes
+
+    board = {}
+    for a in concentrations:
+        kwargs = {**(env_kwargs or {}), "concentration": float(a)}
+        board[f"{float(a):g}"] = evaluate_in_processes(
+            env_id, kwargs, recipes, episodes=episodes, seed=seed, processes=processes,
+            progress=progress)
+    return board
+
+
+def _final(e, key):
+    return float(e["final"].get(key, math.nan))
+
+
+def summarise_board(board: dict, reference: str = "straight") -> dict:
+    """Per concentration and policy: mean, std and standard error of the
+    return, of every final metric, of the decision time and of the
+    per-field ratios to ``reference`` (``ratio_<metric>``), the ratio of
+    the means of the impulse per metre (``ipm_ratio_of_means``) and the
+    success rate."""
+    from .rollouts import stats, summarise
+
+    out = {}
+    for a, policies in board.items():
+        ref = policies.get(reference)
+        out[a] = {}
+        for name, episodes in policies.items():
+            s = summarise(episodes)
+            s["decision_ms"] = stats([e.get("decision_ms", math.nan) for e in episodes])
+            if any("plan_ms" in e for e in episodes):
+                s["plan_ms"] = stats([e.get("plan_ms", math.nan) for e in episodes])
+            s["success_rate"] = float(np.mean([_final(e, "success") > 0 for e in episodes]))
+            if ref is not None:
+                for key in NORMALISED:
+                    r = [_final(e, key) / _final(b, key) if _final(b, key) > 0 else math.nan
+                         for e, b in zip(episodes, ref)]
+                    s[f"ratio_{key}"] = stats(r)
+                mine = np.mean([_final(e, "impulse_per_metre") for e in episodes])
+                theirs = np.mean([_final(b, "impulse_per_metre") for b in ref])
+                s["ipm_ratio_of_means"] = float(mine / theirs) if theirs > 0 else math.nan
+                paths = np.mean([_final(e, "path_length") for e in episodes])
+                s["path_ratio_of_means"] = float(
+                    paths / np.mean([_final(b, "path_length") for b in ref]))
+            out[a][name] = s
+    return out
+
+
+def route_choice_pays(summary: dict, planners) -> dict:
+    """``{concentration: (best planner, its impulse-per-metre ratio, its
+    path ratio, pays)}``: the planner of ``planners`` with the lowest ratio
+    of means among those within the detour limit."""
+    verdict = {}
+    for a, policies in summary.items():
+        rows = [(p, policies[p]["ipm_ratio_of_means"], policies[p]["path_ratio_of_means"])
+                for p in planners if p in policies and "ipm_ratio_of_means" in policies[p]]
+        fair = [r for r in rows if r[2] <= DETOUR_LIMIT] or rows
+        if not fair:
+            continue
+        best = min(fair, key=lambda r: r[1])
+        verdict[a] = (*best, bool(best[1] <= ROUTE_CHOICE_RATIO and best[2] <= DETOUR_LIMIT))
+    return verdict
+
+
+def _num(x: float, digits: int) -> str:
+    """``x`` to ``digits`` significant digits, without an exponent."""
+    if x == 0 or not math.isfinite(x):
+        return f"{x:g}"
+    decimals = max(digits - 1 - int(math.floor(math.log10(abs(x)))), 0)
+    return f"{x:.{decimals}f}"
+
+
+def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
+    if not s or not math.isfinite(s.get("mean", math.nan)):
+        return "–"
+    return f"{_num(s['mean'] / scale, digits)} ± {_num(s['sem'] / scale, 2)}"
+
+
+def board_markdown(report: dict) -> str:
+    """The Markdown of a leaderboard report (the JSON of :func:`main`)."""
+    summary = report["summary"]
+    lines = [f"Command: `{report['command']}`", "",
+             f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}); "
+             f"{report['episodes']} fields per concentration, field k seeded "
+             f"{report['seed']} + k, the same fields for every policy; "
+             f"{report['machine']}; {report['date']}; {report['wall_s']:.0f} s.", "",
+             "Means ± standard errors over the fields. Ratios are to the straight line on "
+             "the same field (mean of the per-field ratios); *ratio of means* is the mean "
+             "impulse per metre over the straight line's.", ""]
+    verdict = route_choice_pays(summary, report["planners"])
+    lines += ["## Does route choice pay?", "",
+              f"Route choice pays when the best planner meets at most {ROUTE_CHOICE_RATIO} "
+              f"times the straight line's impulse per metre (ratio of means), sailing at most "
+              f"{DETOUR_LIMIT - 1:.0%} further.", "",
+              "| A | best planner | impulse per metre / straight (ratio of means) | "
+              "path / straight | pays |", "|---|---|---|---|---|"]
+    for a, (name, ratio, path, pays) in verdict.items():
+        lines.append(f"| {a} | {name} | {ratio:.3f} | {path:.3f} | "
+                     f"{'yes' if pays else '**no**'} |")
+    for a, policies in summary.items():
+        lines += ["", f"## A = {a}", "",
+                  "| policy | return | success | " + " | ".join(
+                      f"{h} [{u}]" if u else h for _, h, _, u in SHOWN)
+                  + " | decision [ms] |",
+                  "|---" * (len(SHOWN) + 4) + "|"]
+        for name, s in policies.items():
+            cells = [name, _pm(s["return"], 1.0, 4), f"{s['success_rate']:.0%}"]
+            cells += [_pm(s.get(key), scale) for key, _, scale, _ in SHOWN]
+            cells.append(_pm(s["decision_ms"], 1.0, 2))
+            lines.append("| " + " | ".join(cells) + " |")
+        lines += ["", "Normalised by the straight line on the same field:", "",
+                  "| policy | " + " | ".join(NORMALISED) + " | impulse per metre, ratio of means "
+                  "| plan [ms] |", "|---" * (len(NORMALISED) + 3) + "|"]
+        for name, s in policies.items():
+            cells = [name] + [_pm(s.get(f"ratio_{k}"), 1.0, 3) for k in NORMALISED]
+            cells.append(f"{s.get('ipm_ratio_of_means', math.nan):.3f}")
+            cells.append(_pm(s.get("plan_ms"), 1.0, 2))
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _kwargs_text(kwargs: dict) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in kwargs.items()) or "defaults"
+
+
+def plot_board(report: dict, path: Path) -> None:
+    """Impulse per metre over the straight line's, and the return, against
+    the concentration, per policy, with standard errors."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    summary = report["summary"]
+    conc = [float(a) for a in summary]
+    names = list(next(iter(summary.values())))
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 4))
+    for name in names:
+        rows = [summary[a][name] for a in summary]
+        ax0.errorbar(conc, [r["ratio_impulse_per_metre"]["mean"] for r in rows],
+                     [r["ratio_impulse_per_metre"]["sem"] for r in rows], marker="o",
+                     capsize=3, label=name)
+        ax1.errorbar(conc, [r["return"]["mean"] for r in rows],
+                     [r["return"]["sem"] for r in rows], marker="o", capsize=3, label=name)
+    ax0.axhline(ROUTE_CHOICE_RATIO, color="grey", ls="--", lw=1,
+                label=f"{ROUTE_CHOICE_RATIO} × straight")
+    ax0.set(xlabel="ice concentration A", ylabel="impulse per metre / straight line's",
+            title="ice met, per field, over the straight line's")
+    ax1.set(xlabel="ice concentration A", ylabel="return", title="return")
+    ax0.legend(fontsize=8)
+    fig.suptitle(f"{report['env']}: {report['episodes']} paired fields per concentration")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--env", default=DEFAULT_ENV, help=f"ship environment id ({DEFAULT_ENV})")
+    p.add_argument("--concentrations", default="0.2,0.3,0.4,0.5",
+                   help="comma-separated ice concentrations (0.2,0.3,0.4,0.5)")
+    p.add_argument("--episodes", type=int, default=20, help="fields per concentration (20)")
+    p.add_argument("--seed", type=int, default=10_000, help="seed of field 0 (10000)")
+    p.add_argument("--policies", default="straight,reactive,lattice",
+                   help="comma-separated baselines (straight,reactive,lattice)")
+    p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR",
+                   help="a trained policy (agents.train's run directory), repeatable")
+    p.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
+                   help="gymnasium.make keywords (YAML values)")
+    p.add_argument("--processes", type=int, default=2, help="worker processes (2)")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output ({DEFAULT_OUT})")
+    p.add_argument("--render", action="store_true",
+                   help="write the table and the plot again from the JSON in --out")
+    return p
+
+
+def _write(report: dict, out: Path) -> None:
+    (out / "leaderboard.md").write_text("# Ship navigation leaderboard\n\n"
+                                        + board_markdown(report))
+    plot_board(report, out / "leaderboard.png")
+
+
+def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboard") -> dict:
+    parser = build_parser(prog)
+    args = parser.parse_args(argv)
+    out = args.out
+    if args.render:
+        path = out / "leaderboard.json"
+        if not path.exists():
+            parser.error(f"--render: {path} does not exist")
+        report = json.loads(path.read_text())
+        _write(report, out)
+        return report
+
+    import numba
+
+    from .baselines import baseline_names
+    from .envs import make_checked_env, parse_key_values
+    from .planners import PLANNERS
+
+    if args.episodes < 2:
+        parser.error("--episodes must be at least 2 (standard errors)")
+    if args.processes < 1:
+        parser.error("--processes must be at least 1")
+    try:
+        conc = [float(a) for a in args.concentrations.split(",") if a.strip()]
+        env_kwargs = parse_key_values(args.env_kwargs)
+    except ValueError as err:
+        parser.error(str(err))
+    if not conc:
+        parser.error("--concentrations is empty")
+    if "concentration" in env_kwargs:
+        parser.error("--env-kwargs concentration: the concentrations come from --concentrations")
+    valid = baseline_names(args.env)
+    policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    for name in policies:
+        if name not in valid:
+            parser.error(f"unknown policy {name!r} for {args.env}; valid: {', '.join(valid)}")
+    if "straight" not in policies:
+        policies.insert(0, "straight")
+    recipes = {name: ("baseline", name, {}) for name in policies}
+    for item in args.trained:
+        name, sep, run_dir = item.partition("=")
+        if not sep or not name or not Path(run_dir).is_dir():
+            parser.error(f"--trained takes NAME=RUN_DIR with an existing directory, got {item!r}")
+        recipes[name] = ("trained", run_dir, {})
+    for a in conc:
+        try:
+            make_checked_env(args.env, {**env_kwargs, "concentration": a}).close()
+        except (TypeError, ValueError) as err:
+            print(f"{prog}: error: {args.env} with concentration {a:g}: {err}", file=sys.stderr)
+            raise SystemExit(2) from None
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
+                            processes=args.processes, env_kwargs=env_kwargs)
+    summary = summarise_board(board)
+    argv_text = " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
+    report = dict(
+        command=f"{prog} {argv_text}".strip(), env=args.env, env_kwargs=env_kwargs,
+        episodes=args.episodes, seed=args.seed,
+        planners=[p for p in recipes if p in PLANNERS or p == "reactive"],
+        machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
+        date=datetime.date.today().isoformat(), wall_s=time.perf_counter() - t0,
+        summary=summary,
+        episodes_detail={a: {name: [{k: v for k, v in e.items()
+                                     if k not in ("rewards", "trace")} for e in eps]
+                             for name, eps in policies_.items()}
+                         for a, policies_ in board.items()})
+    (out / "leaderboard.json").write_text(json.dumps(report, indent=1))
+    _write(report, out)
+    print(board_markdown(report))
+    return report
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,331 @@
+"""Route planners of the ship environments that read the ice (privileged).
+
+Three planner baselines steer the ship environments
+(``iceenvs/ShipNavigation-v0``, ``-v1`` and ``iceenvs/ShipBeset-v0``):
+
+==============  ==========================================================  ================
+name            planner                                                     reads
+==============  ==========================================================  ================
+``straight``    full speed straight for the goal line                       the observation
+``reactive``    steer for the least obstructed sector of the ice lidar      the observation
+``lattice``     :class:`LatticePlanner`: the cheapest route over a state    the floes within
+                lattice with the ship's turning limit, the ice costed by     its sensor range
+                the collision impulse it would take, replanned every few
+                steps and followed by pure pursuit
+==============  ==========================================================  ================
+
+The first two are the environments' own controllers
+(:mod:`iceenvs.ship_controllers`). The lattice planner follows the
+lattice planner of AUTO-IceNav (de Schaetzen et al., IEEE Transactions on
+Robotics, 2025) in its parts: a lattice of motion primitives the ship can
+follow, a cost of path length plus a weight times the ice the hull's
+swath meets, a receding horizon and a path-tracking controller. It reads
+the floes through :meth:`iceenvs.ship_env.ShipEnv.ice_near` (privileged
+information, as AUTO-IceNav's planners read the floe polygons of their
+simulator); a policy sees only its observation.
+
+**The lattice.** Stages every ``stage_length`` (30 m) along the route
+(+x, towards the goal line), lateral positions every ``lateral_step``
+(1.5 m) across the channel, and the heading as a slope dy/dx in steps of
+``lateral_step / stage_length`` (0.05) up to ``max_slope`` (0.5, 27°). A
+primitive goes straight from one stage to the next, and the slope
+changes by at most one step between primitives: a turning radius of
+about ``stage_length² / lateral_step`` = 600 m. Gentle turns are chosen
+on purpose: a turning hull sweeps its sides through the ice (the stern
+swings out at the yaw rate times half the length, 1.5 m/s at the
+prescribed ship's full 0.04 rad/s), which the swath cost does not count,
+and measured on ShipNavigation-v1 at A = 0.4 a lattice with a 100 m
+radius met more ice than the straight line. Every primitive advances
+along x, so the lattice is acyclic and the cheapest route over it is
+found exactly by dynamic programming, stage by stage (the route A* would
+return, with no heuristic to tune).
+
+**The cost.** A route costs its length plus its ice cost divided by
+``metre_cost`` [N s/m], the impulse that one metre of detour is worth.
+Each floe i within the sensor range is expected to take the impulse of a
+head-on collision with the hull, J_i = (1 + e) v m_i M / (m_i + M)
+(e the restitution, v the ship's speed, M its mass); the route's
+centre line meets it when it passes within r_i + B/2 of its centre (B
+the beam: the hull's swath). J_i is spread over that enlarged disc as a
+cone, highest at the centre (``cone=True``; ``False``: evenly over each
+chord), so that a route through the centre pays J_i and a glancing route
+less, and a floe that must be pushed far aside costs more than one
+brushed. ``metre_cost`` defaults to the environment's own trade-off:
+the reward charges ``time_weight`` for each step of ``speed`` ×
+``control_interval`` metres and ``impulse_weight`` / ``impulse_scale`` for
+each N s, so one metre is worth ``impulse_scale · time_weight /
+(impulse_weight · speed · control_interval)`` N s.
+
+**Replanning and tracking.** A route is planned over ``horizon`` (500 m,
+AUTO-IceNav's) or to the goal line, every ``replan_steps`` steps (5, 10 s
+of model time) or when the ship is more than ``max_off_route`` (10 m) off
+its route; the ship steers for the point ``lookahead`` (30 m) ahead on
+it, as :class:`~iceenvs.ship_controllers.StraightLinePolicy` steers for
+the goal. ``decision_times`` holds the wall time of each plan [s].
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit
+
+from iceenvs.ship_controllers import StraightLinePolicy
+
+__all__ = ["LatticePlanner", "impulse_costmap", "lattice_route", "PLANNERS"]
+
+
+@njit(cache=True)
+def impulse_costmap(x0, y0, nx, ny, cell, px, py, reach, impulse, cone=False):
+    """Cost density [N s/m] on a grid of ``nx`` × ``ny`` cells of side
+    ``cell`` [m] whose corner is (``x0``, ``y0``): each floe spreads its
+    ``impulse`` over the disc of radius ``reach`` about (``px``, ``py``),
+    so that the line integral through the centre is the impulse: evenly
+    (density impulse / (2 reach)) or, with ``cone``, as a cone (density
+    impulse (1 − ρ/reach) / reach at distance ρ from the centre)."""
+    cost = np.zeros((nx, ny))
+    for i in range(px.size):
+        r = reach[i]
+        d = impulse[i] / (2.0 * r)
+        lo_x = max(int(math.floor((px[i] - r - x0) / cell)), 0)
+        hi_x = min(int(math.floor((px[i] + r - x0) / cell)), nx - 1)
+        lo_y = max(int(math.floor((py[i] - r - y0) / cell)), 0)
+        hi_y = min(int(math.floor((py[i] + r - y0) / cell)), ny - 1)
+        for a in range(lo_x, hi_x + 1):
+            cx = x0 + (a + 0.5) * cell - px[i]
+            for b in range(lo_y, hi_y + 1):
+                cy = y0 + (b + 0.5) * cell - py[i]
+                q = cx * cx + cy * cy
+                if q <= r * r:
+                    cost[a, b] += 2.0 * d * (1.0 - math.sqrt(q) / r) if cone else d
+    return cost
+
+
+@njit(cache=True)
+def lattice_route(cost, cell, stage_cells, n_stages, y_start, slope_start, max_slope, y_low,
+                  y_high, metre_weight):
+    """The cheapest route over the lattice on the cost grid ``cost`` (x
+    index, y index; cells of side ``cell``; the route starts at the grid's
+    x = 0).
+
+    Stages every ``stage_cells`` cells along x, ``n_stages`` primitives;
+    lateral positions are the y cells ``y_low`` … ``y_high``; a primitive
+    moves j cells across (|j| ≤ ``max_slope``), j changing by at most one
+    from one primitive to the next. The route starts at cell ``y_start``
+    with slope ``slope_start``. A primitive costs its length [m] plus
+    ``metre_weight`` × the line integral of ``cost`` along it.
+
+    Returns (ys, total): the y cell of the route at each stage (n_stages +
+    1) and its cost [m].
+    """
+    ns = 2 * max_slope + 1
+    ny = cost.shape[1]
+    inf = np.inf
+    best = np.full((n_stages + 1, ny, ns), inf)
+    came = np.full((n_stages + 1, ny, ns), -1, dtype=np.int64)
+    best[0, y_start, slope_start + max_slope] = 0.0
+    dx = stage_cells * cell
+    for k in range(n_stages):
+        a0 = k * stage_cells
+        for y in range(y_low, y_high + 1):
+            for s in range(ns):
+                here = best[k, y, s]
+                if here == inf:
+                    continue
+                for t in range(max(s - 1, 0), min(s + 2, ns)):
+                    j = t - max_slope
+                    y1 = y + j
+                    if y1 < y_low or y1 > y_high:
+                        continue
+                    length = math.sqrt(dx * dx + (j * cell) ** 2)
+                    ice = 0.0
+                    for m in range(stage_cells):
+                        f = (m + 0.5) / stage_cells
+                        b = int(math.floor(y + f * j + 0.5))
+                        ice += cost[a0 + m, b]
+                    total = here + length + metre_weight * ice * length / stage_cells
+                    if total < best[k + 1, y1, t]:
+                        best[k + 1, y1, t] = total
+                        came[k + 1, y1, t] = s
+    # the cheapest end state, then back along the parents
+    end_y, end_s, low = -1, -1, inf
+    for y in range(y_low, y_high + 1):
+        for s in range(ns):
+            if best[n_stages, y, s] < low:
+                low = best[n_stages, y, s]
+                end_y, end_s = y, s
+    ys = np.empty(n_stages + 1, dtype=np.int64)
+    y, s = end_y, end_s
+    for k in range(n_stages, 0, -1):
+        ys[k] = y
+        prev = came[k, y, s]
+        y = y - (s - max_slope)
+        s = prev
+    ys[0] = y
+    return ys, low
+
+
+#: the impulse [N s] one metre of detour is worth when the environment's
+#: reward charges no ice impulse (ShipNavigation-v0's and -v1's trade-off)
+DEFAULT_METRE_COST = 12_500.0
+
+
+class LatticePlanner(StraightLinePolicy):
+    """Plan the cheapest route through the ice over a state lattice and
+    follow it (see :mod:`agents.planners`).
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        A ship environment (its ``unwrapped`` has ``ice_near``); one
+        environment, not a vector of them.
+    seed : int
+        Unused (the planner is deterministic); kept for the baseline
+        interface.
+    metre_cost : float, optional
+        Impulse [N s] one metre of detour is worth; default: the
+        environment's reward's trade-off (:data:`DEFAULT_METRE_COST` for a
+        reward without an ice-impulse term).
+    cone : bool
+        Spread each floe's impulse as a cone over its enlarged disc (True)
+        or evenly over each chord.
+    horizon, stage_length, lateral_step, lookahead, max_off_route : float [m]
+    max_slope : float — steepest slope dy/dx of the route
+    replan_steps : int — env steps between plans
+    show : bool — draw the route and its swath on the environment's frames
+    """
+
+    stage_length = 30.0
+    lateral_step = 1.5
+    max_slope = 0.5
+    horizon = 500.0
+    replan_steps = 5
+    lookahead = 30.0
+    max_off_route = 10.0
+    #: distance [m] kept between the route and the channel's edges
+    edge_margin = 10.0
+
+    def __init__(self, env, seed: int = 0, *, metre_cost: float | None = None, cone: bool = True,
+                 horizon: float | None = None, replan_steps: int | None = None,
+                 show: bool = True, **geometry):
+        super().__init__(env, seed)
+        u = self.unwrapped
+        if not hasattr(u, "ice_near"):
+            raise ValueError(f"LatticePlanner needs a ship environment with ice_near, got "
+                             f"{type(u).__name__}")
+        for name, value in geometry.items():
+            if name not in ("stage_length", "lateral_step", "max_slope", "lookahead",
+                            "max_off_route", "edge_margin"):
+                raise TypeError(f"LatticePlanner got an unknown argument {name!r}")
+            setattr(self, name, float(value))
+        if horizon is not None:
+            self.horizon = float(horizon)
+        if replan_steps is not None:
+            if isinstance(replan_steps, bool) or int(replan_steps) != replan_steps \
+                    or replan_steps < 1:
+                raise ValueError(f"replan_steps must be an integer >= 1, got {replan_steps!r}")
+            self.replan_steps = int(replan_steps)
+        for name in ("stage_length", "lateral_step", "max_slope", "horizon", "lookahead"):
+            if not (math.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+                raise ValueError(f"{name} must be a positive number, got {getattr(self, name)!r}")
+        if metre_cost is None:
+            p = u.reward_params
+            metre_cost = DEFAULT_METRE_COST     # a reward without both terms
+            if p.get("impulse_weight", 0.0) > 0 and p.get("time_weight", 0.0) > 0 \
+                    and "impulse_scale" in p:
+                metre_cost = (p["impulse_scale"] * p["time_weight"]
+                              / (p["impulse_weight"] * u.max_speed * u.control_interval))
+        if not (math.isfinite(metre_cost) and metre_cost > 0):
+            raise ValueError(f"metre_cost must be a positive number, got {metre_cost!r}")
+        self.metre_cost = float(metre_cost)
+        self.show = bool(show)
+        self.cone = bool(cone)
+        self.decision_times: list[float] = []
+        self.route = None
+        self._age = 0
+
+    def reset(self, seed: int | None = None) -> None:
+        self.route = None
+        self._age = 0
+        self.decision_times = []
+
+    # -- planning --------------------------------------------------------------------
+    def floe_impulses(self, masses) -> np.ndarray:
+        """The impulse [N s] each floe of ``masses`` is expected to take from
+        the hull: a head-on collision at the ship's speed."""
+        u = self.unwrapped
+        ship = u.ship
+        big = float(ship.mass)
+        m = np.asarray(masses, dtype=float)
+        return (1.0 + u.contact.restitution) * u.max_speed * m * big / (m + big)
+
+    def plan(self) -> np.ndarray:
+        """Plan a route from the ship's pose now: (K, 2) points [m], one a
+        stage."""
+        t0 = time.perf_counter()
+        u = self.unwrapped
+        ship = u.sim.ship
+        x, y = (float(v) for v in ship.position)
+        heading = float(ship.heading)
+        cell = self.lateral_step
+        stage_cells = max(int(round(self.stage_length / cell)), 1)
+        reach_x = min(self.horizon, max(u.goal_x - x, 0.0) + 2.0 * self.stage_length)
+        n_stages = max(int(math.ceil(reach_x / (stage_cells * cell))), 1)
+        max_slope = max(int(round(self.max_slope * stage_cells)), 1)
+        half = 0.5 * u.channel_width - self.edge_margin
+        low_y, high_y = u.centre_y - half, u.centre_y + half
+        # grid rows: y = y0 + (b + 0.5) cell, aligned so that the ship's y is a row centre
+        below = int(math.ceil((y - low_y) / cell)) + 1
+        y0 = y - (below + 0.5) * cell
+        ny = below + int(math.ceil((high_y - y) / cell)) + 2
+        nx = n_stages * stage_cells
+        ice = u.ice_near(math.hypot(reach_x, max(y - low_y, high_y - y)) + 60.0)
+        beam = float(np.ptp(ship.vertices @ np.array([-math.sin(heading), math.cos(heading)])))
+        reach = ice["radii"] + 0.5 * beam
+        cost = impulse_costmap(x, y0, nx, ny, cell, ice["positions"][:, 0],
+                               ice["positions"][:, 1], reach, self.floe_impulses(ice["masses"]),
+                               self.cone)
+        rows = y0 + (np.arange(ny) + 0.5) * cell
+        y_low = int(np.searchsorted(rows, min(low_y, y)))
+        y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
+        slope = int(round(math.tan(max(min(heading, 1.2), -1.2)) * stage_cells))
+        slope = max(min(slope, max_slope), -max_slope)
+        ys, _ = lattice_route(cost, cell, stage_cells, n_stages, below, slope, max_slope,
+                              y_low, y_high, 1.0 / self.metre_cost)
+        route = np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]])
+        self.decision_times.append(time.perf_counter() - t0)
+        if self.show:
+            u.plan_overlay = (route, 0.5 * beam)
+        return route
+
+    def _off_route(self, position) -> float:
+        xs, ys = self.route[:, 0], self.route[:, 1]
+        return abs(float(np.interp(position[0], xs, ys)) - float(position[1]))
+
+    def act(self, obs):
+        u = self.unwrapped
+        ship = u.sim.ship
+        position = np.asarray(ship.position, dtype=float)
+        if (self.route is None or self._age >= self.replan_steps
+                or position[0] >= self.route[-1, 0] - self.lookahead
+                or self._off_route(position) > self.max_off_route):
+            self.route = self.plan()
+            self._age = 0
+        self._age += 1
+        target_x = position[0] + self.lookahead
+        target_y = float(np.interp(target_x, self.route[:, 0], self.route[:, 1]))
+        bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
+        bearing = math.atan2(math.sin(bearing), math.cos(bearing))
+        return self._steer(bearing, self._reader(obs))
+
+    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
+        vector = obs["vector"] if isinstance(obs, dict) else obs
+        if self.unwrapped.obs_type != "image" and np.ndim(vector) == 2:
+            raise ValueError("LatticePlanner steers one environment (it reads its floes); "
+                             "got a batch of observations")
+        return super().predict(obs, state, episode_start, deterministic)
+
+
+#: the planners of this module: baseline name → class ``(env, seed)``
+PLANNERS = {"lattice": LatticePlanner}

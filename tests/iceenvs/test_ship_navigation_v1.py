@@ -1,0 +1,218 @@
+"""ShipNavigation-v1: its field against AUTO-IceNav's cited distribution and
+the heterogeneity options, the kinetic-energy metrics against exact cases,
+the lattice planner against the straight line, and the reset time."""
+import math
+import time
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import iceenvs  # noqa: F401  (registers the ids)
+from physics.floes import FloeField
+from physics.ice_fields import (AUTO_ICENAV_SIZES, Lead, field_keep_probability,
+                                floe_area_quantile, navigation_field)
+from physics.ship import TransitBox
+from iceenvs.ship_navigation_v1 import ICE_AHEAD, ShipNavigationV1Env
+
+V1 = "iceenvs/ShipNavigation-v1"
+
+
+# -- the field ------------------------------------------------------------------------------
+
+def test_default_geometry_is_auto_icenavs():
+    """Ship 100 m before the ice, ice over the next 1000 m to the goal line,
+    a channel 200 m wide, floes 1.2 m thick, A drawn from 0.2-0.5."""
+    env = gym.make(V1)
+    try:
+        env.reset(seed=0)
+        u = env.unwrapped
+        x = u.sim.positions[:, 0]
+        r = u.sim.radii
+        assert u.goal_x - u.start_x == 1100.0 and u.width == 200.0 == u.channel_width
+        assert u.ice_band == (u.start_x + ICE_AHEAD, u.goal_x)
+        assert np.all(x - r >= u.ice_band[0]) and np.all(x + r <= u.ice_band[1])
+        np.testing.assert_allclose(u.sim.masses, 910.0 * 1.2 * math.pi * r ** 2, rtol=1e-12)
+        drawn = [u.episode["concentration"]]
+        for seed in range(1, 6):
+            env.reset(seed=seed)
+            drawn.append(u.episode["concentration"])
+        assert min(drawn) >= 0.2 and max(drawn) <= 0.5 and len(set(drawn)) == 6
+    finally:
+        env.close()
+
+
+def test_field_sizes_and_concentration_match_the_cited_law():
+    """Pooled over 10 fields at A = 0.4 (about 8000 floes), the floe areas'
+    quartiles lie within 6 % of the law's (the sampling error of a quartile
+    of n draws is about 1.5/√n of the inter-quartile range: < 2 %; the
+    placement keeps every floe that fits), and each field covers A of its
+    band to within its largest floe."""
+    areas = []
+    for seed in range(10):
+        field, covered = navigation_field(AUTO_ICENAV_SIZES, concentration=0.4,
+                                          band=(150.0, 1150.0), width=200.0,
+                                          rng=np.random.default_rng(seed))
+        a = math.pi * field.radii ** 2
+        assert abs(covered - 0.4) <= a.max() / 2.0e5 + 1e-12
+        assert covered == pytest.approx(float(a.sum()) / 2.0e5, rel=1e-12)
+        areas.append(a)
+    pooled = np.concatenate(areas)
+    for q in (0.25, 0.5, 0.75):
+        assert np.quantile(pooled, q) == pytest.approx(floe_area_quantile(AUTO_ICENAV_SIZES, q),
+                                                       rel=0.06)
+    r = np.sqrt(pooled / math.pi)
+    assert r.min() >= 2.0 and r.max() < 50.0
+
+
+def test_thick_class_leads_and_gradient():
+    """Thick floes at the drawn fraction (binomial: within 4 σ), no floe
+    reaching into a lead, and the concentration's linear gradient across
+    the channel: with gradient g the port half holds (1 + g/2)/(1 − g/2)
+    of the starboard half's ice, within the scatter of 8 fields."""
+    rng = np.random.default_rng(1)
+    lead = Lead(600.0, 100.0, 0.3, 25.0)
+    field, covered = navigation_field(AUTO_ICENAV_SIZES, concentration=0.3,
+                                      band=(150.0, 1150.0), width=200.0, rng=rng,
+                                      thick_fraction=0.25, thick_thickness=3.0, leads=(lead,))
+    thick = field.thickness == 3.0
+    n = field.n
+    assert np.all((field.thickness == 1.2) | thick)
+    assert abs(thick.sum() - 0.25 * n) <= 4.0 * math.sqrt(0.25 * 0.75 * n)
+    gap = lead.distance(field.positions, 200.0) - field.radii
+    assert gap.min() >= 0.5 * lead.width
+    assert covered == pytest.approx(0.3, abs=0.01)
+    ratios = []
+    for seed in range(8):
+        f, _ = navigation_field(AUTO_ICENAV_SIZES, concentration=0.3, band=(150.0, 1150.0),
+                                width=200.0, rng=np.random.default_rng(seed), gradient=0.6)
+        a = math.pi * f.radii ** 2
+        port = f.positions[:, 1] >= 100.0
+        ratios.append(a[port].sum() / a[~port].sum())
+    assert np.mean(ratios) == pytest.approx(1.3 / 0.7, rel=0.12)
+
+
+def test_keep_probability_and_bad_options():
+    p = field_keep_probability(np.array([[0.0, 0.0], [0.0, 100.0], [0.0, 199.9]]),
+                               np.ones(3), width=200.0, gradient=0.5)
+    np.testing.assert_allclose(p, [0.5 / 1.5, 1.0 / 1.5, 1.4995 / 1.5])
+    with pytest.raises(ValueError, match="placed above 0.8"):
+        navigation_field(AUTO_ICENAV_SIZES, concentration=0.5, band=(0.0, 1000.0), width=200.0,
+                         rng=np.random.default_rng(0), gradient=1.0)
+    with pytest.raises(ValueError, match="gradient"):
+        navigation_field(AUTO_ICENAV_SIZES, concentration=0.3, band=(0.0, 1000.0), width=200.0,
+                         rng=np.random.default_rng(0), gradient=1.5)
+    with pytest.raises(ValueError, match="band"):
+        navigation_field(AUTO_ICENAV_SIZES, concentration=0.3, band=(10.0, 0.0), width=200.0,
+                         rng=np.random.default_rng(0))
+    with pytest.raises(ValueError, match="leads"):
+        gym.make(V1, leads=2.5)
+    with pytest.raises(ValueError, match="no ice"):
+        gym.make(V1, goal_distance=80.0)
+
+
+def test_reset_takes_under_a_second():
+    env = gym.make(V1, concentration=0.5)
+    try:
+        env.reset(seed=0)                       # compiles and loads the kernels
+        start = time.perf_counter()
+        for seed in range(1, 4):
+            env.reset(seed=seed)
+        assert (time.perf_counter() - start) / 3 < 1.0
+    finally:
+        env.close()
+
+
+# -- kinetic-energy metrics -------------------------------------------------------------------
+
+class _OneFloe(ShipNavigationV1Env):
+    """One floe of radius 5 m on the route, 100 m ahead, no drag."""
+
+    def _forcing(self):
+        return self.preset.make_forcing(water_skin_drag=0.0, water_form_drag=0.0,
+                                        air_skin_drag=0.0, air_form_drag=0.0)
+
+    def _ice(self, rng):
+        box = TransitBox(self.length, self.width, band=self.ice_band)
+        field = FloeField(np.array([[self.start_x + 100.0, self.centre_y]]), np.array([5.0]),
+                          1.2, np.zeros((1, 2)), density=910.0)
+        self._field_concentration = float(field.areas.sum()) / box.band_area
+        return field, box, self._forcing()
+
+
+def test_kinetic_energy_metrics_of_a_head_on_collision():
+    """A prescribed ship at v hits a floe at rest head-on; the floe leaves
+    at u = (1 + e) v. Then the impulse is m u, the work of the hull on the
+    ice (``energy_to_ice``) v m u, the ice's gain ½ m u² and the energy
+    dissipated ½ m v² (1 − e²) (the ship's frame). Tolerances: 1e-6 for
+    the engine's time integration of the work (about 1e-9 measured), 1e-9
+    for the gain, which is read from the state."""
+    env = _OneFloe(goal_distance=300.0, length=700.0)
+    env.reset(seed=0)
+    for _ in range(40):
+        _, _, _, _, info = env.step(np.zeros(1))
+    m = float(env.sim.masses[0])
+    u = float(np.hypot(*env.sim.velocities[0]))
+    v = 2.0
+    e = u / v - 1.0
+    assert info["collisions"] == 1 and 0.0 < e < 1.0
+    assert info["max_impulse"] == pytest.approx(m * u, rel=1e-6)
+    assert info["energy_to_ice"] == pytest.approx(v * m * u, rel=1e-6)
+    assert info["ice_energy_gain"] == pytest.approx(0.5 * m * u * u, rel=1e-9)
+    assert info["energy_dissipated"] == pytest.approx(0.5 * m * v * v * (1.0 - e * e), rel=1e-5)
+
+
+def test_kinetic_energy_metrics_are_zero_in_open_water():
+    class Empty(_OneFloe):
+        def _ice(self, rng):
+            field, box, forcing = super()._ice(rng)
+            field = FloeField(np.array([[self.start_x + 100.0, 10.0]]), np.array([2.0]), 1.2,
+                              np.zeros((1, 2)), density=910.0)
+            return field, box, forcing
+
+    env = Empty(goal_distance=300.0, length=700.0)
+    env.reset(seed=0)
+    for _ in range(40):
+        _, _, _, _, info = env.step(np.zeros(1))
+    assert info["collisions"] == 0
+    assert info["ice_energy_gain"] == 0.0 == info["energy_dissipated"] == info["energy_to_ice"]
+
+
+# -- the lattice planner ----------------------------------------------------------------------
+
+def test_lattice_planner_beats_the_straight_line_on_fixed_fields():
+    """On 3 fixed fields at A = 0.3 (400 m of ice), the lattice planner meets
+    less ice impulse per metre than the straight line on every field,
+    sailing at most 5 % further, and reaches the goal."""
+    from agents.baselines import make_baseline
+    from agents.rollouts import run_episode
+
+    env = gym.make(V1, concentration=0.3, goal_distance=500.0, length=900.0)
+    try:
+        straight = make_baseline("straight", env)
+        lattice = make_baseline("lattice", env)
+        for seed in (0, 1, 2):
+            s = run_episode(env, straight, seed, None)["final"]
+            p = run_episode(env, lattice, seed, None)["final"]
+            assert p["success"] and s["success"]
+            assert p["impulse_per_metre"] < s["impulse_per_metre"], (seed, p, s)
+            assert p["path_length"] <= 1.05 * s["path_length"]
+        assert len(lattice.decision_times) > 5
+    finally:
+        env.close()
+
+
+def test_lattice_route_over_an_empty_and_a_blocked_field():
+    """Exact cases of the search: with no ice the route stays on the start
+    row at zero slope and costs its length; a wall of cost across every
+    row but one is crossed on that row."""
+    from agents.planners import lattice_route
+
+    cost = np.zeros((300, 41))
+    ys, total = lattice_route(cost, 1.0, 10, 30, 20, 0, 3, 0, 40, 1.0)
+    assert np.all(ys == 20) and total == pytest.approx(300.0, rel=1e-12)
+    cost[150:160, :] = 1e6
+    cost[150:160, 31] = 0.0
+    ys, total = lattice_route(cost, 1.0, 10, 30, 20, 0, 3, 0, 40, 1.0)
+    assert ys[15] == 31 == ys[16]
+    assert total < 1e5
