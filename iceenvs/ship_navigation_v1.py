@@ -24,6 +24,9 @@ MAX_EPISODE_STEPS = 550
 #: the floe-size laws of v1's fields: name → :class:`physics.ice_fields.LogMassSizes`
 FIELD_SIZES = {"auto_icenav": AUTO_ICENAV_SIZES}
 
+#: draws of the leads before a field that cannot be made is an error
+LEAD_DRAWS = 10
+
 #: open water [m] between the ship's start and the ice edge (AUTO-IceNav: 100 m)
 ICE_AHEAD = 100.0
 
@@ -226,12 +229,20 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         e = self.episode
         box = TransitBox(self.length, self.width, band=self.ice_band)
         forcing = self._forcing()
-        self.leads = self._leads(rng)
-        field, covered = navigation_field(
-            FIELD_SIZES[e["floe_sizes"]], concentration=e["concentration"], band=self.ice_band,
-            width=self.width, rng=rng, thickness=e["ice_thickness"],
-            density=self.preset.forcing.ice_density, thick_fraction=e["thick_fraction"],
-            thick_thickness=e["thick_thickness"], leads=self.leads, gradient=e["gradient"])
+        for attempt in range(LEAD_DRAWS):
+            self.leads = self._leads(rng)
+            try:
+                field, covered = navigation_field(
+                    FIELD_SIZES[e["floe_sizes"]], concentration=e["concentration"],
+                    band=self.ice_band, width=self.width, rng=rng, thickness=e["ice_thickness"],
+                    density=self.preset.forcing.ice_density, thick_fraction=e["thick_fraction"],
+                    thick_thickness=e["thick_thickness"], leads=self.leads,
+                    gradient=e["gradient"])
+                break
+            except ValueError:
+                # leads whose open water the concentration cannot spare are drawn again
+                if not self.leads or attempt == LEAD_DRAWS - 1:
+                    raise
         self._field_concentration = covered
         (sx, sy), _ = self._ship_start()
         gap = box.minimum_image(field.positions - [sx, sy])
