@@ -18,7 +18,7 @@ metre and return against concentration)::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
-        [--policies straight,reactive,lattice] [--trained NAME=RUN_DIR ...]
+        [--policies straight,reactive,lattice] [--trained NAME=RUN_DIR[@STEPS] ...]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
 """
@@ -149,12 +149,13 @@ def board_markdown(report: dict) -> str:
              f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}); "
              f"{report['episodes']} fields per concentration, field k seeded "
              f"{report['seed']} + k, the same fields for every policy; "
-             f"{report['machine']}; {report['date']}; {report['wall_s']:.0f} s.", "",
+             f"{report['machine']}; {report['date']}; {report['wall_s']:.0f} s of wall time.",
+             "",
              "Means ± standard errors over the fields. Ratios are to the straight line on "
              "the same field (mean of the per-field ratios); *ratio of means* is the mean "
              "impulse per metre over the straight line's.", ""]
     verdict = route_choice_pays(summary, report["planners"])
-    lines += ["## Does route choice pay?", "",
+    lines += ["### Does route choice pay?", "",
               f"Route choice pays when the best planner meets at most {ROUTE_CHOICE_RATIO} "
               f"times the straight line's impulse per metre (ratio of means), sailing at most "
               f"{DETOUR_LIMIT - 1:.0%} further.", "",
@@ -164,7 +165,7 @@ def board_markdown(report: dict) -> str:
         lines.append(f"| {a} | {name} | {ratio:.3f} | {path:.3f} | "
                      f"{'yes' if pays else '**no**'} |")
     for a, policies in summary.items():
-        lines += ["", f"## A = {a}", "",
+        lines += ["", f"### A = {a}", "",
                   "| policy | return | success | " + " | ".join(
                       f"{h} [{u}]" if u else h for _, h, _, u in SHOWN)
                   + " | decision [ms] |",
@@ -230,21 +231,40 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--seed", type=int, default=10_000, help="seed of field 0 (10000)")
     p.add_argument("--policies", default="straight,reactive,lattice",
                    help="comma-separated baselines (straight,reactive,lattice)")
-    p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR",
-                   help="a trained policy (agents.train's run directory), repeatable")
+    p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR[@STEPS]",
+                   help="a trained policy (agents.train's run directory; @STEPS: its checkpoint "
+                        "at STEPS steps), repeatable")
     p.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make keywords (YAML values)")
     p.add_argument("--processes", type=int, default=2, help="worker processes (2)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output ({DEFAULT_OUT})")
     p.add_argument("--render", action="store_true",
                    help="write the table and the plot again from the JSON in --out")
+    p.add_argument("--merge", action="store_true",
+                   help="keep the policies of the JSON in --out (same environment, arguments, "
+                        "concentrations and fields) and run only the others")
     return p
 
 
 def _write(report: dict, out: Path) -> None:
-    (out / "leaderboard.md").write_text("# Ship navigation leaderboard\n\n"
-                                        + board_markdown(report))
+    (out / "leaderboard.md").write_text(board_markdown(report))
     plot_board(report, out / "leaderboard.png")
+
+
+def _mergeable(parser, args, out: Path, conc, env_kwargs) -> dict:
+    """The report in ``out`` that ``--merge`` adds to, checked to be of the
+    same environment, arguments, fields and concentrations."""
+    path = out / "leaderboard.json"
+    if not path.exists():
+        parser.error(f"--merge: {path} does not exist")
+    old = json.loads(path.read_text())
+    same = (old.get("env") == args.env and old.get("env_kwargs") == env_kwargs
+            and old.get("episodes") == args.episodes and old.get("seed") == args.seed
+            and list(old.get("episodes_detail", {})) == [f"{a:g}" for a in conc])
+    if not same:
+        parser.error(f"--merge: {path} is of another environment, arguments, fields or "
+                     f"concentrations")
+    return old
 
 
 def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboard") -> dict:
@@ -287,28 +307,39 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         policies.insert(0, "straight")
     recipes = {name: ("baseline", name, {}) for name in policies}
     for item in args.trained:
-        name, sep, run_dir = item.partition("=")
-        if not sep or not name or not Path(run_dir).is_dir():
-            parser.error(f"--trained takes NAME=RUN_DIR with an existing directory, got {item!r}")
-        recipes[name] = ("trained", run_dir, {})
+        name, sep, target = item.partition("=")
+        run_dir, at, steps = target.partition("@")
+        if not sep or not name or not Path(run_dir).is_dir() or (at and not steps.isdigit()):
+            parser.error(f"--trained takes NAME=RUN_DIR or NAME=RUN_DIR@STEPS with an existing "
+                         f"directory, got {item!r}")
+        recipes[name] = ("trained", run_dir, {"checkpoint": int(steps)} if at else {})
     for a in conc:
         try:
             make_checked_env(args.env, {**env_kwargs, "concentration": a}).close()
         except (TypeError, ValueError) as err:
             print(f"{prog}: error: {args.env} with concentration {a:g}: {err}", file=sys.stderr)
             raise SystemExit(2) from None
+    old = _mergeable(parser, args, out, conc, env_kwargs) if args.merge else None
     out.mkdir(parents=True, exist_ok=True)
+    if old is not None:
+        recipes = {name: r for name, r in recipes.items()
+                   if name not in next(iter(old["episodes_detail"].values()))}
     t0 = time.perf_counter()
     board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
                             processes=args.processes, env_kwargs=env_kwargs)
+    if old is not None:
+        board = {a: {**old["episodes_detail"][a], **board[a]} for a in board}
+        recipes = {name: None for name in board[next(iter(board))]}
     summary = summarise_board(board)
     argv_text = " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
     report = dict(
-        command=f"{prog} {argv_text}".strip(), env=args.env, env_kwargs=env_kwargs,
+        command=(f"{old['command']}` then `" if old else "") + f"{prog} {argv_text}".strip(),
+        env=args.env, env_kwargs=env_kwargs,
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p in PLANNERS or p == "reactive"],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
-        date=datetime.date.today().isoformat(), wall_s=time.perf_counter() - t0,
+        date=datetime.date.today().isoformat(),
+        wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0),
         summary=summary,
         episodes_detail={a: {name: [{k: v for k, v in e.items()
                                      if k not in ("rewards", "trace")} for e in eps]
