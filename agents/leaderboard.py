@@ -85,7 +85,7 @@ def summarise_board(board: dict, reference: str = "straight") -> dict:
     per-field ratios to ``reference`` (``ratio_<metric>``), the ratio of
     the means of the impulse per metre (``ipm_ratio_of_means``) and the
     success rate."""
-    from .rollouts import stats, summarise
+    from .rollouts import compare, stats, summarise
 
     out = {}
     for a, policies in board.items():
@@ -105,6 +105,9 @@ def summarise_board(board: dict, reference: str = "straight") -> dict:
                 mine = np.mean([_final(e, "impulse_per_metre") for e in episodes])
                 theirs = np.mean([_final(b, "impulse_per_metre") for b in ref])
                 s["ipm_ratio_of_means"] = float(mine / theirs) if theirs > 0 else math.nan
+                s["paired_return"] = compare(episodes, ref)
+                s["paired_impulse_per_metre"] = compare(episodes, ref, "impulse_per_metre",
+                                                        lower_is_better=True)
                 paths = np.mean([_final(e, "path_length") for e in episodes])
                 s["path_ratio_of_means"] = float(
                     paths / np.mean([_final(b, "path_length") for b in ref]))
@@ -175,12 +178,20 @@ def board_markdown(report: dict) -> str:
             cells += [_pm(s.get(key), scale) for key, _, scale, _ in SHOWN]
             cells.append(_pm(s["decision_ms"], 1.0, 2))
             lines.append("| " + " | ".join(cells) + " |")
-        lines += ["", "Normalised by the straight line on the same field:", "",
+        lines += ["", "Normalised by the straight line on the same field, and the paired "
+                  "differences (policy − straight line; *beats*: better by more than two "
+                  "standard errors):", "",
                   "| policy | " + " | ".join(NORMALISED) + " | impulse per metre, ratio of means "
-                  "| plan [ms] |", "|---" * (len(NORMALISED) + 3) + "|"]
+                  "| return − straight's | impulse per metre − straight's [kN s/m] "
+                  "| plan [ms] |", "|---" * (len(NORMALISED) + 5) + "|"]
         for name, s in policies.items():
             cells = [name] + [_pm(s.get(f"ratio_{k}"), 1.0, 3) for k in NORMALISED]
             cells.append(f"{s.get('ipm_ratio_of_means', math.nan):.3f}")
+            for key, scale in (("paired_return", 1.0), ("paired_impulse_per_metre", 1e3)):
+                c = s.get(key)
+                cells.append("–" if c is None or name == "straight" else
+                             f"{_num(c['diff'] / scale, 3)} ± {_num(c['sem'] / scale, 2)}"
+                             + (" (beats)" if c["beats"] else ""))
             cells.append(_pm(s.get("plan_ms"), 1.0, 2))
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
@@ -276,6 +287,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         if not path.exists():
             parser.error(f"--render: {path} does not exist")
         report = json.loads(path.read_text())
+        report["summary"] = summarise_board(report["episodes_detail"])
         _write(report, out)
         return report
 
