@@ -303,15 +303,21 @@ class ShipEnv(HertzEnv):
                               density=p.forcing.ice_density)
             packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
             pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
-        from physics.hull import PSV_HULL
-
-        start, _ = self._ship_start()
-        gap = box.minimum_image(pos - np.asarray(start))
-        keep = np.hypot(gap[:, 0], gap[:, 1]) > PSV_HULL.circumradius + r + START_CLEARANCE
+        keep = self._clear_of_start(pos, r, box)
         pos, r = pos[keep], r[keep]
         field = FloeField(pos, r, p.thickness, np.zeros((r.size, 2)),
                           density=p.forcing.ice_density)
         return field.take(spatial_order(field.positions, box))
+
+    def _clear_of_start(self, positions, radii, box) -> np.ndarray:
+        """Mask of the floes (``positions``, ``radii`` in ``box``) that leave
+        :data:`START_CLEARANCE` of open water round the hull's reach at the
+        ship's start."""
+        from physics.hull import PSV_HULL
+
+        start, _ = self._ship_start()
+        gap = box.minimum_image(np.asarray(positions) - np.asarray(start))
+        return np.hypot(gap[:, 0], gap[:, 1]) > PSV_HULL.circumradius + radii + START_CLEARANCE
 
     def _make_ship(self, rng):
         from physics.ship import psv_ship

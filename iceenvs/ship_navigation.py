@@ -221,11 +221,17 @@ class ShipNavigationEnv(ShipEnv):
         forcing = self._forcing()
         field = self._floe_field(box, rng, concentration=e["concentration"],
                                  floe_sizes=e["floe_sizes"])
+        return self._drifting(field, forcing), box, forcing
+
+    def _drifting(self, field, forcing):
+        """``field`` at its free drift under the episode's wind and current
+        (unchanged, at rest, without them)."""
+        e = self.episode
         if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
             u = steady_drift(forcing, field.radii, field.thickness, field.masses)
             field = FloeField(field.positions, field.radii, field.thickness, u,
                               density=field.density)
-        return field, box, forcing
+        return field
 
     def _terminated(self, now):
         if self.mode == "dynamic" and self.slow_time >= self.episode["beset_time"]:

@@ -11,7 +11,7 @@ from physics.ship import TransitBox
 
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
-from .ship_env import CONTROLS, START_CLEARANCE, ship_features
+from .ship_env import CONTROLS, ship_features
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
@@ -80,6 +80,7 @@ _TASK = tuple(
     TaskParameter("gradient_range", (0.0, 0.0), "range of the drawn gradients",
                   interval(-1.0, 1.0)),
 )
+
 
 class ShipNavigationV1Env(ShipNavigationEnv):
     __doc__ = f"""Cross a kilometre of pack ice, floes and gaps as in AUTO-IceNav's ice
@@ -200,12 +201,6 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         return dict(super().default_reward_params(), impulse_scale=2.5e5, impulse_cap=10.0,
                     time_weight=0.2)
 
-    def _draw_episode(self, task, rng):
-        task = super()._draw_episode(task, rng)
-        if task["gradient"] is None:
-            task["gradient"] = float(rng.uniform(*task["gradient_range"]))
-        return task
-
     @property
     def ice_band(self) -> tuple[float, float]:
         """(x0, x1) [m] of the band of ice: from 100 m ahead of the start to
@@ -224,9 +219,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         return tuple(leads)
 
     def _ice(self, rng):
-        from physics.floes import FloeField, spatial_order
-        from physics.forcing import steady_drift
-        from physics.hull import PSV_HULL
+        from physics.floes import spatial_order
 
         e = self.episode
         box = TransitBox(self.length, self.width, band=self.ice_band)
@@ -246,15 +239,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                 if not self.leads or attempt == LEAD_DRAWS - 1:
                     raise
         self._field_concentration = covered
-        (sx, sy), _ = self._ship_start()
-        gap = box.minimum_image(field.positions - [sx, sy])
-        keep = gap[:, 0] ** 2 + gap[:, 1] ** 2 > (PSV_HULL.circumradius + field.radii
-                                                  + START_CLEARANCE) ** 2
-        field = field.take(keep.nonzero()[0])
-        if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
-            u = steady_drift(forcing, field.radii, field.thickness, field.masses)
-            field = FloeField(field.positions, field.radii, field.thickness, u,
-                              density=field.density)
+        field = field.take(self._clear_of_start(field.positions, field.radii, box).nonzero()[0])
+        field = self._drifting(field, forcing)
         return field.take(spatial_order(field.positions, box)), box, forcing
 
 

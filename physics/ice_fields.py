@@ -272,8 +272,7 @@ def navigation_field(sizes: LogMassSizes, *, concentration: float, band: tuple, 
         cut = int(np.searchsorted(area, target))
         if cut < r.size and key[order[cut]] * float(np.max(p)) <= 1.0:
             break
-        placed = min(1.25 * placed, MAX_PLACED_CONCENTRATION + 1e-9) \
-            if placed < MAX_PLACED_CONCENTRATION else 2.0
+        placed *= 1.25
     kept = np.sort(order[: cut + 1])
     pos, r = pos[kept], r[kept]
     covered = math.pi * float(np.sum(r ** 2)) / region.area
