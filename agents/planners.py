@@ -252,15 +252,6 @@ class LatticePlanner(StraightLinePolicy):
         self.decision_times = []
 
     # -- planning --------------------------------------------------------------------
-    def floe_impulses(self, masses) -> np.ndarray:
-        """The impulse [N s] each floe of ``masses`` is expected to take from
-        the hull: a head-on collision at the ship's speed."""
-        u = self.unwrapped
-        ship = u.ship
-        big = float(ship.mass)
-        m = np.asarray(masses, dtype=float)
-        return (1.0 + u.contact.restitution) * u.max_speed * m * big / (m + big)
-
     def plan(self) -> np.ndarray:
         """Plan a route from the ship's pose now: (K, 2) points [m], one a
         stage."""
@@ -285,7 +276,7 @@ class LatticePlanner(StraightLinePolicy):
         beam = float(np.ptp(ship.vertices @ np.array([-math.sin(heading), math.cos(heading)])))
         reach = ice["radii"] + 0.5 * beam
         cost = impulse_costmap(x, y0, nx, ny, cell, ice["positions"][:, 0],
-                               ice["positions"][:, 1], reach, self.floe_impulses(ice["masses"]),
+                               ice["positions"][:, 1], reach, u.expected_impulses(ice["masses"]),
                                self.cone)
         rows = y0 + (np.arange(ny) + 0.5) * cell
         y_low = int(np.searchsorted(rows, min(low_y, y)))

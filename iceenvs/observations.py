@@ -21,7 +21,10 @@ Scaling of the vector (every entry is clipped into the observation space):
   [0, 10];
 * a force F [N] or moment M [N m] is ``sign(F) log10(1 + |F| / 1 N)`` (the
   stress scaling with 1 N or 1 N m);
-* a distance is divided by 100 m and a yaw rate by 0.1 rad/s.
+* a distance is divided by 100 m and a yaw rate by 0.1 rad/s;
+* an impulse J [N s] is ``log10(1 + J / 10⁴ N s)`` (so 1 ↔ 9·10⁴ N s,
+  the head-on impulse of a floe of about 3 m radius from a ship at 2 m/s,
+  and 3 ↔ 10⁷ N s, that of one of 40 m).
 """
 from __future__ import annotations
 
@@ -41,6 +44,7 @@ __all__ = ["Feature", "FLOE_FEATURES", "floe_physics", "normalise", "normalise_r
 STRESS_REF = 1.0          # N/m
 TEMPERATURE_REF = 1e-6    # m²/s²
 RATE_REF = 0.01           # 1/s
+IMPULSE_REF = 1e4         # N s
 
 
 @dataclass(frozen=True)
@@ -169,7 +173,7 @@ def observation_vectors(raw: np.ndarray, features, actions: np.ndarray) -> np.nd
 #: the scalings (the names of the module docstring) as the codes of :func:`_scaled`
 _SCALING_CODES = {"none": 0, "log stress": 1, "log force": 1, "/ 1 m/s": 2,
                   "log temperature": 3, "log rate": 4, "exponent": 5, "/ 100 m": 6,
-                  "/ 0.1 rad/s": 7}
+                  "/ 0.1 rad/s": 7, "log impulse": 8}
 
 
 @lru_cache(maxsize=64)
@@ -197,6 +201,8 @@ def _scaled(code, x):
         return x / 100.0
     if code == 7:
         return x / 0.1
+    if code == 8:
+        return math.log10(1.0 + max(x, 0.0) / IMPULSE_REF)
     return x
 
 

@@ -487,6 +487,16 @@ class ShipEnv(HertzEnv):
                 "radii": sim.radii[near].copy(), "masses": sim.masses[near].copy(),
                 "index": near}
 
+    def expected_impulses(self, masses) -> np.ndarray:
+        """The impulse [N s] each floe of ``masses`` [kg] is expected to take
+        from the hull: that of a head-on collision at the ship's full speed
+        v, (1 + e) v m M / (m + M), with e the restitution and M the ship's
+        mass. The lattice planner's ice cost and v1's swath sensor weigh
+        the floes by it."""
+        m = np.asarray(masses, dtype=float)
+        big = float(self._ship.mass)
+        return (1.0 + self.contact.restitution) * self.max_speed * m * big / (m + big)
+
     #: a planned route to draw on the frames: ((K, 2) points [m], swath half-width [m]) or None
     plan_overlay = None
 

@@ -9,14 +9,17 @@ from dataclasses import replace
 from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, navigation_field
 from physics.ship import TransitBox
 
+import numpy as np
+
 from .base import TaskParameter, choice, interval, number, task_table
-from .observations import feature_table
+from .observations import Feature, feature_table
 from .ship_env import CONTROLS, ship_features
+from .ship_sensors import swath_scan
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
 __all__ = ["ShipNavigationV1Env", "ShipNavigationV1VectorEnv", "MAX_EPISODE_STEPS",
-           "FIELD_SIZES", "ICE_AHEAD"]
+           "FIELD_SIZES", "ICE_AHEAD", "swath_features"]
 
 #: two straight transits of the default field (275 steps each)
 MAX_EPISODE_STEPS = 550
@@ -30,7 +33,21 @@ LEAD_DRAWS = 10
 #: open water [m] between the ship's start and the ice edge (AUTO-IceNav: 100 m)
 ICE_AHEAD = 100.0
 
-_FEATURES = ship_features(15, 250.0)
+#: the swath sensor's default edges [m] of its bands of distance ahead
+SWATH_BANDS = (0.0, 100.0, 250.0)
+
+
+def swath_features(rays: int, bands=SWATH_BANDS) -> tuple[Feature, ...]:
+    """The observation entries of the swath sensor
+    (:func:`iceenvs.ship_sensors.ice_swath`) of ``rays`` courses, band by
+    band, course by course."""
+    return tuple(
+        Feature(f"swath_{b}_{k}", f"course {k}: expected impulse of the floes its swath meets "
+                f"{bands[b]:g}-{bands[b + 1]:g} m ahead", "N s", "log impulse", 0.0, 6.0)
+        for b in range(len(bands) - 1) for k in range(rays))
+
+
+_FEATURES = ship_features(15, 250.0) + swath_features(9)
 #: entries of the default vector observation: the features, then the last action
 _N_VECTOR = len(_FEATURES) + len(CONTROLS["yaw"][1])
 
@@ -137,9 +154,16 @@ class ShipNavigationV1Env(ShipNavigationEnv):
 
     ## Observation Space
     `obs_type="vector"` (default): `Box(float32)` of {_N_VECTOR} entries: the
-    {len(_FEATURES)} of the table below with a 15-sector lidar reaching
-    250 m ahead (v0: 9 sectors, 150 m), then `time_left` with `horizon=N`,
-    then the last action. `obs_type="image"` and `"dict"` as v0.
+    {len(_FEATURES)} of the table below, then `time_left` with `horizon=N`,
+    then the last action. `obs_type="image"` and `"dict"` as v0. Beside
+    v0's entries, with a 15-sector lidar reaching 250 m ahead (v0: 9
+    sectors, 150 m), a *swath sensor* (:func:`iceenvs.ship_sensors.ice_swath`)
+    shows the floes' sizes, which the lidar does not: for 9 straight
+    courses fanned over ±40° about the heading, the expected collision
+    impulse (:meth:`ShipEnv.expected_impulses`) of the floes the hull's
+    swath along each would meet, 0-100 m and 100-250 m ahead of the ship.
+    It is what the lattice planner weighs, seen from the ship.
+    `swath_rays=0` leaves it out.
 
 {feature_table(_FEATURES)}
 
@@ -173,7 +197,9 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     ## Arguments
     As v0, with the defaults `length=1500.0`, `width=200.0`,
     `channel_width=200.0`, `goal_distance=1100.0` [m], `lidar_sectors=15`
-    and `lidar_range=250.0` [m].
+    and `lidar_range=250.0` [m]; and the swath sensor's `swath_rays=9`
+    (0: none), `swath_fan=π/2` [rad] (the angle from the first course to
+    the last is fan × (rays − 1) / rays) and `swath_bands=(0, 100, 250)` [m].
 
     ## Version History
     * v1: a field comparable to AUTO-IceNav's (v0 stays registered,
@@ -189,7 +215,20 @@ class ShipNavigationV1Env(ShipNavigationEnv):
 
     def __init__(self, *, length: float = 1500.0, width: float = 200.0,
                  channel_width: float = 200.0, goal_distance: float = 1100.0,
-                 lidar_sectors: int = 15, lidar_range: float = 250.0, **kwargs):
+                 lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,
+                 swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS, **kwargs):
+        self.swath_rays = _integer(0, 64)("swath_rays", swath_rays)
+        if not (isinstance(swath_fan, (int, float)) and 0.0 < swath_fan <= math.pi):
+            raise ValueError(f"swath_fan must be a number in (0, π], got {swath_fan!r}")
+        self.swath_fan = float(swath_fan)
+        bands = np.asarray(swath_bands, dtype=float)
+        if (bands.ndim != 1 or bands.size < 2 or not np.all(np.isfinite(bands))
+                or bands[0] < 0.0 or not np.all(np.diff(bands) > 0.0)):
+            raise ValueError(f"swath_bands must be at least two increasing finite distances "
+                             f"[m] from 0 on, got {swath_bands!r}")
+        self.swath_bands = bands
+        self.extra_features = swath_features(self.swath_rays, tuple(bands.tolist()))
+        self.extra_measures = tuple(f.name for f in self.extra_features)
         super().__init__(length=length, width=width, channel_width=channel_width,
                          goal_distance=goal_distance, lidar_sectors=lidar_sectors,
                          lidar_range=lidar_range, **kwargs)
@@ -200,6 +239,28 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     def default_reward_params(self) -> dict:
         return dict(super().default_reward_params(), impulse_scale=2.5e5, impulse_cap=10.0,
                     time_weight=0.2)
+
+    def _extra_measures(self, envs) -> np.ndarray:
+        """The swath sensor of each of ``envs``: (M, bands × rays)."""
+        out = np.empty((len(envs), len(self.extra_measures)))
+        if not self.swath_rays:
+            return out
+        for k, env in enumerate(envs):
+            sim = env.sim
+            ship = sim.ship
+            x, y = (float(v) for v in ship.position)
+            box = sim.box
+            sums = swath_scan(x, y, float(ship.heading), sim.positions, sim.radii,
+                              env._swath_weights, self.swath_rays, self.swath_fan,
+                              0.5 * env._ship.hull.beam, self.swath_bands, float(box.lx),
+                              float(box.ly), box.periodic[0], box.periodic[1])
+            out[k] = sums.T.ravel()
+        return out
+
+    def _make_sim(self, rng):
+        sim = super()._make_sim(rng)
+        self._swath_weights = self.expected_impulses(sim.masses)
+        return sim
 
     @property
     def ice_band(self) -> tuple[float, float]:

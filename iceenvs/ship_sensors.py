@@ -1,5 +1,5 @@
-"""What a ship among the floes senses: a sector lidar and an egocentric
-occupancy image.
+"""What a ship among the floes senses: a sector lidar, a swath sensor and
+an egocentric occupancy image.
 
 Both sensors read one snapshot of the ice, floes as discs (centres
 ``positions`` (N, 2) [m], ``radii`` (N,) [m]), and the ship's pose
@@ -32,6 +32,23 @@ an exact picture the sensor's reach should stay below half the box length.
       point stands for the same area, so uniform coverage gives the
       true fraction) and angles at the midpoints of equal sub-sectors.
       A point counts when it lies inside any floe.
+
+:func:`ice_swath`
+    The ice a straight course would meet, with the floes' sizes: a fan of
+    ``rays`` courses spanning ``fan`` [rad] about the heading (course k at
+    heading − fan/2 + (k + 1/2) fan/rays, anticlockwise; with an odd
+    number the middle one is straight ahead). A course's swath is the
+    band of half-width ``half_beam`` [m] about its ray. A floe of radius r
+    whose centre lies at ``along`` [m] along the ray and ``across`` [m]
+    from it is met when across < r + half_beam, and adds its weight w (an
+    expected collision impulse, say) times 1 − across / (r + half_beam):
+    all of it when the course runs through its centre, little when it only
+    grazes. The sums are kept per band of ``along``: ``bands`` are the
+    band edges [m] (0, 100, 250: the ice within 100 m ahead of the ship's
+    centroid and from 100 to 250 m). Floes behind the centroid are not
+    counted. Unlike the lidar's first edge and wedge concentration, the
+    sums tell a large floe from a few small ones: the weight grows with
+    the floe's mass.
 
 :func:`occupancy_image`
     A (4, size, size) uint8 picture of a square of side ``extent`` [m]
@@ -72,7 +89,8 @@ from numba import njit
 from physics.checks import check_range
 from physics.domain import minimum_image
 
-__all__ = ["ice_lidar", "lidar_scan", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
+__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "occupancy_image",
+           "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
 LIDAR_RINGS = 8
@@ -302,6 +320,85 @@ def lidar_scan(x, y, heading, positions, radii, sectors, fov, max_range, lx, ly,
             if covered[i, j]:
                 concentration[j // LIDAR_RAYS] += 1.0
     return distance, concentration / (LIDAR_RINGS * LIDAR_RAYS)
+
+
+# -- swath sensor ---------------------------------------------------------------------------
+
+def ice_swath(ship_xy, heading, positions, radii, weights, *, rays: int = 9,
+              fan: float = 0.5 * math.pi, half_beam: float = 9.0, bands=(0.0, 100.0, 250.0),
+              box_lengths=None, periodic=(False, False)) -> np.ndarray:
+    """The weights of the floes each of a fan of straight courses would
+    meet, per band of distance ahead (see the module docstring).
+
+    Parameters
+    ----------
+    ship_xy : (2,) [m]; heading : float [rad]
+    positions : (N, 2) [m]; radii : (N,) [m]
+    weights : (N,) — what a floe met through its centre adds (e.g. its
+        expected collision impulse [N s]); non-negative
+    rays : int ≥ 1; fan : float in (0, π] [rad]; half_beam : float > 0 [m]
+    bands : increasing band edges [m], at least two, the first ≥ 0
+    box_lengths, periodic : as :func:`ice_lidar`
+
+    Returns
+    -------
+    (rays, len(bands) − 1) array: course k's sum in band b.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> s = ice_swath((0.0, 0.0), 0.0, np.array([[50.0, 0.0]]), np.array([5.0]),
+    ...               np.array([2.0]), rays=3, half_beam=5.0)
+    >>> s.round(3).tolist()     # the middle course runs through the centre
+    [[0.0, 0.0], [2.0, 0.0], [0.0, 0.0]]
+    """
+    xy, heading = _check_pose(ship_xy, heading)
+    k = _check_int("rays", rays, 1)
+    check_range("fan", fan, 0.0, math.pi, low_open=True)
+    check_range("half_beam", half_beam, 0.0, None, low_open=True)
+    p, r = _check_floes(positions, radii)
+    w = np.asarray(weights, dtype=float)
+    if w.shape != r.shape or not (np.all(np.isfinite(w)) and np.all(w >= 0.0)):
+        raise ValueError(f"weights must be {r.shape[0]} finite non-negative numbers (one per "
+                         f"floe), got shape {w.shape}")
+    edges = np.asarray(bands, dtype=float)
+    if (edges.ndim != 1 or edges.size < 2 or not np.all(np.isfinite(edges))
+            or edges[0] < 0.0 or not np.all(np.diff(edges) > 0.0)):
+        raise ValueError(f"bands must be at least two increasing finite distances from 0 on, "
+                         f"got {bands!r}")
+    lengths, per = _check_box(box_lengths, periodic)
+    lx, ly = (1.0, 1.0) if lengths is None else (float(lengths[0]), float(lengths[1]))
+    return swath_scan(xy[0], xy[1], heading, p, r, w, k, float(fan), float(half_beam), edges,
+                      lx, ly, per[0], per[1])
+
+
+@njit(cache=True, error_model="numpy")
+def swath_scan(x, y, heading, positions, radii, weights, rays, fan, half_beam, bands, lx, ly,
+               periodic_x, periodic_y):
+    """:func:`ice_swath` without the checks of its arguments."""
+    nb = bands.size - 1
+    out = np.zeros((rays, nb))
+    far = bands[nb]
+    ray_cos, ray_sin = np.empty(rays), np.empty(rays)
+    for k in range(rays):
+        theta = heading - 0.5 * fan + (k + 0.5) * fan / rays
+        ray_cos[k], ray_sin[k] = math.cos(theta), math.sin(theta)
+    for f in range(radii.shape[0]):
+        dx = minimum_image(positions[f, 0] - x, lx, periodic_x)
+        dy = minimum_image(positions[f, 1] - y, ly, periodic_y)
+        reach = radii[f] + half_beam
+        if dx * dx + dy * dy >= (far + reach) * (far + reach):
+            continue
+        for k in range(rays):
+            along = dx * ray_cos[k] + dy * ray_sin[k]
+            across = abs(dy * ray_cos[k] - dx * ray_sin[k])
+            if across >= reach or along < bands[0] or along >= far:
+                continue
+            b = 0
+            while along >= bands[b + 1]:
+                b += 1
+            out[k, b] += weights[f] * (1.0 - across / reach)
+    return out
 
 
 # -- occupancy image -------------------------------------------------------------------------

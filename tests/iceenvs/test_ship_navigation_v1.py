@@ -178,6 +178,56 @@ def test_kinetic_energy_metrics_are_zero_in_open_water():
     assert info["ice_energy_gain"] == 0.0 == info["energy_dissipated"] == info["energy_to_ice"]
 
 
+# -- the swath sensor -------------------------------------------------------------------------
+
+def test_swath_sensor_sees_a_floe_ahead_with_its_expected_impulse():
+    """The floe 100 m dead ahead of _OneFloe, seen from 40 m further on:
+    60 m ahead of the centroid, in the near band of the middle course,
+    with all of its expected head-on impulse (1 + e) v m M / (m + M); the
+    courses beside it, 10° off, pass it 10.4 m off its centre (reach
+    5 m + half the beam) or miss it."""
+    env = _OneFloe(goal_distance=300.0, length=700.0)
+    env.reset(seed=0)
+    for _ in range(10):                        # 20 s at 2 m/s: 40 m
+        obs, _, _, _, info = env.step(np.zeros(1))
+    raw = info["physics"]
+    m, big = float(env.sim.masses[0]), float(env.ship.mass)
+    e = env.contact.restitution
+    expected = (1.0 + e) * 2.0 * m * big / (m + big)
+    assert env.expected_impulses([m])[0] == pytest.approx(expected, rel=1e-12)
+    ahead = env.sim.positions[0] - env.sim.ship.position
+    half = 5.0 + 0.5 * env.ship.hull.beam
+    assert abs(ahead[1]) < 1e-6 and 59.0 < ahead[0] < 61.0
+    assert raw["swath_0_4"] == pytest.approx(expected * (1.0 - abs(ahead[1]) / half), rel=1e-9)
+    assert raw["swath_1_4"] == 0.0                             # nothing 100-250 m ahead
+    for k in (3, 5):
+        theta = (k - 4) * 0.5 * math.pi / 9
+        across = abs(ahead[0] * math.sin(theta) - ahead[1] * math.cos(theta))
+        want = expected * max(1.0 - across / half, 0.0)
+        assert raw[f"swath_0_{k}"] == pytest.approx(want, rel=1e-9, abs=1e-9)
+    names = [f.name for f in env.features]
+    assert obs[names.index("swath_0_4")] == pytest.approx(math.log10(1.0 + raw["swath_0_4"] / 1e4),
+                                                          rel=1e-6)
+
+
+def test_swath_sensor_options():
+    plain = gym.make(V1, swath_rays=0)
+    full = gym.make(V1)
+    try:
+        assert full.observation_space.shape[0] - plain.observation_space.shape[0] == 18
+        assert not any(f.name.startswith("swath") for f in plain.unwrapped.features)
+        assert plain.reset(seed=0)[0].shape == plain.observation_space.shape
+    finally:
+        plain.close()
+        full.close()
+    for kwargs, name in ((dict(swath_rays=-1), "swath_rays"), (dict(swath_rays=2.5), "swath_rays"),
+                         (dict(swath_fan=0.0), "swath_fan"), (dict(swath_fan=4.0), "swath_fan"),
+                         (dict(swath_bands=(0.0,)), "swath_bands"),
+                         (dict(swath_bands=(0.0, 50.0, 20.0)), "swath_bands")):
+        with pytest.raises(ValueError, match=name):
+            gym.make(V1, **kwargs)
+
+
 # -- the lattice planner ----------------------------------------------------------------------
 
 def test_lattice_planner_beats_the_straight_line_on_fixed_fields():

@@ -1,12 +1,13 @@
-"""Tests of iceenvs.ship_sensors: the sector lidar and the egocentric occupancy
-image against analytic geometry and against direct per-ray, per-sample and
-per-pixel evaluation of the documented conventions."""
+"""Tests of iceenvs.ship_sensors: the sector lidar, the swath sensor and the
+egocentric occupancy image against analytic geometry and against direct
+per-ray, per-sample and per-pixel evaluation of the documented
+conventions."""
 import math
 
 import numpy as np
 import pytest
 
-from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, ice_lidar, lidar_scan,
+from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, ice_lidar, ice_swath, lidar_scan,
                                   occupancy_image)
 
 TWO_PI = 2.0 * math.pi
@@ -367,3 +368,82 @@ def test_image_rejects_bad_input(kwargs, name):
         occupancy_image(args.pop("ship_xy"), args.pop("heading"), args.pop("positions"),
                         args.pop("radii"), args.pop("hull_vertices"), args.pop("goal_x"),
                         **args)
+
+
+# -- swath sensor -------------------------------------------------------------------------------
+
+def swath_by_hand(ship, heading, positions, radii, weights, rays, fan, half_beam, bands):
+    """Course by course and floe by floe, as the module docstring states it."""
+    d = np.asarray(positions, float) - ship
+    out = np.zeros((rays, len(bands) - 1))
+    for k in range(rays):
+        u = unit(heading - 0.5 * fan + (k + 0.5) * fan / rays)
+        for (dx, dy), r, w in zip(d, radii, weights):
+            along = dx * u[0] + dy * u[1]
+            across = abs(dx * u[1] - dy * u[0])
+            reach = r + half_beam
+            for b in range(len(bands) - 1):
+                if across < reach and bands[b] <= along < bands[b + 1]:
+                    out[k, b] += w * (1.0 - across / reach)
+    return out
+
+
+def test_swath_weighs_a_floe_by_how_centrally_a_course_meets_it():
+    # one floe 60 m dead ahead, 4 m to port of the ship's axis; half beam 6 m, radius 4 m:
+    # the straight course meets it 4 m off its centre, 4/10 of the reach
+    s = ice_swath((0.0, 0.0), 0.0, np.array([[60.0, 4.0]]), np.array([4.0]),
+                  np.array([3.0]), rays=3, fan=0.5, half_beam=6.0, bands=(0.0, 50.0, 100.0))
+    assert s.shape == (3, 2)
+    assert s[1, 0] == 0.0                               # not in the near band
+    assert s[1, 1] == pytest.approx(3.0 * (1.0 - 0.4), rel=1e-12)
+    # the port course (1/6 rad to port) passes 60 sin(1/6) − 4 cos(1/6) ≈ 6.0 m from its centre
+    across = abs(4.0 * math.cos(1 / 6) - 60.0 * math.sin(1 / 6))
+    assert s[2, 1] == pytest.approx(3.0 * (1.0 - across / 10.0), rel=1e-12)
+    assert s[0, 1] == 0.0                               # starboard: 14 m off, beyond the reach
+
+
+def test_swath_of_a_field_matches_evaluation_by_hand():
+    rng = np.random.default_rng(4)
+    positions = rng.uniform(-150.0, 250.0, (300, 2))
+    radii = rng.uniform(1.0, 25.0, 300)
+    weights = rng.uniform(0.0, 5.0, 300)
+    for heading in (0.0, 0.7, -2.5):
+        got = ice_swath((10.0, -5.0), heading, positions, radii, weights, rays=7, fan=1.2,
+                        half_beam=9.0, bands=(0.0, 40.0, 120.0, 200.0))
+        want = swath_by_hand(np.array([10.0, -5.0]), heading, positions, radii, weights, 7,
+                             1.2, 9.0, (0.0, 40.0, 120.0, 200.0))
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def test_swath_ignores_floes_behind_and_beyond_and_sees_periodic_images():
+    radii, weights = np.array([5.0]), np.array([1.0])
+    behind = ice_swath((0.0, 0.0), 0.0, np.array([[-20.0, 0.0]]), radii, weights, rays=1)
+    beyond = ice_swath((0.0, 0.0), 0.0, np.array([[260.0, 0.0]]), radii, weights, rays=1)
+    assert behind.sum() == 0.0 and beyond.sum() == 0.0
+    # a floe 30 m ahead through the periodic edge of a 100 m box
+    wrapped = ice_swath((90.0, 50.0), 0.0, np.array([[20.0, 50.0]]), radii, weights, rays=1,
+                        box_lengths=(100.0, 100.0), periodic=(True, False))
+    assert wrapped[0, 0] == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(rays=0), "rays"),
+    (dict(rays=1.5), "rays"),
+    (dict(fan=0.0), "fan"),
+    (dict(fan=4.0), "fan"),
+    (dict(half_beam=0.0), "half_beam"),
+    (dict(weights=[1.0, 2.0]), "weights"),
+    (dict(weights=[-1.0]), "weights"),
+    (dict(weights=[float("nan")]), "weights"),
+    (dict(bands=(0.0,)), "bands"),
+    (dict(bands=(0.0, 50.0, 40.0)), "bands"),
+    (dict(bands=(-10.0, 50.0)), "bands"),
+    (dict(radii=[-1.0]), "radii"),
+    (dict(heading=float("nan")), "heading"),
+])
+def test_swath_rejects_bad_input(kwargs, name):
+    args = dict(ship_xy=(0.0, 0.0), heading=0.0, weights=[1.0], **FLOE)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=name):
+        ice_swath(args.pop("ship_xy"), args.pop("heading"), args.pop("positions"),
+                  args.pop("radii"), args.pop("weights"), **args)
