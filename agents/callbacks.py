@@ -1,10 +1,11 @@
 """Training callbacks: the physics metrics of ``info["physics"]`` logged
-next to the returns (and written to ``metrics.csv``), and a tqdm progress
-bar."""
+next to the returns (and written to ``metrics.csv``), a tqdm progress
+bar and a wall-clock budget."""
 from __future__ import annotations
 
 import csv
 import math
+import time
 from collections import deque
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from iceenvs.facts import env_facts
 
-__all__ = ["PhysicsMetricsCallback", "TqdmCallback"]
+__all__ = ["PhysicsMetricsCallback", "TqdmCallback", "TimeBudgetCallback"]
 
 
 class PhysicsMetricsCallback(BaseCallback):
@@ -144,3 +145,29 @@ class TqdmCallback(BaseCallback):
     def _on_training_end(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+class TimeBudgetCallback(BaseCallback):
+    """Stop training once ``minutes`` of wall-clock time have passed since
+    it started (checked every step; the run then saves its model as at the
+    end of its timesteps). ``stopped_at`` holds the timesteps it stopped
+    at, or None."""
+
+    def __init__(self, minutes: float):
+        super().__init__(0)
+        if not (math.isfinite(minutes) and minutes > 0):
+            raise ValueError(f"minutes must be a positive number, got {minutes!r}")
+        self.seconds = 60.0 * float(minutes)
+        self.stopped_at = None
+        self._start = None
+
+    def _on_training_start(self) -> None:
+        self._start = time.perf_counter()
+
+    def _on_step(self) -> bool:
+        if time.perf_counter() - self._start < self.seconds:
+            return True
+        self.stopped_at = self.num_timesteps
+        print(f"training stopped by its budget of {self.seconds / 60:g} minutes at "
+              f"{self.num_timesteps} steps")
+        return False

@@ -35,6 +35,7 @@ import argparse
 import copy
 import importlib.util
 import inspect
+import math
 import shlex
 import shutil
 import sys
@@ -122,6 +123,9 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                         "vector environment), subproc (a process each), dummy (one after the "
                         "other here); auto (default): for several, native where the environment "
                         "has one, else subproc; dummy for one")
+    p.add_argument("--minutes", type=float, default=None,
+                   help="stop after this much wall-clock training time and save the model "
+                        "as at the end (default: no limit)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p
@@ -139,6 +143,8 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
             parser.error(f"--{name.replace('_', '-')} must be >= 0")
     if args.eval_episodes < 1:
         parser.error("--eval-episodes must be >= 1")
+    if args.minutes is not None and not (math.isfinite(args.minutes) and args.minutes > 0):
+        parser.error(f"--minutes must be a positive number, got {args.minutes}")
     if args.vectorization == "native":
         from .envs import has_native_vector_env
 
@@ -385,7 +391,7 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path) 
     """Checkpoints, evaluation, physics metrics and the progress bar."""
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
-    from .callbacks import PhysicsMetricsCallback, TqdmCallback
+    from .callbacks import PhysicsMetricsCallback, TimeBudgetCallback, TqdmCallback
 
     n_envs = hp["n_envs"]
     callbacks = []
@@ -401,6 +407,8 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path) 
                                       deterministic=True, verbose=args.verbose))
     callbacks.append(PhysicsMetricsCallback(args.env, run_dir / "metrics.csv"))
     callbacks.append(TqdmCallback(hp["n_timesteps"], disable=args.no_progress))
+    if args.minutes is not None:
+        callbacks.append(TimeBudgetCallback(args.minutes))
     return callbacks
 
 

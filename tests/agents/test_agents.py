@@ -15,6 +15,7 @@ from iceenvs import ENV_IDS
 pytest.importorskip("stable_baselines3")
 
 from agents import train
+from agents.callbacks import TimeBudgetCallback
 from agents.baselines import baseline_names, make_baseline
 from agents.planners import PLANNERS
 from cli_checks import assert_refused
@@ -185,6 +186,20 @@ def _train_in_process(tmp_path, name, seed):
     return np.concatenate([v.numpy().ravel() for v in params.values()])
 
 
+def test_time_budget_stops_training_and_saves_the_model(tmp_path, capsys):
+    out = tmp_path / "budget"
+    train.main(["--env", ITD, "--algo", "ppo", "--timesteps", "100000", "--n-envs", "2",
+                "--out", str(out), "--eval-freq", "0", "--save-freq", "0", "--no-progress",
+                "--minutes", "1e-9", "--hyperparams", *TINY_PPO, *env_kwargs_args(ITD)])
+    assert "training stopped by its budget" in capsys.readouterr().out
+    from stable_baselines3 import PPO
+
+    # the budget is checked every step: the run stops within its first rollout
+    assert PPO.load(out / "model.zip", device="cpu").num_timesteps < 100000
+    with pytest.raises(ValueError, match="minutes"):
+        TimeBudgetCallback(0.0)
+
+
 def test_same_seed_same_training(tmp_path):
     a = _train_in_process(tmp_path, "a", seed=5)
     b = _train_in_process(tmp_path, "b", seed=5)
@@ -306,6 +321,7 @@ def test_baseline_alone_from_the_command_line(tmp_path):
     (["--env", CONVERGENCE, "--algo", "dqn"], ("ppo", "sac")),
     (["--env", CONVERGENCE, "--algo", "ppo", "--hyperparams", "n_stepz=3"],
      ("n_steps", "batch_size", "env_kwargs")),
+    (["--env", CONVERGENCE, "--algo", "ppo", "--minutes", "-1"], ("--minutes",)),
 ])
 def test_bad_input_lists_valid_choices(argv, expected, capsys, tmp_path):
     assert_refused(train.main, argv, expected, tmp_path / "run", capsys)

@@ -184,8 +184,8 @@ def test_swath_sensor_sees_a_floe_ahead_with_its_expected_impulse():
     """The floe 100 m dead ahead of _OneFloe, seen from 40 m further on:
     60 m ahead of the centroid, in the near band of the middle course,
     with all of its expected head-on impulse (1 + e) v m M / (m + M); the
-    courses beside it, 10° off, pass it 10.4 m off its centre (reach
-    5 m + half the beam) or miss it."""
+    courses beside it, 10° off, pass 10.4 m from its centre and see the
+    part 1 − 10.4 m / (5 m + half the beam) of it."""
     env = _OneFloe(goal_distance=300.0, length=700.0)
     env.reset(seed=0)
     for _ in range(10):                        # 20 s at 2 m/s: 40 m
