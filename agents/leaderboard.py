@@ -19,6 +19,7 @@ metre and return against concentration)::
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
         [--policies straight,reactive,lattice] [--trained NAME=RUN_DIR[@STEPS] ...]
+        [--merge [--replace NAMES]]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
 """
@@ -254,6 +255,9 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--merge", action="store_true",
                    help="keep the policies of the JSON in --out (same environment, arguments, "
                         "concentrations and fields) and run only the others")
+    p.add_argument("--replace", default="", metavar="NAMES",
+                   help="with --merge: comma-separated policies to run again and replace "
+                        "though the JSON has them")
     return p
 
 
@@ -296,6 +300,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     from .baselines import baseline_names
     from .envs import make_checked_env, parse_key_values
     from .planners import PLANNERS
+    from .rollouts import trained_argument
 
     if args.episodes < 2:
         parser.error("--episodes must be at least 2 (standard errors)")
@@ -319,23 +324,28 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         policies.insert(0, "straight")
     recipes = {name: ("baseline", name, {}) for name in policies}
     for item in args.trained:
-        name, sep, target = item.partition("=")
-        run_dir, at, steps = target.partition("@")
-        if not sep or not name or not Path(run_dir).is_dir() or (at and not steps.isdigit()):
-            parser.error(f"--trained takes NAME=RUN_DIR or NAME=RUN_DIR@STEPS with an existing "
-                         f"directory, got {item!r}")
-        recipes[name] = ("trained", run_dir, {"checkpoint": int(steps)} if at else {})
+        try:
+            name, run_dir, steps = trained_argument(item)
+        except ValueError as err:
+            parser.error(str(err))
+        recipes[name] = ("trained", run_dir, {} if steps is None else {"checkpoint": steps})
     for a in conc:
         try:
             make_checked_env(args.env, {**env_kwargs, "concentration": a}).close()
         except (TypeError, ValueError) as err:
             print(f"{prog}: error: {args.env} with concentration {a:g}: {err}", file=sys.stderr)
             raise SystemExit(2) from None
+    again = [n.strip() for n in args.replace.split(",") if n.strip()]
+    if again and not args.merge:
+        parser.error("--replace needs --merge")
+    for name in again:
+        if name not in recipes:
+            parser.error(f"--replace {name}: not among the policies of this run")
     old = _mergeable(parser, args, out, conc, env_kwargs) if args.merge else None
     out.mkdir(parents=True, exist_ok=True)
     if old is not None:
         recipes = {name: r for name, r in recipes.items()
-                   if name not in next(iter(old["episodes_detail"].values()))}
+                   if name in again or name not in next(iter(old["episodes_detail"].values()))}
     t0 = time.perf_counter()
     board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
                             processes=args.processes, env_kwargs=env_kwargs)

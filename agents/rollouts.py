@@ -18,8 +18,8 @@ import yaml
 
 from iceenvs.facts import env_facts
 
-__all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "rounded",
-           "stats", "summarise", "compare"]
+__all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
+           "evaluate_in_processes", "rounded", "stats", "summarise", "compare"]
 
 
 def checkpoint_files(run_dir: Path, checkpoint: int | None = None) -> tuple[Path, Path]:
@@ -81,6 +81,26 @@ class TrainedPolicy:
         if self.normalization is not None:
             obs = self.normalization.normalize_obs(obs).astype(np.float32)
         return self.model.predict(obs, deterministic=deterministic)
+
+
+def trained_argument(item: str) -> tuple[str, str, int | None]:
+    """``(name, run_dir, checkpoint or None)`` of a ``--trained`` argument
+    ``NAME=RUN_DIR`` or ``NAME=RUN_DIR@STEPS``: the run directory of
+    :mod:`agents.train` (it must hold ``args.yaml``) and, with ``@STEPS``,
+    its checkpoint at STEPS steps.
+
+    Raises
+    ------
+    ValueError
+        Another form, or a directory that is not a run directory."""
+    name, sep, target = item.partition("=")
+    run_dir, at, steps = target.partition("@")
+    if not sep or not name or (at and not steps.isdigit()):
+        raise ValueError(f"--trained takes NAME=RUN_DIR or NAME=RUN_DIR@STEPS, got {item!r}")
+    if not (Path(run_dir) / "args.yaml").is_file():
+        raise ValueError(f"--trained {item}: {run_dir} is not an existing run directory of "
+                         f"agents.train (no args.yaml)")
+    return name, run_dir, int(steps) if at else None
 
 
 def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:

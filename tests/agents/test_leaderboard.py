@@ -28,6 +28,12 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
     # the straight line's episodes are kept, not run again
     assert merged["episodes_detail"]["0.2"]["straight"] == \
         json.loads(json.dumps(report["episodes_detail"]["0.2"]["straight"]))
+    # --replace runs a kept policy again: the same fields, the same episodes
+    again = leaderboard.main(base + ["--policies", "straight", "--merge", "--replace",
+                                     "straight"])
+    assert list(again["summary"]["0.2"]) == ["straight", "lattice"]
+    assert [e["ret"] for e in again["episodes_detail"]["0.2"]["straight"]] == \
+        [e["ret"] for e in merged["episodes_detail"]["0.2"]["straight"]]
     text = (out / "leaderboard.md").read_text()
     assert "### Does route choice pay?" in text and "| 0.2 | lattice |" in text
     (out / "leaderboard.md").unlink()
@@ -39,9 +45,10 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
     (["--policies", "straight,nonsense"], "unknown policy"),
     (["--episodes", "1"], "at least 2"),
     (["--concentrations", "0.2", "--env-kwargs", "concentration=0.3"], "concentrations"),
-    (["--trained", "ppo=/no/such/run"], "existing directory"),
+    (["--trained", "ppo=/no/such/run"], "existing run directory"),
     (["--merge"], "does not exist"),
     (["--render"], "does not exist"),
+    (["--replace", "straight"], "needs --merge"),
 ])
 def test_leaderboard_refuses_bad_arguments(tmp_path, capsys, args, message):
     assert_refused(leaderboard.main, args, [message], tmp_path / "none", capsys)

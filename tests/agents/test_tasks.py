@@ -49,3 +49,37 @@ def test_bad_arguments_exit(tmp_path):
         tasks.main(["--ids", "NoSuchEnv-v0", "--out", str(tmp_path)])
     with pytest.raises(SystemExit):
         tasks.main(ARGS[:2] + ["--grid", "1", "--out", str(tmp_path)])
+
+
+def test_ship_row_adds_the_straight_line_and_the_planner_and_keep_merges(tmp_path):
+    tasks.main(ARGS + ["--out", str(tmp_path)])
+    ship = ["--ids", "ShipNavigation-v0", "--episodes", "2", "--grid", "2", "--seeds", "1",
+            "--processes", "1", "--no-progress", "--out", str(tmp_path), "--keep"]
+    kept, row = tasks.main(ship)                    # every row of tasks.json
+    assert kept["id"] == "iceenvs/ThicknessDistribution-v0"
+    assert row["planners"] == ["straight", "lattice"] and row["trained"] == []
+    assert set(row["over_constant"]) == {"heuristic", "straight", "lattice"}
+    for name, c in row["over_constant"].items():
+        assert c["diff"] == pytest.approx(row["returns"][name]["mean"]
+                                          - row["returns"]["constant"]["mean"])
+    saved = json.loads((tmp_path / "tasks.json").read_text())
+    assert [r["id"] for r in saved["rows"]] == ["iceenvs/ThicknessDistribution-v0",
+                                                 "iceenvs/ShipNavigation-v0"]
+    assert "` then `python -m agents.tasks --ids ShipNavigation-v0" in saved["command"]
+    table = (tmp_path / "tasks.md").read_text()
+    assert "straight: " in table and "lattice: " in table
+
+
+def test_trained_and_keep_arguments_are_checked(tmp_path):
+    base = ARGS + ["--out", str(tmp_path)]
+    with pytest.raises(SystemExit):                       # nothing to keep yet
+        tasks.main(base + ["--keep"])
+    with pytest.raises(SystemExit):                       # not a run directory
+        tasks.main(base + ["--trained", f"ppo={tmp_path}"])
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "args.yaml").write_text("env: iceenvs/WindDrift-v0\n")
+    with pytest.raises(SystemExit):                       # a run of another environment
+        tasks.main(base + ["--trained", f"ppo={run}"])
+    with pytest.raises(SystemExit):
+        tasks.main(base + ["--trained", f"ppo={run}@latest"])
