@@ -162,12 +162,13 @@ PEER_COLUMNS = ["environment", "floes", "model time per step", "steps/s (mean)",
 def peer_comparison(seconds: float, runs: int, seed: int, warmup: float,
                     quiet: bool = False) -> dict:
     """BenchNPIN ``ship-ice-v0`` (in its own virtualenv,
-    :mod:`benchmarks.benchnpin_peer`) and ShipNavigation-v0 (default and
-    :data:`PEER_LIKE`) timed one after the other with the same protocol."""
+    :mod:`benchmarks.benchnpin_peer`), ShipNavigation-v0 (default and
+    :data:`PEER_LIKE`) and ShipNavigation-v1 (default) timed one after the
+    other with the same protocol."""
     from . import benchnpin_peer
 
     ours = "iceenvs/ShipNavigation-v0"
-    with harness.Progress(3, "BenchNPIN side by side", quiet) as bar:
+    with harness.Progress(4, "BenchNPIN side by side", quiet) as bar:
         try:
             peer = benchnpin_peer.measure(seconds=seconds, runs=runs, seed=seed)
         except RuntimeError as exc:
@@ -177,7 +178,9 @@ def peer_comparison(seconds: float, runs: int, seed: int, warmup: float,
         bar.advance()
         like = _child(ours, seconds, runs, seed, warmup, PEER_LIKE)
         bar.advance()
-    return dict(peer=peer, default=default, peer_like=like)
+        v1 = _child("iceenvs/ShipNavigation-v1", seconds, runs, seed, warmup)
+        bar.advance()
+    return dict(peer=peer, default=default, peer_like=like, v1=v1)
 
 
 def peer_table(result: dict) -> dict:
@@ -195,8 +198,12 @@ def peer_table(result: dict) -> dict:
                      f"{peer.get('interval', math.nan):g} s", f"{peer['mean']:.1f}",
                      f"{peer['min']:.1f}–{peer['max']:.1f}", "1"])
     for key, label in (("default", "`ShipNavigation-v0` (default: A 0.2–0.6, pack floes)"),
-                       ("peer_like", "`ShipNavigation-v0`, brash floes, A = 0.09")):
-        r = result[key]
+                       ("peer_like", "`ShipNavigation-v0`, brash floes, A = 0.09"),
+                       ("v1", "`ShipNavigation-v1` (default: A 0.2–0.5, AUTO-IceNav's "
+                              "floes, 1 km of ice)")):
+        r = result.get(key)
+        if r is None:                  # a record from before v1 joined the comparison
+            continue
         if "failed" in r:
             rows.append([label, f"failed: {r['failed']}", "", "", "", ""])
             continue

@@ -66,3 +66,21 @@ def test_a_failing_environment_is_reported_not_raised(monkeypatch):
     assert row == dict(id="iceenvs/WindDrift-v0", failed="ValueError: broken")
     cells = environments.env_row(row)
     assert len(cells) == len(environments.COLUMNS) and "failed" in cells[1]
+
+
+def test_peer_table_sets_v1_beside_benchnpin_and_reads_older_records():
+    peer = dict(mean=5.0, min=4.0, max=6.0, interval=0.1, version="0.1.1",
+                config=dict(concentration=0.5, floes_per_episode=dict(min=120, max=140)))
+
+    def ours(rate):
+        return dict(mean=rate, min=0.8 * rate, max=1.2 * rate, interval=2.0, unit="s",
+                    floes=100)
+
+    result = dict(peer=peer, default=ours(600.0), peer_like=ours(800.0), v1=ours(60.0))
+    rows = environments.peer_table(result)["rows"]
+    assert [r[0].split("`")[1] for r in rows] == ["ship-ice-v0", "ShipNavigation-v0",
+                                                  "ShipNavigation-v0", "ShipNavigation-v1"]
+    # the ratio to BenchNPIN's mean, and its range from the extreme runs
+    assert rows[3][-1] == "12.0 (8.0–18.0)"
+    del result["v1"]
+    assert len(environments.peer_table(result)["rows"]) == 3
