@@ -119,7 +119,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       from the start (AUTO-IceNav: the same);
     * floe areas drawn from AUTO-IceNav's log-mass law (radii 2–50 m,
       median 64 m²; :data:`physics.ice_fields.AUTO_ICENAV_SIZES`), each floe
-      a disc of its area (AUTO-IceNav's are convex polygons), at rest;
+      a disc of its area (AUTO-IceNav's are convex polygons), at rest; the
+      rare floes over 49.7 m in radius are shrunk to it, the largest that
+      the engine's neighbour search allows across a periodic channel
+      200 m wide;
     * Herman (2013) material (Hertz contacts with friction) 1.2 m thick;
     * the concentration drawn per episode from 0.2–0.5.
 
@@ -257,6 +260,22 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             out[k] = sums.T.ravel()
         return out
 
+    def _fitting(self, field):
+        """``field`` with its few floes too large for the periodic channel
+        shrunk to fit: the engine's minimum-image neighbour search needs the
+        largest pair's reach, 2 r + skin, below half the width, so a 200 m
+        channel holds radii up to about 49.7 m, and the floe law's
+        (clipped at 50 m) are shrunk to that. Shrinking a floe opens no
+        overlap."""
+        from physics.engine import default_skin
+
+        if field.n == 0:
+            return field
+        limit = 0.999 * 0.5 * (0.5 * self.width - default_skin(field.radii))
+        if field.radii.max() <= limit:
+            return field
+        return replace(field, radii=np.minimum(field.radii, limit))
+
     def _make_sim(self, rng):
         sim = super()._make_sim(rng)
         self._swath_weights = self.expected_impulses(sim.masses)
@@ -301,6 +320,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                     raise
         self._field_concentration = covered
         field = field.take(self._clear_of_start(field.positions, field.radii, box).nonzero()[0])
+        field = self._fitting(field)
         field = self._drifting(field, forcing)
         return field.take(spatial_order(field.positions, box)), box, forcing
 

@@ -278,11 +278,17 @@ def check_time_step(dt: float, contact_time: float, what: str) -> None:
             f"use dt <= {0.1 * contact_time:.3g} s")
 
 
+def default_skin(radii: np.ndarray) -> float:
+    """The skin [m] of a Hertz engine's neighbour lists unless one is given:
+    a tenth of the mean radius."""
+    return 0.1 * float(np.mean(radii))
+
+
 def neighbour_cut(radii: np.ndarray, box: Box, skin: float | None) -> tuple[float, float]:
     """(skin, cut-off of the largest pair 2 r_max + skin) of a Hertz engine's
-    neighbour lists: the skin defaults to a tenth of the mean radius, and a
+    neighbour lists: the skin defaults to :func:`default_skin`, and a
     periodic side must exceed twice the cut-off (``ValueError``)."""
-    skin = 0.1 * float(np.mean(radii)) if skin is None else float(skin)
+    skin = default_skin(radii) if skin is None else float(skin)
     check_range("skin", skin, 0.0, None, low_open=True)
     cut = 2.0 * float(radii.max()) + skin
     for length, per, axis in ((box.lx, box.periodic[0], "x"), (box.ly, box.periodic[1], "y")):

@@ -266,3 +266,27 @@ def test_lattice_route_over_an_empty_and_a_blocked_field():
     ys, total = lattice_route(cost, 1.0, 10, 30, 20, 0, 3, 0, 40, 1.0)
     assert ys[15] == 31 == ys[16]
     assert total < 1e5
+
+
+def test_a_floe_at_the_size_laws_cap_fits_the_periodic_channel(monkeypatch):
+    """The floe law clips radii at 50 m, but the engine's neighbour search
+    across the 200 m periodic channel needs 2 r + skin < 100 m: such a
+    floe is shrunk just enough, and the episode runs."""
+    import iceenvs.ship_navigation_v1 as v1
+
+    def with_a_giant(*args, **kwargs):
+        field = FloeField(np.array([[600.0, 100.0], [300.0, 20.0]]), np.array([50.0, 3.0]),
+                          1.2, np.zeros((2, 2)), density=910.0)
+        return field, 0.04
+
+    monkeypatch.setattr(v1, "navigation_field", with_a_giant)
+    env = gym.make(V1, concentration=0.2, leads=0)
+    try:
+        env.reset(seed=0)
+        r = env.unwrapped.sim.radii
+        skin = 0.1 * r.mean()
+        # shrunk, enough to fit, and not much more (0.1 % margin, the skin of the final radii)
+        assert r.max() < 50.0 and 99.5 < 2.0 * r.max() + skin < 100.0
+        env.step(np.zeros(1, dtype=np.float32))
+    finally:
+        env.close()
