@@ -24,6 +24,7 @@ SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: environments timed on a ship task, the pressured ship task and a
 #: wind-driven one; the long ship channel of the resting-floe benchmark
 EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
+                                             "iceenvs/ShipNavigation-v1",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
                "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0",
                                         "iceenvs/WindDrift-v0"},
