@@ -143,8 +143,9 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       impulse per metre. With the default two leads it meets 0.49, 0.60
       and 0.68 times it at A = 0.2, 0.3 and 0.4 (0.83 at 0.5), sailing
       1-1.3 % further. The docs' page "Ship navigation: does route choice
-      pay?" gives the measured leaderboard, the variants and PPO (which
-      does not beat the straight line after an hour of training).
+      pay?" gives the measured leaderboard, the variants and PPO (which,
+      after an hour of training, avoids the large floes but strays out of
+      the channel, and does not beat the straight line's return).
     * *What a good policy does:* reads the ice ahead and steers for leads
       and the open water between the large floes, in gentle turns (a
       turning hull sweeps its sides through the ice).
