@@ -6,15 +6,16 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
+
+from physics.checks import check_range
 from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, navigation_field
 from physics.ship import TransitBox
-
-import numpy as np
 
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .ship_env import CONTROLS, ship_features
-from .ship_sensors import swath_scan
+from .ship_sensors import check_bands, swath_scan
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
@@ -222,15 +223,9 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                  lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,
                  swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS, **kwargs):
         self.swath_rays = _integer(0, 64)("swath_rays", swath_rays)
-        if not (isinstance(swath_fan, (int, float)) and 0.0 < swath_fan <= math.pi):
-            raise ValueError(f"swath_fan must be a number in (0, π], got {swath_fan!r}")
+        check_range("swath_fan", swath_fan, 0.0, math.pi, low_open=True)
         self.swath_fan = float(swath_fan)
-        bands = np.asarray(swath_bands, dtype=float)
-        if (bands.ndim != 1 or bands.size < 2 or not np.all(np.isfinite(bands))
-                or bands[0] < 0.0 or not np.all(np.diff(bands) > 0.0)):
-            raise ValueError(f"swath_bands must be at least two increasing finite distances "
-                             f"[m] from 0 on, got {swath_bands!r}")
-        self.swath_bands = bands
+        self.swath_bands = bands = check_bands("swath_bands", swath_bands)
         self.extra_features = swath_features(self.swath_rays, tuple(bands.tolist()))
         self.extra_measures = tuple(f.name for f in self.extra_features)
         super().__init__(length=length, width=width, channel_width=channel_width,

@@ -89,7 +89,7 @@ from numba import njit
 from physics.checks import check_range
 from physics.domain import minimum_image
 
-__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "occupancy_image",
+__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "check_bands", "occupancy_image",
            "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
@@ -361,15 +361,27 @@ def ice_swath(ship_xy, heading, positions, radii, weights, *, rays: int = 9,
     if w.shape != r.shape or not (np.all(np.isfinite(w)) and np.all(w >= 0.0)):
         raise ValueError(f"weights must be {r.shape[0]} finite non-negative numbers (one per "
                          f"floe), got shape {w.shape}")
-    edges = np.asarray(bands, dtype=float)
-    if (edges.ndim != 1 or edges.size < 2 or not np.all(np.isfinite(edges))
-            or edges[0] < 0.0 or not np.all(np.diff(edges) > 0.0)):
-        raise ValueError(f"bands must be at least two increasing finite distances from 0 on, "
-                         f"got {bands!r}")
+    edges = check_bands("bands", bands)
     lengths, per = _check_box(box_lengths, periodic)
     lx, ly = (1.0, 1.0) if lengths is None else (float(lengths[0]), float(lengths[1]))
     return swath_scan(xy[0], xy[1], heading, p, r, w, k, float(fan), float(half_beam), edges,
                       lx, ly, per[0], per[1])
+
+
+def check_bands(name: str, bands) -> np.ndarray:
+    """The band edges [m] of a swath sensor as a float array: at least two
+    finite, increasing distances from 0 on (``ValueError`` naming ``name``
+    otherwise)."""
+    try:
+        edges = np.asarray(bands, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be at least two increasing finite distances [m] from 0 "
+                         f"on, got {bands!r}") from None
+    if (edges.ndim != 1 or edges.size < 2 or not np.all(np.isfinite(edges))
+            or edges[0] < 0.0 or not np.all(np.diff(edges) > 0.0)):
+        raise ValueError(f"{name} must be at least two increasing finite distances [m] from 0 "
+                         f"on, got {bands!r}")
+    return edges
 
 
 @njit(cache=True, error_model="numpy")
