@@ -3,6 +3,7 @@
     python -m agents.train --env iceenvs/Convergence-v0 --algo ppo [--timesteps N]
         [--seed S] [--n-envs K] [--out DIR] [--force] [--eval-freq F]
         [--eval-episodes E] [--hyperparams key=value ...] [--env-kwargs key=value ...]
+        [--minutes M]
 
 ``main`` runs named steps: parse and check the arguments → read the
 hyperparameters (``agents/hyperparams/<algo>.yaml``, the env's entry over
@@ -19,7 +20,11 @@ A start that fails before learning begins (making the environments, the
 model or the callbacks) leaves no half-written run directory: a directory
 this call created is removed, and in a directory that existed before
 (``--force``) the artefacts this call wrote are removed; the error is
-raised again.
+raised again. An error while learning loses nothing learnt: the model so
+far is saved as the checkpoint at its number of steps (evaluate it as
+``RUN_DIR@STEPS``), and the error is raised again. ``--minutes`` stops
+learning after that much wall-clock time and saves the model as at the
+end.
 
 The run directory (default ``runs/agents/<env-name>_<algo>_<seed>``)
 holds ``model.zip``, ``vecnormalize.pkl`` (when the observations or
@@ -421,13 +426,20 @@ def learn(model, hp: dict, callbacks: list) -> None:
                 progress_bar=False)
 
 
-def save(model, env, run_dir: Path) -> None:
-    """Write ``model.zip`` and, when normalising, ``vecnormalize.pkl``."""
+def save(model, env, run_dir: Path, steps: int | None = None) -> None:
+    """Write ``model.zip`` and, when normalising, ``vecnormalize.pkl``; with
+    ``steps``, the checkpoint at that many steps instead, named as the
+    checkpoint callback names them (``checkpoints/model_<steps>_steps.zip``)."""
     from stable_baselines3.common.vec_env import VecNormalize
 
-    model.save(run_dir / "model.zip")
+    model_path, stats_path = run_dir / "model.zip", run_dir / "vecnormalize.pkl"
+    if steps is not None:
+        (run_dir / "checkpoints").mkdir(exist_ok=True)
+        model_path = run_dir / "checkpoints" / f"model_{steps}_steps.zip"
+        stats_path = run_dir / "checkpoints" / f"model_vecnormalize_{steps}_steps.pkl"
+    model.save(model_path)
     if isinstance(env, VecNormalize):
-        env.save(str(run_dir / "vecnormalize.pkl"))
+        env.save(str(stats_path))
 
 
 def _close(*things) -> None:
@@ -472,7 +484,15 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
         discard_run_dir(run_dir, created)
         raise
     try:
-        learn(model, hp, callbacks)
+        try:
+            learn(model, hp, callbacks)
+        except Exception:
+            # nothing learnt is lost: the model so far becomes a checkpoint
+            steps = model.num_timesteps
+            save(model, env, run_dir, steps)
+            print(f"training stopped by an error at {steps} steps; the model so far is saved "
+                  f"as its checkpoint (evaluate it as {run_dir}@{steps})", file=sys.stderr)
+            raise
         save(model, env, run_dir)
     finally:
         _close(env, eval_env)

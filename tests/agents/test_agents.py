@@ -200,6 +200,27 @@ def test_time_budget_stops_training_and_saves_the_model(tmp_path, capsys):
         TimeBudgetCallback(0.0)
 
 
+def test_an_error_during_training_keeps_the_model_so_far(tmp_path, monkeypatch, capsys):
+    from stable_baselines3 import PPO
+
+    real_learn = PPO.learn
+
+    def learn_then_fail(self, *args, **kwargs):
+        real_learn(self, *args, **kwargs)
+        raise RuntimeError("an environment failed")
+
+    monkeypatch.setattr(PPO, "learn", learn_then_fail)
+    out = tmp_path / "failing"
+    with pytest.raises(RuntimeError, match="an environment failed"):
+        train.main(["--env", ITD, "--algo", "ppo", "--timesteps", "128", "--n-envs", "2",
+                    "--out", str(out), "--eval-freq", "0", "--save-freq", "0", "--no-progress",
+                    "--hyperparams", *TINY_PPO, *env_kwargs_args(ITD)])
+    steps = PPO.load(out / "checkpoints" / "model_128_steps.zip", device="cpu").num_timesteps
+    assert steps == 128 and not (out / "model.zip").exists()
+    assert (out / "checkpoints" / "model_vecnormalize_128_steps.pkl").is_file()
+    assert f"{out}@128" in capsys.readouterr().err
+
+
 def test_same_seed_same_training(tmp_path):
     a = _train_in_process(tmp_path, "a", seed=5)
     b = _train_in_process(tmp_path, "b", seed=5)
