@@ -167,7 +167,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     courses fanned over ±40° about the heading, the expected collision
     impulse (:meth:`ShipEnv.expected_impulses`) of the floes the hull's
     swath along each would meet, 0-100 m and 100-250 m ahead of the ship.
-    It is what the lattice planner weighs, seen from the ship.
+    It weighs the floes by the impulse the lattice planner costs them at.
     `swath_rays=0` leaves it out.
 
 {feature_table(_FEATURES)}
