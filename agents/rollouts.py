@@ -32,13 +32,10 @@ def checkpoint_files(run_dir: Path, checkpoint: int | None = None) -> tuple[Path
     FileNotFoundError
         When there is no such model; the message lists the run's checkpoints.
     """
+    from .train import checkpoint_paths
+
     run_dir = Path(run_dir)
-    if checkpoint is None:
-        model, stats = run_dir / "model.zip", run_dir / "vecnormalize.pkl"
-    else:
-        folder = run_dir / "checkpoints"
-        model = folder / f"model_{checkpoint}_steps.zip"
-        stats = folder / f"model_vecnormalize_{checkpoint}_steps.pkl"
+    model, stats = checkpoint_paths(run_dir, checkpoint)
     if not model.is_file():
         saved = sorted(int(p.stem.split("_")[1]) for p in (run_dir / "checkpoints").glob(
             "model_*_steps.zip"))

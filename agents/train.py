@@ -49,7 +49,7 @@ from pathlib import Path
 import yaml
 
 __all__ = ["ALGOS", "HYPERPARAMS_DIR", "SPECIAL_KEYS", "build_parser", "main",
-           "read_hyperparams", "valid_keys", "default_run_dir", "RUN_FILES"]
+           "read_hyperparams", "valid_keys", "default_run_dir", "checkpoint_paths", "RUN_FILES"]
 
 #: algorithm names of the command line → stable-baselines3 class names
 ALGOS = {"ppo": "PPO", "sac": "SAC"}
@@ -426,17 +426,27 @@ def learn(model, hp: dict, callbacks: list) -> None:
                 progress_bar=False)
 
 
+def checkpoint_paths(run_dir: Path, steps: int | None = None) -> tuple[Path, Path]:
+    """(model, normalisation statistics) paths of a run: the final ones
+    (``model.zip``, ``vecnormalize.pkl``) or, with ``steps``, those of the
+    checkpoint at that many steps, as the checkpoint callback names them
+    (``checkpoints/model_<steps>_steps.zip``,
+    ``checkpoints/model_vecnormalize_<steps>_steps.pkl``)."""
+    run_dir = Path(run_dir)
+    if steps is None:
+        return run_dir / "model.zip", run_dir / "vecnormalize.pkl"
+    folder = run_dir / "checkpoints"
+    return folder / f"model_{steps}_steps.zip", folder / f"model_vecnormalize_{steps}_steps.pkl"
+
+
 def save(model, env, run_dir: Path, steps: int | None = None) -> None:
     """Write ``model.zip`` and, when normalising, ``vecnormalize.pkl``; with
-    ``steps``, the checkpoint at that many steps instead, named as the
-    checkpoint callback names them (``checkpoints/model_<steps>_steps.zip``)."""
+    ``steps``, the checkpoint at that many steps instead
+    (:func:`checkpoint_paths`)."""
     from stable_baselines3.common.vec_env import VecNormalize
 
-    model_path, stats_path = run_dir / "model.zip", run_dir / "vecnormalize.pkl"
-    if steps is not None:
-        (run_dir / "checkpoints").mkdir(exist_ok=True)
-        model_path = run_dir / "checkpoints" / f"model_{steps}_steps.zip"
-        stats_path = run_dir / "checkpoints" / f"model_vecnormalize_{steps}_steps.pkl"
+    model_path, stats_path = checkpoint_paths(run_dir, steps)
+    model_path.parent.mkdir(exist_ok=True)
     model.save(model_path)
     if isinstance(env, VecNormalize):
         env.save(str(stats_path))
