@@ -150,15 +150,13 @@ class TqdmCallback(BaseCallback):
 class TimeBudgetCallback(BaseCallback):
     """Stop training once ``minutes`` of wall-clock time have passed since
     it started (checked every step; the run then saves its model as at the
-    end of its timesteps). ``stopped_at`` holds the timesteps it stopped
-    at, or None."""
+    end of its timesteps)."""
 
     def __init__(self, minutes: float):
         super().__init__(0)
         if not (math.isfinite(minutes) and minutes > 0):
             raise ValueError(f"minutes must be a positive number, got {minutes!r}")
         self.seconds = 60.0 * float(minutes)
-        self.stopped_at = None
         self._start = None
 
     def _on_training_start(self) -> None:
@@ -167,7 +165,6 @@ class TimeBudgetCallback(BaseCallback):
     def _on_step(self) -> bool:
         if time.perf_counter() - self._start < self.seconds:
             return True
-        self.stopped_at = self.num_timesteps
         print(f"training stopped by its budget of {self.seconds / 60:g} minutes at "
               f"{self.num_timesteps} steps")
         return False

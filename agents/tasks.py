@@ -56,11 +56,11 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
 
     import iceenvs  # noqa: F401
 
+    from iceenvs.facts import env_facts
+
     from .baselines import ConstantPolicy, baseline_names, make_baseline
     from .baselines import load_results
     from .constant import search_constant_actions
-    from iceenvs.facts import env_facts
-
     from .planners import PLANNERS
     from .rollouts import TrainedPolicy, compare, evaluate, summarise
     from .metrics import env_name
@@ -84,7 +84,7 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
         # the environment's other controllers (the ship's straight line) and the planners
         own = env_facts(env_id).controllers
         planners = [n for n in baseline_names(env_id) if n in PLANNERS or (
-            n in own and n != "heuristic" and own[n] is not own.get("heuristic"))]
+            n in own and own[n] is not own.get("heuristic"))]
         for name in planners:
             policies[name] = make_baseline(name, env, EVAL_SEED)
         for name, (run_dir, checkpoint) in (trained or {}).items():
