@@ -273,7 +273,7 @@ class LatticePlanner(StraightLinePolicy):
         ny = below + int(math.ceil((high_y - y) / cell)) + 2
         nx = n_stages * stage_cells
         ice = u.ice_near(math.hypot(reach_x, max(y - low_y, high_y - y)) + 60.0)
-        beam = float(np.ptp(ship.vertices @ np.array([-math.sin(heading), math.cos(heading)])))
+        beam = float(u.ship.hull.beam)
         reach = ice["radii"] + 0.5 * beam
         cost = impulse_costmap(x, y0, nx, ny, cell, ice["positions"][:, 0],
                                ice["positions"][:, 1], reach, u.expected_impulses(ice["masses"]),
