@@ -256,18 +256,19 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             out[k] = sums.T.ravel()
         return out
 
-    def _fitting(self, field):
+    @staticmethod
+    def _fitting(field, box):
         """``field`` with its few floes too large for the periodic channel
-        shrunk to fit: the engine's minimum-image neighbour search needs the
-        largest pair's reach, 2 r + skin, below half the width, so a 200 m
-        channel holds radii up to about 49.7 m, and the floe law's
-        (clipped at 50 m) are shrunk to that. Shrinking a floe opens no
-        overlap."""
-        from physics.engine import default_skin
+        ``box`` shrunk to fit: the engine's minimum-image neighbour search
+        needs the largest pair's reach, 2 r + skin, below half the width
+        (:func:`physics.engine.largest_radius`), so a 200 m channel holds
+        radii up to about 49.7 m, and the floe law's (clipped at 50 m) are
+        shrunk to that. Shrinking a floe opens no overlap."""
+        from physics.engine import default_skin, largest_radius
 
         if field.n == 0:
             return field
-        limit = 0.999 * 0.5 * (0.5 * self.width - default_skin(field.radii))
+        limit = 0.999 * largest_radius(box, default_skin(field.radii))
         if field.radii.max() <= limit:
             return field
         return replace(field, radii=np.minimum(field.radii, limit))
@@ -316,7 +317,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                     raise
         self._field_concentration = covered
         field = field.take(self._clear_of_start(field.positions, field.radii, box).nonzero()[0])
-        field = self._fitting(field)
+        field = self._fitting(field, box)
         field = self._drifting(field, forcing)
         return field.take(spatial_order(field.positions, box)), box, forcing
 

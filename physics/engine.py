@@ -40,6 +40,7 @@ Mistakes
 from __future__ import annotations
 
 import inspect
+import math
 from enum import Enum
 from typing import Protocol, runtime_checkable
 
@@ -282,6 +283,15 @@ def default_skin(radii: np.ndarray) -> float:
     """The skin [m] of a Hertz engine's neighbour lists unless one is given:
     a tenth of the mean radius."""
     return 0.1 * float(np.mean(radii))
+
+
+def largest_radius(box: Box, skin: float) -> float:
+    """The bound [m] that every floe radius must stay below for
+    :func:`neighbour_cut` to accept the floes in ``box`` with ``skin``:
+    each periodic side must exceed twice the largest pair's cut-off
+    2 r_max + skin (infinite when no side is periodic)."""
+    sides = [length for length, per in zip((box.lx, box.ly), box.periodic) if per]
+    return min((0.5 * (0.5 * length - skin) for length in sides), default=math.inf)
 
 
 def neighbour_cut(radii: np.ndarray, box: Box, skin: float | None) -> tuple[float, float]:
