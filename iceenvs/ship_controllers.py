@@ -21,7 +21,8 @@ class StraightLinePolicy(Controller):
     yaw rate proportional to it (full rate at 0.1 rad); a dynamic ship
     runs at full thrust with a critically damped PD autopilot on it
     (natural frequency 0.05 rad/s, the ship's yaw inertia with added mass).
-    The surge speed of ``control="speed_yaw"`` is the largest.
+    The surge speed of ``control="speed_yaw"`` is the largest. With
+    ``control="course"`` the policy commands the course of the bearing.
 
     The policies read the observation vector (``obs["vector"]`` of a dict
     observation); with ``obs_type="image"`` they read the environment's last
@@ -65,6 +66,9 @@ class StraightLinePolicy(Controller):
             w = self.FREQUENCY
             moment = ship.total_mass[2] * (w * w * bearing - 2.0 * w * get("yaw_rate"))
             return np.array([1.0, moment / ship.max_yaw_moment])
+        if u.control == "course":
+            # the course (from the goal direction) that points the bow along the bearing
+            return np.array([(bearing - self._bearing(get)) / u.episode["max_course"]])
         turn = bearing / self.GAIN_ANGLE
         return np.array([turn]) if u.control == "yaw" else np.array([1.0, turn])
 

@@ -90,6 +90,7 @@ FLOE_SIZES = {
 CONTROLS = {
     "yaw": ("prescribed", ("yaw_rate",)),
     "speed_yaw": ("prescribed", ("surge_speed", "yaw_rate")),
+    "course": ("prescribed", ("course",)),
     "thrust": ("dynamic", ("thrust", "yaw_moment")),
 }
 
@@ -332,7 +333,7 @@ class ShipEnv(HertzEnv):
     @property
     def max_speed(self) -> float:
         """Largest surge speed [m/s] the actions give (the reward's speed scale)."""
-        if self.control == "yaw":
+        if self.control in ("yaw", "course"):
             return self.episode["speed"]
         if self.control == "speed_yaw":
             return self.episode["max_speed"]
@@ -389,9 +390,23 @@ class ShipEnv(HertzEnv):
         elif self.control == "speed_yaw":
             ship.command(surge=0.5 * (float(action[0]) + 1.0) * self.episode["max_speed"],
                          yaw_rate=float(action[1]) * self.episode["max_yaw_rate"])
+        elif self.control == "course":
+            ship.command(surge=self.episode["speed"],
+                         yaw_rate=self.course_yaw_rate(float(action[0]), float(ship.heading)))
         else:
             ship.command(thrust=float(action[0]) * self._ship.max_thrust,
                          yaw_moment=float(action[1]) * self._ship.max_yaw_moment)
+
+    def course_yaw_rate(self, action: float, heading: float) -> float:
+        """The autopilot of ``control="course"``: the yaw rate [rad/s] that
+        brings ``heading`` [rad from the goal direction, +x] to the course
+        ``action`` × `max_course` within one control interval, limited to
+        ±`max_yaw_rate` (the turning radius). The heading error is taken
+        in (−π, π]."""
+        e = self.episode
+        error = math.remainder(action * e["max_course"] - heading, 2.0 * math.pi)
+        limit = e["max_yaw_rate"]
+        return min(max(error / self.control_interval, -limit), limit)
 
     # -- one step ----------------------------------------------------------------------
     #: the environment's own measurements, after those of every ship environment

@@ -49,7 +49,10 @@ _TASK = (
     TaskParameter("max_speed", 4.0, "surge speed [m/s] at action[0] = +1 with "
                   "`control=\"speed_yaw\"`", number(0.1, 8.0)),
     TaskParameter("max_yaw_rate", 0.04, "yaw rate [rad/s] at a full yaw action of the "
-                  "prescribed set-ups", number(0.0, 0.5, low_open=True)),
+                  "prescribed set-ups (the autopilot's limit with `control=\"course\"`)",
+                  number(0.0, 0.5, low_open=True)),
+    TaskParameter("max_course", math.pi / 4, "course [rad from the goal direction] at a "
+                  "full action with `control=\"course\"`", number(0.0, math.pi, low_open=True)),
     TaskParameter("hull_friction", 0.05, "Coulomb coefficient of ice on the hull",
                   number(0.0, 1.0)),
     TaskParameter("beset_speed", 0.05, "with `control=\"thrust\"`: a ship whose surge speed "
@@ -108,6 +111,11 @@ class ShipNavigationEnv(ShipEnv):
     = action[0] × `max_yaw_rate` (0.04 rad/s: a turning radius of 50 m at
     2 m/s). `control="speed_yaw"` (n = 2): surge speed `max_speed`
     (action[0] + 1)/2 and yaw rate action[1] × `max_yaw_rate`.
+    `control="course"` (n = 1): the course action[0] × `max_course`
+    (45°) from the goal direction, which an autopilot holds at the fixed
+    speed (:meth:`~iceenvs.ship_env.ShipEnv.course_yaw_rate`: the yaw rate
+    that reaches it within the step, at most `max_yaw_rate`); action 0
+    sails straight for the goal line.
     `control="thrust"` (n = 2): thrust action[0] × 500 kN (astern below 0;
     full thrust: 5.5 m/s in open water) and yaw moment action[1] × 9.5 MN m.
 

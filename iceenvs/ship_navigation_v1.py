@@ -154,8 +154,9 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     ## Action Space
     As ShipNavigation-v0: `Box(-1, 1, (1,), float32)`, the yaw rate
     action[0] × `max_yaw_rate` (0.04 rad/s) at a fixed 2 m/s
-    (`control="yaw"`); `control="speed_yaw"` and `control="thrust"` as
-    there.
+    (`control="yaw"`); `control="course"` (the course action[0] ×
+    `max_course`, 45°, held by an autopilot), `control="speed_yaw"` and
+    `control="thrust"` as there. The documented PPO run commands courses.
 
     ## Observation Space
     `obs_type="vector"` (default): `Box(float32)` of {_N_VECTOR} entries: the

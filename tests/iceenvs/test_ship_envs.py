@@ -78,6 +78,75 @@ def test_yaw_rate_action_turns_the_prescribed_ship_at_that_rate():
         env.close()
 
 
+def test_course_action_turns_at_the_yaw_limit_then_holds_the_course():
+    """control="course": the autopilot turns at max_yaw_rate (0.04 rad/s,
+    0.08 rad a 2 s step) towards action × max_course and, once within a
+    step's turn, reaches it exactly and holds it; a course across ±π
+    turns the short way."""
+    env = gym.make(NAV, concentration=0.01, control="course")
+    try:
+        env.reset(seed=0)
+        ship = env.unwrapped.sim.ship
+        headings = []
+        for _ in range(12):
+            env.step(np.array([1.0], np.float32))
+            headings.append(ship.heading)
+        # 9 full-rate steps reach 0.72 rad; the tenth closes the last 0.065 rad
+        np.testing.assert_allclose(headings[:9], 0.08 * np.arange(1, 10), rtol=1e-9)
+        np.testing.assert_allclose(headings[9:], math.pi / 4, rtol=1e-9)
+        assert ship.surge == pytest.approx(2.0, rel=1e-9)
+        env.step(np.array([-0.5], np.float32))                 # back towards −π/8
+        assert ship.heading == pytest.approx(math.pi / 4 - 0.08, rel=1e-9)
+        u = env.unwrapped
+        # heading 3 rad, course −0.9 π/4 = −0.71 rad: the short way is anticlockwise,
+        # through π (an error of 2π − 3.71 = +2.58 rad), at the full rate
+        assert u.course_yaw_rate(-0.9, 3.0) == pytest.approx(0.04)
+        assert u.course_yaw_rate(0.0, 0.05) == pytest.approx(-0.025, rel=1e-12)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("planner", ["reactive", "lattice"])
+def test_planners_steer_by_course(planner):
+    """The planners command courses with control="course" (actions within
+    the box, not all equal) and reach the goal line."""
+    from agents.baselines import make_baseline
+
+    env = gym.make(NAV, concentration=0.3, control="course")
+    try:
+        obs, _ = env.reset(seed=1)
+        policy = make_baseline(planner, env, seed=1)
+        actions = []
+        for _ in range(300):
+            action, _ = policy.predict(obs)
+            actions.append(float(action[0]))
+            obs, _, terminated, truncated, info = env.step(action)
+            if terminated or truncated:
+                break
+    finally:
+        env.close()
+    assert info["success"]
+    assert min(actions) >= -1.0 and max(actions) <= 1.0
+    assert len(set(actions)) > 1                   # it steered
+
+
+def test_the_straight_line_is_the_same_path_with_either_steering_action():
+    """The straight line commands zero yaw rate with control="yaw" and the
+    goal direction's course with control="course": the same episode."""
+    runs = []
+    for control in ("yaw", "course"):
+        env = gym.make(NAV, concentration=0.3, control=control)
+        try:
+            obs, _ = env.reset(seed=2)
+            rewards, info, _ = _straight(env, obs)
+        finally:
+            env.close()
+        runs.append((len(rewards), sum(rewards), info["impulse_per_metre"]))
+    assert runs[0][0] == runs[1][0]
+    np.testing.assert_allclose(runs[0][1:], runs[1][1:], rtol=1e-12)
+    assert runs[0][2] > 0.0                                  # the line met ice
+
+
 def test_collision_impulses_are_bounded_by_the_contact_impulses():
     """Over an episode, Σ_c |J_c| of the logged collisions ≤ Σ_c ∫ |F_c| dt
     (``step_contact_impulse``): each J_c is the integral of its contact's
@@ -263,7 +332,8 @@ def test_wind_sets_the_ice_drifting_at_its_free_drift():
         env.close()
 
 
-@pytest.mark.parametrize("control, n", [("yaw", 1), ("speed_yaw", 2), ("thrust", 2)])
+@pytest.mark.parametrize("control, n", [("yaw", 1), ("speed_yaw", 2), ("thrust", 2),
+                                        ("course", 1)])
 def test_controls_have_their_action_spaces(control, n):
     env = gym.make(NAV, concentration=0.3, control=control)
     try:
