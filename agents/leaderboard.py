@@ -155,6 +155,7 @@ def board_markdown(report: dict) -> str:
              f"{report['seed']} + k, the same fields for every policy; "
              f"{report['machine']}; {report['date']}; {report['wall_s']:.0f} s of wall time.",
              "",
+             *_agent_lines(report.get("agent_kwargs") or {}),
              "Means ± standard errors over the fields. Ratios are to the straight line on "
              "the same field (mean of the per-field ratios); *ratio of means* is the mean "
              "impulse per metre over the straight line's.", ""]
@@ -196,6 +197,15 @@ def board_markdown(report: dict) -> str:
             cells.append(_pm(s.get("plan_ms"), 1.0, 2))
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def _agent_lines(agent_kwargs: dict) -> list[str]:
+    """The trained runs that act or observe otherwise than the environment's
+    defaults (:data:`agents.rollouts.AGENT_KWARGS`)."""
+    if not agent_kwargs:
+        return []
+    return ["Trained runs act and observe as they were trained, on the same task: " + "; ".join(
+        f"{name} with {_kwargs_text(kw)}" for name, kw in agent_kwargs.items()) + ".", ""]
 
 
 def _kwargs_text(kwargs: dict) -> str:
@@ -300,7 +310,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     from .baselines import baseline_names
     from .envs import make_checked_env, parse_key_values
     from .planners import PLANNERS
-    from .rollouts import trained_argument
+    from .rollouts import run_agent_kwargs, trained_argument
 
     if args.episodes < 2:
         parser.error("--episodes must be at least 2 (standard errors)")
@@ -325,7 +335,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     recipes = {name: ("baseline", name, {}) for name in policies}
     for item in args.trained:
         try:
-            name, run_dir, steps = trained_argument(item)
+            name, run_dir, steps = trained_argument(item, args.env)
         except ValueError as err:
             parser.error(str(err))
         recipes[name] = ("trained", run_dir, {} if steps is None else {"checkpoint": steps})
@@ -346,6 +356,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     if old is not None:
         recipes = {name: r for name, r in recipes.items()
                    if name in again or name not in next(iter(old["episodes_detail"].values()))}
+    agent_kwargs = {**(old or {}).get("agent_kwargs", {}), **{
+        name: run_agent_kwargs(r[1]) for name, r in recipes.items() if r[0] == "trained"}}
     t0 = time.perf_counter()
     board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
                             processes=args.processes, env_kwargs=env_kwargs)
@@ -357,6 +369,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     report = dict(
         command=(f"{old['command']}` then `" if old else "") + f"{prog} {argv_text}".strip(),
         env=args.env, env_kwargs=env_kwargs,
+        agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p in PLANNERS or p == "reactive"],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",

@@ -6,6 +6,12 @@ search and the task analysis share.
 episodes, :func:`summarise` and :func:`compare` turn them into means,
 standard errors and paired differences. :class:`TrainedPolicy` gives a
 saved model the ``predict`` interface of the baselines.
+
+A trained run acts and observes as it was trained: the environment
+arguments of :data:`AGENT_KWARGS` (how the agent commands and what it
+sees, not the task) come from the run when it is evaluated beside the
+baselines, and the task's from the evaluation. The ice fields do not
+depend on them, so the episodes stay paired.
 """
 from __future__ import annotations
 
@@ -19,7 +25,20 @@ import yaml
 from iceenvs.facts import env_facts
 
 __all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
-           "evaluate_in_processes", "rounded", "stats", "summarise", "compare"]
+           "evaluate_in_processes", "rounded", "stats", "summarise", "compare",
+           "AGENT_KWARGS", "run_agent_kwargs"]
+
+#: environment arguments that set how an agent acts and what it sees rather
+#: than the task: a trained run is evaluated with its own
+AGENT_KWARGS = ("control", "obs_type")
+
+
+def run_agent_kwargs(run_dir: str | Path) -> dict:
+    """The :data:`AGENT_KWARGS` a run of :mod:`agents.train` was trained
+    with (from its ``hyperparams.yaml``; empty when it kept the defaults)."""
+    with open(Path(run_dir) / "hyperparams.yaml") as fh:
+        env_kwargs = yaml.safe_load(fh).get("env_kwargs") or {}
+    return {k: v for k, v in env_kwargs.items() if k in AGENT_KWARGS}
 
 
 def checkpoint_files(run_dir: Path, checkpoint: int | None = None) -> tuple[Path, Path]:
@@ -67,6 +86,8 @@ class TrainedPolicy:
             self.hyperparams = yaml.safe_load(fh)
         self.env_id = self.args["env"]
         self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
+        #: the run's :data:`AGENT_KWARGS`, with which it is evaluated
+        self.agent_kwargs = {k: v for k, v in self.env_kwargs.items() if k in AGENT_KWARGS}
         self.model = algo_class(self.args["algo"]).load(model, device="cpu")
         self.normalization = load_normalization(stats, self.env_id, self.env_kwargs)
 
@@ -80,7 +101,7 @@ class TrainedPolicy:
         return self.model.predict(obs, deterministic=deterministic)
 
 
-def trained_argument(item: str) -> tuple[str, str, int | None]:
+def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, int | None]:
     """``(name, run_dir, checkpoint or None)`` of a ``--trained`` argument
     ``NAME=RUN_DIR`` or ``NAME=RUN_DIR@STEPS``: the run directory of
     :mod:`agents.train` (it must hold ``args.yaml``) and, with ``@STEPS``,
@@ -89,7 +110,8 @@ def trained_argument(item: str) -> tuple[str, str, int | None]:
     Raises
     ------
     ValueError
-        Another form, or a directory that is not a run directory."""
+        Another form, a directory that is not a run directory, or a run
+        trained on another environment than ``env_id`` (when given)."""
     name, sep, target = item.partition("=")
     run_dir, at, steps = target.partition("@")
     if not sep or not name or (at and not steps.isdigit()):
@@ -97,6 +119,12 @@ def trained_argument(item: str) -> tuple[str, str, int | None]:
     if not (Path(run_dir) / "args.yaml").is_file():
         raise ValueError(f"--trained {item}: {run_dir} is not an existing run directory of "
                          f"agents.train (no args.yaml)")
+    if env_id is not None:
+        with open(Path(run_dir) / "args.yaml") as fh:
+            trained_on = yaml.safe_load(fh).get("env")
+        if trained_on != env_id:
+            raise ValueError(f"--trained {item}: the run was trained on {trained_on}, "
+                             f"not {env_id}")
     return name, run_dir, int(steps) if at else None
 
 
@@ -144,11 +172,27 @@ def evaluate(env, policies: dict, *, episodes: int, seed: int, progress: bool = 
     with tqdm(total=episodes * len(policies), unit="episode", desc="evaluating",
               disable=not progress) as bar:
         for name, policy in policies.items():
-            results[name] = []
-            for k in range(episodes):
-                results[name].append(run_episode(env, policy, seed + k, main_metric))
-                bar.update()
+            own = _own_env(env, getattr(policy, "agent_kwargs", {}))
+            try:
+                results[name] = []
+                for k in range(episodes):
+                    results[name].append(run_episode(own, policy, seed + k, main_metric))
+                    bar.update()
+            finally:
+                if own is not env:
+                    own.close()
     return results
+
+
+def _own_env(env, agent_kwargs: dict):
+    """``env``, or, when ``agent_kwargs`` change it, the same task made with
+    them."""
+    import gymnasium as gym
+
+    kwargs = dict(env.spec.kwargs)
+    if all(kwargs.get(k) == v for k, v in agent_kwargs.items()):
+        return env
+    return gym.make(env.spec.id, **{**kwargs, **agent_kwargs})
 
 
 #: the environment and the policies of a worker of :func:`evaluate_in_processes`
@@ -164,21 +208,22 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     from .baselines import make_baseline
     from .envs import make_checked_env
 
-    key = (env_id, repr(sorted(env_kwargs.items())), env_seed)
-    if _WORKER.get("key") != key:
+    if not _WORKER:
         import torch
 
         torch.set_num_threads(1)
-        if "env" in _WORKER:
-            _WORKER["env"].close()
-        _WORKER.clear()
-        _WORKER.update(key=key, env=make_checked_env(env_id, env_kwargs, seed=env_seed))
-    env = _WORKER["env"]
-    if name not in _WORKER:
+        _WORKER.update(envs={}, policies={})
+    key = (env_id, repr(sorted(env_kwargs.items())), env_seed)
+    envs = _WORKER["envs"]
+    if key not in envs:
+        envs[key] = make_checked_env(env_id, env_kwargs, seed=env_seed)
+    env = envs[key]
+    policies = _WORKER["policies"]
+    if (key, name) not in policies:
         kind, target, kwargs = recipe
-        _WORKER[name] = (TrainedPolicy(target, **kwargs) if kind == "trained" else
-                         make_baseline(target, env, seed=env_seed, **kwargs))
-    return run_episode(env, _WORKER[name], episode_seed, env_facts(env_id).main_metric)
+        policies[key, name] = (TrainedPolicy(target, **kwargs) if kind == "trained" else
+                               make_baseline(target, env, seed=env_seed, **kwargs))
+    return run_episode(env, policies[key, name], episode_seed, env_facts(env_id).main_metric)
 
 
 def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
@@ -191,7 +236,8 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
     ``recipes`` maps a policy name to ``("trained", run_dir, {})`` or
     ``("baseline", baseline_name, constructor_kwargs)``; every worker builds
     its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
-    reset with ``seed``) and policies from them."""
+    reset with ``seed``; a trained run's with its :data:`AGENT_KWARGS`) and
+    policies from them."""
     import concurrent.futures
     import multiprocessing
 
@@ -203,7 +249,9 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
             processes, mp_context=multiprocessing.get_context(method)) as pool, \
             tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
                  disable=not progress) as bar:
-        jobs = {pool.submit(_worker_episode, env_id, env_kwargs, seed, name, recipe, seed + k):
+        jobs = {pool.submit(_worker_episode, env_id, {**env_kwargs, **(
+                    run_agent_kwargs(recipe[1]) if recipe[0] == "trained" else {})},
+                    seed, name, recipe, seed + k):
                 (name, k) for name, recipe in recipes.items() for k in range(episodes)}
         for job in concurrent.futures.as_completed(jobs):
             name, k = jobs[job]

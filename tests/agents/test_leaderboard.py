@@ -3,6 +3,7 @@ merging a policy in, rendering again, and refused arguments."""
 import json
 import math
 
+import numpy as np
 import pytest
 
 from agents import leaderboard
@@ -52,3 +53,73 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
 ])
 def test_leaderboard_refuses_bad_arguments(tmp_path, capsys, args, message):
     assert_refused(leaderboard.main, args, [message], tmp_path / "none", capsys)
+
+
+class _FullCourse:
+    """A stub agent that commands a full course (action +1) and was trained
+    with control="course"."""
+    agent_kwargs = {"control": "course"}
+
+    def reset(self, seed=None):
+        pass
+
+    def predict(self, obs, state=None, episode_start=None, deterministic=True):
+        return np.ones(1, np.float32), None
+
+
+def test_an_agent_is_evaluated_with_its_own_control():
+    """An agent trained with control="course" is played with it beside the
+    baselines' yaw-rate control: a full course (45°) reaches the goal line;
+    read as a full yaw rate it would sail in circles."""
+    import gymnasium as gym
+
+    from agents.rollouts import evaluate
+
+    env = gym.make("iceenvs/ShipNavigation-v0", concentration=0.01, goal_distance=200.0,
+                   length=500.0)
+    try:
+        runs = evaluate(env, {"course": _FullCourse()}, episodes=1, seed=0, progress=False)
+        assert env.unwrapped.control == "yaw"
+    finally:
+        env.close()
+    episode = runs["course"][0]
+    assert episode["final"]["success"] == 1.0
+    # the turn to 45° takes 10 steps (40 m sailed, at most 40 m gained towards the
+    # goal), the rest gains cos 45° a metre: at least 40 + 160 √2 m, where the
+    # straight line sails 200 m
+    assert episode["final"]["path_length"] >= 40.0 + 160.0 * math.sqrt(2.0)
+
+
+def test_a_trained_runs_control_is_read_and_reported(tmp_path):
+    """The leaderboard plays a run trained with control="course" with it and
+    says so; the same episodes as the policy played alone in such an
+    environment."""
+    import gymnasium as gym
+
+    from agents import train
+    from agents.rollouts import TrainedPolicy, run_agent_kwargs, run_episode
+
+    run = tmp_path / "run"
+    train.main(["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--timesteps", "64",
+                "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
+                "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32",
+                "--env-kwargs", "control=course", "goal_distance=200.0", "length=500.0"])
+    assert run_agent_kwargs(run) == {"control": "course"}
+    out = tmp_path / "board"
+    report = leaderboard.main(["--concentrations", "0.2", "--episodes", "2", "--processes",
+                               "1", "--out", str(out), "--policies", "straight",
+                               "--trained", f"ppo={run}"] + SHORT)
+    assert report["agent_kwargs"] == {"ppo": {"control": "course"}}
+    assert "ppo with control='course'" in (out / "leaderboard.md").read_text()
+    with pytest.raises(SystemExit):            # a run of another environment is refused
+        leaderboard.main(["--env", "iceenvs/ShipNavigation-v0", "--trained", f"ppo={run}",
+                          "--out", str(tmp_path / "v0")])
+    env = gym.make("iceenvs/ShipNavigation-v1", concentration=0.2, control="course",
+                   goal_distance=200.0, length=500.0)
+    try:
+        alone = [run_episode(env, TrainedPolicy(run), report["seed"] + k, None)["ret"]
+                 for k in range(2)]
+    finally:
+        env.close()
+    np.testing.assert_allclose([e["ret"] for e in report["episodes_detail"]["0.2"]["ppo"]],
+                               alone, rtol=1e-9)
