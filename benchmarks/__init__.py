@@ -30,6 +30,8 @@ suite               what is timed
                     the ship's share of a step (:mod:`benchmarks.ship`)
 ``resting``         ship transits with and without skipping the floes at rest,
                     and env steps/s of a long channel (:mod:`benchmarks.resting`)
+``sensors``         one call of the ship's lidar, swath sensor and image, and
+                    their share of a step (:mod:`benchmarks.sensors`)
 ``compare``         this tree against another revision, side by side
                     (:mod:`benchmarks.compare`)
 ``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
@@ -54,7 +56,7 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "vector",
-          "ship", "resting", "compare", "lammps_scaling")
+          "ship", "resting", "sensors", "compare", "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import benchmarks
-from benchmarks import harddisk, harness, headline, itd, observables
+from benchmarks import harddisk, harness, headline, itd, observables, sensors
 
 
 def _record(suite="hertz", **changes):
@@ -96,7 +96,7 @@ def test_suite_dispatch(tmp_path):
     assert json.loads(path.read_text())["suite"] == "itd"
 
 
-@pytest.mark.parametrize("module", [harddisk, observables, itd])
+@pytest.mark.parametrize("module", [harddisk, observables, itd, sensors])
 def test_quick_run_writes_a_valid_record(module, tmp_path):
     path = tmp_path / f"{module.SUITE}.json"
     assert module.main(["--quick", "--quiet", "--json", str(path)]) == 0

@@ -1,0 +1,139 @@
+"""What the ship's sensors cost: ``python -m benchmarks.sensors``
+(``seaice bench sensors``).
+
+    python -m benchmarks.sensors [--concentrations 0.2 0.3 0.4 0.5] [--seed 1]
+                                 [--calls 2000] [--quiet] [--quick] [--json PATH | --no-json]
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+from . import harness
+
+SUITE = "sensors"
+TITLE = "Ship sensors"
+DESCRIPTION = """
+Wall time of one call of each sensor of the ship environments, on the ice
+field of `iceenvs/ShipNavigation-v1` at each concentration (seeded), with
+the ship after 60 steps of the straight line (120 m, its bow in the ice):
+the sector lidar (`ice_lidar`, v1's 15 sectors over
+the half-disc ahead, 250 m), the swath sensor (`ice_swath`, v1's 9 courses
+over ±40°, bands 0-100 m and 100-250 m, weighted by the floes' expected
+impulses) and the egocentric image (`occupancy_image`, 64 × 64 pixels of
+150 m). Each is called through its public function, with its argument
+checks, and timed as the best of five loops of `--calls` calls after a
+warm-up loop (compilation excluded; the kernels are serial). Beside them,
+the mean wall time of the next 30 environment steps (a zero action) of the
+same field, and each sensor's share of it (the vector
+observation of v1 computes the lidar and the swath once a step, the image
+only with `obs_type="image"` or `"dict"`).
+"""
+
+#: sizes of ``--quick``
+QUICK = dict(concentrations=[0.2], calls=50, steps=3)
+#: straight-line steps before the timing: the ship 120 m on, its bow in the ice
+SAIL_IN = 60
+
+
+def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int = 2000,
+                  steps: int = 30, quiet: bool = False) -> list[dict]:
+    """Per-call wall times [s] of the sensors and of a step (see :data:`DESCRIPTION`)."""
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    rows = []
+    bar = harness.Progress(len(concentrations) * 4, "sensors", quiet)
+    with bar:
+        for a in concentrations:
+            env = gym.make("iceenvs/ShipNavigation-v1", concentration=float(a))
+            try:
+                env.reset(seed=seed)
+                zero = np.zeros(env.action_space.shape, env.action_space.dtype)
+                for _ in range(SAIL_IN):
+                    env.step(zero)
+                row = dict(concentration=float(a), floes=int(env.unwrapped.sim.radii.size))
+                for name, call in _sensor_calls(env.unwrapped).items():
+                    def loop(call=call):
+                        for _ in range(calls):
+                            call()
+                    row[name] = harness.best_time(loop) / calls
+                    bar.advance()
+                t0 = time.perf_counter()
+                for _ in range(steps):
+                    env.step(zero)
+                row["step"] = (time.perf_counter() - t0) / steps
+                bar.advance()
+            finally:
+                env.close()
+            rows.append(row)
+            bar.log(f"  A = {a:g}: lidar {row['lidar'] * 1e6:.3g} µs, swath "
+                    f"{row['swath'] * 1e6:.3g} µs, image {row['image'] * 1e6:.3g} µs, "
+                    f"step {row['step'] * 1e3:.3g} ms")
+    return rows
+
+
+def _sensor_calls(u) -> dict:
+    """{name: call} of each sensor of the ship environment ``u`` (unwrapped)
+    on its present state, with v1's settings."""
+    from iceenvs.ship_sensors import ice_lidar, ice_swath, occupancy_image
+
+    sim = u.sim
+    ship = sim.ship
+    xy, heading = np.array(ship.position, dtype=float), float(ship.heading)
+    hull = np.array(ship.vertices, dtype=float)
+    lengths, periodic = (sim.box.lx, sim.box.ly), tuple(sim.box.periodic)
+    pos, radii = sim.positions, sim.radii
+    return {
+        "lidar": lambda: ice_lidar(xy, heading, pos, radii, sectors=u.lidar_sectors,
+                                   fov=math.pi, max_range=u.lidar_range, box_lengths=lengths,
+                                   periodic=periodic),
+        "swath": lambda: ice_swath(xy, heading, pos, radii, u._swath_weights,
+                                   rays=u.swath_rays, fan=u.swath_fan,
+                                   half_beam=0.5 * u._ship.hull.beam, bands=u.swath_bands,
+                                   box_lengths=lengths, periodic=periodic),
+        "image": lambda: occupancy_image(xy, heading, pos, radii, hull, u.goal_x,
+                                         size=u.image_size, extent=u.image_extent,
+                                         box_lengths=lengths, periodic=periodic),
+    }
+
+
+def sensors_table(rows: list[dict]) -> dict:
+    """The table of a :func:`bench_sensors` result."""
+    return harness.table(
+        "Ship sensors on ShipNavigation-v1's fields, one call",
+        ["A", "floes", "lidar [µs]", "swath [µs]", "image [µs]", "env step [ms]",
+         "lidar + swath / step"],
+        [[r["concentration"], r["floes"], r["lidar"] * 1e6, r["swath"] * 1e6,
+          r["image"] * 1e6, r["step"] * 1e3, (r["lidar"] + r["swath"]) / r["step"]]
+         for r in rows])
+
+
+def main(argv=None, prog: str | None = None) -> int:
+    p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
+    p.add_argument("--concentrations", type=float, nargs="+", default=[0.2, 0.3, 0.4, 0.5])
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--calls", type=int, default=2000, help="calls per timed loop")
+    args, argv = harness.parse(p, argv)
+    if args.calls < 1:
+        p.error("--calls must be at least 1")
+    if any(not 0.0 < a <= 0.9 for a in args.concentrations):
+        p.error("--concentrations must lie in (0, 0.9]")
+    conc, calls, steps = ((QUICK["concentrations"], QUICK["calls"], QUICK["steps"])
+                          if args.quick else (args.concentrations, args.calls, 30))
+    t0 = time.perf_counter()
+    rows = bench_sensors(conc, args.seed, calls, steps, quiet=args.quiet)
+    record = harness.make_record(
+        SUITE, TITLE, DESCRIPTION, harness.command_line(SUITE, argv), [sensors_table(rows)],
+        dict(seed=args.seed, calls=calls, steps=steps, quick=args.quick, rows=rows),
+        time.perf_counter() - t0)
+    harness.finish(args, record)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
