@@ -399,14 +399,22 @@ class ShipEnv(HertzEnv):
 
     def course_yaw_rate(self, action: float, heading: float) -> float:
         """The autopilot of ``control="course"``: the yaw rate [rad/s] that
-        brings ``heading`` [rad from the goal direction, +x] to the course
-        ``action`` × `max_course` within one control interval, limited to
-        ±`max_yaw_rate` (the turning radius). The heading error is taken
-        in (−π, π]."""
+        turns ``heading`` [rad from the goal direction, +x] towards the
+        course ``action`` × `max_course`, the heading error over
+        `course_time` (not below the control interval, which would
+        overshoot), limited to ±`max_yaw_rate` (the turning radius). The
+        heading error is taken in (−π, π].
+
+        A heading that follows its course with a time constant, as a
+        ship's autopilot does, also filters a policy's step-to-step
+        changes of course: turned within one step, each change would yaw
+        the hull at up to its full rate, sweeping its sides through the
+        ice."""
         e = self.episode
         error = math.remainder(action * e["max_course"] - heading, 2.0 * math.pi)
         limit = e["max_yaw_rate"]
-        return min(max(error / self.control_interval, -limit), limit)
+        rate = error / max(e["course_time"], self.control_interval)
+        return min(max(rate, -limit), limit)
 
     # -- one step ----------------------------------------------------------------------
     #: the environment's own measurements, after those of every ship environment

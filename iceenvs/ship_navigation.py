@@ -53,6 +53,10 @@ _TASK = (
                   number(0.0, 0.5, low_open=True)),
     TaskParameter("max_course", math.pi / 4, "course [rad from the goal direction] at a "
                   "full action with `control=\"course\"`", number(0.0, math.pi, low_open=True)),
+    TaskParameter("course_time", 20.0, "time constant [s] of the autopilot of "
+                  "`control=\"course\"`: it turns at (course − heading) / course_time (not "
+                  "below the control interval), at most `max_yaw_rate`",
+                  number(0.0, None, low_open=True)),
     TaskParameter("hull_friction", 0.05, "Coulomb coefficient of ice on the hull",
                   number(0.0, 1.0)),
     TaskParameter("beset_speed", 0.05, "with `control=\"thrust\"`: a ship whose surge speed "
@@ -114,8 +118,8 @@ class ShipNavigationEnv(ShipEnv):
     `control="course"` (n = 1): the course action[0] × `max_course`
     (45°) from the goal direction, which an autopilot holds at the fixed
     speed (:meth:`~iceenvs.ship_env.ShipEnv.course_yaw_rate`: the yaw rate
-    that reaches it within the step, at most `max_yaw_rate`); action 0
-    sails straight for the goal line.
+    (course − heading) / `course_time`, 20 s, at most `max_yaw_rate`);
+    action 0 sails straight for the goal line.
     `control="thrust"` (n = 2): thrust action[0] × 500 kN (astern below 0;
     full thrust: 5.5 m/s in open water) and yaw moment action[1] × 9.5 MN m.
 

@@ -78,11 +78,14 @@ def test_yaw_rate_action_turns_the_prescribed_ship_at_that_rate():
         env.close()
 
 
-def test_course_action_turns_at_the_yaw_limit_then_holds_the_course():
-    """control="course": the autopilot turns at max_yaw_rate (0.04 rad/s,
-    0.08 rad a 2 s step) towards action × max_course and, once within a
-    step's turn, reaches it exactly and holds it; a course across ±π
-    turns the short way."""
+def test_course_action_is_followed_with_the_autopilots_time_constant():
+    """control="course": the autopilot turns at (course − heading) /
+    course_time (20 s), so over 2 s steps the heading error shrinks by
+    1 − 2/20 a step: after k steps of a full course (π/4 = 45°, within the
+    yaw limit: 0.785 rad / 20 s < 0.04 rad/s) the heading is
+    π/4 (1 − 0.9^k). Larger errors turn at max_yaw_rate, the short way
+    round; a course_time below the control interval counts as the
+    interval."""
     env = gym.make(NAV, concentration=0.01, control="course")
     try:
         env.reset(seed=0)
@@ -91,19 +94,24 @@ def test_course_action_turns_at_the_yaw_limit_then_holds_the_course():
         for _ in range(12):
             env.step(np.array([1.0], np.float32))
             headings.append(ship.heading)
-        # 9 full-rate steps reach 0.72 rad; the tenth closes the last 0.065 rad
-        np.testing.assert_allclose(headings[:9], 0.08 * np.arange(1, 10), rtol=1e-9)
-        np.testing.assert_allclose(headings[9:], math.pi / 4, rtol=1e-9)
+        np.testing.assert_allclose(headings, math.pi / 4 * (1.0 - 0.9 ** np.arange(1, 13)),
+                                   rtol=1e-9)
         assert ship.surge == pytest.approx(2.0, rel=1e-9)
-        env.step(np.array([-0.5], np.float32))                 # back towards −π/8
-        assert ship.heading == pytest.approx(math.pi / 4 - 0.08, rel=1e-9)
         u = env.unwrapped
         # heading 3 rad, course −0.9 π/4 = −0.71 rad: the short way is anticlockwise,
         # through π (an error of 2π − 3.71 = +2.58 rad), at the full rate
         assert u.course_yaw_rate(-0.9, 3.0) == pytest.approx(0.04)
-        assert u.course_yaw_rate(0.0, 0.05) == pytest.approx(-0.025, rel=1e-12)
+        assert u.course_yaw_rate(0.0, 0.05) == pytest.approx(-0.0025, rel=1e-12)
     finally:
         env.close()
+    env = gym.make(NAV, concentration=0.01, control="course", course_time=0.5)
+    try:
+        env.reset(seed=0)
+        assert env.unwrapped.course_yaw_rate(0.0, 0.05) == pytest.approx(-0.025, rel=1e-12)
+    finally:
+        env.close()
+    with pytest.raises(ValueError, match="course_time"):
+        gym.make(NAV, control="course", course_time=0.0)
 
 
 @pytest.mark.parametrize("planner", ["reactive", "lattice"])
