@@ -75,8 +75,9 @@ def test_an_agent_is_evaluated_with_its_own_control():
 
     from agents.rollouts import evaluate
 
+    # the task's course_time of 2 s (one step) makes the autopilot turn at its full rate
     env = gym.make("iceenvs/ShipNavigation-v0", concentration=0.01, goal_distance=200.0,
-                   length=500.0)
+                   length=500.0, course_time=2.0)
     try:
         runs = evaluate(env, {"course": _FullCourse()}, episodes=1, seed=0, progress=False)
         assert env.unwrapped.control == "yaw"
