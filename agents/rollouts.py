@@ -37,7 +37,11 @@ def run_agent_kwargs(run_dir: str | Path) -> dict:
     """The :data:`AGENT_KWARGS` a run of :mod:`agents.train` was trained
     with (from its ``hyperparams.yaml``; empty when it kept the defaults)."""
     with open(Path(run_dir) / "hyperparams.yaml") as fh:
-        env_kwargs = yaml.safe_load(fh).get("env_kwargs") or {}
+        return _agent_part(yaml.safe_load(fh).get("env_kwargs") or {})
+
+
+def _agent_part(env_kwargs: dict) -> dict:
+    """The :data:`AGENT_KWARGS` among ``env_kwargs``."""
     return {k: v for k, v in env_kwargs.items() if k in AGENT_KWARGS}
 
 
@@ -87,7 +91,7 @@ class TrainedPolicy:
         self.env_id = self.args["env"]
         self.env_kwargs = self.hyperparams.get("env_kwargs") or {}
         #: the run's :data:`AGENT_KWARGS`, with which it is evaluated
-        self.agent_kwargs = {k: v for k, v in self.env_kwargs.items() if k in AGENT_KWARGS}
+        self.agent_kwargs = _agent_part(self.env_kwargs)
         self.model = algo_class(self.args["algo"]).load(model, device="cpu")
         self.normalization = load_normalization(stats, self.env_id, self.env_kwargs)
 
