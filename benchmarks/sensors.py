@@ -19,18 +19,18 @@ TITLE = "Ship sensors"
 DESCRIPTION = """
 Wall time of one call of each sensor of the ship environments, on the ice
 field of `iceenvs/ShipNavigation-v1` at each concentration (seeded), with
-the ship after 60 steps of the straight line (120 m, its bow in the ice):
-the sector lidar (`ice_lidar`, v1's 15 sectors over
-the half-disc ahead, 250 m), the swath sensor (`ice_swath`, v1's 9 courses
-over ±40°, bands 0-100 m and 100-250 m, weighted by the floes' expected
-impulses) and the egocentric image (`occupancy_image`, 64 × 64 pixels of
-150 m). Each is called through its public function, with its argument
-checks, and timed as the best of five loops of `--calls` calls after a
-warm-up loop (compilation excluded; the kernels are serial). Beside them,
-the mean wall time of the next 30 environment steps (a zero action) of the
-same field, and each sensor's share of it (the vector
-observation of v1 computes the lidar and the swath once a step, the image
-only with `obs_type="image"` or `"dict"`).
+the ship after 60 steps of the straight line (120 m, its bow in the ice),
+each called as the environment calls it: the sector lidar (the compiled
+`lidar_scan` of `ice_lidar`, v1's 15 sectors over the half-disc ahead,
+250 m), the swath sensor (the compiled `swath_scan` of `ice_swath`, v1's 9
+courses over ±40°, bands 0-100 m and 100-250 m, weighted by the floes'
+expected impulses) and the egocentric image (`occupancy_image`, 64 × 64
+pixels of 150 m, with its argument checks). Each is timed as the best of
+five loops of `--calls` calls after a warm-up loop (compilation excluded;
+the kernels are serial). Beside them, the mean wall time of the next 30
+environment steps (a zero action) of the same field, and the lidar's and
+the swath's share of it: v1's vector observation computes both once a
+step, the image only with `obs_type="image"` or `"dict"`.
 """
 
 #: sizes of ``--quick``
@@ -79,26 +79,27 @@ def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int
 
 def _sensor_calls(u) -> dict:
     """{name: call} of each sensor of the ship environment ``u`` (unwrapped)
-    on its present state, with v1's settings."""
-    from iceenvs.ship_sensors import ice_lidar, ice_swath, occupancy_image
+    on its present state, with v1's settings, called as the environment
+    calls it."""
+    from iceenvs.ship_sensors import lidar_scan, occupancy_image, swath_scan
 
     sim = u.sim
     ship = sim.ship
-    xy, heading = np.array(ship.position, dtype=float), float(ship.heading)
+    x, y = (float(v) for v in ship.position)
+    heading = float(ship.heading)
     hull = np.array(ship.vertices, dtype=float)
-    lengths, periodic = (sim.box.lx, sim.box.ly), tuple(sim.box.periodic)
+    box = sim.box
+    lx, ly, (px, py) = float(box.lx), float(box.ly), box.periodic
     pos, radii = sim.positions, sim.radii
     return {
-        "lidar": lambda: ice_lidar(xy, heading, pos, radii, sectors=u.lidar_sectors,
-                                   fov=math.pi, max_range=u.lidar_range, box_lengths=lengths,
-                                   periodic=periodic),
-        "swath": lambda: ice_swath(xy, heading, pos, radii, u._swath_weights,
-                                   rays=u.swath_rays, fan=u.swath_fan,
-                                   half_beam=0.5 * u._ship.hull.beam, bands=u.swath_bands,
-                                   box_lengths=lengths, periodic=periodic),
-        "image": lambda: occupancy_image(xy, heading, pos, radii, hull, u.goal_x,
+        "lidar": lambda: lidar_scan(x, y, heading, pos, radii, u.lidar_sectors, math.pi,
+                                    u.lidar_range, lx, ly, px, py),
+        "swath": lambda: swath_scan(x, y, heading, pos, radii, u._swath_weights, u.swath_rays,
+                                    u.swath_fan, 0.5 * u._ship.hull.beam, u.swath_bands, lx, ly,
+                                    px, py),
+        "image": lambda: occupancy_image((x, y), heading, pos, radii, hull, u.goal_x,
                                          size=u.image_size, extent=u.image_extent,
-                                         box_lengths=lengths, periodic=periodic),
+                                         box_lengths=(lx, ly), periodic=(px, py)),
     }
 
 
