@@ -106,7 +106,7 @@ def _sensor_calls(u) -> dict:
 def sensors_table(rows: list[dict]) -> dict:
     """The table of a :func:`bench_sensors` result."""
     return harness.table(
-        "Ship sensors on ShipNavigation-v1's fields, one call",
+        "Ship sensors on the fields of ShipNavigation-v1, one call",
         ["A", "floes", "lidar [µs]", "swath [µs]", "image [µs]", "env step [ms]",
          "lidar + swath / step"],
         [[r["concentration"], r["floes"], r["lidar"] * 1e6, r["swath"] * 1e6,

@@ -29,6 +29,7 @@ EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0",
                                         "iceenvs/WindDrift-v0"},
                "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"},
+               "benchmarks/sensors.py": {"iceenvs/ShipNavigation-v1"},
                "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 
 
