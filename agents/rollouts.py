@@ -253,9 +253,10 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
             processes, mp_context=multiprocessing.get_context(method)) as pool, \
             tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
                  disable=not progress) as bar:
-        jobs = {pool.submit(_worker_episode, env_id, {**env_kwargs, **(
-                    run_agent_kwargs(recipe[1]) if recipe[0] == "trained" else {})},
-                    seed, name, recipe, seed + k):
+        kwargs = {name: {**env_kwargs, **(run_agent_kwargs(recipe[1])
+                                          if recipe[0] == "trained" else {})}
+                  for name, recipe in recipes.items()}
+        jobs = {pool.submit(_worker_episode, env_id, kwargs[name], seed, name, recipe, seed + k):
                 (name, k) for name, recipe in recipes.items() for k in range(episodes)}
         for job in concurrent.futures.as_completed(jobs):
             name, k = jobs[job]
