@@ -22,10 +22,11 @@ field of `iceenvs/ShipNavigation-v1` at each concentration (seeded), with
 the ship after 60 steps of the straight line (120 m, its bow in the ice),
 each called as the environment calls it: the sector lidar (the compiled
 `lidar_scan` of `ice_lidar`, v1's 15 sectors over the half-disc ahead,
-250 m), the swath sensor (the compiled `swath_scan` of `ice_swath`, v1's 9
-courses over ±40°, bands 0-100 m and 100-250 m, weighted by the floes'
-expected impulses) and the egocentric image (`occupancy_image`, 64 × 64
-pixels of 150 m, with its argument checks). Each is timed as the best of
+250 m), the swath sensor (v1's measurement of it, the compiled
+`swath_scan` of `ice_swath`: 9 courses over ±40°, bands 0-100 m and
+100-250 m, weighted by the floes' expected impulses) and the egocentric
+image (the environment's `occupancy_image`, 64 × 64 pixels of 150 m, with
+its argument checks). Each is timed as the best of
 five loops of `--calls` calls after a warm-up loop (compilation excluded;
 the kernels are serial). Beside them, the mean wall time of the next 30
 environment steps (a zero action) of the same field, and the lidar's and
@@ -79,27 +80,21 @@ def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int
 
 def _sensor_calls(u) -> dict:
     """{name: call} of each sensor of the ship environment ``u`` (unwrapped)
-    on its present state, with v1's settings, called as the environment
-    calls it."""
-    from iceenvs.ship_sensors import lidar_scan, occupancy_image, swath_scan
+    on its present state: the swath and the image through the
+    environment's own methods, the lidar, which the environment calls
+    inside its compiled measurements, with the arguments they pass."""
+    from iceenvs.ship_sensors import lidar_scan
 
     sim = u.sim
     ship = sim.ship
     x, y = (float(v) for v in ship.position)
-    heading = float(ship.heading)
-    hull = np.array(ship.vertices, dtype=float)
     box = sim.box
-    lx, ly, (px, py) = float(box.lx), float(box.ly), box.periodic
-    pos, radii = sim.positions, sim.radii
     return {
-        "lidar": lambda: lidar_scan(x, y, heading, pos, radii, u.lidar_sectors, math.pi,
-                                    u.lidar_range, lx, ly, px, py),
-        "swath": lambda: swath_scan(x, y, heading, pos, radii, u._swath_weights, u.swath_rays,
-                                    u.swath_fan, 0.5 * u._ship.hull.beam, u.swath_bands, lx, ly,
-                                    px, py),
-        "image": lambda: occupancy_image((x, y), heading, pos, radii, hull, u.goal_x,
-                                         size=u.image_size, extent=u.image_extent,
-                                         box_lengths=(lx, ly), periodic=(px, py)),
+        "lidar": lambda: lidar_scan(x, y, float(ship.heading), sim.positions, sim.radii,
+                                    u.lidar_sectors, math.pi, u.lidar_range, float(box.lx),
+                                    float(box.ly), box.periodic[0], box.periodic[1]),
+        "swath": lambda: u._extra_measures([u]),
+        "image": u._image,
     }
 
 
