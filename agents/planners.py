@@ -1,20 +1,23 @@
 """Route planners of the ship environments that read the ice (privileged).
 
-Three planner baselines steer the ship environments
-(``iceenvs/ShipNavigation-v0``, ``-v1`` and ``iceenvs/ShipBeset-v0``):
+Four planner baselines steer the ship environments
+(``iceenvs/ShipNavigation-v0``, ``-v1`` and ``iceenvs/ShipBeset-v0``;
+``swath`` only v1, which has the swath sensor):
 
 ==============  ==========================================================  ================
 name            planner                                                     reads
 ==============  ==========================================================  ================
 ``straight``    full speed straight for the goal line                       the observation
 ``reactive``    steer for the least obstructed sector of the ice lidar      the observation
+``swath``       steer for the swath sensor's course of least ice plus       the observation
+                the price of its extra length (greedy, every step)
 ``lattice``     :class:`LatticePlanner`: the cheapest route over a state    the floes within
                 lattice with the ship's turning limit, the ice costed by     its sensor range
                 the collision impulse it would take, replanned every few
                 steps and followed by pure pursuit
 ==============  ==========================================================  ================
 
-The first two are the environments' own controllers
+The first three are the environments' own controllers
 (:mod:`iceenvs.ship_controllers`). The lattice planner follows the
 lattice planner of AUTO-IceNav (de Schaetzen et al., IEEE Transactions on
 Robotics, 2025) in its parts: a lattice of motion primitives the ship can
@@ -231,12 +234,8 @@ class LatticePlanner(StraightLinePolicy):
             if not (math.isfinite(getattr(self, name)) and getattr(self, name) > 0):
                 raise ValueError(f"{name} must be a positive number, got {getattr(self, name)!r}")
         if metre_cost is None:
-            p = u.reward_params
-            metre_cost = DEFAULT_METRE_COST     # a reward without both terms
-            if p.get("impulse_weight", 0.0) > 0 and p.get("time_weight", 0.0) > 0 \
-                    and "impulse_scale" in p:
-                metre_cost = (p["impulse_scale"] * p["time_weight"]
-                              / (p["impulse_weight"] * u.max_speed * u.control_interval))
+            # the reward's own trade-off, or the default for a reward without both terms
+            metre_cost = u.metre_cost or DEFAULT_METRE_COST
         if not (math.isfinite(metre_cost) and metre_cost > 0):
             raise ValueError(f"metre_cost must be a positive number, got {metre_cost!r}")
         self.metre_cost = float(metre_cost)

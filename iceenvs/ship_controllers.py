@@ -1,6 +1,8 @@
-"""Controllers of the ship environments: the straight line to the goal and
-a reactive planner on the ice lidar (``"straight"`` and ``"reactive"`` in
-the facts of :mod:`iceenvs.ship_navigation` and :mod:`iceenvs.ship_beset`).
+"""Controllers of the ship environments: the straight line to the goal, a
+reactive planner on the ice lidar (``"straight"`` and ``"reactive"`` in
+the facts of :mod:`iceenvs.ship_navigation` and :mod:`iceenvs.ship_beset`)
+and a greedy planner on the swath sensor (``"swath"`` in the facts of
+:mod:`iceenvs.ship_navigation_v1`). All three read only the observation.
 """
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ import numpy as np
 
 from .controllers import Controller
 
-__all__ = ["StraightLinePolicy", "ReactivePlanner"]
+__all__ = ["StraightLinePolicy", "ReactivePlanner", "SwathPlanner"]
 
 
 class StraightLinePolicy(Controller):
@@ -115,3 +117,87 @@ class ReactivePlanner(StraightLinePolicy):
         best = float(theta[int(np.argmax(score))])
         return self._steer(float(np.clip(best, goal - self.max_off_goal,
                                          goal + self.max_off_goal)), get)
+
+
+class SwathPlanner(StraightLinePolicy):
+    """Steer for the course of the swath sensor that costs least: a greedy
+    planner on the observation (ShipNavigation-v1).
+
+    The swath sensor (:func:`iceenvs.ship_sensors.ice_swath`) gives, for
+    each course k of its fan, the expected collision impulse S_k [N s] of
+    the floes the hull's swath along it would meet, per band of distance
+    ahead. Every step the planner scores each course
+
+        S_near + ``far_weight`` S_far + c (L / cos φ_k − L)
+
+    with φ_k the course's angle from the goal direction, L the sensor's
+    reach and c the impulse one metre sailed is worth in the reward
+    (:attr:`iceenvs.ship_env.ShipEnv.metre_cost`, 12 500 N s/m in v1; the
+    lattice planner's too): the ice the course meets plus the price of its extra
+    length over the reach. The far band counts ``far_weight`` (1/2) of
+    its ice: the course will likely change before the ship is there. A
+    course that would take the centroid closer than ``margin`` (15 m) to
+    the channel's edge within ``lookahead`` (150 m) pays 10⁹ N s per metre
+    beyond that line, so the planner keeps to the channel when it can and
+    otherwise turns back the most. The ship then steers for the best
+    course with the autopilot of ``control="course"``
+    (:meth:`iceenvs.ship_env.ShipEnv.course_yaw_rate`: the heading error
+    over `course_time`, 20 s), commanding its yaw rate under
+    ``control="yaw"``, so that it sails the same path with either action
+    (the thrust controls steer for it as :class:`StraightLinePolicy` steers
+    for the goal). Turned faster, the hull would sweep its sides through
+    the ice.
+
+    It is greedy (the courses are straight, and the best one is chosen
+    again every step), reads nothing but the observation, and costs a few
+    tens of microseconds a decision: a baseline a policy of the same
+    observation should reach.
+    """
+
+    far_weight = 0.5
+    margin = 15.0
+    lookahead = 150.0
+    #: cost [N s] per metre of the centroid beyond the channel line
+    outside_cost = 1.0e9
+
+    def __init__(self, env, seed: int = 0):
+        super().__init__(env, seed)
+        u = self.unwrapped
+        if not getattr(u, "swath_rays", 0):
+            raise ValueError(f"{type(self).__name__} reads the swath sensor, which "
+                             f"{type(u).__name__} does not have (swath_rays=0 or none)")
+        rays, fan = u.swath_rays, u.swath_fan
+        self._angles = -0.5 * fan + (np.arange(rays) + 0.5) * fan / rays
+        self._bands = [[f"swath_{b}_{k}" for k in range(rays)]
+                       for b in range(len(u.swath_bands) - 1)]
+        self._reach = float(u.swath_bands[-1])
+
+    @property
+    def metre_cost(self) -> float:
+        """The impulse [N s] one metre sailed is worth in the reward
+        (:attr:`iceenvs.ship_env.ShipEnv.metre_cost`; 0 for a reward
+        without both terms, which then counts only the ice)."""
+        return self.unwrapped.metre_cost or 0.0
+
+    def act(self, obs):
+        u = self.unwrapped
+        get = self._reader(obs)
+        now = u.last_measurement
+        goal = self._bearing(get)
+        # the courses as bearings in the ship frame, and as angles from the goal direction
+        bearing = self._angles + (goal if u.swath_frame == "goal" else 0.0)
+        off = np.clip(bearing - goal, -1.4, 1.4)
+        ice = sum((1.0 if b == 0 else self.far_weight) * np.array([now[n] for n in names])
+                  for b, names in enumerate(self._bands))
+        detour = self._reach * (1.0 / np.cos(off) - 1.0)
+        half = 0.5 * u.channel_width
+        lateral = get("channel_offset") * half + self.lookahead * np.sin(off)
+        beyond = np.maximum(np.abs(lateral) - (half - self.margin), 0.0)
+        score = ice + self.metre_cost * detour + self.outside_cost * beyond
+        best = float(bearing[int(np.argmin(score))])
+        if u.control == "yaw":
+            # the yaw rate the course autopilot would command: the same path with either action
+            e = u.episode
+            rate = u.course_yaw_rate((best - goal) / e["max_course"], -goal)
+            return np.array([rate / e["max_yaw_rate"]])
+        return self._steer(best, get)

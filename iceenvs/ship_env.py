@@ -510,6 +510,21 @@ class ShipEnv(HertzEnv):
                 "radii": sim.radii[near].copy(), "masses": sim.masses[near].copy(),
                 "index": near}
 
+    @property
+    def metre_cost(self) -> float | None:
+        """The ice impulse [N s] that one metre sailed is worth in the
+        reward: it charges `time_weight` a step of `max_speed` ×
+        `control_interval` metres and `impulse_weight` / `impulse_scale`
+        per N s, so a metre is worth impulse_scale · time_weight /
+        (impulse_weight · max_speed · control_interval). None for a reward
+        without both terms."""
+        p = self.reward_params
+        if p.get("impulse_weight", 0.0) > 0 and p.get("time_weight", 0.0) > 0 \
+                and "impulse_scale" in p:
+            return (p["impulse_scale"] * p["time_weight"]
+                    / (p["impulse_weight"] * self.max_speed * self.control_interval))
+        return None
+
     def expected_impulses(self, masses) -> np.ndarray:
         """The impulse [N s] each floe of ``masses`` [kg] is expected to take
         from the hull: that of a head-on collision at the ship's full speed

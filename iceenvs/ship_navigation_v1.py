@@ -14,13 +14,14 @@ from physics.ship import TransitBox
 
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
+from .ship_controllers import SwathPlanner
 from .ship_env import CONTROLS, ship_features
 from .ship_sensors import check_bands, swath_scan
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
 __all__ = ["ShipNavigationV1Env", "ShipNavigationV1VectorEnv", "MAX_EPISODE_STEPS",
-           "FIELD_SIZES", "ICE_AHEAD", "swath_features"]
+           "FIELD_SIZES", "ICE_AHEAD", "SWATH_FRAMES", "swath_features"]
 
 #: two straight transits of the default field (275 steps each)
 MAX_EPISODE_STEPS = 550
@@ -38,13 +39,20 @@ ICE_AHEAD = 100.0
 SWATH_BANDS = (0.0, 100.0, 250.0)
 
 
-def swath_features(rays: int, bands=SWATH_BANDS) -> tuple[Feature, ...]:
+#: the directions the swath sensor's fan can be centred on: name → what about
+SWATH_FRAMES = {"heading": "the ship's heading", "goal": "the goal direction (+x)"}
+
+
+def swath_features(rays: int, bands=SWATH_BANDS, frame: str = "heading") -> tuple[Feature, ...]:
     """The observation entries of the swath sensor
-    (:func:`iceenvs.ship_sensors.ice_swath`) of ``rays`` courses, band by
-    band, course by course."""
+    (:func:`iceenvs.ship_sensors.ice_swath`) of ``rays`` courses fanned
+    about the direction ``frame`` (:data:`SWATH_FRAMES`), band by band,
+    course by course."""
+    about = SWATH_FRAMES[frame]
     return tuple(
-        Feature(f"swath_{b}_{k}", f"course {k}: expected impulse of the floes its swath meets "
-                f"{bands[b]:g}-{bands[b + 1]:g} m ahead", "N s", "log impulse", 0.0, 6.0)
+        Feature(f"swath_{b}_{k}", f"course {k} (of a fan about {about}): expected impulse of "
+                f"the floes its swath meets {bands[b]:g}-{bands[b + 1]:g} m ahead", "N s",
+                "log impulse", 0.0, 6.0)
         for b in range(len(bands) - 1) for k in range(rays))
 
 
@@ -170,7 +178,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     impulse (:meth:`ShipEnv.expected_impulses`) of the floes the hull's
     swath along each would meet, 0-100 m and 100-250 m ahead of the ship.
     It weighs the floes by the impulse the lattice planner costs them at.
-    `swath_rays=0` leaves it out.
+    `swath_frame="goal"` fans the courses about the goal direction (+x)
+    instead, so that course k of the sensor is one course a policy can
+    command with `control="course"`, whatever the heading. `swath_rays=0`
+    leaves it out.
 
 {feature_table(_FEATURES)}
 
@@ -206,7 +217,9 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     `channel_width=200.0`, `goal_distance=1100.0` [m], `lidar_sectors=15`
     and `lidar_range=250.0` [m]; and the swath sensor's `swath_rays=9`
     (0: none), `swath_fan=π/2` [rad] (the angle from the first course to
-    the last is fan × (rays − 1) / rays) and `swath_bands=(0, 100, 250)` [m].
+    the last is fan × (rays − 1) / rays), `swath_bands=(0, 100, 250)` [m]
+    and `swath_frame="heading"` (the fan's centre: `"heading"` or
+    `"goal"`).
 
     ## Version History
     * v1: a field comparable to AUTO-IceNav's (v0 stays registered,
@@ -218,17 +231,24 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     facts = replace(ShipNavigationEnv.facts,
                     summary="cross a kilometre of pack ice (AUTO-IceNav's fields)",
                     small={"concentration": 0.2, "length": 450.0, "goal_distance": 300.0},
-                    speed_target=50)
+                    speed_target=50,
+                    controllers={**ShipNavigationEnv.facts.controllers, "swath": SwathPlanner})
 
     def __init__(self, *, length: float = 1500.0, width: float = 200.0,
                  channel_width: float = 200.0, goal_distance: float = 1100.0,
                  lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,
-                 swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS, **kwargs):
+                 swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS,
+                 swath_frame: str = "heading", **kwargs):
         self.swath_rays = _integer(0, 64)("swath_rays", swath_rays)
         check_range("swath_fan", swath_fan, 0.0, math.pi, low_open=True)
         self.swath_fan = float(swath_fan)
         self.swath_bands = bands = check_bands("swath_bands", swath_bands)
-        self.extra_features = swath_features(self.swath_rays, tuple(bands.tolist()))
+        if swath_frame not in SWATH_FRAMES:
+            raise ValueError(f"swath_frame must be one of {sorted(SWATH_FRAMES)}, "
+                             f"got {swath_frame!r}")
+        self.swath_frame = swath_frame
+        self.extra_features = swath_features(self.swath_rays, tuple(bands.tolist()),
+                                             swath_frame)
         self.extra_measures = tuple(f.name for f in self.extra_features)
         super().__init__(length=length, width=width, channel_width=channel_width,
                          goal_distance=goal_distance, lidar_sectors=lidar_sectors,
@@ -251,7 +271,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             ship = sim.ship
             x, y = (float(v) for v in ship.position)
             box = sim.box
-            sums = swath_scan(x, y, float(ship.heading), sim.positions, sim.radii,
+            about = float(ship.heading) if self.swath_frame == "heading" else 0.0
+            sums = swath_scan(x, y, about, sim.positions, sim.radii,
                               env._swath_weights, self.swath_rays, self.swath_fan,
                               0.5 * env._ship.hull.beam, self.swath_bands, float(box.lx),
                               float(box.ly), box.periodic[0], box.periodic[1])

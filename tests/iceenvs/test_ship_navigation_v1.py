@@ -228,7 +228,112 @@ def test_swath_sensor_options():
             gym.make(V1, **kwargs)
 
 
-# -- the lattice planner ----------------------------------------------------------------------
+def test_swath_frame_centres_the_fan_on_the_heading_or_the_goal_direction():
+    """With the hull turned 0.3 rad off the goal direction, the sensor's
+    sums are those of :func:`iceenvs.ship_sensors.ice_swath` about the
+    heading (``swath_frame="heading"``) or about +x (``"goal"``), from the
+    same snapshot; the two differ."""
+    from iceenvs.ship_sensors import ice_swath
+
+    sums = {}
+    for frame in ("heading", "goal"):
+        env = gym.make(V1, concentration=0.3, swath_frame=frame, control="course").unwrapped
+        env.reset(seed=3)
+        for _ in range(25):
+            env.step(np.array([0.3 / env.episode["max_course"]]))
+        ship = env.sim.ship
+        assert 0.25 < float(ship.heading) < 0.3      # 0.3 (1 - 0.9^25) = 0.278
+        about = float(ship.heading) if frame == "heading" else 0.0
+        want = ice_swath(ship.position, about, env.sim.positions, env.sim.radii,
+                         env._swath_weights, rays=env.swath_rays, fan=env.swath_fan,
+                         half_beam=0.5 * env.ship.hull.beam, bands=env.swath_bands,
+                         box_lengths=(env.sim.box.lx, env.sim.box.ly),
+                         periodic=env.sim.box.periodic)
+        sums[frame] = got = env._extra_measures([env])[0]
+        np.testing.assert_allclose(got, np.asarray(want).T.ravel(), rtol=1e-12, atol=1e-9)
+        about = "the goal" if frame == "goal" else "the ship"
+        assert all(f"fan about {about}" in f.meaning
+                   for f in env.features if f.name.startswith("swath"))
+    assert not np.allclose(sums["heading"], sums["goal"])
+    with pytest.raises(ValueError, match="swath_frame"):
+        gym.make(V1, swath_frame="stern")
+
+
+# -- the planners -----------------------------------------------------------------------------
+
+def test_metre_cost_is_the_rewards_trade_off():
+    """v1 charges 0.2 a step of 2 m/s × 2 s and 1 per 2.5·10⁵ N s: a metre
+    is worth 2.5·10⁵ × 0.2 / 4 = 12 500 N s; a reward without the time
+    term prices no metre."""
+    env = gym.make(V1)
+    assert env.unwrapped.metre_cost == pytest.approx(12_500.0, rel=1e-12)
+    env.close()
+    env = gym.make(V1, reward_params={"time_weight": 0.0})
+    assert env.unwrapped.metre_cost is None
+    env.close()
+
+
+@pytest.mark.parametrize("frame", ["heading", "goal"])
+def test_swath_planner_beats_the_straight_line_on_fixed_fields(frame):
+    """On 3 fixed fields at A = 0.3 (400 m of ice), the swath planner,
+    reading only the observation, meets less ice impulse per metre than
+    the straight line on every field, sailing at most 5 % further, and
+    reaches the goal; either frame of the sensor gives it the same
+    courses to choose from."""
+    from agents.baselines import make_baseline
+    from agents.rollouts import run_episode
+
+    env = gym.make(V1, concentration=0.3, goal_distance=500.0, length=900.0, control="course",
+                   swath_frame=frame)
+    try:
+        straight = make_baseline("straight", env)
+        swath = make_baseline("swath", env)
+        for seed in (0, 1, 2):
+            s = run_episode(env, straight, seed, None)["final"]
+            p = run_episode(env, swath, seed, None)["final"]
+            assert p["success"] and s["success"]
+            assert p["impulse_per_metre"] < s["impulse_per_metre"], (seed, p, s)
+            assert p["path_length"] <= 1.05 * s["path_length"]
+    finally:
+        env.close()
+
+
+def test_swath_planner_commands_the_same_turn_with_either_action():
+    """Under ``control="yaw"`` the planner commands the yaw rate that the
+    course autopilot would turn at for the course it picks under
+    ``control="course"``, from the same state: both environments sail the
+    straight line (action 0 in either) until the planner would turn."""
+    from iceenvs.ship_controllers import SwathPlanner
+
+    envs = {c: gym.make(V1, concentration=0.4, control=c) for c in ("yaw", "course")}
+    obs = {c: env.reset(seed=2)[0] for c, env in envs.items()}
+    planners = {c: SwathPlanner(env) for c, env in envs.items()}
+    try:
+        for _ in range(100):
+            rates = {}
+            for c, env in envs.items():
+                u, action = env.unwrapped, planners[c].act(obs[c])
+                rates[c] = (action[0] * u.episode["max_yaw_rate"] if c == "yaw" else
+                            u.course_yaw_rate(float(action[0]), float(u.sim.ship.heading)))
+            assert rates["yaw"] == pytest.approx(rates["course"], rel=1e-9, abs=1e-12)
+            if rates["yaw"] != 0.0:
+                break
+            obs = {c: env.step(np.zeros(1, dtype=np.float32))[0] for c, env in envs.items()}
+        assert rates["yaw"] != 0.0                  # the planner did turn
+    finally:
+        for env in envs.values():
+            env.close()
+
+
+def test_swath_planner_needs_the_swath_sensor():
+    from iceenvs.ship_controllers import SwathPlanner
+
+    for env_id, kwargs in ((V1, dict(swath_rays=0)), ("iceenvs/ShipNavigation-v0", {})):
+        env = gym.make(env_id, **kwargs)
+        with pytest.raises(ValueError, match="swath sensor"):
+            SwathPlanner(env)
+        env.close()
+
 
 def test_lattice_planner_beats_the_straight_line_on_fixed_fields():
     """On 3 fixed fields at A = 0.3 (400 m of ice), the lattice planner meets
