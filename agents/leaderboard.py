@@ -18,7 +18,7 @@ metre and return against concentration)::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
-        [--policies straight,reactive,lattice] [--trained NAME=RUN_DIR[@STEPS] ...]
+        [--policies NAMES] [--trained NAME=RUN_DIR[@STEPS] ...]
         [--merge [--replace NAMES]]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
@@ -243,6 +243,16 @@ def plot_board(report: dict, path: Path) -> None:
     plt.close(fig)
 
 
+def default_policies(env_id: str) -> list[str]:
+    """The baselines a leaderboard of ``env_id`` runs by default: the
+    straight line, the environment's other controllers and the planners
+    of :mod:`agents.planners` (not the generic ones, nor ``heuristic``,
+    another name of ``reactive``)."""
+    from .baselines import GENERIC, baseline_names
+
+    return [n for n in baseline_names(env_id) if n not in GENERIC and n != "heuristic"]
+
+
 def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -251,8 +261,9 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
                    help="comma-separated ice concentrations (0.2,0.3,0.4,0.5)")
     p.add_argument("--episodes", type=int, default=20, help="fields per concentration (20)")
     p.add_argument("--seed", type=int, default=10_000, help="seed of field 0 (10000)")
-    p.add_argument("--policies", default="straight,reactive,lattice",
-                   help="comma-separated baselines (straight,reactive,lattice)")
+    p.add_argument("--policies", default=None,
+                   help="comma-separated baselines (default: the environment's planners, "
+                        "such as straight,reactive,swath,lattice on ShipNavigation-v1)")
     p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR[@STEPS]",
                    help="a trained policy (agents.train's run directory; @STEPS: its checkpoint "
                         "at STEPS steps), repeatable")
@@ -326,7 +337,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     if "concentration" in env_kwargs:
         parser.error("--env-kwargs concentration: the concentrations come from --concentrations")
     valid = baseline_names(args.env)
-    policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    policies = ([p.strip() for p in args.policies.split(",") if p.strip()]
+                if args.policies is not None else default_policies(args.env))
     for name in policies:
         if name not in valid:
             parser.error(f"unknown policy {name!r} for {args.env}; valid: {', '.join(valid)}")
@@ -371,7 +383,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         env=args.env, env_kwargs=env_kwargs,
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
-        planners=[p for p in recipes if p in PLANNERS or p == "reactive"],
+        planners=[p for p in recipes if p in PLANNERS or p in default_policies(args.env)
+                  and p != "straight"],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
         date=datetime.date.today().isoformat(),
         wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0),
