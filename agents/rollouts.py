@@ -29,8 +29,10 @@ __all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
            "AGENT_KWARGS", "run_agent_kwargs"]
 
 #: environment arguments that set how an agent acts and what it sees rather
-#: than the task: a trained run is evaluated with its own
-AGENT_KWARGS = ("control", "obs_type")
+#: than the task (the action, the observation and the sensors' settings): a
+#: trained run is evaluated with its own
+AGENT_KWARGS = ("control", "obs_type", "lidar_sectors", "lidar_range", "image_size",
+                "image_extent", "swath_rays", "swath_fan", "swath_bands", "swath_frame")
 
 
 def run_agent_kwargs(run_dir: str | Path) -> dict:

@@ -92,8 +92,9 @@ def test_an_agent_is_evaluated_with_its_own_control():
 
 
 def test_a_trained_runs_control_is_read_and_reported(tmp_path):
-    """The leaderboard plays a run trained with control="course" with it and
-    says so; the same episodes as the policy played alone in such an
+    """The leaderboard plays a run trained with control="course" (and v1's
+    swath_frame="goal" of agents/hyperparams/ppo.yaml) with them and says
+    so; the same episodes as the policy played alone in such an
     environment."""
     import gymnasium as gym
 
@@ -105,18 +106,19 @@ def test_a_trained_runs_control_is_read_and_reported(tmp_path):
                 "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
                 "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32",
                 "--env-kwargs", "control=course", "goal_distance=200.0", "length=500.0"])
-    assert run_agent_kwargs(run) == {"control": "course"}
+    agent = {"control": "course", "swath_frame": "goal"}
+    assert run_agent_kwargs(run) == agent
     out = tmp_path / "board"
     report = leaderboard.main(["--concentrations", "0.2", "--episodes", "2", "--processes",
                                "1", "--out", str(out), "--policies", "straight",
                                "--trained", f"ppo={run}"] + SHORT)
-    assert report["agent_kwargs"] == {"ppo": {"control": "course"}}
+    assert report["agent_kwargs"] == {"ppo": agent}
     assert "ppo with control='course'" in (out / "leaderboard.md").read_text()
     with pytest.raises(SystemExit):            # a run of another environment is refused
         leaderboard.main(["--env", "iceenvs/ShipNavigation-v0", "--trained", f"ppo={run}",
                           "--out", str(tmp_path / "v0")])
-    env = gym.make("iceenvs/ShipNavigation-v1", concentration=0.2, control="course",
-                   goal_distance=200.0, length=500.0)
+    env = gym.make("iceenvs/ShipNavigation-v1", concentration=0.2, goal_distance=200.0,
+                   length=500.0, **agent)
     try:
         alone = [run_episode(env, TrainedPolicy(run), report["seed"] + k, None)["ret"]
                  for k in range(2)]
