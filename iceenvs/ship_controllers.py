@@ -149,9 +149,11 @@ class SwathPlanner(StraightLinePolicy):
     the ice.
 
     It is greedy (the courses are straight, and the best one is chosen
-    again every step), reads nothing but the observation, and costs a few
-    tens of microseconds a decision: a baseline a policy of the same
-    observation should reach.
+    again every step), decides on nothing but the observation, and costs a
+    few tens of microseconds a decision: a baseline a policy of the same
+    observation should reach. With ``show`` (default) the chosen course
+    and its swath are drawn on the environment's frames (placed at the
+    ship's position, read for the drawing only).
     """
 
     far_weight = 0.5
@@ -160,9 +162,11 @@ class SwathPlanner(StraightLinePolicy):
     #: cost [N s] per metre of the centroid beyond the channel line
     outside_cost = 1.0e9
 
-    def __init__(self, env, seed: int = 0):
+    def __init__(self, env, seed: int = 0, *, show: bool = True):
         super().__init__(env, seed)
         u = self.unwrapped
+        #: draw the chosen course and its swath on the environment's frames
+        self.show = bool(show)
         if not getattr(u, "swath_rays", 0):
             raise ValueError(f"{type(self).__name__} reads the swath sensor, which "
                              f"{type(u).__name__} does not have (swath_rays=0 or none)")
@@ -194,7 +198,13 @@ class SwathPlanner(StraightLinePolicy):
         lateral = get("channel_offset") * half + self.lookahead * np.sin(off)
         beyond = np.maximum(np.abs(lateral) - (half - self.margin), 0.0)
         score = ice + self.metre_cost * detour + self.outside_cost * beyond
-        best = float(bearing[int(np.argmin(score))])
+        k = int(np.argmin(score))
+        best = float(bearing[k])
+        if self.show:
+            # the chosen course over the sensor's reach, from the ship (drawing only)
+            xy = np.asarray(u.sim.ship.position, dtype=float)
+            course = np.array([math.cos(off[k]), math.sin(off[k])])
+            u.plan_overlay = (np.stack([xy, xy + self._reach * course]), 0.5 * u.ship.hull.beam)
         if u.control == "yaw":
             # the yaw rate the course autopilot would command: the same path with either action
             e = u.episode

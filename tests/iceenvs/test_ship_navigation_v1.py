@@ -320,6 +320,9 @@ def test_swath_planner_commands_the_same_turn_with_either_action():
                 break
             obs = {c: env.step(np.zeros(1, dtype=np.float32))[0] for c, env in envs.items()}
         assert rates["yaw"] != 0.0                  # the planner did turn
+        route, half = envs["yaw"].unwrapped.plan_overlay          # drawn on the frames
+        assert route.shape == (2, 2) and half == pytest.approx(9.0, rel=0.2)
+        assert np.hypot(*(route[1] - route[0])) == pytest.approx(250.0, rel=1e-12)
     finally:
         for env in envs.values():
             env.close()
