@@ -12,10 +12,16 @@ from physics.demo import (draw, draw_transit, force_chains, main, ship_transit, 
 
 def test_walls_hold_the_wind_force_once_the_pack_is_at_rest():
     sim = force_chains(60, 0.8, 20.0, seed=1)
+    # The pack settles within minutes, but when its last floe stops depends on a last
+    # rearrangement that the rounding of the machine's arithmetic can shift (after 300 s one
+    # floe still moved at 4 cm/s on one machine, none faster than 1 cm/s on another), so it
+    # is given up to 10 minutes. At rest: the fastest floe creeps at under 1 cm/s (against
+    # ~0.7 m/s of free drift at 20 m/s)
     sim.advance(300.0)
+    while sim.time < 600.0 and np.hypot(*sim.velocities.T).max() >= 0.01:
+        sim.advance(50.0)
     speed = np.hypot(*sim.velocities.T)
-    # at rest: the fastest floe creeps at 1 cm/s (against ~0.7 m/s of free drift at 20 m/s)
-    assert speed.max() < 0.02
+    assert speed.max() < 0.01
     c = sim.contacts()
     assert 2 * len(c) / sim.n_floes > 2.0           # jammed: chains, not scattered pairs
     push, back = wind_force(sim), wall_force(sim)
