@@ -261,6 +261,27 @@ def test_swath_frame_centres_the_fan_on_the_heading_or_the_goal_direction():
 
 # -- the planners -----------------------------------------------------------------------------
 
+def assert_beats_the_straight_line(name: str, **kwargs):
+    """Planner ``name`` on 3 fixed fields at A = 0.3 (400 m of ice): less ice
+    impulse per metre than the straight line on every field, at most 5 %
+    further, the goal reached. Returns the planner."""
+    from agents.baselines import make_baseline
+    from agents.rollouts import run_episode
+
+    env = gym.make(V1, concentration=0.3, goal_distance=500.0, length=900.0, **kwargs)
+    try:
+        straight, planner = make_baseline("straight", env), make_baseline(name, env)
+        for seed in (0, 1, 2):
+            s = run_episode(env, straight, seed, None)["final"]
+            p = run_episode(env, planner, seed, None)["final"]
+            assert p["success"] and s["success"]
+            assert p["impulse_per_metre"] < s["impulse_per_metre"], (seed, p, s)
+            assert p["path_length"] <= 1.05 * s["path_length"]
+    finally:
+        env.close()
+    return planner
+
+
 def test_metre_cost_is_the_rewards_trade_off():
     """v1 charges 0.2 a step of 2 m/s × 2 s and 1 per 2.5·10⁵ N s: a metre
     is worth 2.5·10⁵ × 0.2 / 4 = 12 500 N s; a reward without the time
@@ -280,22 +301,7 @@ def test_swath_planner_beats_the_straight_line_on_fixed_fields(frame):
     the straight line on every field, sailing at most 5 % further, and
     reaches the goal; either frame of the sensor gives it the same
     courses to choose from."""
-    from agents.baselines import make_baseline
-    from agents.rollouts import run_episode
-
-    env = gym.make(V1, concentration=0.3, goal_distance=500.0, length=900.0, control="course",
-                   swath_frame=frame)
-    try:
-        straight = make_baseline("straight", env)
-        swath = make_baseline("swath", env)
-        for seed in (0, 1, 2):
-            s = run_episode(env, straight, seed, None)["final"]
-            p = run_episode(env, swath, seed, None)["final"]
-            assert p["success"] and s["success"]
-            assert p["impulse_per_metre"] < s["impulse_per_metre"], (seed, p, s)
-            assert p["path_length"] <= 1.05 * s["path_length"]
-    finally:
-        env.close()
+    assert_beats_the_straight_line("swath", control="course", swath_frame=frame)
 
 
 def test_swath_planner_commands_the_same_turn_with_either_action():
@@ -342,22 +348,8 @@ def test_lattice_planner_beats_the_straight_line_on_fixed_fields():
     """On 3 fixed fields at A = 0.3 (400 m of ice), the lattice planner meets
     less ice impulse per metre than the straight line on every field,
     sailing at most 5 % further, and reaches the goal."""
-    from agents.baselines import make_baseline
-    from agents.rollouts import run_episode
-
-    env = gym.make(V1, concentration=0.3, goal_distance=500.0, length=900.0)
-    try:
-        straight = make_baseline("straight", env)
-        lattice = make_baseline("lattice", env)
-        for seed in (0, 1, 2):
-            s = run_episode(env, straight, seed, None)["final"]
-            p = run_episode(env, lattice, seed, None)["final"]
-            assert p["success"] and s["success"]
-            assert p["impulse_per_metre"] < s["impulse_per_metre"], (seed, p, s)
-            assert p["path_length"] <= 1.05 * s["path_length"]
-        assert len(lattice.decision_times) > 5
-    finally:
-        env.close()
+    lattice = assert_beats_the_straight_line("lattice")
+    assert len(lattice.decision_times) > 5
 
 
 def test_lattice_route_over_an_empty_and_a_blocked_field():
