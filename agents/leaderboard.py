@@ -370,6 +370,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
                    if name in again or name not in next(iter(old["episodes_detail"].values()))}
     agent_kwargs = {**(old or {}).get("agent_kwargs", {}), **{
         name: run_agent_kwargs(r[1]) for name, r in recipes.items() if r[0] == "trained"}}
+    planner_names = {*PLANNERS, *default_policies(args.env)}
     t0 = time.perf_counter()
     board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
                             processes=args.processes, env_kwargs=env_kwargs)
@@ -383,8 +384,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         env=args.env, env_kwargs=env_kwargs,
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
-        planners=[p for p in recipes if p in PLANNERS or p in default_policies(args.env)
-                  and p != "straight"],
+        planners=[p for p in recipes if p != "straight" and p in planner_names],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
         date=datetime.date.today().isoformat(),
         wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0),

@@ -200,6 +200,7 @@ class LatticePlanner(StraightLinePolicy):
     show : bool — draw the route and its swath on the environment's frames
     """
 
+    reads_environment = "its floes"
     stage_length = 30.0
     lateral_step = 1.5
     max_slope = 0.5
@@ -309,13 +310,6 @@ class LatticePlanner(StraightLinePolicy):
         bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
         bearing = math.atan2(math.sin(bearing), math.cos(bearing))
         return self._steer(bearing, self._reader(obs))
-
-    def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
-        vector = obs["vector"] if isinstance(obs, dict) else obs
-        if self.unwrapped.obs_type != "image" and np.ndim(vector) == 2:
-            raise ValueError("LatticePlanner steers one environment (it reads its floes); "
-                             "got a batch of observations")
-        return super().predict(obs, state, episode_start, deterministic)
 
 
 #: the planners of this module: baseline name → class ``(env, seed)``

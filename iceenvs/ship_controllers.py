@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .controllers import Controller
+from .ship_sensors import swath_courses
 
 __all__ = ["StraightLinePolicy", "ReactivePlanner", "SwathPlanner"]
 
@@ -78,10 +79,17 @@ class StraightLinePolicy(Controller):
         get = self._reader(obs)
         return self._steer(self._bearing(get), get)
 
+    #: what the policy reads of its environment beyond the observation it is
+    #: given (None: nothing): such a policy steers one environment at a time
+    reads_environment: str | None = None
+
     def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
         space = self.action_space
         vector = obs["vector"] if isinstance(obs, dict) else obs
         if self.unwrapped.obs_type != "image" and np.ndim(vector) == 2:
+            if self.reads_environment:
+                raise ValueError(f"{type(self).__name__} steers one environment (it reads "
+                                 f"{self.reads_environment}); got a batch of observations")
             if isinstance(obs, dict):
                 rows = [{"vector": v} for v in vector]
             else:
@@ -151,10 +159,15 @@ class SwathPlanner(StraightLinePolicy):
     It is greedy (the courses are straight, and the best one is chosen
     again every step), decides on nothing but the observation, and costs a
     few tens of microseconds a decision: a baseline a policy of the same
-    observation should reach. With ``show`` (default) the chosen course
-    and its swath are drawn on the environment's frames (placed at the
-    ship's position, read for the drawing only).
+    observation should reach. It reads the swath sums unscaled from the
+    environment's last measurement (the observation holds their
+    logarithms), so it steers one environment at a time. With ``show``
+    (default) the chosen course and its swath are drawn on the
+    environment's frames (placed at the ship's position, read for the
+    drawing only).
     """
+
+    reads_environment = "the unscaled swath sums of its last measurement"
 
     far_weight = 0.5
     margin = 15.0
@@ -170,8 +183,8 @@ class SwathPlanner(StraightLinePolicy):
         if not getattr(u, "swath_rays", 0):
             raise ValueError(f"{type(self).__name__} reads the swath sensor, which "
                              f"{type(u).__name__} does not have (swath_rays=0 or none)")
-        rays, fan = u.swath_rays, u.swath_fan
-        self._angles = -0.5 * fan + (np.arange(rays) + 0.5) * fan / rays
+        rays = u.swath_rays
+        self._angles = swath_courses(rays, u.swath_fan)
         self._bands = [[f"swath_{b}_{k}" for k in range(rays)]
                        for b in range(len(u.swath_bands) - 1)]
         self._reach = float(u.swath_bands[-1])

@@ -89,8 +89,8 @@ from numba import njit
 from physics.checks import check_range
 from physics.domain import minimum_image
 
-__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "check_bands", "occupancy_image",
-           "LIDAR_RINGS", "LIDAR_RAYS"]
+__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "check_bands",
+           "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
 LIDAR_RINGS = 8
@@ -382,6 +382,13 @@ def check_bands(name: str, bands) -> np.ndarray:
         raise ValueError(f"{name} must be at least two increasing finite distances [m] from 0 "
                          f"on, got {bands!r}")
     return edges
+
+
+def swath_courses(rays: int, fan: float) -> np.ndarray:
+    """The angles [rad] of the courses of :func:`ice_swath` from the centre
+    of its fan, −fan/2 + (k + 1/2) fan/rays for k = 0 … rays − 1
+    (anticlockwise; :func:`swath_scan` adds them to its ``heading``)."""
+    return -0.5 * fan + (np.arange(rays) + 0.5) * fan / rays
 
 
 @njit(cache=True, error_model="numpy")

@@ -334,6 +334,23 @@ def test_swath_planner_commands_the_same_turn_with_either_action():
             env.close()
 
 
+def test_planners_that_read_the_environment_refuse_a_batch():
+    """The swath and lattice planners read their environment beyond the
+    observation given, so a batch of observations is refused, not steered
+    with one environment's state."""
+    from agents.baselines import make_baseline
+
+    env = gym.make(V1, concentration=0.2)
+    obs, _ = env.reset(seed=0)
+    try:
+        for name, what in (("swath", "swath sums"), ("lattice", "its floes")):
+            with pytest.raises(ValueError, match=f"steers one environment.*{what}"):
+                make_baseline(name, env).predict(np.stack([obs, obs]))
+        assert make_baseline("straight", env).predict(np.stack([obs, obs]))[0].shape == (2, 1)
+    finally:
+        env.close()
+
+
 def test_swath_planner_needs_the_swath_sensor():
     from iceenvs.ship_controllers import SwathPlanner
 
