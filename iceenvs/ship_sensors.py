@@ -50,6 +50,13 @@ an exact picture the sensor's reach should stay below half the box length.
     sums tell a large floe from a few small ones: the weight grows with
     the floe's mass.
 
+:func:`channel_room`
+    What the swath's courses leave of the channel: how far the centroid
+    can sail along each before it crosses the channel's edge, capped at
+    the swath's reach. The swath sensor sees the ice of a periodic
+    channel through its images, beyond the edge as within, so a course's
+    ice alone does not tell whether the course stays in the channel.
+
 :func:`occupancy_image`
     A (4, size, size) uint8 picture of a square of side ``extent`` [m]
     around the ship, the ship at the centre and its heading up (towards
@@ -89,8 +96,8 @@ from numba import njit
 from physics.checks import check_range
 from physics.domain import minimum_image
 
-__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "check_bands",
-           "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
+__all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "channel_room",
+           "check_bands", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
 LIDAR_RINGS = 8
@@ -382,6 +389,32 @@ def check_bands(name: str, bands) -> np.ndarray:
         raise ValueError(f"{name} must be at least two increasing finite distances [m] from 0 "
                          f"on, got {bands!r}")
     return edges
+
+
+def channel_room(offset, half_width: float, bearings, reach: float) -> np.ndarray:
+    """How far [m] a centroid ``offset`` [m] to port of a channel's centre
+    line (half-width ``half_width`` [m], along +x) can sail along each of
+    ``bearings`` [rad, anticlockwise from +x] before it crosses the
+    channel's edge outward, capped at ``reach`` [m]: (h − d)/sin α to port,
+    (h + d)/(−sin α) to starboard, ``reach`` along the channel, and 0 on a
+    course that leads further out from outside the channel.
+
+    Example
+    -------
+    >>> channel_room(50.0, 100.0, [0.0, math.pi / 2, -math.pi / 6], 250.0).round(6).tolist()
+    [250.0, 50.0, 250.0]
+    """
+    check_range("offset", offset)
+    check_range("half_width", half_width, 0.0, None, low_open=True)
+    check_range("reach", reach, 0.0, None, low_open=True)
+    angles = np.asarray(bearings, dtype=float)
+    if not np.all(np.isfinite(angles)):
+        raise ValueError("bearings must be finite")
+    d, h = float(offset), float(half_width)
+    s = np.sin(angles)
+    with np.errstate(divide="ignore"):
+        room = np.where(s > 0.0, (h - d) / s, np.where(s < 0.0, (h + d) / -s, np.inf))
+    return np.clip(room, 0.0, float(reach))
 
 
 def swath_courses(rays: int, fan: float) -> np.ndarray:

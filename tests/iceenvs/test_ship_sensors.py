@@ -1,5 +1,6 @@
 """Tests of iceenvs.ship_sensors: the sector lidar, the swath sensor and the
-egocentric occupancy image against analytic geometry and against direct
+egocentric occupancy image, and the room a course leaves in the channel,
+against analytic geometry and against direct
 per-ray, per-sample and per-pixel evaluation of the documented
 conventions."""
 import math
@@ -7,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, ice_lidar, ice_swath, lidar_scan,
-                                  occupancy_image)
+from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, channel_room, ice_lidar, ice_swath,
+                                  lidar_scan, occupancy_image)
 
 TWO_PI = 2.0 * math.pi
 
@@ -447,3 +448,46 @@ def test_swath_rejects_bad_input(kwargs, name):
     with pytest.raises(ValueError, match=name):
         ice_swath(args.pop("ship_xy"), args.pop("heading"), args.pop("positions"),
                   args.pop("radii"), args.pop("weights"), **args)
+
+
+# -- room in the channel ------------------------------------------------------------------------
+
+def test_channel_room_ends_on_the_edge_and_not_before():
+    """From 200 offsets and bearings drawn in a channel of half-width 100 m,
+    the point ``room`` along the course lies on the edge (to 1e-9 m) when
+    the room is below the cap, and every point before it inside; a course
+    whose room reaches the cap stays inside for the whole cap."""
+    rng = np.random.default_rng(4)
+    h, reach = 100.0, 250.0
+    offsets = rng.uniform(-h, h, 200)
+    bearings = rng.uniform(-math.pi, math.pi, (200, 5))
+    for d, angles in zip(offsets, bearings):
+        room = channel_room(d, h, angles, reach)
+        lateral = d + np.linspace(0.0, 1.0, 51)[:, None] * room * np.sin(angles)
+        assert np.all(np.abs(lateral) <= h + 1e-9)
+        short = room < reach
+        np.testing.assert_allclose(np.abs(lateral[-1, short]), h, atol=1e-9)
+
+
+def test_channel_room_along_the_channel_and_from_outside():
+    room = channel_room(-30.0, 100.0, [0.0, math.pi, math.pi / 2, -math.pi / 2], 250.0)
+    np.testing.assert_allclose(room, [250.0, 250.0, 130.0, 70.0], rtol=1e-12)
+    # 10 m beyond the port edge: 0 further out, 210 m across the channel heading in
+    out = channel_room(110.0, 100.0, [math.pi / 2, -math.pi / 2], 500.0)
+    np.testing.assert_allclose(out, [0.0, 210.0], rtol=1e-12)
+    # the docstring's example
+    np.testing.assert_allclose(channel_room(50.0, 100.0, [0.0, math.pi / 2, -math.pi / 6], 250.0),
+                               [250.0, 50.0, 250.0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(offset=float("nan")), "offset"),
+    (dict(half_width=0.0), "half_width"),
+    (dict(reach=-1.0), "reach"),
+    (dict(bearings=[0.0, float("inf")]), "bearings"),
+])
+def test_channel_room_rejects_bad_input(kwargs, name):
+    args = dict(offset=0.0, half_width=100.0, bearings=[0.0], reach=250.0)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=name):
+        channel_room(**args)
