@@ -32,7 +32,8 @@ __all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
 #: than the task (the action, the observation and the sensors' settings): a
 #: trained run is evaluated with its own
 AGENT_KWARGS = ("control", "obs_type", "lidar_sectors", "lidar_range", "image_size",
-                "image_extent", "swath_rays", "swath_fan", "swath_bands", "swath_frame")
+                "image_extent", "swath_rays", "swath_fan", "swath_bands", "swath_frame",
+                "swath_edge")
 
 
 def run_agent_kwargs(run_dir: str | Path) -> dict:

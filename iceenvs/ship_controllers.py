@@ -147,7 +147,10 @@ class SwathPlanner(StraightLinePolicy):
     course that would take the centroid closer than ``margin`` (15 m) to
     the channel's edge within ``lookahead`` (150 m) pays 10⁹ N s per metre
     beyond that line, so the planner keeps to the channel when it can and
-    otherwise turns back the most. The ship then steers for the best
+    otherwise turns back the most. With the sensor's room in the channel
+    (v1's ``swath_edge=True``) it reads the edge from the observation's
+    rooms instead: a course that leaves the channel within ``lookahead``
+    pays 10⁹ N s per metre of it beyond the edge. The ship then steers for the best
     course with the autopilot of ``control="course"``
     (:meth:`iceenvs.ship_env.ShipEnv.course_yaw_rate`: the heading error
     over `course_time`, 20 s), commanding its yaw rate under
@@ -188,6 +191,8 @@ class SwathPlanner(StraightLinePolicy):
         self._bands = [[f"swath_{b}_{k}" for k in range(rays)]
                        for b in range(len(u.swath_bands) - 1)]
         self._reach = float(u.swath_bands[-1])
+        self._rooms = ([f"swath_room_{k}" for k in range(rays)]
+                       if getattr(u, "swath_edge", False) else [])
 
     @property
     def metre_cost(self) -> float:
@@ -207,9 +212,14 @@ class SwathPlanner(StraightLinePolicy):
         ice = sum((1.0 if b == 0 else self.far_weight) * np.array([now[n] for n in names])
                   for b, names in enumerate(self._bands))
         detour = self._reach * (1.0 / np.cos(off) - 1.0)
-        half = 0.5 * u.channel_width
-        lateral = get("channel_offset") * half + self.lookahead * np.sin(off)
-        beyond = np.maximum(np.abs(lateral) - (half - self.margin), 0.0)
+        if self._rooms:
+            # the edge as the observation shows it: the course's metres beyond it
+            room = np.array([get(name) for name in self._rooms])
+            beyond = np.maximum(self.lookahead - room, 0.0)
+        else:
+            half = 0.5 * u.channel_width
+            lateral = get("channel_offset") * half + self.lookahead * np.sin(off)
+            beyond = np.maximum(np.abs(lateral) - (half - self.margin), 0.0)
         score = ice + self.metre_cost * detour + self.outside_cost * beyond
         k = int(np.argmin(score))
         best = float(bearing[k])

@@ -16,7 +16,7 @@ from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .ship_controllers import SwathPlanner
 from .ship_env import CONTROLS, ship_features
-from .ship_sensors import check_bands, swath_scan
+from .ship_sensors import channel_room, check_bands, swath_courses, swath_scan
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
@@ -43,17 +43,26 @@ SWATH_BANDS = (0.0, 100.0, 250.0)
 SWATH_FRAMES = {"heading": "the ship's heading", "goal": "the goal direction (+x)"}
 
 
-def swath_features(rays: int, bands=SWATH_BANDS, frame: str = "heading") -> tuple[Feature, ...]:
+def swath_features(rays: int, bands=SWATH_BANDS, frame: str = "heading",
+                   edge: bool = False) -> tuple[Feature, ...]:
     """The observation entries of the swath sensor
     (:func:`iceenvs.ship_sensors.ice_swath`) of ``rays`` courses fanned
     about the direction ``frame`` (:data:`SWATH_FRAMES`), band by band,
-    course by course."""
+    course by course; with ``edge``, then each course's room in the channel
+    (:func:`iceenvs.ship_sensors.channel_room`)."""
     about = SWATH_FRAMES[frame]
-    return tuple(
+    reach = float(bands[-1])
+    sums = tuple(
         Feature(f"swath_{b}_{k}", f"course {k} (of a fan about {about}): expected impulse of "
                 f"the floes its swath meets {bands[b]:g}-{bands[b + 1]:g} m ahead", "N s",
                 "log impulse", 0.0, 6.0)
         for b in range(len(bands) - 1) for k in range(rays))
+    rooms = tuple(
+        Feature(f"swath_room_{k}", f"course {k}: how far the centroid can sail along it before "
+                f"it leaves the channel (capped at {reach:g} m)", "m", "/ 100 m", 0.0,
+                reach / 100.0)
+        for k in range(rays)) if edge else ()
+    return sums + rooms
 
 
 _FEATURES = ship_features(15, 250.0) + swath_features(9)
@@ -184,7 +193,12 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     `swath_frame="goal"` fans the courses about the goal direction (+x)
     instead, so that course k of the sensor is one course a policy can
     command with `control="course"`, whatever the heading. `swath_rays=0`
-    leaves it out.
+    leaves it out. The channel is periodic across, so the sensor sees the
+    ice beyond the edge through its images, as if it lay inside;
+    `swath_edge=True` adds, after the sums, each course's room in the
+    channel (`swath_room_k`, :func:`iceenvs.ship_sensors.channel_room`):
+    how far the centroid can sail along it before it leaves the channel,
+    capped at 250 m.
 
 {feature_table(_FEATURES)}
 
@@ -220,9 +234,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     `channel_width=200.0`, `goal_distance=1100.0` [m], `lidar_sectors=15`
     and `lidar_range=250.0` [m]; and the swath sensor's `swath_rays=9`
     (0: none), `swath_fan=π/2` [rad] (the angle from the first course to
-    the last is fan × (rays − 1) / rays), `swath_bands=(0, 100, 250)` [m]
-    and `swath_frame="heading"` (the fan's centre: `"heading"` or
-    `"goal"`).
+    the last is fan × (rays − 1) / rays), `swath_bands=(0, 100, 250)` [m],
+    `swath_frame="heading"` (the fan's centre: `"heading"` or
+    `"goal"`) and `swath_edge=False` (True: each course's room in the
+    channel joins the observation).
 
     ## Version History
     * v1: a field comparable to AUTO-IceNav's (v0 stays registered,
@@ -241,7 +256,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                  channel_width: float = 200.0, goal_distance: float = 1100.0,
                  lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,
                  swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS,
-                 swath_frame: str = "heading", **kwargs):
+                 swath_frame: str = "heading", swath_edge: bool = False, **kwargs):
         self.swath_rays = _integer(0, 64)("swath_rays", swath_rays)
         check_range("swath_fan", swath_fan, 0.0, math.pi, low_open=True)
         self.swath_fan = float(swath_fan)
@@ -250,8 +265,11 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             raise ValueError(f"swath_frame must be one of {sorted(SWATH_FRAMES)}, "
                              f"got {swath_frame!r}")
         self.swath_frame = swath_frame
+        if not isinstance(swath_edge, (bool, np.bool_)):
+            raise ValueError(f"swath_edge must be True or False, got {swath_edge!r}")
+        self.swath_edge = bool(swath_edge) and self.swath_rays > 0
         self.extra_features = swath_features(self.swath_rays, tuple(bands.tolist()),
-                                             swath_frame)
+                                             swath_frame, self.swath_edge)
         self.extra_measures = tuple(f.name for f in self.extra_features)
         super().__init__(length=length, width=width, channel_width=channel_width,
                          goal_distance=goal_distance, lidar_sectors=lidar_sectors,
@@ -265,10 +283,13 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                     time_weight=0.2)
 
     def _extra_measures(self, envs) -> np.ndarray:
-        """The swath sensor of each of ``envs``: (M, bands × rays)."""
+        """The swath sensor of each of ``envs``: (M, bands × rays), then with
+        :attr:`swath_edge` each course's room in the channel (M, rays)."""
         out = np.empty((len(envs), len(self.extra_measures)))
         if not self.swath_rays:
             return out
+        courses = swath_courses(self.swath_rays, self.swath_fan)
+        n_sums = self.swath_rays * (len(self.swath_bands) - 1)
         for k, env in enumerate(envs):
             sim = env.sim
             ship = sim.ship
@@ -279,7 +300,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                               env._swath_weights, self.swath_rays, self.swath_fan,
                               0.5 * env._ship.hull.beam, self.swath_bands, float(box.lx),
                               float(box.ly), box.periodic[0], box.periodic[1])
-            out[k] = sums.T.ravel()
+            out[k, :n_sums] = sums.T.ravel()
+            if self.swath_edge:
+                out[k, n_sums:] = channel_room(y - env.centre_y, 0.5 * env.channel_width,
+                                               about + courses, float(self.swath_bands[-1]))
         return out
 
     @staticmethod

@@ -259,6 +259,44 @@ def test_swath_frame_centres_the_fan_on_the_heading_or_the_goal_direction():
         gym.make(V1, swath_frame="stern")
 
 
+@pytest.mark.parametrize("frame", ["heading", "goal"])
+def test_swath_edge_gives_each_courses_room_in_the_channel(frame):
+    """``swath_edge=True`` adds one entry per course after the swath sums:
+    :func:`iceenvs.ship_sensors.channel_room` of the centroid's offset and
+    the course's bearing (the fan about the heading or +x), capped at the
+    sensor's reach; with the hull turned to port the port courses have
+    less room than the starboard ones. Off by default; a non-boolean is
+    refused."""
+    from iceenvs.ship_sensors import channel_room, swath_courses
+
+    env = gym.make(V1, concentration=0.3, control="course", swath_edge=True,
+                   swath_frame=frame).unwrapped
+    plain = gym.make(V1, control="course").unwrapped
+    try:
+        assert env.observation_space.shape[0] - plain.observation_space.shape[0] == 9
+        assert not any(f.name.startswith("swath_room") for f in plain.features)
+        names = [f.name for f in env.features if f.name.startswith("swath_room")]
+        assert names == [f"swath_room_{k}" for k in range(9)]
+        env.reset(seed=3)
+        for _ in range(40):
+            env.step(np.array([1.0]))
+        ship = env.sim.ship
+        x, y = (float(v) for v in ship.position)
+        assert y - env.centre_y > 20.0 and float(ship.heading) > 0.5
+        about = float(ship.heading) if frame == "heading" else 0.0
+        want = channel_room(y - env.centre_y, 0.5 * env.channel_width,
+                            about + swath_courses(9, env.swath_fan), 250.0)
+        now = env.last_measurement
+        got = np.array([now[n] for n in names])
+        np.testing.assert_allclose(got, want, rtol=1e-12)
+        assert got[-1] < got[0] and got.max() <= 250.0 and got.min() > 0.0
+    finally:
+        env.close()
+        plain.close()
+    with pytest.raises(ValueError, match="swath_edge"):
+        gym.make(V1, swath_edge="yes")
+
+
 # -- the planners -----------------------------------------------------------------------------
 
 def assert_beats_the_straight_line(name: str, **kwargs):
@@ -302,6 +340,33 @@ def test_swath_planner_beats_the_straight_line_on_fixed_fields(frame):
     reaches the goal; either frame of the sensor gives it the same
     courses to choose from."""
     assert_beats_the_straight_line("swath", control="course", swath_frame=frame)
+
+
+def test_swath_planner_reads_the_edge_from_the_rooms():
+    """With ``swath_edge=True`` the swath planner takes the channel's edge
+    from the observation: when every course but one shows no room, it
+    commands that one (course control, the fan about the goal, so the
+    action is the course's angle over ``max_course``); on 3 fixed fields it
+    still beats the straight line."""
+    from agents.baselines import make_baseline
+    from iceenvs.ship_sensors import swath_courses
+
+    env = gym.make(V1, concentration=0.3, control="course", swath_edge=True, swath_frame="goal")
+    try:
+        planner = make_baseline("swath", env)
+        obs, _ = env.reset(seed=2)
+        u = env.unwrapped
+        index = {f.name: k for k, f in enumerate(u.features)}
+        for open_course in (1, 6):
+            blocked = obs.copy()
+            for k in range(9):
+                blocked[index[f"swath_room_{k}"]] = 2.5 if k == open_course else 0.0
+            action = planner.predict(blocked)[0]
+            want = swath_courses(9, u.swath_fan)[open_course] / u.episode["max_course"]
+            assert action[0] == pytest.approx(want, rel=1e-5)
+    finally:
+        env.close()
+    assert_beats_the_straight_line("swath", control="course", swath_edge=True)
 
 
 def test_swath_planner_commands_the_same_turn_with_either_action():
