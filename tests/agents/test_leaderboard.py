@@ -93,8 +93,9 @@ def test_an_agent_is_evaluated_with_its_own_control():
 
 def test_a_trained_runs_control_is_read_and_reported(tmp_path):
     """The leaderboard plays a run trained with control="course" and the
-    swath sensor in the goal frame with them and says so; the same
-    episodes as the policy played alone in such an environment."""
+    swath sensor in the goal frame, with the courses' room in the channel,
+    with them and says so; the same episodes as the policy played alone in
+    such an environment."""
     import gymnasium as gym
 
     from agents import train
@@ -104,9 +105,9 @@ def test_a_trained_runs_control_is_read_and_reported(tmp_path):
     train.main(["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--timesteps", "64",
                 "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
                 "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32",
-                "--env-kwargs", "control=course", "swath_frame=goal", "goal_distance=200.0",
-                "length=500.0"])
-    agent = {"control": "course", "swath_frame": "goal"}
+                "--env-kwargs", "control=course", "swath_frame=goal", "swath_edge=true",
+                "goal_distance=200.0", "length=500.0"])
+    agent = {"control": "course", "swath_frame": "goal", "swath_edge": True}
     assert run_agent_kwargs(run) == agent
     out = tmp_path / "board"
     report = leaderboard.main(["--concentrations", "0.2", "--episodes", "2", "--processes",
