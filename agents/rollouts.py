@@ -33,7 +33,7 @@ __all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
 #: trained run is evaluated with its own
 AGENT_KWARGS = ("control", "obs_type", "lidar_sectors", "lidar_range", "image_size",
                 "image_extent", "swath_rays", "swath_fan", "swath_bands", "swath_frame",
-                "swath_edge")
+                "swath_edge", "course_guard")
 
 
 def run_agent_kwargs(run_dir: str | Path) -> dict:

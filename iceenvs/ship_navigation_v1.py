@@ -16,7 +16,8 @@ from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .ship_controllers import SwathPlanner
 from .ship_env import CONTROLS, ship_features
-from .ship_sensors import channel_room, check_bands, swath_courses, swath_scan
+from .ship_sensors import (channel_room, check_bands, course_with_room, swath_courses,
+                            swath_scan)
 from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
 from .vector import vector_class
 
@@ -114,6 +115,10 @@ _TASK = tuple(
                   "None: drawn from `gradient_range`", number(-1.0, 1.0, optional=True)),
     TaskParameter("gradient_range", (0.0, 0.0), "range of the drawn gradients",
                   interval(-1.0, 1.0)),
+    TaskParameter("course_guard", None, "with `control=\"course\"`: room [m] in the channel "
+                  "a commanded course must leave (the autopilot holds the nearest course that "
+                  "does: `guarded_course`); None: every course is held",
+                  number(1.0, 1.0e4, optional=True)),
 )
 
 
@@ -178,6 +183,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     (`control="yaw"`); `control="course"` (the course action[0] ×
     `max_course`, 45°, held by an autopilot), `control="speed_yaw"` and
     `control="thrust"` as there. The documented PPO run commands courses.
+    With `course_guard=g` [m] the autopilot holds, for each commanded
+    course, the nearest that leaves the ship at least g of room in the
+    channel (:meth:`guarded_course`): a course guard that keeps the ship
+    in the channel whatever the policy commands.
 
     ## Observation Space
     `obs_type="vector"` (default): `Box(float32)` of {_N_VECTOR} entries: the
@@ -277,6 +286,24 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         if goal_distance <= ICE_AHEAD:
             raise ValueError(f"goal_distance {goal_distance:g} m leaves no ice: the ice starts "
                              f"{ICE_AHEAD:g} m ahead of the ship")
+
+    def guarded_course(self, course: float) -> float:
+        """The course [rad from the goal direction] the autopilot holds for
+        ``course``: with a `course_guard` g, the nearest that leaves the
+        ship's centroid at least g of room in the channel
+        (:func:`iceenvs.ship_sensors.course_with_room`); ``course`` itself
+        without one."""
+        g = self.episode["course_guard"]
+        if g is None:
+            return float(course)
+        offset = float(self.sim.ship.position[1]) - self.centre_y
+        return course_with_room(course, offset, 0.5 * self.channel_width, g)
+
+    def _apply_action(self, action):
+        if self.control == "course" and self.episode["course_guard"] is not None:
+            turn = self.episode["max_course"]
+            action = np.array([self.guarded_course(float(action[0]) * turn) / turn])
+        super()._apply_action(action)
 
     def default_reward_params(self) -> dict:
         return dict(super().default_reward_params(), impulse_scale=2.5e5, impulse_cap=10.0,

@@ -97,6 +97,7 @@ from physics.checks import check_range
 from physics.domain import minimum_image
 
 __all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "channel_room",
+           "course_with_room",
            "check_bands", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
 
 #: radial sample points per lidar sector (the concentration grid)
@@ -415,6 +416,19 @@ def channel_room(offset, half_width: float, bearings, reach: float) -> np.ndarra
     with np.errstate(divide="ignore"):
         room = np.where(s > 0.0, (h - d) / s, np.where(s < 0.0, (h + d) / -s, np.inf))
     return np.clip(room, 0.0, float(reach))
+
+
+def course_with_room(course: float, offset: float, half_width: float, room: float) -> float:
+    """The course [rad from the channel's direction, +x] nearest ``course``
+    along which a centroid ``offset`` [m] to port of the centre line has at
+    least ``room`` [m] before it leaves the channel (:func:`channel_room`):
+    ``course`` clipped to [−asin((h + d)/g), asin((h − d)/g)], each sine
+    capped to [−1, 1] (d the offset, h the half-width, g the room). From
+    outside the channel only courses back towards it remain."""
+    d, h, g = float(offset), float(half_width), float(room)
+    port = math.asin(max(min((h - d) / g, 1.0), -1.0))
+    starboard = -math.asin(max(min((h + d) / g, 1.0), -1.0))
+    return min(max(float(course), starboard), port)
 
 
 def swath_courses(rays: int, fan: float) -> np.ndarray:

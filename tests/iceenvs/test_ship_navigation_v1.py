@@ -297,6 +297,35 @@ def test_swath_edge_gives_each_courses_room_in_the_channel(frame):
         gym.make(V1, swath_edge="yes")
 
 
+def test_course_guard_keeps_the_commanded_course_in_the_channel():
+    """With ``course_guard=g`` a course action is held as the nearest course
+    whose room in the channel (:func:`iceenvs.ship_sensors.channel_room`)
+    is at least g: the full port course for 120 steps takes the ship out of
+    the channel without the guard and not with it; at every step the held
+    course leaves g of room (to 1e-6 m) or is the commanded one."""
+    from iceenvs.ship_sensors import channel_room
+
+    worst = {}
+    for guard in (None, 150.0):
+        env = gym.make(V1, concentration=0.2, control="course", course_guard=guard).unwrapped
+        env.reset(seed=0)
+        h = 0.5 * env.channel_width
+        worst[guard] = 0.0
+        for _ in range(120):
+            if guard is not None:
+                d = float(env.sim.ship.position[1]) - env.centre_y
+                for course in (-0.7, 0.0, 0.5, 0.785):
+                    held = env.guarded_course(course)
+                    room = channel_room(d, h, [held], 1.0e6)[0]
+                    assert held == course or room >= guard - 1e-6, (d, course, held, room)
+            env.step(np.array([1.0]))
+            worst[guard] = max(worst[guard], abs(env.last_measurement["channel_offset"]))
+        env.close()
+    assert worst[None] > 1.5 and worst[150.0] <= 1.0
+    with pytest.raises(ValueError, match="course_guard"):
+        gym.make(V1, course_guard=0.0)
+
+
 # -- the planners -----------------------------------------------------------------------------
 
 def assert_beats_the_straight_line(name: str, **kwargs):

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, channel_room, ice_lidar, ice_swath,
-                                  lidar_scan, occupancy_image)
+from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, channel_room, course_with_room,
+                                  ice_lidar, ice_swath, lidar_scan, occupancy_image)
 
 TWO_PI = 2.0 * math.pi
 
@@ -491,3 +491,23 @@ def test_channel_room_rejects_bad_input(kwargs, name):
     args.update(kwargs)
     with pytest.raises(ValueError, match=name):
         channel_room(**args)
+
+
+def test_course_with_room_is_the_nearest_course_that_leaves_the_room():
+    """Over 200 drawn offsets and courses, the course kept leaves at least
+    the room asked (to 1e-6 m) and is the course asked when that one does;
+    else it is the nearest that does (a course 1e-3 rad nearer the one
+    asked leaves less). From 10 m outside the port edge, only starboard
+    courses remain."""
+    rng = np.random.default_rng(5)
+    h, g = 100.0, 150.0
+    for d, course in zip(rng.uniform(-h, h, 200), rng.uniform(-1.2, 1.2, 200)):
+        kept = course_with_room(course, d, h, g)
+        assert channel_room(d, h, [kept], 1e6)[0] >= g - 1e-6
+        if channel_room(d, h, [course], 1e6)[0] >= g:
+            assert kept == course
+        else:
+            nearer = kept + 1e-3 * np.sign(course - kept)
+            assert channel_room(d, h, [nearer], 1e6)[0] < g
+    assert course_with_room(0.7, 110.0, h, g) < 0.0
+    assert course_with_room(-0.5, 110.0, h, g) == -0.5
