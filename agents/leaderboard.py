@@ -5,7 +5,9 @@ Every policy sails the same seeded ice fields at each concentration
 the same draws, so paired), and the table gives per policy and
 concentration the mean and standard error of the return and of
 AUTO-IceNav's metrics, and the metrics normalised by the straight line's
-on the same field (the mean over the fields of the per-field ratio).
+on the same field (the mean over the fields of the per-field ratio). The
+return and the impulse per metre are also paired with the straight line's
+over the fields of all concentrations together, the task's spread.
 
 Route choice *pays* at a concentration when the best planner meets at
 most 0.7 times the straight line's ice impulse per metre (the ratio of
@@ -37,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["run_leaderboard", "summarise_board", "board_markdown", "plot_board", "main",
+__all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "plot_board", "main",
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
 DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
@@ -116,6 +118,41 @@ def summarise_board(board: dict, reference: str = "straight") -> dict:
     return out
 
 
+def pooled_comparison(board: dict, reference: str = "straight") -> dict:
+    """Per policy, paired with ``reference`` over the fields of every
+    concentration together (the task's spread of concentrations): the
+    differences of the return and of the impulse per metre
+    (:func:`agents.rollouts.compare`) and the ratios of the means of the
+    impulse per metre and of the path. Empty without ``reference``."""
+    from .rollouts import compare
+
+    if any(reference not in policies for policies in board.values()):
+        return {}
+    names = [n for n in next(iter(board.values())) if n != reference
+             and all(n in policies for policies in board.values())]
+    ref = [e for policies in board.values() for e in policies[reference]]
+    out = {}
+    for name in names:
+        mine = [e for policies in board.values() for e in policies[name]]
+        ratio = {key: float(np.mean([_final(e, key) for e in mine])
+                            / np.mean([_final(b, key) for b in ref]))
+                 for key in ("impulse_per_metre", "path_length")}
+        out[name] = dict(
+            fields=len(mine), paired_return=compare(mine, ref),
+            paired_impulse_per_metre=compare(mine, ref, "impulse_per_metre",
+                                             lower_is_better=True),
+            ipm_ratio_of_means=ratio["impulse_per_metre"],
+            path_ratio_of_means=ratio["path_length"])
+    return out
+
+
+def _paired_cell(c: dict | None, scale: float) -> str:
+    if c is None:
+        return "–"
+    return (f"{_num(c['diff'] / scale, 3)} ± {_num(c['sem'] / scale, 2)}"
+            + (" (beats)" if c["beats"] else ""))
+
+
 def route_choice_pays(summary: dict, planners) -> dict:
     """``{concentration: (best planner, its impulse-per-metre ratio, its
     path ratio, pays)}``: the planner of ``planners`` with the lowest ratio
@@ -169,6 +206,19 @@ def board_markdown(report: dict) -> str:
     for a, (name, ratio, path, pays) in verdict.items():
         lines.append(f"| {a} | {name} | {ratio:.3f} | {path:.3f} | "
                      f"{'yes' if pays else '**no**'} |")
+    pooled = pooled_comparison(report["episodes_detail"]) if len(summary) > 1 else {}
+    if pooled:
+        n = next(iter(pooled.values()))["fields"]
+        lines += ["", "### All concentrations together", "",
+                  f"Each policy paired with the straight line on all {n} fields (policy − "
+                  "straight line; *beats*: better by more than two standard errors):", "",
+                  "| policy | return − straight's | impulse per metre − straight's [kN s/m] "
+                  "| impulse per metre, ratio of means | path, ratio of means |",
+                  "|---|---|---|---|---|"]
+        for name, c in pooled.items():
+            lines.append(f"| {name} | {_paired_cell(c['paired_return'], 1.0)} | "
+                         f"{_paired_cell(c['paired_impulse_per_metre'], 1e3)} | "
+                         f"{c['ipm_ratio_of_means']:.3f} | {c['path_ratio_of_means']:.3f} |")
     for a, policies in summary.items():
         lines += ["", f"### A = {a}", "",
                   "| policy | return | success | " + " | ".join(
@@ -190,10 +240,7 @@ def board_markdown(report: dict) -> str:
             cells = [name] + [_pm(s.get(f"ratio_{k}"), 1.0, 3) for k in NORMALISED]
             cells.append(f"{s.get('ipm_ratio_of_means', math.nan):.3f}")
             for key, scale in (("paired_return", 1.0), ("paired_impulse_per_metre", 1e3)):
-                c = s.get(key)
-                cells.append("–" if c is None or name == "straight" else
-                             f"{_num(c['diff'] / scale, 3)} ± {_num(c['sem'] / scale, 2)}"
-                             + (" (beats)" if c["beats"] else ""))
+                cells.append(_paired_cell(None if name == "straight" else s.get(key), scale))
             cells.append(_pm(s.get("plan_ms"), 1.0, 2))
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

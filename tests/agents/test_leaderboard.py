@@ -42,6 +42,34 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
     assert (out / "leaderboard.md").read_text() == text
 
 
+def _episode(ret, ipm, path):
+    return {"ret": ret, "final": {"impulse_per_metre": ipm, "path_length": path}}
+
+
+def test_all_concentrations_are_paired_field_by_field():
+    """Pooled over the concentrations, each field is paired with the
+    straight line's on the same field: differences of 1, 2, 3 and 6 give a
+    mean of 3 and a standard error of sqrt(14 / 3) / 2; the ratios are of
+    the means over every field."""
+    board = {"0.2": {"straight": [_episode(10.0, 4e3, 100.0), _episode(20.0, 6e3, 100.0)],
+                     "x": [_episode(11.0, 3e3, 110.0), _episode(22.0, 4e3, 100.0)]},
+             "0.3": {"straight": [_episode(30.0, 10e3, 100.0), _episode(40.0, 20e3, 100.0)],
+                     "x": [_episode(33.0, 5e3, 100.0), _episode(46.0, 10e3, 110.0)]}}
+    c = leaderboard.pooled_comparison(board)["x"]
+    assert c["fields"] == 4
+    assert c["paired_return"]["diff"] == pytest.approx(3.0, rel=1e-12)
+    assert c["paired_return"]["sem"] == pytest.approx(math.sqrt(14.0 / 3.0) / 2.0, rel=1e-12)
+    assert c["paired_return"]["beats"]     # 3 > 2 × 1.08
+    # impulse per metre: −1, −2, −5, −10 (10³); lower is better
+    assert c["paired_impulse_per_metre"]["diff"] == pytest.approx(-4.5e3, rel=1e-12)
+    assert c["ipm_ratio_of_means"] == pytest.approx(22.0 / 40.0, rel=1e-12)
+    assert c["path_ratio_of_means"] == pytest.approx(1.05, rel=1e-12)
+    assert "straight" not in leaderboard.pooled_comparison(board)
+    # without the straight line on every concentration there is nothing to pair with
+    del board["0.3"]["straight"]
+    assert leaderboard.pooled_comparison(board) == {}
+
+
 @pytest.mark.parametrize("args, message", [
     (["--policies", "straight,nonsense"], "unknown policy"),
     (["--episodes", "1"], "at least 2"),
