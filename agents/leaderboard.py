@@ -78,6 +78,27 @@ def run_leaderboard(env_id: str, concentrations, recipes: dict, *, episodes: int
     return board
 
 
+def host_signature() -> str:
+    """What the trajectories depend on beyond the seed: the library versions
+    and the CPU features NumPy and Numba compute with. A DEM trajectory is
+    chaotic, so a sum rounded otherwise (another SIMD width, another
+    version) sends a ship along another trajectory from the same field."""
+    import numba
+
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+        simd = " ".join(f for f in __cpu_dispatch__ if __cpu_features__.get(f))
+    except ImportError:            # a NumPy without these tables: the version alone
+        simd = "?"
+    try:
+        import llvmlite.binding as llvm
+        cpu = numba.config.CPU_NAME or llvm.get_host_cpu_name()
+    except (ImportError, AttributeError):
+        cpu = "?"
+    return (f"{platform.machine()}, numpy {np.__version__} ({simd}), "
+            f"numba {numba.__version__} ({cpu})")
+
+
 def _final(e, key):
     return float(e["final"].get(key, math.nan))
 
@@ -190,7 +211,8 @@ def board_markdown(report: dict) -> str:
              f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}); "
              f"{report['episodes']} fields per concentration, field k seeded "
              f"{report['seed']} + k, the same fields for every policy; "
-             f"{report['machine']}; {report['date']}; {report['wall_s']:.0f} s of wall time.",
+             f"{report.get('host', report['machine'])}; {report['date']}; "
+             f"{report['wall_s']:.0f} s of wall time.",
              "",
              *_agent_lines(report.get("agent_kwargs") or {}),
              "Means ± standard errors over the fields. Ratios are to the straight line on "
@@ -334,9 +356,11 @@ def _write(report: dict, out: Path) -> None:
     plot_board(report, out / "leaderboard.png")
 
 
-def _mergeable(parser, args, out: Path, conc, env_kwargs) -> dict:
+def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
     """The report in ``out`` that ``--merge`` adds to, checked to be of the
-    same environment, arguments, fields and concentrations."""
+    same environment, arguments, fields and concentrations, and, unless
+    every policy of it runs again (``again``), of the same host
+    (:func:`host_signature`)."""
     path = out / "leaderboard.json"
     if not path.exists():
         parser.error(f"--merge: {path} does not exist")
@@ -347,6 +371,14 @@ def _mergeable(parser, args, out: Path, conc, env_kwargs) -> dict:
     if not same:
         parser.error(f"--merge: {path} is of another environment, arguments, fields or "
                      f"concentrations")
+    kept = set(next(iter(old["episodes_detail"].values()))) - set(again)
+    if kept and old.get("host") != host_signature():
+        parser.error(f"--merge: {path} was computed on another host "
+                     f"({old.get('host', 'not recorded')}; this one: {host_signature()}). Its "
+                     f"episodes start from the same fields but do not follow the same "
+                     f"trajectories here, so they would not pair with new ones: run all of its "
+                     f"policies again (--replace {','.join(sorted(kept))}) or write elsewhere "
+                     f"(--out)")
     return old
 
 
@@ -410,7 +442,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     for name in again:
         if name not in recipes:
             parser.error(f"--replace {name}: not among the policies of this run")
-    old = _mergeable(parser, args, out, conc, env_kwargs) if args.merge else None
+    old = _mergeable(parser, args, out, conc, env_kwargs, again) if args.merge else None
     out.mkdir(parents=True, exist_ok=True)
     if old is not None:
         recipes = {name: r for name, r in recipes.items()
@@ -433,6 +465,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p != "straight" and p in planner_names],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
+        host=host_signature(),
         date=datetime.date.today().isoformat(),
         wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0),
         summary=summary,

@@ -12,7 +12,7 @@ from cli_checks import assert_refused
 SHORT = ["--env-kwargs", "goal_distance=200.0", "length=500.0"]
 
 
-def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
+def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path, capsys):
     out = tmp_path / "board"
     base = ["--concentrations", "0.2", "--episodes", "2", "--processes", "1",
             "--out", str(out)] + SHORT
@@ -40,6 +40,17 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path):
     (out / "leaderboard.md").unlink()
     leaderboard.main(["--render", "--out", str(out)])
     assert (out / "leaderboard.md").read_text() == text
+    # episodes of another host start from the same fields but round otherwise, so
+    # they would not pair with new ones: merging onto them is refused ...
+    assert again["host"] == leaderboard.host_signature()
+    (out / "leaderboard.json").write_text(json.dumps({**again, "host": "another host"}))
+    with pytest.raises(SystemExit):
+        leaderboard.main(base + ["--policies", "straight", "--merge"])
+    assert "another host" in capsys.readouterr().err
+    # ... unless every policy of them runs again
+    fresh = leaderboard.main(base + ["--policies", "straight,lattice", "--merge", "--replace",
+                                     "straight,lattice"])
+    assert fresh["host"] == leaderboard.host_signature()
 
 
 def _episode(ret, ipm, path):
