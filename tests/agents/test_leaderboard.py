@@ -132,8 +132,8 @@ def test_an_agent_is_evaluated_with_its_own_control():
 
 def test_a_trained_runs_control_is_read_and_reported(tmp_path):
     """The leaderboard plays a run trained with control="course" and the
-    swath sensor in the goal frame, with the courses' room in the channel,
-    with them and says so; the same episodes as the policy played alone in
+    swath sensor in the goal frame, with the courses' room in the channel
+    and the course guard, with them and says so; the same episodes as the policy played alone in
     such an environment."""
     import gymnasium as gym
 
@@ -146,7 +146,9 @@ def test_a_trained_runs_control_is_read_and_reported(tmp_path):
                 "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32",
                 "--env-kwargs", "control=course", "swath_frame=goal", "swath_edge=true",
                 "goal_distance=200.0", "length=500.0"])
-    agent = {"control": "course", "swath_frame": "goal", "swath_edge": True}
+    # the course guard comes from the file's env_kwargs, the rest from --env-kwargs
+    agent = {"control": "course", "swath_frame": "goal", "swath_edge": True,
+             "course_guard": 150}
     assert run_agent_kwargs(run) == agent
     out = tmp_path / "board"
     report = leaderboard.main(["--concentrations", "0.2", "--episodes", "2", "--processes",
