@@ -163,16 +163,18 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       (`leads=0`) little: at A = 0.4 nearly every beam-wide corridor holds
       floes every few metres, and the lattice planner
       (:mod:`agents.planners`) meets 0.83 times the straight line's ice
-      impulse per metre. With the default two leads it meets 0.49, 0.60
-      and 0.68 times it at A = 0.2, 0.3 and 0.4 (0.83 at 0.5), sailing
-      1-1.3 % further. The swath planner
+      impulse per metre. With the default two leads it meets 0.51, 0.65
+      and 0.69 times it at A = 0.2, 0.3 and 0.4 (0.80 at 0.5), sailing
+      1-1.4 % further. The swath planner
       (:class:`iceenvs.ship_controllers.SwathPlanner`), deciding on the
-      observation alone, meets 0.56, 0.67, 0.79 and 0.80 times it at
-      A = 0.2-0.5 and beats its return by 17-18 at A = 0.2-0.4. The docs'
-      page "Ship navigation: does route choice pay?" gives the measured
-      leaderboard, the variants and PPO (which, after an hour of training
-      with `control="course"`, meets less ice than the straight line and
-      matches its return, without beating it by two standard errors).
+      observation alone, meets 0.57, 0.72, 0.78 and 0.78 times it at
+      A = 0.2-0.5 and beats its return by 14-29 at every concentration.
+      The docs' page "Ship navigation: does route choice pay?" gives the
+      measured leaderboard, the variants and PPO (which, after an hour of
+      training commanding courses with `course_guard=150`, never leaves
+      the channel, meets 0.78-0.97 times the straight line's ice and is
+      ahead of its return at every concentration, by less than two
+      standard errors).
     * *What a good policy does:* reads the ice ahead and steers for leads
       and the open water between the large floes, in gentle turns (a
       turning hull sweeps its sides through the ice).
@@ -182,7 +184,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     action[0] × `max_yaw_rate` (0.04 rad/s) at a fixed 2 m/s
     (`control="yaw"`); `control="course"` (the course action[0] ×
     `max_course`, 45°, held by an autopilot), `control="speed_yaw"` and
-    `control="thrust"` as there. The documented PPO run commands courses.
+    `control="thrust"` as there. The documented PPO run commands courses,
+    with a course guard of 150 m.
     With `course_guard=g` [m] the autopilot holds, for each commanded
     course, the nearest that leaves the ship at least g of room in the
     channel (:meth:`guarded_course`): a course guard that keeps the ship
