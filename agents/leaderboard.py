@@ -372,9 +372,10 @@ def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
         parser.error(f"--merge: {path} is of another environment, arguments, fields or "
                      f"concentrations")
     kept = set(next(iter(old["episodes_detail"].values()))) - set(again)
-    if kept and old.get("host") != host_signature():
+    host = host_signature()
+    if kept and old.get("host") != host:
         parser.error(f"--merge: {path} was computed on another host "
-                     f"({old.get('host', 'not recorded')}; this one: {host_signature()}). Its "
+                     f"({old.get('host', 'not recorded')}; this one: {host}). Its "
                      f"episodes start from the same fields but do not follow the same "
                      f"trajectories here, so they would not pair with new ones: run all of its "
                      f"policies again (--replace {','.join(sorted(kept))}) or write elsewhere "

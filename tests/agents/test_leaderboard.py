@@ -133,8 +133,8 @@ def test_an_agent_is_evaluated_with_its_own_control():
 def test_a_trained_runs_control_is_read_and_reported(tmp_path):
     """The leaderboard plays a run trained with control="course" and the
     swath sensor in the goal frame, with the courses' room in the channel
-    and the course guard, with them and says so; the same episodes as the policy played alone in
-    such an environment."""
+    and the course guard, with them and says so; the same episodes as the
+    policy played alone in such an environment."""
     import gymnasium as gym
 
     from agents import train
