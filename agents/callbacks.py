@@ -149,18 +149,20 @@ class TqdmCallback(BaseCallback):
 
 class TimeBudgetCallback(BaseCallback):
     """Stop training once ``minutes`` of wall-clock time have passed since
-    it started (checked every step; the run then saves its model as at the
-    end of its timesteps)."""
+    it started, or since ``started`` (a ``time.perf_counter`` value, e.g.
+    before a warm start that belongs to the budget); checked every step,
+    the run then saves its model as at the end of its timesteps."""
 
-    def __init__(self, minutes: float):
+    def __init__(self, minutes: float, started: float | None = None):
         super().__init__(0)
         if not (math.isfinite(minutes) and minutes > 0):
             raise ValueError(f"minutes must be a positive number, got {minutes!r}")
         self.seconds = 60.0 * float(minutes)
-        self._start = None
+        self._started = started
+        self._start = started
 
     def _on_training_start(self) -> None:
-        self._start = time.perf_counter()
+        self._start = time.perf_counter() if self._started is None else self._started
 
     def _on_step(self) -> bool:
         if time.perf_counter() - self._start < self.seconds:

@@ -44,6 +44,7 @@ import math
 import shlex
 import shutil
 import sys
+import time
 from pathlib import Path
 
 import yaml
@@ -55,14 +56,14 @@ __all__ = ["ALGOS", "HYPERPARAMS_DIR", "SPECIAL_KEYS", "build_parser", "main",
 ALGOS = {"ppo": "PPO", "sac": "SAC"}
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 #: hyperparameters that are not arguments of the algorithm's constructor
-SPECIAL_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs")
+SPECIAL_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs", "pretrain")
 #: constructor arguments the trainer sets itself
 _RESERVED = {"self", "policy", "env", "seed", "verbose", "device", "tensorboard_log",
              "_init_setup_model"}
 #: model artefacts that --force removes from an existing run directory
 RUN_FILES = ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml", "command.txt",
-             "metrics.csv", "checkpoints", "eval", "logs", "evaluation.md", "evaluation.json",
-             "evaluation.png")
+             "pretrain.yaml", "metrics.csv", "checkpoints", "eval", "logs", "evaluation.md",
+             "evaluation.json", "evaluation.png")
 #: the evaluation environment is seeded this far from the training seed
 EVAL_SEED_OFFSET = 1000
 
@@ -220,6 +221,14 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
         if not isinstance(hp.get(key), int) or hp[key] < 1:
             raise ValueError(f"hyperparameter {key} must be an integer >= 1, got "
                              f"{hp.get(key)!r}")
+    from .pretrain import pretrain_settings
+
+    pretrain = pretrain_settings(hp.get("pretrain"))
+    if pretrain is not None and algo != "ppo":
+        raise ValueError(f"hyperparameter pretrain: warm starts are made for ppo, not {algo}")
+    hp.pop("pretrain", None)
+    if pretrain is not None:
+        hp["pretrain"] = pretrain
     hp.setdefault("policy", "MlpPolicy")
     hp.setdefault("env_kwargs", {})
     return hp
@@ -392,8 +401,11 @@ def make_model(args: argparse.Namespace, hp: dict, env, run_dir: Path):
 
 
 # -- step 7: callbacks -----------------------------------------------------------------------
-def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path) -> list:
-    """Checkpoints, evaluation, physics metrics and the progress bar."""
+def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path,
+                   started: float | None = None) -> list:
+    """Checkpoints, evaluation, physics metrics and the progress bar; the
+    ``--minutes`` budget counts from ``started`` (a ``time.perf_counter``
+    value; default: the start of learning)."""
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
     from .callbacks import PhysicsMetricsCallback, TimeBudgetCallback, TqdmCallback
@@ -413,8 +425,29 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path) 
     callbacks.append(PhysicsMetricsCallback(args.env, run_dir / "metrics.csv"))
     callbacks.append(TqdmCallback(hp["n_timesteps"], disable=args.no_progress))
     if args.minutes is not None:
-        callbacks.append(TimeBudgetCallback(args.minutes))
+        callbacks.append(TimeBudgetCallback(args.minutes, started=started))
     return callbacks
+
+
+# -- step 7b: warm start ------------------------------------------------------------------------
+def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path) -> dict | None:
+    """Fit the policy to a planner's decisions when ``hp["pretrain"]`` asks
+    for it (:mod:`agents.pretrain`), write ``pretrain.yaml`` and, when
+    checkpointing, the checkpoint at 0 steps (the clone before PPO)."""
+    if not hp.get("pretrain"):
+        return None
+    from .pretrain import pretrain
+
+    report = pretrain(model, env, args.env, hp["env_kwargs"], hp["pretrain"],
+                      gamma=float(hp.get("gamma", 0.99)), progress=not args.no_progress)
+    with open(run_dir / "pretrain.yaml", "w") as fh:
+        yaml.safe_dump(report, fh, sort_keys=True)
+    if args.save_freq > 0:
+        save(model, env, run_dir, 0)      # the clone before PPO: RUN_DIR@0
+    print(f"warm start from {report['teacher']}: {report['decisions']} decisions in "
+          f"{report['collect_seconds']:.0f} s; action mean squared error "
+          f"{report['action_mse']:.3g} (variance {report['action_variance']:.3g})")
+    return report
 
 
 # -- step 8: learn and save --------------------------------------------------------------------
@@ -486,9 +519,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
         import torch
 
         torch.set_num_threads(1)
+        started = time.perf_counter()
         env, eval_env = make_envs(args, hp)
         model = make_model(args, hp, env, run_dir)
-        callbacks = make_callbacks(args, hp, eval_env, run_dir)
+        callbacks = make_callbacks(args, hp, eval_env, run_dir,
+                                   started=started if hp.get("pretrain") else None)
+        warm_start(args, hp, model, env, run_dir)
     except BaseException:
         _close(env, eval_env, model.logger if model is not None else None)
         discard_run_dir(run_dir, created)

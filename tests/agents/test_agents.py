@@ -30,7 +30,7 @@ ITD = "iceenvs/ThicknessDistribution-v0"
 # the thickness model takes 5-day steps so that 16 steps see a season change
 SMALL = {env_id: {**kwargs, **({"days_per_step": 5.0} if env_id == ITD else {}),
                   "max_episode_steps": 16} for env_id, kwargs in ALL_SMALL.items()}
-TINY_PPO = ["n_steps=64", "batch_size=64", "n_epochs=2",
+TINY_PPO = ["n_steps=64", "batch_size=64", "n_epochs=2", "pretrain=null",
             "policy_kwargs={net_arch: [16, 16]}"]
 
 

@@ -143,7 +143,7 @@ def test_a_trained_runs_control_is_read_and_reported(tmp_path):
     run = tmp_path / "run"
     train.main(["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--timesteps", "64",
                 "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
-                "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32",
+                "--no-progress", "--hyperparams", "n_steps=32", "batch_size=32", "pretrain=null",
                 "--env-kwargs", "control=course", "swath_frame=goal", "swath_edge=true",
                 "goal_distance=200.0", "length=500.0"])
     # the course guard comes from the file's env_kwargs, the rest from --env-kwargs

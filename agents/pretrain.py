@@ -1,0 +1,260 @@
+"""Warm-start a policy from a planner's decisions (behaviour cloning).
+
+A policy trained by PPO from scratch searches the whole action space; a
+planner of the suite already knows a good route. The ``pretrain``
+hyperparameter starts PPO from a copy of the planner instead:
+
+1. **Demonstrations.** The planner (a baseline of
+   :func:`agents.baselines.make_baseline`, e.g. ``swath``) sails
+   ``episodes`` episodes of the training environment, seeded
+   ``seed, seed + 1, …`` (apart from the fields of the leaderboard and of
+   the training run), and each step's raw observation, action and reward
+   are kept.
+2. **Normalisation.** The observation statistics of ``VecNormalize`` are
+   primed with the demonstrations' observations, and its return
+   statistics with their discounted returns, so that the policy is fitted
+   on the inputs it will see when PPO starts.
+3. **Actor.** The mean of the policy's Gaussian is fitted to the planner's
+   actions (mean squared error, Adam, ``epochs`` passes in batches of
+   ``batch_size``). Its standard deviation stays at ``log_std_init``.
+4. **Critic.** The value head is fitted to the discounted returns of the
+   planner's episodes (normalised rewards, the run's ``gamma``), so that
+   the first advantages of PPO are not those of a random critic.
+
+The hyperparameter is a mapping, e.g. in ``agents/hyperparams/ppo.yaml``::
+
+    pretrain:
+      teacher: swath
+      episodes: 60
+      seed: 30000
+      epochs: 50
+
+``pretrain.yaml`` in the run directory records the number of decisions,
+the fit of actor and critic and the seconds each part took.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+__all__ = ["PRETRAIN_DEFAULTS", "pretrain_settings", "Demonstrations", "collect", "prime_normalization",
+           "fit_policy", "pretrain"]
+
+#: settings of ``pretrain`` that may be left out
+PRETRAIN_DEFAULTS = {"episodes": 60, "seed": 30000, "epochs": 50, "batch_size": 256,
+                     "learning_rate": 1.0e-3}
+
+
+def pretrain_settings(value) -> dict | None:
+    """The settings of a ``pretrain`` hyperparameter with defaults filled in
+    (``None`` for none, ``False`` or an empty mapping).
+
+    Raises
+    ------
+    ValueError
+        For a value that is not a mapping, a mapping without ``teacher``,
+        an unknown key or a count that is not a positive integer.
+    """
+    if value is None or value is False or value == {}:
+        return None
+    if not isinstance(value, dict):
+        raise ValueError(f"hyperparameter pretrain must be a mapping with a teacher, got {value!r}")
+    unknown = sorted(set(value) - {"teacher", *PRETRAIN_DEFAULTS})
+    if unknown:
+        raise ValueError(f"unknown pretrain settings {unknown}; valid: teacher, "
+                         f"{', '.join(PRETRAIN_DEFAULTS)}")
+    if not isinstance(value.get("teacher"), str):
+        raise ValueError("hyperparameter pretrain needs a teacher: the name of a baseline such "
+                         "as swath")
+    settings = {**PRETRAIN_DEFAULTS, **value}
+    for key in ("episodes", "epochs", "batch_size"):
+        if not isinstance(settings[key], int) or isinstance(settings[key], bool) \
+                or settings[key] < 1:
+            raise ValueError(f"pretrain {key} must be an integer >= 1, got {settings[key]!r}")
+    if not isinstance(settings["seed"], int) or isinstance(settings["seed"], bool):
+        raise ValueError(f"pretrain seed must be an integer, got {settings['seed']!r}")
+    if not float(settings["learning_rate"]) > 0:
+        raise ValueError(f"pretrain learning_rate must be > 0, got {settings['learning_rate']!r}")
+    return settings
+
+
+class Demonstrations:
+    """A teacher's decisions: raw observations ``obs`` (n, …), actions
+    ``actions`` (n, k), rewards ``rewards`` (n,) and ``episode_starts``
+    (n,), True at the first step of each episode."""
+
+    def __init__(self, obs, actions, rewards, episode_starts):
+        self.obs = np.asarray(obs, dtype=np.float32)
+        self.actions = np.asarray(actions, dtype=np.float32)
+        self.rewards = np.asarray(rewards, dtype=np.float64)
+        self.episode_starts = np.asarray(episode_starts, dtype=bool)
+
+    def __len__(self) -> int:
+        return len(self.obs)
+
+    def running_returns(self, gamma: float, scale: float = 1.0) -> np.ndarray:
+        """The discounted return so far at each step, ``R_t = γ R_{t-1} +
+        r_t / scale`` (restarted at each episode): what ``VecNormalize``
+        tracks to scale the rewards."""
+        out = np.empty(len(self))
+        running = 0.0
+        for t, (r, start) in enumerate(zip(self.rewards, self.episode_starts)):
+            running = (0.0 if start else gamma * running) + r / scale
+            out[t] = running
+        return out
+
+    def returns_to_go(self, gamma: float, scale: float = 1.0) -> np.ndarray:
+        """The discounted return from each step to the end of its episode,
+        ``G_t = r_t / scale + γ G_{t+1}``: the value of the teacher."""
+        out = np.empty(len(self))
+        following = 0.0
+        for t in range(len(self) - 1, -1, -1):
+            ends = t == len(self) - 1 or self.episode_starts[t + 1]
+            following = self.rewards[t] / scale + (0.0 if ends else gamma * following)
+            out[t] = following
+        return out
+
+
+def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: int,
+            progress: bool = False) -> Demonstrations:
+    """Sail ``episodes`` episodes of ``teacher`` (a baseline name) on
+    ``gymnasium.make(env_id, **env_kwargs)``, seeded ``seed + k``."""
+    import gymnasium as gym
+    from tqdm.auto import tqdm
+
+    from .baselines import make_baseline
+
+    env = gym.make(env_id, **env_kwargs)
+    try:
+        policy = make_baseline(teacher, env, seed=seed)
+        obs_list, actions, rewards, starts = [], [], [], []
+        for k in tqdm(range(episodes), desc=f"{teacher} demonstrations", unit="episode",
+                      disable=not progress):
+            obs, _ = env.reset(seed=seed + k)
+            policy.reset(seed + k)
+            done, first = False, True
+            while not done:
+                action = np.asarray(policy.predict(obs)[0], dtype=np.float32)
+                obs_list.append(np.array(obs, dtype=np.float32))
+                actions.append(action.reshape(env.action_space.shape))
+                starts.append(first)
+                obs, reward, terminated, truncated, _ = env.step(action)
+                rewards.append(float(reward))
+                done, first = terminated or truncated, False
+    finally:
+        env.close()
+    return Demonstrations(obs_list, actions, rewards, starts)
+
+
+def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> None:
+    """Start the statistics of a ``VecNormalize`` from the demonstrations:
+    observations (when it normalises them) and discounted returns (when it
+    normalises rewards)."""
+    if vec_normalize.norm_obs:
+        vec_normalize.obs_rms.update(demos.obs)
+    if vec_normalize.norm_reward:
+        vec_normalize.ret_rms.update(demos.running_returns(gamma))
+
+
+def _fit(params, loss_of, n: int, epochs: int, batch_size: int, learning_rate: float,
+         generator) -> float:
+    """Adam on ``loss_of(batch_indices)`` over shuffled batches; the loss
+    of the last epoch (mean over its batches)."""
+    import torch
+
+    optimizer = torch.optim.Adam(params, lr=learning_rate)
+    last = float("nan")
+    for _ in range(epochs):
+        total, count = 0.0, 0
+        for batch in torch.randperm(n, generator=generator).split(batch_size):
+            loss = loss_of(batch)
+            optimizer.zero_grad()
+            loss.backward()
+            optimizer.step()
+            total += loss.item() * len(batch)
+            count += len(batch)
+        last = total / count
+    return last
+
+
+def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray | None, *,
+               epochs: int, batch_size: int, learning_rate: float, seed: int) -> dict:
+    """Fit an SB3 actor-critic ``policy`` on (already normalised) ``obs``:
+    the mean of its action distribution to ``actions`` and, when given,
+    its value to ``values``.
+
+    Only the actor's parameters (features, actor layers, action head)
+    are trained for the actions, and only the critic's (value layers and
+    head) for the values; the log standard deviation is left alone.
+
+    Returns
+    -------
+    dict
+        ``action_mse``, ``action_variance`` and, with values,
+        ``value_mse`` and ``value_variance``, on the whole data after the
+        fit.
+    """
+    import torch
+
+    generator = torch.Generator().manual_seed(int(seed))
+    x = torch.as_tensor(obs, dtype=torch.float32)
+    y = torch.as_tensor(actions, dtype=torch.float32).reshape(len(x), -1)
+    policy.set_training_mode(True)
+
+    def mean_of(o):
+        return policy.get_distribution(o).distribution.mean
+
+    actor = [*policy.pi_features_extractor.parameters(),
+             *policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
+    _fit(actor, lambda b: ((mean_of(x[b]) - y[b]) ** 2).mean(), len(x), epochs, batch_size,
+         learning_rate, generator)
+    report = {}
+    with torch.no_grad():
+        report["action_mse"] = float(((mean_of(x) - y) ** 2).mean())
+        report["action_variance"] = float(y.var(unbiased=False))
+    if values is not None:
+        v = torch.as_tensor(values, dtype=torch.float32).reshape(-1, 1)
+        critic = [*policy.mlp_extractor.value_net.parameters(), *policy.value_net.parameters()]
+        if not policy.share_features_extractor:
+            critic += list(policy.vf_features_extractor.parameters())
+        _fit(critic, lambda b: ((policy.predict_values(x[b]) - v[b]) ** 2).mean(), len(x),
+             epochs, batch_size, learning_rate, generator)
+        with torch.no_grad():
+            report["value_mse"] = float(((policy.predict_values(x) - v) ** 2).mean())
+            report["value_variance"] = float(v.var(unbiased=False))
+    policy.set_training_mode(False)
+    return report
+
+
+def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: float,
+             progress: bool = False) -> dict:
+    """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
+    training stack ``env`` from the demonstrations of ``settings["teacher"]``
+    (steps 1-4 of the module's description).
+
+    Returns
+    -------
+    dict
+        The settings, ``decisions``, the fit (:func:`fit_policy`) and
+        ``collect_seconds`` and ``fit_seconds``.
+    """
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    start = time.perf_counter()
+    demos = collect(env_id, env_kwargs, settings["teacher"], settings["episodes"],
+                    settings["seed"], progress=progress)
+    collected = time.perf_counter()
+    obs, scale = demos.obs, 1.0
+    norm = env if isinstance(env, VecNormalize) else None
+    if norm is not None:
+        prime_normalization(norm, demos, gamma)
+        obs = norm.normalize_obs(demos.obs)
+        if norm.norm_reward:
+            scale = float(np.sqrt(norm.ret_rms.var + norm.epsilon))
+    report = fit_policy(model.policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
+                        epochs=settings["epochs"], batch_size=settings["batch_size"],
+                        learning_rate=float(settings["learning_rate"]), seed=settings["seed"])
+    return {**settings, "decisions": len(demos), **report,
+            "collect_seconds": round(collected - start, 1),
+            "fit_seconds": round(time.perf_counter() - collected, 1)}

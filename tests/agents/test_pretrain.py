@@ -1,0 +1,100 @@
+"""The warm start of PPO from a planner's decisions (agents.pretrain)."""
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+from agents import train
+from agents.pretrain import Demonstrations, fit_policy, pretrain_settings
+
+# two episodes of 3 and 2 steps
+DEMOS = Demonstrations(obs=np.zeros((5, 1)), actions=np.zeros((5, 1)),
+                       rewards=[1.0, 2.0, 4.0, 1.0, 3.0],
+                       episode_starts=[True, False, False, True, False])
+
+
+def test_discounted_returns_of_the_demonstrations_exactly():
+    # gamma 0.5: running 1, 2.5, 5.25 | 1, 3.5; to go 1 + 0.5 (2 + 0.5 4) = 3, 4, 4 | 2.5, 3
+    np.testing.assert_allclose(DEMOS.running_returns(0.5), [1.0, 2.5, 5.25, 1.0, 3.5])
+    np.testing.assert_allclose(DEMOS.returns_to_go(0.5), [3.0, 4.0, 4.0, 2.5, 3.0])
+    np.testing.assert_allclose(DEMOS.returns_to_go(0.5, scale=2.0), [1.5, 2.0, 2.0, 1.25, 1.5])
+
+
+@pytest.mark.parametrize("value, message", [
+    ("swath", "must be a mapping"),
+    ({"episodes": 3}, "needs a teacher"),
+    ({"teacher": "swath", "epoch": 3}, r"unknown pretrain settings \['epoch'\]"),
+    ({"teacher": "swath", "episodes": 0}, "episodes must be an integer >= 1"),
+    ({"teacher": "swath", "learning_rate": 0}, "learning_rate must be > 0"),
+])
+def test_bad_settings_are_refused_with_what_is_wrong(value, message):
+    with pytest.raises(ValueError, match=message):
+        pretrain_settings(value)
+
+
+def test_settings_get_their_defaults_and_none_means_no_warm_start():
+    assert pretrain_settings(None) is None and pretrain_settings({}) is None
+    settings = pretrain_settings({"teacher": "swath", "episodes": 3})
+    assert settings["episodes"] == 3 and settings["seed"] == 30000 and settings["epochs"] == 50
+    hp = train.read_hyperparams("ppo", "iceenvs/ShipNavigation-v1",
+                                ["pretrain={teacher: swath, episodes: 2}"])
+    assert hp["pretrain"]["teacher"] == "swath" and hp["pretrain"]["episodes"] == 2
+    assert "pretrain" not in train.read_hyperparams("ppo", "iceenvs/Convergence-v0")
+    assert "pretrain" not in train.read_hyperparams("ppo", "iceenvs/ShipNavigation-v1",
+                                                    ["pretrain=null"])
+    with pytest.raises(ValueError, match="made for ppo, not sac"):
+        train.read_hyperparams("sac", "iceenvs/Convergence-v0", ["pretrain={teacher: zero}"])
+
+
+def test_the_fit_reproduces_a_smooth_teacher_and_leaves_the_noise_alone():
+    """A PPO policy fitted to actions tanh(x·w) and values x·v of 2000
+    random observations: the mean squared errors fall below a tenth of the
+    variances (a constant predictor's error is the variance), and the
+    log standard deviation is untouched."""
+    import torch
+    from stable_baselines3 import PPO
+
+    env = gym.make("Pendulum-v1")
+    model = PPO("MlpPolicy", env, seed=0, device="cpu", policy_kwargs={"log_std_init": -1.0})
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(2000, 3)).astype(np.float32)
+    actions = np.tanh(x @ np.array([[0.8], [-0.5], [0.3]]))
+    values = x @ np.array([2.0, 1.0, -1.0]) + 5.0
+    before = model.policy.log_std.detach().clone()
+    fit = fit_policy(model.policy, x, actions, values, epochs=30, batch_size=128,
+                     learning_rate=3e-3, seed=0)
+    assert fit["action_mse"] < 0.1 * fit["action_variance"]
+    assert fit["value_mse"] < 0.1 * fit["value_variance"]
+    torch.testing.assert_close(model.policy.log_std, before, rtol=0, atol=0)
+    env.close()
+
+
+def test_a_warm_started_run_starts_from_the_planner(tmp_path):
+    """Two episodes of the swath planner on a short field: the run writes
+    pretrain.yaml and its clone before PPO (RUN@0), whose deterministic
+    actions on the planner's own observations are closer to the planner's
+    than the planner's mean action is; the normalisation has seen every
+    decision."""
+    import pickle
+
+    from agents.pretrain import collect
+    from agents.rollouts import TrainedPolicy
+
+    run = tmp_path / "run"
+    env_kwargs = {"control": "course", "swath_frame": "goal", "swath_edge": True,
+                  "course_guard": 150, "goal_distance": 200.0, "length": 500.0}
+    train.main(["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--timesteps", "32",
+                "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
+                "--save-freq", "1000", "--no-progress", "--hyperparams", "n_steps=32",
+                "batch_size=32", "pretrain={teacher: swath, episodes: 2, epochs: 40}",
+                "--env-kwargs", *(f"{k}={v}" for k, v in env_kwargs.items())])
+    report = yaml.safe_load((run / "pretrain.yaml").read_text())
+    assert report["teacher"] == "swath" and report["decisions"] > 50
+    assert report["action_mse"] < report["action_variance"]
+    with open(run / "checkpoints" / "model_vecnormalize_0_steps.pkl", "rb") as fh:
+        assert pickle.load(fh).obs_rms.count >= report["decisions"]
+    demos = collect("iceenvs/ShipNavigation-v1", env_kwargs, "swath", 2, 30000)
+    assert len(demos) == report["decisions"]              # the same episodes again
+    clone = TrainedPolicy(f"{run}", checkpoint=0).predict(demos.obs)[0]
+    error = np.mean((clone - demos.actions) ** 2)
+    assert error < np.mean((demos.actions - demos.actions.mean()) ** 2)
