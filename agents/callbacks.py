@@ -159,7 +159,7 @@ class TimeBudgetCallback(BaseCallback):
             raise ValueError(f"minutes must be a positive number, got {minutes!r}")
         self.seconds = 60.0 * float(minutes)
         self._started = started
-        self._start = started
+        self._start = None
 
     def _on_training_start(self) -> None:
         self._start = time.perf_counter() if self._started is None else self._started

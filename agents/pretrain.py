@@ -93,14 +93,14 @@ class Demonstrations:
     def __len__(self) -> int:
         return len(self.obs)
 
-    def running_returns(self, gamma: float, scale: float = 1.0) -> np.ndarray:
+    def running_returns(self, gamma: float) -> np.ndarray:
         """The discounted return so far at each step, ``R_t = γ R_{t-1} +
-        r_t / scale`` (restarted at each episode): what ``VecNormalize``
-        tracks to scale the rewards."""
+        r_t`` (restarted at each episode): what ``VecNormalize`` tracks to
+        scale the rewards."""
         out = np.empty(len(self))
         running = 0.0
         for t, (r, start) in enumerate(zip(self.rewards, self.episode_starts)):
-            running = (0.0 if start else gamma * running) + r / scale
+            running = (0.0 if start else gamma * running) + r
             out[t] = running
         return out
 
@@ -158,24 +158,18 @@ def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> N
 
 
 def _fit(params, loss_of, n: int, epochs: int, batch_size: int, learning_rate: float,
-         generator) -> float:
-    """Adam on ``loss_of(batch_indices)`` over shuffled batches; the loss
-    of the last epoch (mean over its batches)."""
+         generator) -> None:
+    """Adam on ``loss_of(batch_indices)`` over ``epochs`` passes of shuffled
+    batches."""
     import torch
 
     optimizer = torch.optim.Adam(params, lr=learning_rate)
-    last = float("nan")
     for _ in range(epochs):
-        total, count = 0.0, 0
         for batch in torch.randperm(n, generator=generator).split(batch_size):
             loss = loss_of(batch)
             optimizer.zero_grad()
             loss.backward()
             optimizer.step()
-            total += loss.item() * len(batch)
-            count += len(batch)
-        last = total / count
-    return last
 
 
 def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray | None, *,
