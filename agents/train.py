@@ -226,6 +226,12 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     pretrain = pretrain_settings(hp.get("pretrain"))
     if pretrain is not None and algo != "ppo":
         raise ValueError(f"hyperparameter pretrain: warm starts are made for ppo, not {algo}")
+    if pretrain is not None:
+        from .baselines import baseline_names
+
+        if pretrain["teacher"] not in baseline_names(env_id):
+            raise ValueError(f"hyperparameter pretrain: unknown teacher {pretrain['teacher']!r} "
+                             f"for {env_id}; valid: {', '.join(baseline_names(env_id))}")
     hp.pop("pretrain", None)
     if pretrain is not None:
         hp["pretrain"] = pretrain

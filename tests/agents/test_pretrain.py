@@ -42,6 +42,9 @@ def test_settings_get_their_defaults_and_none_means_no_warm_start():
     assert "pretrain" not in train.read_hyperparams("ppo", "iceenvs/Convergence-v0")
     assert "pretrain" not in train.read_hyperparams("ppo", "iceenvs/ShipNavigation-v1",
                                                     ["pretrain=null"])
+    with pytest.raises(ValueError, match="unknown teacher 'swat' for iceenvs/ShipNavigation-v1; "
+                                         "valid: .*swath"):
+        train.read_hyperparams("ppo", "iceenvs/ShipNavigation-v1", ["pretrain={teacher: swat}"])
     with pytest.raises(ValueError, match="made for ppo, not sac"):
         train.read_hyperparams("sac", "iceenvs/Convergence-v0", ["pretrain={teacher: zero}"])
 
