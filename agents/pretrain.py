@@ -20,6 +20,15 @@ hyperparameter starts PPO from a copy of the planner instead:
 4. **Critic.** The value head is fitted to the discounted returns of the
    planner's episodes (normalised rewards, the run's ``gamma``), so that
    the first advantages of PPO are not those of a random critic.
+5. **Anchor** (optional, ``anchor`` > 0). PPO may drift from the clone
+   towards what pays under its exploration noise rather than on the mean
+   course it is evaluated on. With an anchor, every optimiser step of PPO
+   also descends ``anchor`` × the mean squared distance between the
+   policy's mean action and the planner's on a batch of the
+   demonstrations (:class:`BehaviourAnchor`): PPO's loss gains a
+   behaviour-cloning term, as in demonstration-augmented policy gradients
+   (Rajeswaran et al., 2018). The term's value is logged as
+   ``train/anchor_mse``.
 
 The hyperparameter is a mapping, e.g. in ``agents/hyperparams/ppo.yaml``::
 
@@ -28,6 +37,7 @@ The hyperparameter is a mapping, e.g. in ``agents/hyperparams/ppo.yaml``::
       episodes: 60
       seed: 30000
       epochs: 50
+      anchor: 1.0
 
 ``pretrain.yaml`` in the run directory records the number of decisions,
 the fit of actor and critic and the seconds each part took.
@@ -39,11 +49,11 @@ import time
 import numpy as np
 
 __all__ = ["PRETRAIN_DEFAULTS", "pretrain_settings", "Demonstrations", "collect", "prime_normalization",
-           "fit_policy", "pretrain"]
+           "fit_policy", "BehaviourAnchor", "pretrain"]
 
 #: settings of ``pretrain`` that may be left out
 PRETRAIN_DEFAULTS = {"episodes": 60, "seed": 30000, "epochs": 50, "batch_size": 256,
-                     "learning_rate": 1.0e-3}
+                     "learning_rate": 1.0e-3, "anchor": 0.0}
 
 
 def pretrain_settings(value) -> dict | None:
@@ -76,6 +86,10 @@ def pretrain_settings(value) -> dict | None:
         raise ValueError(f"pretrain seed must be an integer, got {settings['seed']!r}")
     if not float(settings["learning_rate"]) > 0:
         raise ValueError(f"pretrain learning_rate must be > 0, got {settings['learning_rate']!r}")
+    if isinstance(settings["anchor"], bool) or not isinstance(settings["anchor"], (int, float)) \
+            or not settings["anchor"] >= 0:
+        raise ValueError(f"pretrain anchor must be a number >= 0, got {settings['anchor']!r}")
+    settings["anchor"] = float(settings["anchor"])
     return settings
 
 
@@ -221,11 +235,76 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     return report
 
 
+class BehaviourAnchor:
+    """Add ``coef`` × the gradient of the behaviour-cloning loss to the
+    gradients of ``model.policy`` before each step of its optimiser.
+
+    The loss is the mean squared distance between the policy's mean
+    action and the teacher's on ``batch_size`` demonstrations drawn
+    (seeded by ``seed``) at each step; their raw observations are
+    normalised with ``normalizer`` (a ``VecNormalize`` or ``None``) at
+    its current statistics. The hook is registered on the optimiser, so
+    it acts on every step of ``model.train()`` and on nothing that is
+    saved; :meth:`remove` takes it off.
+
+    Attributes
+    ----------
+    mse : float
+        The mean of the loss over the steps since the last rollout
+        (``nan`` before the first), also recorded in the model's logger
+        as ``train/anchor_mse``.
+    """
+
+    def __init__(self, model, demos: Demonstrations, normalizer, coef: float, batch_size: int,
+                 seed: int):
+        if not coef > 0:
+            raise ValueError(f"anchor coefficient must be > 0, got {coef!r}")
+        self.model, self.demos, self.normalizer = model, demos, normalizer
+        self.coef, self.batch_size = float(coef), int(batch_size)
+        self.rng = np.random.default_rng(seed)
+        self.mse = float("nan")
+        self._sum, self._count, self._timesteps = 0.0, 0, None
+        self._handle = model.policy.optimizer.register_step_pre_hook(self._before_step)
+
+    def loss(self):
+        """The behaviour-cloning loss on a fresh batch (a torch scalar)."""
+        import torch
+
+        idx = self.rng.integers(len(self.demos), size=min(self.batch_size, len(self.demos)))
+        obs = self.demos.obs[idx]
+        if self.normalizer is not None and self.normalizer.norm_obs:
+            obs = self.normalizer.normalize_obs(obs)
+        policy = self.model.policy
+        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        y = torch.as_tensor(self.demos.actions[idx]).reshape(len(idx), -1)
+        return ((policy.get_distribution(x).distribution.mean - y) ** 2).mean()
+
+    def _before_step(self, optimizer, args, kwargs) -> None:
+        import torch
+
+        with torch.enable_grad():
+            loss = self.loss()
+            (self.coef * loss).backward()
+        if self._timesteps != self.model.num_timesteps:   # a new update
+            self._sum, self._count, self._timesteps = 0.0, 0, self.model.num_timesteps
+        self._sum += float(loss.detach())
+        self._count += 1
+        self.mse = self._sum / self._count
+        self.model.logger.record("train/anchor_mse", self.mse)
+
+    def remove(self) -> None:
+        """Stop adding the term."""
+        self._handle.remove()
+
+
 def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: float,
              progress: bool = False) -> dict:
     """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
     training stack ``env`` from the demonstrations of ``settings["teacher"]``
     (steps 1-4 of the module's description).
+
+    With ``settings["anchor"]`` > 0, a :class:`BehaviourAnchor` on the
+    same demonstrations is left on the model's optimiser for PPO.
 
     Returns
     -------
@@ -249,6 +328,9 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
     report = fit_policy(model.policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
                         epochs=settings["epochs"], batch_size=settings["batch_size"],
                         learning_rate=float(settings["learning_rate"]), seed=settings["seed"])
+    if settings["anchor"] > 0:
+        BehaviourAnchor(model, demos, norm, settings["anchor"], settings["batch_size"],
+                        seed=settings["seed"] + 1)
     return {**settings, "decisions": len(demos), **report,
             "collect_seconds": round(collected - start, 1),
             "fit_seconds": round(time.perf_counter() - collected, 1)}

@@ -26,6 +26,8 @@ def test_discounted_returns_of_the_demonstrations_exactly():
     ({"teacher": "swath", "epoch": 3}, r"unknown pretrain settings \['epoch'\]"),
     ({"teacher": "swath", "episodes": 0}, "episodes must be an integer >= 1"),
     ({"teacher": "swath", "learning_rate": 0}, "learning_rate must be > 0"),
+    ({"teacher": "swath", "anchor": -1.0}, "anchor must be a number >= 0"),
+    ({"teacher": "swath", "anchor": "strong"}, "anchor must be a number >= 0"),
 ])
 def test_bad_settings_are_refused_with_what_is_wrong(value, message):
     with pytest.raises(ValueError, match=message):
@@ -36,6 +38,7 @@ def test_settings_get_their_defaults_and_none_means_no_warm_start():
     assert pretrain_settings(None) is None and pretrain_settings({}) is None
     settings = pretrain_settings({"teacher": "swath", "episodes": 3})
     assert settings["episodes"] == 3 and settings["seed"] == 30000 and settings["epochs"] == 50
+    assert settings["anchor"] == 0.0
     hp = train.read_hyperparams("ppo", "iceenvs/ShipNavigation-v1",
                                 ["pretrain={teacher: swath, episodes: 2}"])
     assert hp["pretrain"]["teacher"] == "swath" and hp["pretrain"]["episodes"] == 2
@@ -72,12 +75,64 @@ def test_the_fit_reproduces_a_smooth_teacher_and_leaves_the_noise_alone():
     env.close()
 
 
+def _anchor_run(coef: float | None):
+    """PPO on Pendulum (learning rate 1e-2, 4 updates of 10 steps) with or
+    without an anchor to the teacher a = 0.5; returns the policy's mean
+    squared distance to the teacher before and after, and the model."""
+    import torch
+    from stable_baselines3 import PPO
+
+    from agents.pretrain import BehaviourAnchor
+
+    env = gym.make("Pendulum-v1")
+    model = PPO("MlpPolicy", env, seed=0, device="cpu", n_steps=64, batch_size=64,
+                learning_rate=1e-2)
+    rng = np.random.default_rng(1)
+    obs = np.column_stack([np.cos(th := rng.uniform(-np.pi, np.pi, 500)), np.sin(th),
+                           rng.uniform(-8, 8, 500)]).astype(np.float32)
+    demos = Demonstrations(obs, np.full((500, 1), 0.5), np.zeros(500), np.zeros(500, bool))
+
+    def distance():
+        with torch.no_grad():
+            mean = model.policy.get_distribution(torch.as_tensor(obs)).distribution.mean
+        return float(((mean - 0.5) ** 2).mean())
+
+    before = distance()
+    anchor = None if coef is None else BehaviourAnchor(model, demos, None, coef, 128, seed=0)
+    model.learn(256)
+    env.close()
+    return before, distance(), model, anchor
+
+
+def test_an_anchor_holds_ppo_to_the_teacher():
+    """With a strong anchor (coefficient 100) every PPO step also pulls the
+    mean action towards the teacher's: after 40 steps it is within a fifth
+    of the starting squared distance; PPO alone (the same seed) is not.
+    The term is logged, and once removed it no longer acts."""
+    start, free, _, _ = _anchor_run(None)
+    start_anchored, anchored, model, anchor = _anchor_run(100.0)
+    assert start_anchored == pytest.approx(start, rel=1e-6)       # the same initial policy
+    assert anchored < 0.2 * start < free
+    assert 0 <= anchor.mse < start
+    assert model.logger.name_to_value["train/anchor_mse"] == anchor.mse
+    anchor.remove()
+    params = [p.detach().clone() for p in model.policy.action_net.parameters()]
+    model.policy.optimizer.zero_grad()
+    for p in model.policy.parameters():
+        p.grad = None
+    model.policy.optimizer.step()          # no gradient and no anchor: nothing moves
+    for p, q in zip(model.policy.action_net.parameters(), params):
+        assert bool((p.detach() == q).all())
+    with pytest.raises(ValueError, match="must be > 0"):
+        type(anchor)(model, anchor.demos, None, 0.0, 128, seed=0)
+
+
 def test_a_warm_started_run_starts_from_the_planner(tmp_path):
     """Two episodes of the swath planner on a short field: the run writes
     pretrain.yaml and its clone before PPO (RUN@0), whose deterministic
     actions on the planner's own observations are closer to the planner's
     than the planner's mean action is; the normalisation has seen every
-    decision."""
+    decision. PPO trains on with the anchor (one update)."""
     import pickle
 
     from agents.pretrain import collect
@@ -89,10 +144,10 @@ def test_a_warm_started_run_starts_from_the_planner(tmp_path):
     train.main(["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--timesteps", "32",
                 "--n-envs", "1", "--seed", "1", "--out", str(run), "--eval-freq", "0",
                 "--save-freq", "1000", "--no-progress", "--hyperparams", "n_steps=32",
-                "batch_size=32", "pretrain={teacher: swath, episodes: 2, epochs: 40}",
+                "batch_size=32", "pretrain={teacher: swath, episodes: 2, epochs: 40, anchor: 1.0}",
                 "--env-kwargs", *(f"{k}={v}" for k, v in env_kwargs.items())])
     report = yaml.safe_load((run / "pretrain.yaml").read_text())
-    assert report["teacher"] == "swath" and report["decisions"] > 50
+    assert report["teacher"] == "swath" and report["decisions"] > 50 and report["anchor"] == 1.0
     assert report["action_mse"] < report["action_variance"]
     with open(run / "checkpoints" / "model_vecnormalize_0_steps.pkl", "rb") as fh:
         assert pickle.load(fh).obs_rms.count >= report["decisions"]
