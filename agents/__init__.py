@@ -22,7 +22,8 @@ metrics, progress bar), :mod:`agents.envs` (vectorised environments,
 ``--env-kwargs`` parsing and checking),
 :mod:`agents.metrics` (the physics entries each task logs, read from its
 facts), :mod:`agents.pretrain` (a warm start of PPO from a planner's
-decisions, the ``pretrain`` hyperparameter) and the hyperparameter tables
+decisions and an anchor to them in PPO's loss, the ``pretrain``
+hyperparameter) and the hyperparameter tables
 ``agents/hyperparams/{ppo,sac}.yaml`` (a ``default`` entry, and an entry
 per id only where the id needs one).
 

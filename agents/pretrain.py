@@ -244,8 +244,9 @@ class BehaviourAnchor:
     (seeded by ``seed``) at each step; their raw observations are
     normalised with ``normalizer`` (a ``VecNormalize`` or ``None``) at
     its current statistics. The hook is registered on the optimiser, so
-    it acts on every step of ``model.train()`` and on nothing that is
-    saved; :meth:`remove` takes it off.
+    it acts on every step of ``model.train()`` (after PPO has clipped its
+    own gradient) and on nothing that is saved; :meth:`remove` takes it
+    off.
 
     Attributes
     ----------
@@ -301,7 +302,7 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
              progress: bool = False) -> dict:
     """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
     training stack ``env`` from the demonstrations of ``settings["teacher"]``
-    (steps 1-4 of the module's description).
+    (steps 1-5 of the module's description).
 
     With ``settings["anchor"]`` > 0, a :class:`BehaviourAnchor` on the
     same demonstrations is left on the model's optimiser for PPO.
