@@ -171,11 +171,12 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       A = 0.2-0.5 and beats its return by 14-29 at every concentration.
       The docs' page "Ship navigation: does route choice pay?" gives the
       measured leaderboard, the variants and PPO (which, started from a
-      clone of the swath planner and trained for an hour commanding
-      courses with `course_guard=150`, never leaves the channel, meets
-      0.77-0.90 times the straight line's ice and beats its return by
-      more than two standard errors over the 80 fields of A = 0.2-0.5,
-      but not the planners).
+      clone of the swath planner, anchored to its decisions and trained
+      for an hour commanding courses with `course_guard=150`, never
+      leaves the channel, meets 0.76-0.97 times the straight line's ice,
+      less by more than two standard errors over the 80 fields of
+      A = 0.2-0.5, and returns more by 1.6 standard errors; it loses to
+      the planners).
     * *What a good policy does:* reads the ice ahead and steers for leads
       and the open water between the large floes, in gentle turns (a
       turning hull sweeps its sides through the ice).
