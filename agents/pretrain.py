@@ -171,6 +171,13 @@ def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> N
         vec_normalize.ret_rms.update(demos.running_returns(gamma))
 
 
+def _action_mse(policy, obs, actions):
+    """The mean squared distance between the mean action of an SB3
+    policy's distribution on ``obs`` and ``actions`` (torch tensors of
+    the same leading length; a torch scalar)."""
+    return ((policy.get_distribution(obs).distribution.mean - actions) ** 2).mean()
+
+
 def _fit(params, loss_of, n: int, epochs: int, batch_size: int, learning_rate: float,
          generator) -> None:
     """Adam on ``loss_of(batch_indices)`` over ``epochs`` passes of shuffled
@@ -210,16 +217,13 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     y = torch.as_tensor(actions, dtype=torch.float32).reshape(len(x), -1)
     policy.set_training_mode(True)
 
-    def mean_of(o):
-        return policy.get_distribution(o).distribution.mean
-
     actor = [*policy.pi_features_extractor.parameters(),
              *policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
-    _fit(actor, lambda b: ((mean_of(x[b]) - y[b]) ** 2).mean(), len(x), epochs, batch_size,
+    _fit(actor, lambda b: _action_mse(policy, x[b], y[b]), len(x), epochs, batch_size,
          learning_rate, generator)
     report = {}
     with torch.no_grad():
-        report["action_mse"] = float(((mean_of(x) - y) ** 2).mean())
+        report["action_mse"] = float(_action_mse(policy, x, y))
         report["action_variance"] = float(y.var(unbiased=False))
     if values is not None:
         v = torch.as_tensor(values, dtype=torch.float32).reshape(-1, 1)
@@ -273,12 +277,11 @@ class BehaviourAnchor:
 
         idx = self.rng.integers(len(self.demos), size=min(self.batch_size, len(self.demos)))
         obs = self.demos.obs[idx]
-        if self.normalizer is not None and self.normalizer.norm_obs:
+        if self.normalizer is not None:
             obs = self.normalizer.normalize_obs(obs)
-        policy = self.model.policy
         x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
         y = torch.as_tensor(self.demos.actions[idx]).reshape(len(idx), -1)
-        return ((policy.get_distribution(x).distribution.mean - y) ** 2).mean()
+        return _action_mse(self.model.policy, x, y)
 
     def _before_step(self, optimizer, args, kwargs) -> None:
         import torch

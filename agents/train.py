@@ -223,17 +223,16 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
                              f"{hp.get(key)!r}")
     from .pretrain import pretrain_settings
 
-    pretrain = pretrain_settings(hp.get("pretrain"))
-    if pretrain is not None and algo != "ppo":
-        raise ValueError(f"hyperparameter pretrain: warm starts are made for ppo, not {algo}")
+    pretrain = pretrain_settings(hp.pop("pretrain", None))
     if pretrain is not None:
         from .baselines import baseline_names
 
-        if pretrain["teacher"] not in baseline_names(env_id):
+        if algo != "ppo":
+            raise ValueError(f"hyperparameter pretrain: warm starts are made for ppo, not {algo}")
+        teachers = baseline_names(env_id)
+        if pretrain["teacher"] not in teachers:
             raise ValueError(f"hyperparameter pretrain: unknown teacher {pretrain['teacher']!r} "
-                             f"for {env_id}; valid: {', '.join(baseline_names(env_id))}")
-    hp.pop("pretrain", None)
-    if pretrain is not None:
+                             f"for {env_id}; valid: {', '.join(teachers)}")
         hp["pretrain"] = pretrain
     hp.setdefault("policy", "MlpPolicy")
     hp.setdefault("env_kwargs", {})
