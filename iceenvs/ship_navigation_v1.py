@@ -171,12 +171,13 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       A = 0.2-0.5 and beats its return by 14-29 at every concentration.
       The docs' page "Ship navigation: does route choice pay?" gives the
       measured leaderboard, the variants and PPO (which, started from a
-      clone of the swath planner, anchored to its decisions and trained
-      for an hour commanding courses with `course_guard=150`, never
-      leaves the channel, meets 0.76-0.97 times the straight line's ice,
-      less by more than two standard errors over the 80 fields of
-      A = 0.2-0.5, and returns more by 1.6 standard errors; it loses to
-      the planners).
+      clone of the swath planner, anchored to its decisions, with a limit
+      on the size of its updates and trained for an hour commanding
+      courses with `course_guard=150`, never leaves the channel, meets
+      0.79-0.89 times the straight line's ice and returns more, both by
+      more than two standard errors over the leaderboard's 80 fields of
+      A = 0.2-0.5, by less on 40 other fields; it loses to the planners
+      and to its start).
     * *What a good policy does:* reads the ice ahead and steers for leads
       and the open water between the large floes, in gentle turns (a
       turning hull sweeps its sides through the ice).
