@@ -29,11 +29,11 @@ suite (N = 20000, Herman (2013) material table, at rest in its own state): the
 kick–drift pass, the pair loop, both, and a Verlet-list rebuild, with the
 serial kernels, the parallel kernels on one thread and on all threads taking
 turns in five rounds. Each phase is timed as a parallel region of its own, as
-a box with walls runs it (the step of a periodic box runs the kick–drift pass
-and the pair loop in one team of threads). The kick–drift pass is timed with
+the step runs it. The kick–drift pass is timed with
 Δt = 0: the same work as a real step, but the state stays as it is, so that
-every pass is alike and no list rebuild is due. Times are medians of the
-rounds; the speed-ups over the serial kernels are those of one round.
+every pass is alike and no list rebuild is due. The parallel kernels run in
+the chunks of the step (a number that depends on N alone). Times are medians of
+the rounds; the speed-ups over the serial kernels are those of one round.
 """
 #: sizes of ``--quick``
 QUICK = dict(floes=400, passes=5)
@@ -62,8 +62,8 @@ def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, chunks, floes, law
     for _ in range(passes):
         if kick:
             if parallel:
-                res = K.first_half_parallel(n_threads * K.KICK_TASKS_PER_THREAD, floes, buffers,
-                                            chunks.shared, ref, drive, step)
+                res = K.first_half_parallel(chunks.bounds.shape[0] - 1, floes, buffers, chunks,
+                                            ref, drive, step)
             else:
                 res = K.first_half(K.floe_rows(floes, 0, n, buffers), ref, drive, step)
             total += res[0] + res[1] + res[2] + res[3]
@@ -72,7 +72,7 @@ def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, chunks, floes, law
                 K.pair_forces_parallel(chunks, floes, law, box, verlet, dt, buffers)
             else:
                 K.owner_pairs(0, chunks.owners.shape[0], chunks.owners, floes, law, box, verlet,
-                              dt, fbuf[0], tbuf[0], 0, n, fbuf[0], tbuf[0])
+                              dt, fbuf, tbuf)
     return total
 
 
@@ -103,10 +103,10 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
         floes = f._replace(pos=f.pos.copy(), vel=f.vel.copy(), omega=f.omega.copy())
         verlet = v._replace(hist=v.hist.copy(), ref=v.ref.copy())
         return (K.pair_chunks(verlet, n_chunks), floes, sim._law, box, verlet,
-                K.force_buffers(n_chunks, sim.n_floes), verlet.ref, sim._drive())
+                K.force_buffers(sim.n_floes), verlet.ref, sim._drive())
 
     configs = kernel_configs(threads_all)
-    data = [arrays(threads if parallel else 1) for _, parallel, threads in configs]
+    data = [arrays(sim.n_chunks if parallel else 1) for _, parallel, threads in configs]
 
     def run(k, phase, count):
         _, parallel, threads = configs[k]

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+from contextlib import contextmanager
 
 import numba
 import numpy as np
@@ -43,7 +45,42 @@ from .params import ContactParams, PaperPreset
 from .progress import steps_with_bar
 from .ship import Ship, ShipLoads, ShipState
 
-__all__ = ["HertzSimulation", "Contacts", "minimum_contact_time"]
+__all__ = ["HertzSimulation", "Contacts", "minimum_contact_time", "usable_cores"]
+
+#: the smallest field that runs the parallel step by default
+PARALLEL_FROM = 5000
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system
+    tells it, else the machine's count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:          # not on Linux
+        return os.cpu_count() or 1
+
+
+@contextmanager
+def threads_within_cores(active: bool = True):
+    """Run the block on at most :func:`usable_cores` of Numba's threads.
+
+    More threads than cores (a pool sized for another machine, or
+    ``NUMBA_NUM_THREADS`` set high on a shared host) only add waiting: at
+    the end of each parallel region every thread waits for the slowest, and
+    a thread that has no core of its own is the slowest by a whole time
+    slice of the system's scheduler. The results do not change, since the
+    parallel step's chunks do not depend on the threads
+    (:func:`physics.hertz_kernels.chunk_count`)."""
+    threads = numba.get_num_threads() if active else 0
+    cores = usable_cores() if active else 0
+    if threads <= cores:
+        yield
+        return
+    numba.set_num_threads(cores)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(threads)
 
 
 def minimum_contact_time(radius, thickness, density, contact: ContactParams, speed: float,
@@ -124,7 +161,10 @@ class HertzSimulation(FloeProperties):
         Verlet-list skin [m] (default 0.1 × the mean radius).
     parallel : bool, optional
         Use the multi-threaded kernels (default: when N ≥ 5000 and Numba has
-        more than one thread). Both paths give the same result to rounding.
+        more than one thread). Both paths give the same result to rounding;
+        the parallel one gives the same state bit for bit on any number of
+        threads (its chunks, :attr:`n_chunks`, depend on N alone). It runs
+        on at most as many threads as the process has cores.
     allow_overlap : bool
         Accept initial overlaps above 1 % of the smaller radius (e.g. when
         restoring a saved, compressed state).
@@ -209,8 +249,12 @@ class HertzSimulation(FloeProperties):
         # neighbour-list sizing
         self.skin, self.max_cut = neighbour_cut(f.radii, box, skin)
         if parallel is None:
-            parallel = n >= 5000 and numba.get_num_threads() > 1 and not skip_resting
+            parallel = n >= PARALLEL_FROM and numba.get_num_threads() > 1 and not skip_resting
         self.parallel = bool(parallel)
+        #: chunks of the parallel step (:func:`physics.hertz_kernels.chunk_count`):
+        #: a function of N alone, so that the new state does not depend on
+        #: the number of threads
+        self.n_chunks = int(K.chunk_count(n))
 
         # positions inside the box; walls must not cut floes deeply
         self._pos = positions_in_box(f, box, allow_overlap)
@@ -367,9 +411,10 @@ class HertzSimulation(FloeProperties):
                 done, status, nreb, self._verlet, self.n_awake = run_steps_resting(
                     args[0], self.dt, self.time, *args[1:6], self._verlet, args[6])
             else:
-                done, status, nreb, self._verlet = K.run_steps(
-                    args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
-                    numba.get_num_threads(), args[6])
+                with threads_within_cores(self.parallel):
+                    done, status, nreb, self._verlet = K.run_steps(
+                        args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
+                        self.n_chunks, args[6])
             left = self._after_run(done, status, nreb, left)
         self._check_status(HertzStatus(status))
 
@@ -704,7 +749,8 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         time = np.array([sims[k].time for k in todo])
         resting = np.array([sims[k].skip_resting for k in todo])
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
-        run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
+        with threads_within_cores():
+            run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
         for m, k in enumerate(todo):
             if nreb[m]:                     # a rebuilt list (reading an item costs 10 µs)
                 sims[k]._verlet = verlets[m]

@@ -6,28 +6,27 @@ kernels run them over all pairs or floes, each in a serial and a parallel
 
 * serial pair loop: one pass over the Verlet list, the force of a pair is
   added to i and subtracted from j at once (a scatter);
-* parallel pair loop: the owners of the list are split into as many chunks
-  as there are threads, with equal numbers of pairs. The owners of chunk c
-  lie in a range of floe numbers of their own (:func:`chunk_range`; the
-  ranges of the chunks cut 0 … N−1 into consecutive pieces): a chunk adds
-  the forces of floes in its range straight to the shared buffer
-  (``fbuf[0]``, ``tbuf[0]``), which no other chunk writes there, and those
-  of partners outside it to its private buffer (``fbuf[c + 1]``,
-  ``tbuf[c + 1]``). So no two chunks ever write the same memory. The
-  private buffers are added per floe at the start of the next step, just
-  before the kick and drift of the same floes (:func:`gather_buffers`).
-  When the floes are numbered in space
-  (:func:`physics.floes.spatial_order`) partners are mostly in the same
-  range, the private buffers hold only the floes along the cuts, and the
-  threads share little memory.
+* parallel pair loop: the owners of the list are split into chunks with
+  equal numbers of pairs (:func:`pair_chunks`). The owners of chunk c lie
+  in a range of floe numbers of their own (:func:`chunk_range`; the ranges
+  of the chunks cut 0 … N−1 into consecutive pieces): a chunk adds the
+  forces of floes in its range straight to the force buffer, which no
+  other chunk writes there. A pair whose partner lies outside the range (a
+  *cut* pair) writes the partner's share to a slot of its own instead, and
+  the slots are added to their floes, in the order of the chunks, at the
+  start of the next step, just before the kick and drift of the same floes
+  (:func:`gather_cut`). So no two chunks ever write the same memory. When
+  the floes are numbered in space (:func:`physics.floes.spatial_order`),
+  partners are mostly in the same range and only the pairs along the cuts
+  between the chunks' patches have slots.
 
-In a periodic box the parallel step runs as a team of threads
-(:func:`team_steps`, :mod:`physics.thread_team`) that stays in one parallel
-region from one list rebuild to the next and meets at spin barriers between
-the kick–drift pass and the pair loop, instead of starting a parallel region
-for each (1–2.5 µs each on two threads). Boxes with walls use the kernels
-:func:`first_half_parallel`, :func:`wall_forces_parallel` and
-:func:`pair_forces_parallel`, one region each.
+The number of chunks is a function of N alone (:func:`chunk_count`), not of
+the number of threads: every sum is taken in the same order whatever thread
+runs which chunk, and the new state is the same bit for bit on any number of
+threads. The parallel step runs each phase (the kick–drift pass, the wall
+forces, the pair loop) as one parallel region (``prange``) over the chunks,
+which the threading layer hands out in the same consecutive blocks every
+step.
 
 Step (LAMMPS ``fix nve/sphere`` order): half kick with F(t) → drift →
 affine remap of a deforming box → drag and wall forces (they need only the
@@ -40,8 +39,8 @@ plain structures: reading a field costs nothing): the floes
 (:class:`~physics.contact.ContactLaw`), the box
 (:class:`~physics.domain.KernelBox`), the Verlet list (:class:`VerletList`)
 and, inside a run, the one kick–drift pass (:class:`Kick`), the chunks of
-the parallel pair loop (:class:`PairChunks`), the force buffers
-(:class:`ForceBuffers`) and the thread team (:class:`Team`). The arrays of
+the parallel pair loop (:class:`PairChunks`) and the force buffer
+(:class:`ForceBuffers`). The arrays of
 a bundle are shared, not copied: a kernel that writes into them changes the
 caller's state.
 
@@ -64,11 +63,9 @@ from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
 from .domain import box_lengths_at, minimum_image
-from .hull_contact import (ShipBundle, hull_forces, ship_closing_kick, ship_floe_skins,
+from .hull_contact import (hull_forces, ship_closing_kick, ship_floe_skins,
                            ship_kick_drift)
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
-from .thread_team import (claim, overtaken, sync_size, take_token, task_done, task_order,
-                          wait_generation)
 
 
 class HertzStatus(IntEnum):
@@ -92,8 +89,6 @@ _NON_FINITE = int(HertzStatus.NON_FINITE)
 _CONCENTRATION_LIMIT = int(HertzStatus.CONCENTRATION_LIMIT)
 _UNSTABLE = int(HertzStatus.UNSTABLE)
 _SHIP_LOG_FULL = int(HertzStatus.SHIP_LOG_FULL)
-# why a team run (team_steps) returned early: the Verlet list must be rebuilt
-TEAM_ALL_DONE, TEAM_REBUILD = 0, 1
 
 
 class Floes(NamedTuple):
@@ -205,50 +200,42 @@ class Kick(NamedTuple):
 
 
 class PairChunks(NamedTuple):
-    """The chunks of the parallel pair loop (:func:`pair_chunks`)."""
+    """The chunks of the parallel pair loop (:func:`pair_chunks`) and the
+    cut pairs' slots (see the module docstring)."""
 
     #: floes that own pairs
     owners: np.ndarray
     #: chunk c is owners[bounds[c]:bounds[c + 1]]
     bounds: np.ndarray
-    #: the floes the chunks can write to their private buffers (:func:`scatter_floes`)
+    #: (M,) the slot (row of ``cut``) of each pair of the list whose partner
+    #: lies outside its chunk's range, −1 for the others
+    slot: np.ndarray
+    #: (S, 3) the partner's force (x, y) and torque of each cut pair, written
+    #: by the pair loop and added to the partner (then zeroed) by :func:`gather_cut`
+    cut: np.ndarray
+    #: the floes that are partners of cut pairs, in increasing order
     shared: np.ndarray
+    #: (len(shared) + 1,) the slots of floe shared[k] are gather[first[k]:first[k + 1]]
+    first: np.ndarray
+    #: slots per shared floe, each floe's in increasing order (= chunk order)
+    gather: np.ndarray
 
 
 class ForceBuffers(NamedTuple):
-    """Buffer 0 (shared) and one private buffer per chunk of the pair loop
-    (:func:`force_buffers`)."""
+    """The force buffer of a run (:func:`force_buffers`): the pair loop
+    adds to it, the kick–drift pass kicks with it."""
 
-    #: (B, N, 2) forces [N]
+    #: (N, 2) forces [N]
     force: np.ndarray
-    #: (B, N) torques [N m]
+    #: (N,) torques [N m]
     torque: np.ndarray
 
 
-class Team(NamedTuple):
-    """The thread team of :func:`team_steps` (:mod:`physics.thread_team`)."""
-
-    n_threads: int
-    #: tasks of the kick–drift phase
-    n_kick: int
-    #: sync arrays of the kick–drift and pair phases, and of the ship's
-    #: phase between them (one task, :func:`ship_after_kick`)
-    sync_kick: np.ndarray
-    sync_pair: np.ndarray
-    sync_ship: np.ndarray
-    #: (n_kick, 4) partial results of the kick pass
-    part: np.ndarray
-    #: (2,) results of the ship's phase: largest squared displacement,
-    #: 1 if the ship's collision log is full (else 0)
-    ship_out: np.ndarray
-    #: (steps done, status, reason, centre x, centre y, log full) of the run
-    out: np.ndarray
-
 N_CHUNKS = 64   # chunks of the parallel wall-force loop
-# tasks per thread of the parallel kick–drift pass: in the thread team
-# (team_steps) a thread that is done with its own tasks takes over the last
-# ones of a slower thread
-KICK_TASKS_PER_THREAD = 2
+#: floes per chunk of the parallel step (:func:`chunk_count`)
+FLOES_PER_CHUNK = 1024
+#: most chunks of the parallel step
+MAX_CHUNKS = 1024
 
 
 # ---------------------------------------------------------------------------
@@ -493,12 +480,13 @@ def listed_pair(p, j, dx, dy, vxi, vyi, wi, ri, imi, floes, law, hist, dt_histor
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, torque, j_lo, j_hi,
-                force_out, torque_out, path=None, due=None):
+def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, torque,
+                slot=None, cut=None, path=None, due=None):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
-    both floes of its pair at once (a scatter into ``force``, ``torque``;
-    for a partner j outside j_lo ≤ j < j_hi into ``force_out``,
-    ``torque_out`` instead).
+    both floes of its pair at once (a scatter into ``force``, ``torque``).
+    With the ``slot`` of each pair (:class:`PairChunks`), the partner's
+    share of a pair p with slot[p] ≥ 0 goes to row slot[p] of ``cut``
+    instead.
 
     Only floes that touch are written: in loose ice most listed pairs are
     apart, and a write of zero would still claim the cache line for this
@@ -537,14 +525,15 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
                 fxi += res[1]
                 fyi += res[2]
                 tqi += res[3]
-                if j_lo <= j < j_hi:
+                if slot is None or slot[p] < 0:
                     force[j, 0] -= res[1]
                     force[j, 1] -= res[2]
                     torque[j] += res[4]
                 else:
-                    force_out[j, 0] -= res[1]
-                    force_out[j, 1] -= res[2]
-                    torque_out[j] += res[4]
+                    q = slot[p]
+                    cut[q, 0] = -res[1]
+                    cut[q, 1] = -res[2]
+                    cut[q, 2] = res[4]
         if fxi != 0.0 or fyi != 0.0 or tqi != 0.0:
             force[i, 0] += fxi
             force[i, 1] += fyi
@@ -561,8 +550,7 @@ def forces_serial(floes, law, wall_law, drive, box, verlet, dt_history, force, t
         wall_forces(0, n, floes, wall_law, box, dt_history, force, torque)
     start = verlet.start
     owners = np.nonzero(start[1:] > start[:-1])[0]
-    owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt_history, force, torque, 0,
-                n, force, torque)
+    owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt_history, force, torque)
 
 
 @njit(cache=True, error_model="numpy")
@@ -596,60 +584,75 @@ def chunk_range(c, owners, bounds, n):
 
 
 @njit(cache=True, error_model="numpy")
-def scatter_floes(owners, bounds, start, nbr, n):
-    """The floes, in increasing order, that the chunks of
-    :func:`owner_chunks` can write to their private buffers (partners
-    outside the chunk's :func:`chunk_range`): only these floes can have
-    non-zero entries in fbuf[1:], tbuf[1:] that the next kick must add up.
-    With the floes numbered in space they are the few along the cuts
-    between the ranges; the kick does not look at the private buffers of
-    the others at all."""
-    mask = np.zeros(n, dtype=np.uint8)
-    for c in range(bounds.shape[0] - 1):
+def chunk_count(n):
+    """Chunks of the parallel step of N floes: the largest power of two
+    not above N / :data:`FLOES_PER_CHUNK`, at least 1 and at most
+    :data:`MAX_CHUNKS`. A function of N alone, so that the order of every
+    sum, and so the new state bit for bit, does not depend on the number
+    of threads; a power of two, so that 2, 4, 8, ... threads share the
+    chunks evenly."""
+    c = 1
+    while 2 * c * FLOES_PER_CHUNK <= n and 2 * c <= MAX_CHUNKS:
+        c *= 2
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def pair_chunks(verlet, n_chunks):
+    """The list's owners cut into ``n_chunks`` chunks of the parallel pair
+    loop (:func:`owner_chunks`) and a slot for each pair whose partner lies
+    outside its chunk's :func:`chunk_range` (a cut pair), numbered in the
+    order of the list. ``first`` and ``gather`` list each partner's slots
+    in that order, which is the order of the chunks: :func:`gather_cut`
+    adds them up in the same order whatever thread ran which chunk. With
+    the floes numbered in space only the pairs across the boundaries
+    between the chunks' patches are cut."""
+    start, nbr = verlet.start, verlet.nbr
+    n = start.shape[0] - 1
+    owners, bounds = owner_chunks(start, n_chunks)
+    slot = np.full(nbr.shape[0], -1, dtype=np.int64)
+    count = np.zeros(n, dtype=np.int64)
+    n_slots = 0
+    for c in range(n_chunks):
         lo, hi = chunk_range(c, owners, bounds, n)
         for k in range(bounds[c], bounds[c + 1]):
             i = owners[k]
             for p in range(start[i], start[i + 1]):
                 j = nbr[p]
                 if j < lo or j >= hi:
-                    mask[j] = 1
-    return np.nonzero(mask)[0]
-
-
-@njit(cache=True, error_model="numpy")
-def pair_chunks(verlet, n_chunks):
-    """The list's owners cut into ``n_chunks`` chunks of the parallel pair
-    loop (:func:`owner_chunks`) with the floes they can write to their
-    private buffers (:func:`scatter_floes`)."""
-    owners, bounds = owner_chunks(verlet.start, n_chunks)
-    shared = scatter_floes(owners, bounds, verlet.start, verlet.nbr, verlet.start.shape[0] - 1)
-    return PairChunks(owners, bounds, shared)
+                    slot[p] = n_slots
+                    n_slots += 1
+                    count[j] += 1
+    shared = np.nonzero(count)[0]
+    first = np.zeros(shared.shape[0] + 1, dtype=np.int64)
+    at = np.zeros(n, dtype=np.int64)
+    for k in range(shared.shape[0]):
+        first[k + 1] = first[k] + count[shared[k]]
+        at[shared[k]] = first[k]
+    gather = np.empty(n_slots, dtype=np.int64)
+    for p in range(nbr.shape[0]):           # slots increase with p
+        if slot[p] >= 0:
+            j = nbr[p]
+            gather[at[j]] = slot[p]
+            at[j] += 1
+    return PairChunks(owners, bounds, slot, np.zeros((n_slots, 3)), shared, first, gather)
 
 
 @njit(cache=True, error_model="numpy")
 def pair_task(k, chunks, floes, law, box, verlet, dt_history, buffers):
-    """Chunk k of the parallel pair loop (:func:`pair_forces_parallel`, a
-    task of :func:`team_member`): :func:`owner_pairs` over the k-th run of
-    owners of :func:`owner_chunks`, into the shared buffers fbuf[0],
-    tbuf[0] for the floes of its :func:`chunk_range` and into its private
-    buffers fbuf[k + 1], tbuf[k + 1] for the others (with one chunk,
-    every floe is in its range)."""
-    owners, bounds = chunks.owners, chunks.bounds
-    fbuf, tbuf = buffers.force, buffers.torque
-    run = owners[bounds[k]:bounds[k + 1]]
-    lo, hi = chunk_range(k, owners, bounds, floes.pos.shape[0])
-    b = min(k + 1, fbuf.shape[0] - 1)
-    owner_pairs(0, run.shape[0], run, floes, law, box, verlet, dt_history, fbuf[0], tbuf[0], lo,
-                hi, fbuf[b], tbuf[b])
+    """Chunk k of the parallel pair loop (:func:`pair_forces_parallel`):
+    :func:`owner_pairs` over the k-th run of owners of
+    :func:`owner_chunks`, into the force buffer for the floes of its
+    :func:`chunk_range` and into the slots of its cut pairs for the
+    others."""
+    owner_pairs(chunks.bounds[k], chunks.bounds[k + 1], chunks.owners, floes, law, box, verlet,
+                dt_history, buffers.force, buffers.torque, chunks.slot, chunks.cut)
 
 
 @njit(cache=True, error_model="numpy")
-def force_buffers(n_chunks, n):
-    """Zeroed :class:`ForceBuffers` (fbuf (B, N, 2), tbuf (B, N)) for a
-    pair loop in ``n_chunks`` chunks: the shared buffer 0, then a private
-    buffer per chunk if there are two or more (:func:`pair_task`)."""
-    n_buf = n_chunks + 1 if n_chunks > 1 else 1
-    return ForceBuffers(np.zeros((n_buf, n, 2)), np.zeros((n_buf, n)))
+def force_buffers(n):
+    """A zeroed :class:`ForceBuffers` of N floes."""
+    return ForceBuffers(np.zeros((n, 2)), np.zeros(n))
 
 
 # Parallel kernels that other compiled kernels call are never cached on disk
@@ -676,26 +679,27 @@ def wall_forces_parallel(floes, wall_law, box, dt_history, force, torque):
 
 
 @njit(cache=True, error_model="numpy")
-def gather_buffers(i_lo, i_hi, buffers, shared):
-    """Add the private force buffers b >= 1 of floes i_lo..i_hi-1 into
-    buffer 0 and clear them. Only the floes listed in ``shared`` (sorted;
-    :func:`scatter_floes`) can hold non-zero entries, and only non-zero
-    entries are reset: a line left clean stays in the cache of the pair-loop
-    thread that reads it next."""
-    fbuf, tbuf = buffers.force, buffers.torque
+def gather_cut(i_lo, i_hi, chunks, force, torque):
+    """Add the slots of the cut pairs of floes i_lo..i_hi−1
+    (:func:`pair_chunks`) to their force and torque, in the order of the
+    chunks, and clear them. Only non-zero slots (pairs in contact) are
+    added and reset: a line left clean stays in the cache of the pair-loop
+    thread that writes it next."""
+    shared, first, gather, cut = chunks.shared, chunks.first, chunks.gather, chunks.cut
     for k in range(np.searchsorted(shared, i_lo), np.searchsorted(shared, i_hi)):
         i = shared[k]
-        for b in range(1, fbuf.shape[0]):
-            gx = fbuf[b, i, 0]
-            gy = fbuf[b, i, 1]
-            gt = tbuf[b, i]
+        for m in range(first[k], first[k + 1]):
+            q = gather[m]
+            gx = cut[q, 0]
+            gy = cut[q, 1]
+            gt = cut[q, 2]
             if gx != 0.0 or gy != 0.0 or gt != 0.0:
-                fbuf[0, i, 0] += gx
-                fbuf[0, i, 1] += gy
-                tbuf[0, i] += gt
-                fbuf[b, i, 0] = 0.0
-                fbuf[b, i, 1] = 0.0
-                tbuf[b, i] = 0.0
+                force[i, 0] += gx
+                force[i, 1] += gy
+                torque[i] += gt
+                cut[q, 0] = 0.0
+                cut[q, 1] = 0.0
+                cut[q, 2] = 0.0
 
 
 # The kick–drift pass may reassociate floating-point sums (``reassoc``): with
@@ -846,12 +850,12 @@ def combine_chunks(part):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def floe_rows(floes, lo, hi, buffers):
-    """Floes lo..hi−1 of ``floes`` (views) with their rows of the shared
-    force buffer (buffer 0 of ``buffers``) as their forces."""
+    """Floes lo..hi−1 of ``floes`` (views) with their rows of the force
+    buffer ``buffers`` as their forces."""
     f = floes
     return Floes(f.pos[lo:hi], f.vel[lo:hi], f.omega[lo:hi], f.radius[lo:hi], f.inv_mass[lo:hi],
-                 f.inv_inertia[lo:hi], f.rank[lo:hi], buffers.force[0, lo:hi],
-                 buffers.torque[0, lo:hi], f.wall_hist[lo:hi])
+                 f.inv_inertia[lo:hi], f.rank[lo:hi], buffers.force[lo:hi],
+                 buffers.torque[lo:hi], f.wall_hist[lo:hi])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -863,15 +867,14 @@ def drive_rows(drive, lo, hi):
 
 
 @njit(cache=True, error_model="numpy")
-def kick_task(k, n_tasks, floes, buffers, shared, ref, drive, kick, part):
-    """Part k of a parallel kick–drift pass (:func:`first_half_parallel`, a
-    task of :func:`team_member`): :func:`gather_buffers` and
-    :func:`first_half` over the k-th of ``n_tasks`` equal runs of floes,
-    its results in part[k]."""
+def kick_task(k, n_tasks, floes, buffers, chunks, ref, drive, kick, part):
+    """Part k of a parallel kick–drift pass (:func:`first_half_parallel`):
+    :func:`gather_cut` and :func:`first_half` over the k-th of
+    ``n_tasks`` equal runs of floes, its results in part[k]."""
     n = floes.pos.shape[0]
     lo = k * n // n_tasks
     hi = (k + 1) * n // n_tasks
-    gather_buffers(lo, hi, buffers, shared)
+    gather_cut(lo, hi, chunks, buffers.force, buffers.torque)
     w, sx_, sy_, v2 = first_half(floe_rows(floes, lo, hi, buffers), ref[lo:hi],
                                  drive_rows(drive, lo, hi), kick)
     part[k, 0] = w
@@ -881,28 +884,23 @@ def kick_task(k, n_tasks, floes, buffers, shared, ref, drive, kick, part):
 
 
 @njit(cache=False, parallel=True, error_model="numpy")
-def first_half_parallel(n_tasks, floes, buffers, shared, ref, drive, kick):
+def first_half_parallel(n_tasks, floes, buffers, chunks, ref, drive, kick):
     """:func:`first_half` over all floes in parallel (no race), kicking
-    with the shared force buffer (buffer 0 of ``buffers``; ``floes.force``
-    is not used), each thread first adding up its floes' private pair-force
-    buffers (:func:`gather_buffers`). ``shared`` lists the floes that can
-    have private entries (:func:`scatter_floes`); ``ref`` are the positions
-    at the list build.
+    with the force buffer ``buffers`` (``floes.force`` is not used), each
+    task first adding the slots of its floes' cut pairs
+    (:func:`gather_cut`); ``ref`` are the positions at the list build.
 
-    The floes are cut into ``n_tasks`` consecutive runs (a few per
-    thread, :data:`KICK_TASKS_PER_THREAD`); the runtime gives each thread
-    the same consecutive block of runs every step, so each core keeps its
-    floes in its own caches. The chunks of the pair loop
-    (:func:`owner_chunks`) hold equal numbers of pairs; when the floes are
-    numbered in space (:func:`physics.floes.spatial_order`, as
+    The floes are cut into ``n_tasks`` consecutive runs (as many as the
+    pair loop has chunks); the runtime gives each thread the same
+    consecutive block of runs every step, so each core keeps its floes in
+    its own caches. The chunks of the pair loop (:func:`owner_chunks`)
+    hold equal numbers of pairs; when the floes are numbered in space
+    (:func:`physics.floes.spatial_order`, as
     :func:`physics.floes.make_floe_field` does) both splits cut the box into
     about the same patches, and a thread mostly reads and writes its own
     floes in both loops. Each task writes only its own floes and its own
     row of the partial results, which are reduced in task order: the new
-    state of every floe is the same bit for bit for any number of threads
-    and tasks (and equal to the serial pass), the sums of the displacements
-    equal to rounding, and the outcome for a given number of tasks is
-    repeatable whatever thread did which task.
+    state is the same bit for bit whatever thread did which task.
 
     Each run gets views of its floes (:func:`kick_task`) and loops from a
     start index known at compile time to be 0: with a start known only at
@@ -910,7 +908,7 @@ def first_half_parallel(n_tasks, floes, buffers, shared, ref, drive, kick):
     does not vectorise (2.5 times as slow)."""
     part = np.empty((n_tasks, 4))
     for t in prange(n_tasks):
-        kick_task(t, n_tasks, floes, buffers, shared, ref, drive, kick, part)
+        kick_task(t, n_tasks, floes, buffers, chunks, ref, drive, kick, part)
     return combine_chunks(part)
 
 
@@ -950,155 +948,20 @@ def ship_after_kick(ship, floes, box, verlet, time, dt, vmax2, lx, ly, cx, cy, m
     test of their list when there is a ship or a floe with a wider skin:
     the hull's contacts (:func:`~physics.hull_contact.hull_forces` at
     ``time``, the time after the step, with the pass's largest squared
-    speed ``vmax2``; its forces added to buffer 0 of ``buffers``), then
+    speed ``vmax2``; its forces added to ``buffers``), then
     the pass over the wide-skinned floes (:func:`wide_floes_pass`, with the
     old centre (cx, cy) and the pass's sums of the displacements (mx, my)).
     Returns (the new largest squared displacement, whether the ship's
     collision log is full)."""
     log_full = False
     if ship.active:
-        log_full = not hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), buffers.force[0],
-                                   buffers.torque[0])
+        log_full = not hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), buffers.force,
+                                   buffers.torque)
     if verlet.wide.shape[0] > 0:
         n = floes.pos.shape[0]
         worst = wide_floes_pass(floes.pos, verlet, lx, ly, box.periodic_x, box.periodic_y, cx, cy,
                                 mx / n, my / n, worst)
     return worst, log_full
-
-
-# A named tuple inside a named tuple (the ship's contact law in its bundle)
-# cannot be an argument of a prange body (numba 0.68 raises "scalar type ...
-# given for non scalar argument"): team_steps takes the ship's bundle as the
-# fields before its law, the law and the fields after it, and each thread
-# puts it together again. (The slices must be written as literals: 15 = this.)
-SHIP_LAW_FIELD = ShipBundle._fields.index("law")
-assert SHIP_LAW_FIELD == 15, "change the slices of the ship's bundle in run_steps"
-
-
-@njit(cache=True, error_model="numpy")
-def team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
-                chunks, buffers, ship_head, ship_law, ship_tail):
-    """Thread t's part of :func:`team_steps`: up to ``n_steps`` steps of a
-    periodic box, each a kick–drift phase of ``team.n_kick`` tasks and a
-    pair phase of ``team.n_threads`` tasks (the chunks of
-    :func:`owner_chunks`, each with its private force buffer), with a
-    ``sync`` array each (:mod:`physics.thread_team`).
-
-    With a ship (or floes with a wider skin, :func:`wide_floes_pass`) a
-    phase of one task lies between them: :func:`ship_after_kick`, done by
-    whichever thread claims it, while the others wait, since it adds the
-    hull's forces to the shared force buffer that the pair tasks write
-    too. Its results go to ``team.ship_out``. The ship's kick–drift is
-    done by the thread that claims kick task 0 (it reads and writes only
-    the ship's state, which no other task of the phase touches).
-
-    Every thread makes the same decisions (stop, rebuild) from the same
-    partial results ``team.part`` of the kick pass (and ``team.ship_out``).
-    The thread that takes the token writes (steps done, status, reason,
-    centre x, centre y, log full) to ``team.out``."""
-    n_threads, n_kick = team.n_threads, team.n_kick
-    sync_kick, sync_pair, part, out = team.sync_kick, team.sync_pair, team.part, team.out
-    sync_ship, ship_out = team.sync_ship, team.ship_out
-    ship = ShipBundle(*ship_head, ship_law, *ship_tail)
-    ship_phase = ship.active or verlet.wide.shape[0] > 0
-    n = floes.pos.shape[0]
-    px = box.periodic_x
-    py = box.periodic_y
-    deform = box.deforming
-    lx_old, ly_old = lx0, ly0
-    cx = verlet.centre[0]
-    cy = verlet.centre[1]
-    status = _OK
-    reason = TEAM_ALL_DONE
-    log_full = False
-    done = 0
-    gk = 0                                  # generation of the kick phase,
-    gp = 0                                  # of the pair phase
-    gs = 0                                  # and of the ship's phase
-    for s in range(n_steps):
-        if deform:
-            lx, ly, conc = box_lengths_at(box, time + (step0 + s + 1) * dt)
-            if conc >= box.max_concentration or conc <= 0.0:
-                status = _CONCENTRATION_LIMIT
-                break
-        else:
-            lx, ly = lx_old, ly_old
-        dt_kick = 0.5 * dt if step0 + s == 0 else dt
-        kick = Kick(dt_kick, dt, lx, ly, px, py, lx / lx_old, ly / ly_old, cx, cy)
-        gk += 1
-        for m in range(n_kick):
-            k = task_order(t, m, n_threads, n_kick)     # its own tasks first
-            if claim(sync_kick, k, gk):
-                if k == 0:
-                    # only the ship's and the pair phase read the box lengths
-                    box.lengths[0] = lx
-                    box.lengths[1] = ly
-                    if ship.active:
-                        ship_kick_drift(ship, dt_kick, dt)
-                kick_task(k, n_kick, floes, buffers, chunks.shared, verlet.ref, drive, kick, part)
-                task_done(sync_kick, n_kick)
-        wait_generation(sync_kick, n_kick, gk)
-        worst, mx, my, vmax2 = combine_chunks(part)
-        if overtaken(sync_kick, n_kick, gk):
-            return                          # left behind: the others finish the run
-        done += 1
-        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != _OK:
-            break
-        if ship_phase:
-            gs += 1
-            if claim(sync_ship, 0, gs):
-                w, full = ship_after_kick(ship, floes, box, verlet, time + (step0 + s + 1) * dt,
-                                          dt, vmax2, lx, ly, cx, cy, mx, my, worst, buffers)
-                ship_out[0] = w
-                ship_out[1] = 1.0 if full else 0.0
-                task_done(sync_ship, 1)
-            wait_generation(sync_ship, 1, gs)
-            worst = ship_out[0]
-            log_full = ship_out[1] != 0.0
-            if overtaken(sync_ship, 1, gs):
-                return                      # ship_out may be the next step's
-        cx = mx / n
-        cy = my / n
-        if list_expired(worst, lx, ly, verlet):
-            reason = TEAM_REBUILD
-            break
-        gp += 1
-        for m in range(n_threads):
-            k = task_order(t, m, n_threads, n_threads)
-            if claim(sync_pair, k, gp):
-                pair_task(k, chunks, floes, law, box, verlet, dt, buffers)
-                task_done(sync_pair, n_threads)
-        wait_generation(sync_pair, n_threads, gp)
-        if log_full:
-            # the step is finished; the caller empties the log
-            status = _SHIP_LOG_FULL
-            break
-        lx_old, ly_old = lx, ly
-    if take_token(sync_pair, n_threads):
-        out[0] = done
-        out[1] = status
-        out[2] = reason
-        out[3] = cx
-        out[4] = cy
-        out[5] = 1.0 if log_full else 0.0
-
-
-@njit(cache=False, parallel=True, error_model="numpy")
-def team_steps(team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet, chunks,
-               buffers, ship_head, ship_law, ship_tail):
-    """Steps of a periodic box by a team of threads that stays in one
-    parallel region (:func:`team_member`; :mod:`physics.thread_team`) until
-    the run ends, the Verlet list must be rebuilt or the ship's collision
-    log is full. Same arithmetic, in the same order, as the step of
-    :func:`run_steps` with :func:`first_half_parallel` and
-    :func:`pair_forces_parallel` (and the ship's step): the new state is
-    the same bit for bit. (lx0, ly0) are the box lengths before the first
-    step (the team writes the new ones into ``box.lengths``). The ship's
-    bundle comes in three parts (:data:`SHIP_LAW_FIELD`)."""
-    for t in prange(team.n_threads):
-        team_member(t, team, n_steps, step0, dt, time, lx0, ly0, floes, law, drive, box, verlet,
-                    chunks, buffers, ship_head, ship_law, ship_tail)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -1220,8 +1083,8 @@ def rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, deforming, dt)
 
 
 @njit(cache=True, error_model="numpy")
-def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_pair,
-              ship, with_team=True):
+def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_chunks,
+              ship):
     """Advance the floes by ``n_steps`` velocity-Verlet steps.
 
     Between two steps of one call the second half kick of a step and the
@@ -1232,20 +1095,16 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     list is rebuilt whenever the displacement criterion of
     :mod:`physics.neighbors` could be violated.
 
-    ``n_pair`` is the number of chunks of the pair loop of the parallel
-    path (the number of threads; 1 for the serial path), each with a
-    private force buffer; its kick–drift pass has
-    :data:`KICK_TASKS_PER_THREAD` tasks per chunk.
+    ``n_chunks`` is the number of chunks of the parallel path
+    (:func:`chunk_count`; ignored by the serial path): its kick–drift pass
+    and its pair loop each run as one parallel region over that many
+    chunks, whatever the number of threads, and the new state depends on
+    the chunks, not on the threads.
 
     ``ship`` is a :class:`~physics.hull_contact.ShipBundle` (inactive
     without a ship). With a ship every step also moves the ship before the
     floes' kick–drift pass and adds the hull contacts after it
     (:mod:`physics.hull_contact`).
-
-    ``with_team``: whether the parallel step of a periodic box runs as a
-    thread team (:func:`team_steps`); with False it runs one parallel
-    region per phase and step, as in a box with walls (the same new state
-    bit for bit; for comparisons).
 
     Returns (steps done, status (a :class:`HertzStatus` value), number of
     list rebuilds, the Verlet list now). A status other than OK stops the
@@ -1255,17 +1114,15 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     px = box.periodic_x
     py = box.periodic_y
     walls = not (px and py)
-    lengths = box.lengths
     n = floes.pos.shape[0]
-    n_pair = n_pair if parallel else 1
-    n_kick = n_pair * KICK_TASKS_PER_THREAD if parallel else 1
-    buffers = force_buffers(n_pair, n)
-    buffers.force[0] = floes.force
-    buffers.torque[0] = floes.torque
-    # the serial kick–drift pass kicks with buffer 0
+    n_chunks = n_chunks if parallel else 1
+    buffers = force_buffers(n)
+    buffers.force[:] = floes.force
+    buffers.torque[:] = floes.torque
+    # the serial kick–drift pass kicks with the buffer
     work = floe_rows(floes, 0, n, buffers)
     n_rebuilds = 0
-    chunks = pair_chunks(verlet, n_pair)
+    chunks = pair_chunks(verlet, n_chunks)
     # the serial step skips the looks at pairs and walls that cannot touch
     # (the paths of owner_pairs, wall_forces); the parallel one looks at all
     path = np.zeros(n)
@@ -1274,94 +1131,61 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     skip = not (parallel or box.deforming)
     done = 0
     status = _OK
-    # parallel path in a periodic box: a team of threads that stays in one
-    # parallel region between list rebuilds; the serial path and boxes with
-    # walls kick one step at a time. Both end a step whose list expired with
-    # the same rebuild and pair loop.
-    use_team = parallel and not walls and with_team
     log_full = False
-    team = Team(n_pair, n_kick, np.zeros(sync_size(n_kick), dtype=np.int64),
-                np.zeros(sync_size(n_pair), dtype=np.int64), np.zeros(sync_size(1), dtype=np.int64),
-                np.empty((n_kick, 4)), np.empty(2), np.empty(6))
     step = 0
     while step < n_steps:
-        if use_team:
-            team.sync_kick[:] = 0
-            team.sync_pair[:] = 0
-            team.sync_ship[:] = 0
-            team_steps(team, n_steps - step, step, dt, time, lengths[0], lengths[1], floes, law,
-                       drive, box, verlet, chunks, buffers, ship[:15], ship.law, ship[16:])
-            out = team.out
-            k = int(out[0])
-            status = int(out[1])
-            verlet.centre[0] = out[3]
-            verlet.centre[1] = out[4]
-            log_full = out[5] != 0.0
-            done += k
-            step += k
-            if status != _OK or int(out[2]) != TEAM_REBUILD:
-                break
-            # the team stopped after the kick (and the ship's phase) of a
-            # step whose list expired: rebuild and finish that step below
-            lx, ly = lengths[0], lengths[1]
-            expired = True
+        status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
+        if status != _OK:
+            break
+        lx, ly = kick.lx, kick.ly
+        if parallel:
+            worst, mx, my, vmax2 = first_half_parallel(n_chunks, floes, buffers, chunks,
+                                                       verlet.ref, drive, kick)
         else:
-            status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
-            if status != _OK:
-                break
-            lx, ly = kick.lx, kick.ly
+            worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
+        done += 1
+        step += 1
+        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
+        if status != _OK:
+            break
+        if walls:
             if parallel:
-                worst, mx, my, vmax2 = first_half_parallel(n_kick, floes, buffers, chunks.shared,
-                                                           verlet.ref, drive, kick)
+                wall_forces_parallel(floes, wall_law, box, dt, buffers.force, buffers.torque)
+            elif skip:
+                wall_forces(0, n, floes, wall_law, box, dt, buffers.force, buffers.torque, path,
+                            wall_due)
             else:
-                worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
-            done += 1
-            step += 1
-            status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-            if status != _OK:
-                break
-            if walls:
-                if parallel:
-                    wall_forces_parallel(floes, wall_law, box, dt, buffers.force[0],
-                                         buffers.torque[0])
-                elif skip:
-                    wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
-                                buffers.torque[0], path, wall_due)
-                else:
-                    wall_forces(0, n, floes, wall_law, box, dt, buffers.force[0],
-                                buffers.torque[0])
-            if ship.active or verlet.wide.shape[0] > 0:
-                worst, log_full = ship_after_kick(ship, floes, box, verlet, time + step * dt, dt,
-                                                  vmax2, lx, ly, kick.cx, kick.cy, mx, my, worst,
-                                                  buffers)
-            verlet.centre[0] = mx / n
-            verlet.centre[1] = my / n
-            expired = list_expired(worst, lx, ly, verlet)
-        if expired:
+                wall_forces(0, n, floes, wall_law, box, dt, buffers.force, buffers.torque)
+        if ship.active or verlet.wide.shape[0] > 0:
+            worst, log_full = ship_after_kick(ship, floes, box, verlet, time + step * dt, dt,
+                                              vmax2, lx, ly, kick.cx, kick.cy, mx, my, worst,
+                                              buffers)
+        verlet.centre[0] = mx / n
+        verlet.centre[1] = my / n
+        if list_expired(worst, lx, ly, verlet):
             verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, box.deforming,
                                     dt)
-            chunks = pair_chunks(verlet, n_pair)
+            chunks = pair_chunks(verlet, n_chunks)
             due = np.full(verlet.nbr.shape[0], -np.inf)
             n_rebuilds += 1
-        # drag and wall forces are already in buffer 0; add the pair forces
+        # drag and wall forces are already in the buffer; add the pair forces
         if parallel:
             pair_forces_parallel(chunks, floes, law, box, verlet, dt, buffers)
         elif skip:
             owners = chunks.owners
-            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,
-                        buffers.force[0], buffers.torque[0], 0, n, buffers.force[0],
-                        buffers.torque[0], path, due)
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
+                        buffers.torque, None, None, path, due)
         else:
             owners = chunks.owners
-            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt,
-                        buffers.force[0], buffers.torque[0], 0, n, buffers.force[0],
-                        buffers.torque[0])
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
+                        buffers.torque)
         if log_full:
             status = _SHIP_LOG_FULL
             break
     # total force of the last step, and the closing half kick
-    floes.force[:] = buffers.force.sum(axis=0)
-    floes.torque[:] = buffers.torque.sum(axis=0)
+    gather_cut(0, n, chunks, buffers.force, buffers.torque)
+    floes.force[:] = buffers.force
+    floes.torque[:] = buffers.torque
     if done > 0:
         half_kick(floes, dt)
         if ship.active:

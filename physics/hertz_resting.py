@@ -450,10 +450,10 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     px = box.periodic_x
     py = box.periodic_y
     n = floes.pos.shape[0]
-    buffers = force_buffers(1, n)
-    buffers.force[0] = floes.force
-    buffers.torque[0] = floes.torque
-    fbuf, tbuf = buffers.force[0], buffers.torque[0]
+    buffers = force_buffers(n)
+    buffers.force[:] = floes.force
+    buffers.torque[:] = floes.torque
+    fbuf, tbuf = buffers.force, buffers.torque
     work = floe_rows(floes, 0, n, buffers)
     awake = find_awake(floes, drive, box, verlet)
     pairs = live_pairs(verlet, awake)

@@ -441,31 +441,45 @@ def test_parallel_path_equals_serial_path(box_type):
 
 
 @pytest.mark.parametrize("n_chunks", [2, 3, 5])
-def test_pair_chunks_write_disjoint_memory_and_scatter_floes_lists_the_rest(n_chunks):
+def test_pair_chunks_write_disjoint_memory_and_slot_every_cut_pair(n_chunks):
     """The parallel pair loop is race-free: the ranges of floe numbers
-    that the chunks write to the shared force buffer (``chunk_range``) cut
+    that the chunks write to the force buffer (``chunk_range``) cut
     0 … N−1 into consecutive pieces and hold every owner of their chunk;
-    every other floe a chunk can write (a partner outside its range, into
-    the chunk's private buffer) is listed by ``scatter_floes`` (sorted), so
-    the kick adds it up. With the floes numbered in space (as
-    ``make_floe_field`` does) these are only the few floes along the cuts."""
-    from physics.hertz_kernels import chunk_range, owner_chunks, scatter_floes
+    every pair whose partner lies outside its chunk's range (a cut pair)
+    has a slot of its own, numbered in the order of the list, and the
+    others none; ``gather`` lists each partner's slots in that order
+    (which is the order of the chunks), and ``shared`` the partners of
+    cut pairs. With the floes numbered in space (as ``make_floe_field``
+    does) these are only the few floes along the cuts."""
+    from physics.hertz_kernels import VerletList, chunk_range, pair_chunks
 
     n = 800
     floes, box = make_floe_field(n, concentration=0.6, alpha=1.8, mean_diameter=8.0, seed=5)
     rank = radius_rank(floes.radii)
     start, nbr = build_pair_list(floes.positions, floes.radii, rank, box.lx, box.ly, True, True,
                                  0.4, choose_cell_size(floes.radii, box.lx, box.ly, 0.4))
-    owners, bounds = owner_chunks(start, n_chunks)
+    verlet = VerletList(start, nbr, np.zeros((nbr.size, 2)), floes.positions, np.array([box.lx, box.ly]),
+                        np.zeros(2), 0.4, 1.0, 1.0, np.full(n, 0.4), 0.4, np.zeros(0, dtype=np.int64),
+                        np.zeros((0, 2)), np.zeros(0))
+    ch = pair_chunks(verlet, n_chunks)
+    owners, bounds = ch.owners, ch.bounds
     ranges = [chunk_range(c, owners, bounds, n) for c in range(n_chunks)]
     assert ranges[0][0] == 0 and ranges[-1][1] == n
     assert all(ranges[c][1] == ranges[c + 1][0] for c in range(n_chunks - 1))
-    outside = set()
+    expect = np.full(nbr.size, -1)
+    slots = 0
     for c, (lo, hi) in enumerate(ranges):
         for i in owners[bounds[c]:bounds[c + 1]]:
             assert lo <= i < hi
-            outside.update(int(j) for j in nbr[start[i]:start[i + 1]] if not lo <= j < hi)
-    shared = scatter_floes(owners, bounds, start, nbr, n)
-    assert len(outside) > 0
-    assert shared.tolist() == sorted(outside)
-    assert len(shared) < 0.1 * n
+            for p in range(start[i], start[i + 1]):
+                if not lo <= nbr[p] < hi:
+                    expect[p] = slots
+                    slots += 1
+    np.testing.assert_array_equal(ch.slot, expect)
+    cut = np.flatnonzero(expect >= 0)
+    assert ch.cut.shape == (slots, 3) and slots > 0 and not ch.cut.any()
+    assert ch.shared.tolist() == sorted(set(nbr[cut].tolist()))
+    for k, j in enumerate(ch.shared):
+        np.testing.assert_array_equal(ch.gather[ch.first[k]:ch.first[k + 1]],
+                                      expect[cut[nbr[cut] == j]])
+    assert len(ch.shared) < 0.1 * n

@@ -20,13 +20,15 @@ def _floes(pos, vel, omega, force, torque, inv_mass, inv_inertia):
 
 
 def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
-    """The parallel kick–drift pass over 3000 floes with forcing, called 30
-    times on the same input, alternately on one thread and on all threads:
-    for a given number of threads the new state and the reduced results
-    (largest displacement, summed displacements, largest speed) are
-    identical bit for bit every time; the new state is identical for any
-    number of threads and to the serial pass, and the reduced results agree
-    to rounding (the sums are added in another order)."""
+    """The parallel kick–drift pass over 3000 floes with forcing, with the
+    slots of the cut pairs of four chunks full, called 30 times on the same
+    input, alternately on one thread and on all threads: for a given number
+    of tasks the new state and the reduced results (largest displacement,
+    summed displacements, largest speed) are identical bit for bit
+    whatever the threads; the new state is identical for any number of
+    tasks and to the serial pass (the slots added up, then the kick), and
+    the reduced results agree to rounding (the sums are added in another
+    order)."""
     floes, box = make_floe_field(3000, concentration=0.7, alpha=1.8, mean_diameter=8.0, seed=2,
                                  velocity_std=0.05)
     sim = HertzSimulation(floes, box, HERMAN2013.contact, Forcing(HERMAN2013.forcing,
@@ -34,33 +36,33 @@ def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
     sim.step(3)
     n = floes.n
     rng = np.random.default_rng(1)
-    fbuf = rng.normal(0.0, 1e3, (2, n, 2))
-    tbuf = rng.normal(0.0, 1e3, (2, n))
-    shared = np.flatnonzero(rng.random(n) < 0.3)
+    chunks = K.pair_chunks(sim._verlet, 4)
+    assert chunks.cut.shape[0] > 0
+    cut = rng.normal(0.0, 1e3, chunks.cut.shape)
+    force = rng.normal(0.0, 1e3, (n, 2))
+    torque = rng.normal(0.0, 1e3, n)
     drive = K.make_drive(sim._drag, (6.0, -3.0))
     kick = K.Kick(0.002, 0.002, box.lx, box.ly, True, True, 1.0, 1.0, 0.01, -0.02)
     ref = sim.positions + rng.normal(0.0, 0.05, (n, 2))
 
     def fresh_state():
         return [sim.positions.copy(), sim.velocities.copy(), sim.angular_velocities.copy(),
-                fbuf.copy(), tbuf.copy()]
+                force.copy(), torque.copy(), cut.copy()]
 
     def bundles(state):
-        return (_floes(*state[:3], state[3][0], state[4][0], sim._floes.inv_mass,
-                        sim._floes.inv_inertia),
-                K.ForceBuffers(state[3], state[4]))
+        return (_floes(*state[:5], sim._floes.inv_mass, sim._floes.inv_inertia),
+                K.ForceBuffers(state[3], state[4]), chunks._replace(cut=state[5]))
 
-    def run(kernel, n_tasks):
+    def run(n_tasks):
         state = fresh_state()
-        floes, buffers = bundles(state)
-        out = kernel(n_tasks, floes, buffers, shared, ref.copy(), drive, kick)
+        floes, buffers, ch = bundles(state)
+        out = K.first_half_parallel(n_tasks, floes, buffers, ch, ref.copy(), drive, kick)
         return np.array(out), state
 
     def serial_pass():
-        """The serial path: the buffers added up, then the kick of buffer 0."""
         state = fresh_state()
-        floes, buffers = bundles(state)
-        K.gather_buffers(0, n, buffers, shared)
+        floes, buffers, ch = bundles(state)
+        K.gather_cut(0, n, ch, state[3], state[4])
         out = K.first_half(floes, ref.copy(), drive, kick)
         return np.array(out), state
 
@@ -68,25 +70,26 @@ def test_kick_pass_is_bitwise_repeatable_and_equals_the_serial_pass():
     first = {}
     for k in range(30):
         nt = 1 if k % 2 else threads
+        n_tasks = 4 if k % 3 else 7
         numba.set_num_threads(nt)
         try:
-            out, state = run(K.first_half_parallel, nt)
+            out, state = run(n_tasks)
         finally:
             numba.set_num_threads(threads)
-        if nt not in first:
-            first[nt] = out, state
-        assert np.array_equal(out, first[nt][0])
-        for a, b in zip(state, first[threads][1]):
+        if n_tasks not in first:
+            first[n_tasks] = out, state
+        assert np.array_equal(out, first[n_tasks][0])
+        for a, b in zip(state, first[7][1]):
             assert np.array_equal(a, b)
     serial, serial_state = serial_pass()
     for out, _ in first.values():
         np.testing.assert_allclose(out, serial, rtol=1e-12, atol=0)
-    first_state = first[threads][1]
+    first_state = first[7][1]
     for a, b in zip(first_state, serial_state):
         assert np.array_equal(a, b)        # per-floe updates do not depend on the chunking
-    # the pass did something: every mobile floe moved and the buffers were reset
+    # the pass did something: every mobile floe moved and the slots were added and reset
     assert np.all(first_state[0] != sim.positions)
-    assert np.all(first_state[3][1:][:, shared] == 0.0)
+    assert np.all(first_state[5] == 0.0)
 
 
 def _reference_pass(dt_kick, dt, pos, vel, omega, force, torque, inv_mass, inv_inertia, box,

@@ -2,7 +2,7 @@
 ``wall_forces`` with the floes' paths): a pair or wall found apart is not
 looked at again until the floes' paths could have closed the gap, and is
 looked at once they could. The whole-run equality with the parallel step,
-which looks at every pair, is in ``test_thread_team.py``."""
+which looks at every pair, is in ``test_parallel_step.py``."""
 from __future__ import annotations
 
 import numpy as np
@@ -36,7 +36,7 @@ def test_a_pair_apart_is_looked_at_again_once_the_paths_allow():
 
     def look():
         K.owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, 1e-3, force, torque,
-                      0, 2, force, torque, path, due)
+                      None, None, path, due)
 
     look()
     assert np.all(force == 0.0) and due[0] == pytest.approx(0.5, abs=1e-8)
