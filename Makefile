@@ -67,6 +67,7 @@ bench: setup
 	$(PY) -m benchmarks.ship
 	$(PY) -m benchmarks.resting
 	$(PY) -m benchmarks.sensors
+	$(PY) -m benchmarks.scaling
 	$(PY) -m benchmarks.headline
 
 docs: setup

@@ -32,6 +32,9 @@ suite               what is timed
                     and env steps/s of a long channel (:mod:`benchmarks.resting`)
 ``sensors``         one call of the ship's lidar, swath sensor and image, and
                     their share of a step (:mod:`benchmarks.sensors`)
+``scaling``         speed-up against Numba threads of the Hertz step, the native
+                    vector environments and PPO, beside a memory-bound ceiling
+                    loop (:mod:`benchmarks.scaling`)
 ``compare``         this tree against another revision, side by side
                     (:mod:`benchmarks.compare`)
 ``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
@@ -56,7 +59,7 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "vector",
-          "ship", "resting", "sensors", "compare", "lammps_scaling")
+          "ship", "resting", "sensors", "scaling", "compare", "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

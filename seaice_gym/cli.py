@@ -51,6 +51,7 @@ BENCH_SUITES = {
     "vector": "native vector environments against the others, and PPO steps/s with each",
     "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "sensors": "one call of the ship's lidar, swath sensor and image, and their share of a step",
+    "scaling": "speed-up against Numba threads: Hertz step, vector envs, PPO, the memory-bound ceiling",
     "compare": "this tree against another revision, side by side",
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
     "resting": "skipping the floes at rest: transit statistics on and off, env steps/s",

@@ -7,6 +7,8 @@ repository) when the builder starts:
   from the class docstring (its specification), with a frame rendered by
   ``env.render()`` after a seeded reset and a few seeded steps
   (``frames/<name>.png``, reused if present);
+* ``figures/scaling.png`` — the speed-up against Numba threads of each
+  workload of the scaling benchmark's record, shown with its tables;
 * ``api/<module>.md`` — one autodoc page per public module;
 * ``include/`` — parts of hand-written pages: the lists of those pages in
   registry order (``environments_toc.md``, ``api_toc.md``), the tables of the
@@ -195,11 +197,93 @@ def _cell(value) -> str:
     return table_cell(value)
 
 
+def scaling_figure(record: dict, path: Path) -> bool:
+    """The speed-up over one thread against Numba threads of each workload
+    of a scaling record (``benchmarks.scaling``), one panel each, beside the
+    ceiling loop and the ideal line, as a PNG at ``path`` (rewritten only
+    when it changes). Returns ``False``, writing nothing, when the record
+    has no timed workload beside the ceiling loop."""
+    import io
+    import textwrap
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import FuncFormatter
+
+    results = [r for r in record["data"]["results"] if "failed" not in r]
+    ceiling = next((r for r in results if r["workload"] == "ceiling"), None)
+    panels = [r for r in results if r["workload"] != "ceiling"]
+    if not panels:
+        return False
+    threads = record["data"]["threads"]
+    cols = min(3, len(panels))
+    rows = -(-len(panels) // cols)
+    fig = Figure(figsize=(3.4 * cols, 3.0 * rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax, res in zip(axes, panels):
+        ax.plot(threads, threads, ":", color="0.4", label="ideal", zorder=3)
+        if ceiling is not None:
+            ax.plot([r["threads"] for r in ceiling["rows"]],
+                    [r["speedup"] for r in ceiling["rows"]], "--o", color="black", ms=3,
+                    label="ceiling loop")
+        x = [r["threads"] for r in res["rows"]]
+        y = [r["speedup"] for r in res["rows"]]
+        low = [max(0.0, s - min(r["paired"])) for s, r in zip(y, res["rows"])]
+        high = [max(0.0, max(r["paired"]) - s) for s, r in zip(y, res["rows"])]
+        ax.errorbar(x, y, yerr=[low, high], fmt="-o", color="tab:blue", ms=4, capsize=2,
+                    label="this workload")
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log", base=2)
+        ax.set_xticks(threads, [str(k) for k in threads])
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.minorticks_off()
+        ax.set_title("\n".join(textwrap.wrap(res["label"], 40)), fontsize=8)
+        ax.set_xlabel("Numba threads", fontsize=8)
+        ax.set_ylabel("speed-up over 1 thread", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, which="major", alpha=0.3)
+    for ax in axes[len(panels):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=7, loc="upper left")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
+    data = buffer.getvalue()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.is_file() or path.read_bytes() != data:
+        path.write_bytes(data)
+    return True
+
+
+def with_scaling_figure(text: str, record: dict, out: Path) -> str:
+    """The rendered scaling record ``text`` with its figure
+    (:func:`scaling_figure`, written to ``figures/scaling.png`` of ``out``)
+    between its tables and its last line (command, machine, date)."""
+    if not scaling_figure(record, out / "figures" / "scaling.png"):
+        return text
+    body, _, last = text.strip().rpartition("\n\n")
+    figure = "\n".join([
+        f"```{{figure}} /{out.name}/figures/scaling.png",
+        ":alt: speed-up over one thread against Numba threads, each workload beside the "
+        "ceiling loop and the ideal line",
+        ":width: 100%", "",
+        "Speed-up over one thread against Numba threads, best over best, with the range of the "
+        "same-round ratios as bars: each workload (solid) beside the memory-bound ceiling loop "
+        "(dashed) and ideal scaling (dotted).",
+        "```"])
+    return f"{body}\n\n{figure}\n\n{last}\n"
+
+
 def generate_benchmarks(out: Path, directory: Path) -> None:
     from benchmarks.harness import load_records, render_markdown
 
     records = load_records(directory)
-    parts = [render_markdown(r).strip() + "\n" for r in records]
+    parts = []
+    for r in records:
+        text = render_markdown(r).strip() + "\n"
+        if r["suite"] == "scaling":
+            text = with_scaling_figure(text, r, out)
+        parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
     write_if_changed(out / "include" / "benchmarks.md", "\n".join(parts))
