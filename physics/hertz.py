@@ -698,7 +698,8 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
     each (rounded to whole steps of each one's Δt) in compiled calls that
     run the simulations in parallel over Numba's threads
     (:func:`physics.hertz_batch.run_many`), one simulation per thread at a
-    time. Each simulation does exactly what its own :meth:`HertzSimulation.advance`
+    time, handed to the threads one by one as they come free. Each
+    simulation does exactly what its own :meth:`HertzSimulation.advance`
     would: the same arithmetic in the same order, so the same state.
 
     Parameters
@@ -749,7 +750,11 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         time = np.array([sims[k].time for k in todo])
         resting = np.array([sims[k].skip_resting for k in todo])
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
-        with threads_within_cores():
+        # one simulation at a time to whichever thread is free: the ship
+        # environments' simulations cost from nothing (floes at rest) to ten
+        # times the mean (a ship among many woken floes), and equal blocks of
+        # them would leave most threads waiting for the heaviest block
+        with threads_within_cores(), numba.parallel_chunksize(1):
             run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
         for m, k in enumerate(todo):
             if nreb[m]:                     # a rebuilt list (reading an item costs 10 µs)
