@@ -481,12 +481,12 @@ def listed_pair(p, j, dx, dy, vxi, vyi, wi, ri, imi, floes, law, hist, dt_histor
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, torque,
-                slot=None, cut=None, path=None, due=None):
+                j_lo=0, j_hi=0, slot=None, cut=None, path=None, due=None):
     """Forces of the pairs owned by floes owners[k_lo:k_hi], each added to
     both floes of its pair at once (a scatter into ``force``, ``torque``).
     With the ``slot`` of each pair (:class:`PairChunks`), the partner's
-    share of a pair p with slot[p] ≥ 0 goes to row slot[p] of ``cut``
-    instead.
+    share of a pair whose partner j lies outside j_lo ≤ j < j_hi (its
+    chunk's :func:`chunk_range`) goes to row slot[p] of ``cut`` instead.
 
     Only floes that touch are written: in loose ice most listed pairs are
     apart, and a write of zero would still claim the cache line for this
@@ -525,7 +525,7 @@ def owner_pairs(k_lo, k_hi, owners, floes, law, box, verlet, dt_history, force, 
                 fxi += res[1]
                 fyi += res[2]
                 tqi += res[3]
-                if slot is None or slot[p] < 0:
+                if slot is None or j_lo <= j < j_hi:
                     force[j, 0] -= res[1]
                     force[j, 1] -= res[2]
                     torque[j] += res[4]
@@ -645,8 +645,9 @@ def pair_task(k, chunks, floes, law, box, verlet, dt_history, buffers):
     :func:`owner_chunks`, into the force buffer for the floes of its
     :func:`chunk_range` and into the slots of its cut pairs for the
     others."""
+    lo, hi = chunk_range(k, chunks.owners, chunks.bounds, floes.pos.shape[0])
     owner_pairs(chunks.bounds[k], chunks.bounds[k + 1], chunks.owners, floes, law, box, verlet,
-                dt_history, buffers.force, buffers.torque, chunks.slot, chunks.cut)
+                dt_history, buffers.force, buffers.torque, lo, hi, chunks.slot, chunks.cut)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1174,7 +1175,7 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
         elif skip:
             owners = chunks.owners
             owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
-                        buffers.torque, None, None, path, due)
+                        buffers.torque, 0, 0, None, None, path, due)
         else:
             owners = chunks.owners
             owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,

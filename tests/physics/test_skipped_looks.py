@@ -36,7 +36,7 @@ def test_a_pair_apart_is_looked_at_again_once_the_paths_allow():
 
     def look():
         K.owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, 1e-3, force, torque,
-                      None, None, path, due)
+                      0, 0, None, None, path, due)
 
     look()
     assert np.all(force == 0.0) and due[0] == pytest.approx(0.5, abs=1e-8)
