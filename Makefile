@@ -68,6 +68,7 @@ bench: setup
 	$(PY) -m benchmarks.resting
 	$(PY) -m benchmarks.sensors
 	$(PY) -m benchmarks.scaling
+	$(PY) -m benchmarks.where_time_goes
 	$(PY) -m benchmarks.headline
 
 docs: setup

@@ -10,37 +10,40 @@ One module per suite, each with a ``main(argv)`` and a ``python -m`` entry
 point (``seaice bench <suite>`` runs the same), all sharing
 :mod:`benchmarks.harness`:
 
-==================  ==============================================================
-suite               what is timed
-==================  ==============================================================
-``hertz``           floe-steps/s of the Hertz engine at Ā = 0.7 and jammed, on
-                    the serial and parallel kernels (:mod:`benchmarks.hertz`)
-``hertz_phases``    each phase of a Hertz step on its own
-                    (:mod:`benchmarks.hertz_phases`)
-``harddisk``        collisions/s of the hard-disc engine (:mod:`benchmarks.harddisk`)
-``observables``     clusters, g_ffd, g_rdf, fabric and stress on 10⁵ floes
-                    (:mod:`benchmarks.observables`)
-``itd``             the ice-thickness-distribution models (:mod:`benchmarks.itd`)
-``environments``    sustained steps/s of every environment
-                    (:mod:`benchmarks.environments`)
-``vector``          env steps/s of the native vector environments against the
-                    single environment, SyncVectorEnv and SubprocVecEnv, and
-                    PPO training steps/s with each (:mod:`benchmarks.vector`)
-``ship``            floe-steps/s with and without a ship among the floes, and
-                    the ship's share of a step (:mod:`benchmarks.ship`)
-``resting``         ship transits with and without skipping the floes at rest,
-                    and env steps/s of a long channel (:mod:`benchmarks.resting`)
-``sensors``         one call of the ship's lidar, swath sensor and image, and
-                    their share of a step (:mod:`benchmarks.sensors`)
-``scaling``         speed-up against Numba threads of the Hertz step, the native
-                    vector environments and PPO, beside a memory-bound ceiling
-                    loop (:mod:`benchmarks.scaling`)
-``compare``         this tree against another revision, side by side
-                    (:mod:`benchmarks.compare`)
-``lammps_scaling``  the LAMMPS engine on MPI ranks against ours on threads at
-                    N = 200000, its strong and weak scaling, and a projection
-                    to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
-==================  ==============================================================
+===================  ==============================================================
+suite                what is timed
+===================  ==============================================================
+``hertz``            floe-steps/s of the Hertz engine at Ā = 0.7 and jammed, on
+                     the serial and parallel kernels (:mod:`benchmarks.hertz`)
+``hertz_phases``     each phase of a Hertz step on its own
+                     (:mod:`benchmarks.hertz_phases`)
+``harddisk``         collisions/s of the hard-disc engine (:mod:`benchmarks.harddisk`)
+``observables``      clusters, g_ffd, g_rdf, fabric and stress on 10⁵ floes
+                     (:mod:`benchmarks.observables`)
+``itd``              the ice-thickness-distribution models (:mod:`benchmarks.itd`)
+``environments``     sustained steps/s of every environment
+                     (:mod:`benchmarks.environments`)
+``vector``           env steps/s of the native vector environments against the
+                     single environment, SyncVectorEnv and SubprocVecEnv, and
+                     PPO training steps/s with each (:mod:`benchmarks.vector`)
+``ship``             floe-steps/s with and without a ship among the floes, and
+                     the ship's share of a step (:mod:`benchmarks.ship`)
+``resting``          ship transits with and without skipping the floes at rest,
+                     and env steps/s of a long channel (:mod:`benchmarks.resting`)
+``sensors``          one call of the ship's lidar, swath sensor and image, and
+                     their share of a step (:mod:`benchmarks.sensors`)
+``scaling``          speed-up against Numba threads of the Hertz step, the native
+                     vector environments and PPO, beside a memory-bound ceiling
+                     loop (:mod:`benchmarks.scaling`)
+``where_time_goes``  where the time of a ShipNavigation-v1 step and of PPO on it
+                     goes: a late engine substep in parts, the episode, a
+                     profile of training (:mod:`benchmarks.where_time_goes`)
+``compare``          this tree against another revision, side by side
+                     (:mod:`benchmarks.compare`)
+``lammps_scaling``   the LAMMPS engine on MPI ranks against ours on threads at
+                     N = 200000, its strong and weak scaling, and a projection
+                     to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
+===================  ==============================================================
 
 Every suite writes one JSON record to ``docs/benchmarks/<suite>.json`` of
 the checkout, whatever the working directory
@@ -59,7 +62,7 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "vector",
-          "ship", "resting", "sensors", "scaling", "compare", "lammps_scaling")
+          "ship", "resting", "sensors", "scaling", "where_time_goes", "compare", "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

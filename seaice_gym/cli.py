@@ -52,6 +52,7 @@ BENCH_SUITES = {
     "ship": "floe-steps/s with and without a ship, and the ship's share of a step",
     "sensors": "one call of the ship's lidar, swath sensor and image, and their share of a step",
     "scaling": "speed-up against Numba threads: Hertz step, vector envs, PPO, the memory-bound ceiling",
+    "where_time_goes": "where a ShipNavigation-v1 step and PPO on it spend their time",
     "compare": "this tree against another revision, side by side",
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
     "resting": "skipping the floes at rest: transit statistics on and off, env steps/s",

@@ -23,7 +23,8 @@ SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: stiffness_scale option (WindDrift-v0, Convergence-v0); the vector
 #: environments timed on a ship task, the pressured ship task and a
 #: wind-driven one; the long ship channel of the resting-floe benchmark; the
-#: ship tasks whose vector environments and training the scaling suite times
+#: ship tasks whose vector environments and training the scaling suite times;
+#: the ship task whose step and training the where_time_goes suite breaks down
 EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                                              "iceenvs/ShipNavigation-v1",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
@@ -32,6 +33,7 @@ EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"},
                "benchmarks/sensors.py": {"iceenvs/ShipNavigation-v1"},
                "benchmarks/scaling.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"},
+               "benchmarks/where_time_goes.py": {"iceenvs/ShipNavigation-v1"},
                "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 
 

@@ -9,6 +9,8 @@ repository) when the builder starts:
   (``frames/<name>.png``, reused if present);
 * ``figures/scaling.png`` — the speed-up against Numba threads of each
   workload of the scaling benchmark's record, shown with its tables;
+* ``figures/where_time_goes.png`` — the shares of a ShipNavigation-v1
+  substep and of PPO training on it, from the where_time_goes record;
 * ``api/<module>.md`` — one autodoc page per public module;
 * ``include/`` — parts of hand-written pages: the lists of those pages in
   registry order (``environments_toc.md``, ``api_toc.md``), the tables of the
@@ -274,6 +276,83 @@ def with_scaling_figure(text: str, record: dict, out: Path) -> str:
     return f"{body}\n\n{figure}\n\n{last}\n"
 
 
+#: colours of the where_time_goes figure's parts, in order
+_SHARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
+                  "tab:pink", "tab:gray")
+
+
+def where_time_goes_figure(record: dict, path: Path) -> bool:
+    """Horizontal stacked bars of the shares of a where_time_goes record
+    (``benchmarks.where_time_goes``): a late engine substep (its kick–drift
+    pass, live-pair loop and the rest) and PPO training (engine,
+    environments' Python, adapter, VecNormalize, policy, buffer, update,
+    rest), as a PNG at ``path`` (rewritten only when it changes). Returns
+    ``False``, writing nothing, when the record has neither."""
+    import io
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from benchmarks.where_time_goes import SHARE_LABELS, SHARES
+
+    data = record["data"]
+    bars = []
+    if data.get("substep"):
+        s = data["substep"]["summary"]["shares"]
+        bars.append(("engine substep", [("kick–drift pass", s["kick_drift"]),
+                                        ("live-pair loop", s["live_pairs"]),
+                                        ("rest of the substep", s["rest"])]))
+    if data.get("ppo"):
+        s = data["ppo"]["shares"]
+        bars.append(("PPO training", [(SHARE_LABELS[k].split(" (")[0], s[k]) for k in SHARES]))
+    if not bars:
+        return False
+    fig = Figure(figsize=(7.5, 1.0 + 1.6 * len(bars)), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(bars), 1, squeeze=False).ravel()
+    for ax, (name, parts) in zip(axes, bars):
+        left = 0.0
+        for (label, share), colour in zip(parts, _SHARE_COLOURS):
+            share = max(0.0, float(share or 0.0))
+            ax.barh([0], [100 * share], left=[100 * left], color=colour, edgecolor="white",
+                    label=label)
+            if share >= 0.06:
+                ax.text(100 * (left + share / 2), 0, f"{100 * share:.0f} %", ha="center",
+                        va="center", fontsize=7, color="white")
+            left += share
+        ax.set_xlim(0, 100)
+        ax.set_yticks([])
+        ax.set_title(name, fontsize=9, loc="left")
+        ax.set_xlabel("share of the wall time [%]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
+    data = buffer.getvalue()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.is_file() or path.read_bytes() != data:
+        path.write_bytes(data)
+    return True
+
+
+def with_where_time_goes_figure(text: str, record: dict, out: Path) -> str:
+    """The rendered where_time_goes record ``text`` with its figure
+    (:func:`where_time_goes_figure`, written to ``figures/where_time_goes.png``
+    of ``out``) between its tables and its last line."""
+    if not where_time_goes_figure(record, out / "figures" / "where_time_goes.png"):
+        return text
+    body, _, last = text.strip().rpartition("\n\n")
+    figure = "\n".join([
+        f"```{{figure}} /{out.name}/figures/where_time_goes.png",
+        ":alt: shares of the wall time of a ShipNavigation-v1 engine substep and of PPO "
+        "training on it",
+        ":width: 100%", "",
+        "Shares of the wall time: a late ShipNavigation-v1 engine substep (top) and PPO "
+        "training on its native vector environment (bottom), from the tables above.",
+        "```"])
+    return f"{body}\n\n{figure}\n\n{last}\n"
+
+
 def generate_benchmarks(out: Path, directory: Path) -> None:
     from benchmarks.harness import load_records, render_markdown
 
@@ -283,6 +362,8 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
         text = render_markdown(r).strip() + "\n"
         if r["suite"] == "scaling":
             text = with_scaling_figure(text, r, out)
+        elif r["suite"] == "where_time_goes":
+            text = with_where_time_goes_figure(text, r, out)
         parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
