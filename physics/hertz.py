@@ -194,6 +194,8 @@ class HertzSimulation(FloeProperties):
     n_steps, n_rebuilds : counters
     n_awake : floes integrated at the end of the last :meth:`step` (all of
         them unless ``skip_resting``)
+    n_chunks : chunks of the parallel step (a function of N alone; the
+        serial step ignores it)
 
     Examples
     --------
