@@ -752,10 +752,11 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         time = np.array([sims[k].time for k in todo])
         resting = np.array([sims[k].skip_resting for k in todo])
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
-        # one simulation at a time to whichever thread is free: the ship
-        # environments' simulations cost from nothing (floes at rest) to ten
-        # times the mean (a ship among many woken floes), and equal blocks of
-        # them would leave most threads waiting for the heaviest block
+        # one simulation at a time to whichever thread is free: a ship
+        # environment's step costs twenty times as much late in an episode,
+        # among the floes its ship has woken, as early on, among floes at
+        # rest (`seaice bench where_time_goes`), and equal blocks of
+        # simulations would leave threads waiting for the heaviest block
         with threads_within_cores(), numba.parallel_chunksize(1):
             run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
         for m, k in enumerate(todo):
