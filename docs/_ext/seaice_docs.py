@@ -53,6 +53,33 @@ def write_if_changed(path: Path, text: str) -> None:
         path.write_text(text, encoding="utf-8")
 
 
+def save_png_if_changed(fig, path: Path) -> None:
+    """A Matplotlib figure as a PNG at ``path`` (no software tag, so the
+    bytes depend on the figure alone), rewritten only when it changes."""
+    import io
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
+    data = buffer.getvalue()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.is_file() or path.read_bytes() != data:
+        path.write_bytes(data)
+
+
+def with_record_figure(text: str, record: dict, out: Path, draw, alt: str, caption: str) -> str:
+    """The rendered record ``text`` with the figure that ``draw(record,
+    path)`` writes to ``figures/<suite>.png`` of ``out`` between its tables
+    and its last line (command, machine, date); ``text`` as it is when
+    ``draw`` returns False (nothing to draw)."""
+    name = f"{record['suite']}.png"
+    if not draw(record, out / "figures" / name):
+        return text
+    body, _, last = text.strip().rpartition("\n\n")
+    figure = "\n".join([f"```{{figure}} /{out.name}/figures/{name}", f":alt: {alt}",
+                        ":width: 100%", "", caption, "```"])
+    return f"{body}\n\n{figure}\n\n{last}\n"
+
+
 def myst_roles(text: str) -> str:
     """Docstring roles (``:func:`x```) in MyST syntax (``{func}`x```)."""
     return _ROLE.sub(r"{\1}`", text)
@@ -205,7 +232,6 @@ def scaling_figure(record: dict, path: Path) -> bool:
     ceiling loop and the ideal line, as a PNG at ``path`` (rewritten only
     when it changes). Returns ``False``, writing nothing, when the record
     has no timed workload beside the ceiling loop."""
-    import io
     import textwrap
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -248,32 +274,8 @@ def scaling_figure(record: dict, path: Path) -> bool:
     for ax in axes[len(panels):]:
         ax.set_visible(False)
     axes[0].legend(fontsize=7, loc="upper left")
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
-    data = buffer.getvalue()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not path.is_file() or path.read_bytes() != data:
-        path.write_bytes(data)
+    save_png_if_changed(fig, path)
     return True
-
-
-def with_scaling_figure(text: str, record: dict, out: Path) -> str:
-    """The rendered scaling record ``text`` with its figure
-    (:func:`scaling_figure`, written to ``figures/scaling.png`` of ``out``)
-    between its tables and its last line (command, machine, date)."""
-    if not scaling_figure(record, out / "figures" / "scaling.png"):
-        return text
-    body, _, last = text.strip().rpartition("\n\n")
-    figure = "\n".join([
-        f"```{{figure}} /{out.name}/figures/scaling.png",
-        ":alt: speed-up over one thread against Numba threads, each workload beside the "
-        "ceiling loop and the ideal line",
-        ":width: 100%", "",
-        "Speed-up over one thread against Numba threads, best over best, with the range of the "
-        "same-round ratios as bars: each workload (solid) beside the memory-bound ceiling loop "
-        "(dashed) and ideal scaling (dotted).",
-        "```"])
-    return f"{body}\n\n{figure}\n\n{last}\n"
 
 
 #: colours of the where_time_goes figure's parts, in order
@@ -288,7 +290,6 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
     environments' Python, adapter, VecNormalize, policy, buffer, update,
     rest), as a PNG at ``path`` (rewritten only when it changes). Returns
     ``False``, writing nothing, when the record has neither."""
-    import io
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -326,31 +327,8 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
         ax.set_xlabel("share of the wall time [%]", fontsize=8)
         ax.tick_params(labelsize=7)
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
-    data = buffer.getvalue()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not path.is_file() or path.read_bytes() != data:
-        path.write_bytes(data)
+    save_png_if_changed(fig, path)
     return True
-
-
-def with_where_time_goes_figure(text: str, record: dict, out: Path) -> str:
-    """The rendered where_time_goes record ``text`` with its figure
-    (:func:`where_time_goes_figure`, written to ``figures/where_time_goes.png``
-    of ``out``) between its tables and its last line."""
-    if not where_time_goes_figure(record, out / "figures" / "where_time_goes.png"):
-        return text
-    body, _, last = text.strip().rpartition("\n\n")
-    figure = "\n".join([
-        f"```{{figure}} /{out.name}/figures/where_time_goes.png",
-        ":alt: shares of the wall time of a ShipNavigation-v1 engine substep and of PPO "
-        "training on it",
-        ":width: 100%", "",
-        "Shares of the wall time: a late ShipNavigation-v1 engine substep (top) and PPO "
-        "training on its native vector environment (bottom), from the tables above.",
-        "```"])
-    return f"{body}\n\n{figure}\n\n{last}\n"
 
 
 def generate_benchmarks(out: Path, directory: Path) -> None:
@@ -361,9 +339,20 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
     for r in records:
         text = render_markdown(r).strip() + "\n"
         if r["suite"] == "scaling":
-            text = with_scaling_figure(text, r, out)
+            text = with_record_figure(
+                text, r, out, scaling_figure,
+                "speed-up over one thread against Numba threads, each workload beside the "
+                "ceiling loop and the ideal line",
+                "Speed-up over one thread against Numba threads, best over best, with the range "
+                "of the same-round ratios as bars: each workload (solid) beside the "
+                "memory-bound ceiling loop (dashed) and ideal scaling (dotted).")
         elif r["suite"] == "where_time_goes":
-            text = with_where_time_goes_figure(text, r, out)
+            text = with_record_figure(
+                text, r, out, where_time_goes_figure,
+                "shares of the wall time of a ShipNavigation-v1 engine substep and of PPO "
+                "training on it",
+                "Shares of the wall time: a late ShipNavigation-v1 engine substep (top) and PPO "
+                "training on its native vector environment (bottom), from the tables above.")
         parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
