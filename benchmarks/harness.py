@@ -269,6 +269,34 @@ def spawn_together(fn: Callable, arg_lists: Sequence[tuple], *, threads: int | N
 
 
 # ---------------------------------------------------------------------------
+# options
+# ---------------------------------------------------------------------------
+
+def pick_names(text: str | None, known: Sequence[str], what: str,
+               groups: dict[str, Sequence[str]] | None = None) -> list[str]:
+    """The names of a comma-separated option (``"a,b"``: names of ``known``
+    or of ``groups``, each standing for several) in the order of ``known``;
+    ``None``: all of them.
+
+    Raises
+    ------
+    ValueError
+        If a name is unknown ("unknown ``what``(s) ..."), or none is given.
+    """
+    if text is None:
+        return list(known)
+    groups = groups or {}
+    asked = [w.strip() for w in str(text).split(",") if w.strip()]
+    unknown = [w for w in asked if w not in known and w not in groups]
+    if unknown or not asked:
+        also = f", or the groups {', '.join(groups)}" if groups else ""
+        raise ValueError(f"unknown {what}(s) {', '.join(unknown) or '(none)'}; known: "
+                         f"{', '.join(known)}{also}")
+    picked = {k for w in asked for k in groups.get(w, (w,))}
+    return [k for k in known if k in picked]
+
+
+# ---------------------------------------------------------------------------
 # timing
 # ---------------------------------------------------------------------------
 

@@ -138,15 +138,7 @@ def parse_workloads(text: str | None) -> list[str]:
     ValueError
         If a name is unknown, or none is given.
     """
-    if text is None:
-        return list(WORKLOADS)
-    asked = [w.strip() for w in str(text).split(",") if w.strip()]
-    unknown = [w for w in asked if w not in WORKLOADS and w not in GROUPS]
-    if unknown or not asked:
-        raise ValueError(f"unknown workload(s) {', '.join(unknown) or '(none)'}; known: "
-                         f"{', '.join(WORKLOADS)}, or the groups {', '.join(GROUPS)}")
-    picked = {k for w in asked for k in GROUPS.get(w, (w,))}
-    return [k for k in WORKLOADS if k in picked]
+    return harness.pick_names(text, WORKLOADS, "workload", GROUPS)
 
 
 # ---------------------------------------------------------------------------

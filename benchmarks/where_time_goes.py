@@ -471,14 +471,7 @@ def parse_parts(text: str | None) -> list[str]:
     ValueError
         If a name is unknown, or none is given.
     """
-    if text is None:
-        return list(PARTS)
-    asked = [w.strip() for w in str(text).split(",") if w.strip()]
-    unknown = [w for w in asked if w not in PARTS]
-    if unknown or not asked:
-        raise ValueError(f"unknown part(s) {', '.join(unknown) or '(none)'}; known: "
-                         f"{', '.join(PARTS)}")
-    return [k for k in PARTS if k in asked]
+    return harness.pick_names(text, PARTS, "part")
 
 
 def run_benchmark(parts, st: dict, episode_seed: int, seed: int, quiet: bool = False) -> dict:
