@@ -42,7 +42,7 @@ QUICK = dict(floes=400, passes=5)
 # The phases of a Hertz step, timed one by one. Compiled in this process,
 # like the parallel kernels it calls (see physics.hertz_kernels).
 @numba.njit(cache=False)
-def _phase_loop(passes, parallel, n_threads, kick, pairs, dt, chunks, floes, law, box, verlet,
+def _phase_loop(passes, parallel, kick, pairs, dt, chunks, floes, law, box, verlet,
                 buffers, ref, drive, still, periodic, unit):
     """``passes`` kick–drift passes and/or pair loops of the Hertz step with
     a kick and drift of Δt = ``still`` (0: the same work as a real step, but
@@ -117,7 +117,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
                 K.rebuild(sim._floes, sim._verlet, sim.box.lx, sim.box.ly, True, True, parallel)
         else:
             _, kick, pairs = PHASES[phase]
-            _phase_loop(count, parallel, threads, kick, pairs, dt, *data[k], 0.0, True, 1.0)
+            _phase_loop(count, parallel, kick, pairs, dt, *data[k], 0.0, True, 1.0)
         return (time.perf_counter() - t0) / count
 
     with harness.Progress(len(configs) * len(PHASES) * (REPEATS + 1), "hertz_phases",
