@@ -38,6 +38,7 @@ from .floes import FloeField
 from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .hertz_batch import run_many
+from .hertz_free_drift import DEFAULT_WINDOW, TALLY, run_steps_free
 from .hertz_resting import run_steps_resting
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, LocalIce, Stress, fabric, stress
@@ -185,6 +186,18 @@ class HertzSimulation(FloeProperties):
         floes: worth it when most floes lie still (a ship in calm ice). It
         runs the serial step only: with ``parallel=True`` it is a
         ``ValueError``, and ``parallel=None`` then means serial.
+    free_drift : bool
+        Let the floes that can touch nothing drift in closed form (default
+        False): the run is cut into windows of :attr:`free_window` steps,
+        and a floe that is shown to stay clear of every floe, wall and the
+        hull through a window follows its forcing alone, computed for the
+        whole window at once, while the others take the full step
+        (:mod:`physics.hertz_free_drift`). Bounds on the motion of the
+        others are checked at every step, and a window ends early where
+        one fails. The result is that of the full step to rounding, at the
+        cost of the floes that are close to something: worth it where most
+        floes drift apart (a ship in loose ice). Serial only, as
+        ``skip_resting``, which it includes; a rigid box only.
 
     Attributes
     ----------
@@ -193,7 +206,9 @@ class HertzSimulation(FloeProperties):
     force, torque : read-only snapshots of the total force and torque of the last step
     n_steps, n_rebuilds : counters
     n_awake : floes integrated at the end of the last :meth:`step` (all of
-        them unless ``skip_resting``)
+        them unless ``skip_resting``; with ``free_drift``, the floes engaged
+        in the last window)
+    free_window : steps of a free-drift window (default 64)
     n_chunks : chunks of the parallel step (a function of N alone; the
         serial step ignores it)
 
@@ -216,16 +231,34 @@ class HertzSimulation(FloeProperties):
                  forcing: Forcing | None = None, dt: float = 0.002, *,
                  impact_speed: float = 0.1, skin: float | None = None,
                  parallel: bool | None = None, allow_overlap: bool = False,
-                 ship: Ship | None = None, skip_resting: bool = False):
+                 ship: Ship | None = None, skip_resting: bool = False,
+                 free_drift: bool = False):
         contact = checked_hertz_arguments(field, box, contact, forcing, dt, impact_speed)
         if ship is not None and not isinstance(ship, Ship):
             raise TypeError(f"ship must be a physics.ship.Ship or None, got {type(ship).__name__}")
-        if not isinstance(skip_resting, (bool, np.bool_)):
-            raise TypeError(f"skip_resting must be True or False, got {skip_resting!r}")
-        if skip_resting and parallel:
-            raise ValueError("skip_resting=True runs the serial step only: pass parallel=False "
-                             "or None, not parallel=True")
+        for name, value in (("skip_resting", skip_resting), ("free_drift", free_drift)):
+            if not isinstance(value, (bool, np.bool_)):
+                raise TypeError(f"{name} must be True or False, got {value!r}")
+            if value and parallel:
+                raise ValueError(f"{name}=True runs the serial step only: pass parallel=False "
+                                 f"or None, not parallel=True")
+        if skip_resting and free_drift:
+            raise ValueError("skip_resting and free_drift are two serial steps: choose one "
+                             "(free_drift lets resting floes lie as well)")
+        if free_drift and box.kernel_box(0.0).deforming:
+            raise ValueError("free_drift=True needs a rigid box: a deforming box moves every "
+                             "floe at every step")
         self.skip_resting = bool(skip_resting)
+        self.free_drift = bool(free_drift)
+        #: steps of a free-drift window (:mod:`physics.hertz_free_drift`)
+        self.free_window = DEFAULT_WINDOW
+        #: the free-drift step's check mode: the free floes stepped one step at a
+        #: time with the full step's arithmetic instead of in closed form (no
+        #: faster than the full step; its result bit for bit where the windows
+        #: are right)
+        self.free_iterate = False
+        #: what the free-drift step counted (:data:`physics.hertz_free_drift.TALLY`)
+        self.free_tally = np.zeros(len(TALLY), dtype=np.int64)
         self.field = field.copy()
         self.box = box
         self.contact = contact
@@ -251,7 +284,8 @@ class HertzSimulation(FloeProperties):
         # neighbour-list sizing
         self.skin, self.max_cut = neighbour_cut(f.radii, box, skin)
         if parallel is None:
-            parallel = n >= PARALLEL_FROM and numba.get_num_threads() > 1 and not skip_resting
+            parallel = (n >= PARALLEL_FROM and numba.get_num_threads() > 1
+                        and not (skip_resting or free_drift))
         self.parallel = bool(parallel)
         #: chunks of the parallel step (:func:`physics.hertz_kernels.chunk_count`):
         #: a function of N alone, so that the new state does not depend on
@@ -394,6 +428,15 @@ class HertzSimulation(FloeProperties):
                         verlet, 0.0, force, torque)
 
     # -- running -------------------------------------------------------------
+    @property
+    def _step_mode(self) -> int:
+        """The serial step (:func:`physics.hertz_batch.run_many`): 0 full,
+        1 skipping the resting floes, 2 free drift, 3 free drift stepped
+        (:attr:`free_iterate`)."""
+        if self.free_drift:
+            return 3 if self.free_iterate else 2
+        return 1 if self.skip_resting else 0
+
     def step(self, n: int = 1) -> None:
         """Advance by ``n`` time steps.
 
@@ -412,6 +455,10 @@ class HertzSimulation(FloeProperties):
             if self.skip_resting:
                 done, status, nreb, self._verlet, self.n_awake = run_steps_resting(
                     args[0], self.dt, self.time, *args[1:6], self._verlet, args[6])
+            elif self.free_drift:
+                done, status, nreb, self._verlet, self.n_awake = run_steps_free(
+                    args[0], self.dt, self.time, *args[1:6], self._verlet, args[6],
+                    self.free_window, self.free_tally, self.free_iterate)
             else:
                 with threads_within_cores(self.parallel):
                     done, status, nreb, self._verlet = K.run_steps(
@@ -648,7 +695,8 @@ class HertzSimulation(FloeProperties):
                          self._omega.copy(), f.density, f.frozen.copy())
 
     def __repr__(self):
-        rest = ", skip_resting=True" if self.skip_resting else ""
+        rest = (", skip_resting=True" if self.skip_resting
+                else ", free_drift=True" if self.free_drift else "")
         return (f"HertzSimulation(n_floes={self.n_floes}, box={self.box!r}, dt={self.dt:g}, "
                 f"time={self.time:.6g}, parallel={self.parallel}{rest})")
 
@@ -750,7 +798,9 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
                                                         [sims[k]._verlet for k in todo])
         dt = np.array([sims[k].dt for k in todo])
         time = np.array([sims[k].time for k in todo])
-        resting = np.array([sims[k].skip_resting for k in todo])
+        mode = np.array([sims[k]._step_mode for k in todo], dtype=np.int64)
+        window = np.array([sims[k].free_window for k in todo], dtype=np.int64)
+        tally = np.stack([sims[k].free_tally for k in todo])
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
         # one simulation at a time to whichever thread is free: a ship
         # environment's step costs twenty times as much late in an episode,
@@ -758,11 +808,13 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         # rest (`seaice bench where_time_goes`), and equal blocks of
         # simulations would leave threads waiting for the heaviest block
         with threads_within_cores(), numba.parallel_chunksize(1):
-            run_many(n_steps, dt, time, resting, runs, verlets, done, stat, nreb, awake)
+            run_many(n_steps, dt, time, mode, window, tally, runs, verlets, done, stat, nreb,
+                     awake)
         for m, k in enumerate(todo):
+            sims[k].free_tally[:] = tally[m]
             if nreb[m]:                     # a rebuilt list (reading an item costs 10 µs)
                 sims[k]._verlet = verlets[m]
-            if sims[k].skip_resting:
+            if mode[m]:
                 sims[k].n_awake = int(awake[m])
             status[k] = HertzStatus(int(stat[m]))
             left[k] = sims[k]._after_run(int(done[m]), status[k], int(nreb[m]), left[k])

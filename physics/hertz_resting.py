@@ -147,10 +147,10 @@ def find_awake(floes, drive, box, verlet):
 
 
 @njit(cache=True, error_model="numpy")
-def live_pairs(verlet, awake):
-    """The :class:`LivePairs` of ``verlet`` (after a build) for the floes
-    awake now; their number goes to ``awake.count[2]``."""
-    start, nbr, flag = verlet.start, verlet.nbr, awake.flag
+def pair_index(verlet):
+    """(owner of each listed pair, and each floe's pairs as a partner in CSR
+    form: slice bounds and pairs) of the Verlet list ``verlet``."""
+    start, nbr = verlet.start, verlet.nbr
     n = start.shape[0] - 1
     m = nbr.shape[0]
     owner = np.empty(m, dtype=np.int64)
@@ -163,13 +163,25 @@ def live_pairs(verlet, awake):
         partner_start[i + 1] += partner_start[i]
     fill = partner_start[:-1].copy()
     as_partner = np.empty(m, dtype=np.int64)
+    for p in range(m):
+        j = nbr[p]
+        as_partner[fill[j]] = p
+        fill[j] += 1
+    return owner, partner_start, as_partner
+
+
+@njit(cache=True, error_model="numpy")
+def live_pairs(verlet, awake):
+    """The :class:`LivePairs` of ``verlet`` (after a build) for the floes
+    awake now; their number goes to ``awake.count[2]``."""
+    nbr, flag = verlet.nbr, awake.flag
+    m = nbr.shape[0]
+    owner, partner_start, as_partner = pair_index(verlet)
     live = np.empty(m, dtype=np.int64)
     mark = np.zeros(m, dtype=np.uint8)
     n_live = 0
     for p in range(m):
         j = nbr[p]
-        as_partner[fill[j]] = p
-        fill[j] += 1
         if flag[owner[p]] or flag[j]:
             mark[p] = 1
             live[n_live] = p

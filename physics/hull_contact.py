@@ -368,14 +368,17 @@ def floe_hull_contact(ship, dx, dy, vx, vy, w, r, inv_mass, spring, a_last, dt_h
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
+def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque, looked=None):
     """The hull's step after the floes' drift: the list check (and build),
     the contacts (their forces added to ``force``, ``torque`` of the floes),
     the collision log, the step record and the ship's new accelerations.
 
     ``floe_speed`` is the largest floe speed of the drift (for the list's
-    validity), ``time`` the time after the step. Returns False when the log
-    is full (the caller stops the run after this step and empties it)."""
+    validity), ``time`` the time after the step. With ``looked`` (N,), the
+    floes of the list with ``looked[i] == 0`` are passed over: the caller
+    has shown that they cannot touch the hull in this step
+    (:mod:`physics.hertz_free_drift`). Returns False when the log is full
+    (the caller stops the run after this step and empties it)."""
     s = ship.state
     s[S_FLOE_TRAVEL] += dt * floe_speed
     pos, vel, omega, radius, inv_mass = (floes.pos, floes.vel, floes.omega, floes.radius,
@@ -399,6 +402,8 @@ def hull_forces(ship, floes, box, time, dt, floe_speed, force, torque):
     room = True
     for k in range(counts[C_CAND]):
         i = ship.cand[k]
+        if looked is not None and looked[i] == 0:
+            continue
         res = floe_hull_contact(ship, minimum_image(pos[i, 0] - s[S_X], lx, px_),
                                 minimum_image(pos[i, 1] - s[S_Y], ly, py_), vel[i, 0], vel[i, 1],
                                 omega[i], radius[i], inv_mass[i], hist[i, 0], hist[i, 1], dt)
