@@ -66,6 +66,7 @@ bench: setup
 	$(PY) -m benchmarks.vector
 	$(PY) -m benchmarks.ship
 	$(PY) -m benchmarks.resting
+	$(PY) -m benchmarks.free_drift
 	$(PY) -m benchmarks.sensors
 	$(PY) -m benchmarks.scaling
 	$(PY) -m benchmarks.where_time_goes

@@ -30,6 +30,9 @@ suite                what is timed
                      the ship's share of a step (:mod:`benchmarks.ship`)
 ``resting``          ship transits with and without skipping the floes at rest,
                      and env steps/s of a long channel (:mod:`benchmarks.resting`)
+``free_drift``       ShipNavigation-v1 episodes with the free-drift step against
+                     the exact one: paired statistics, route choice under each,
+                     env steps/s (:mod:`benchmarks.free_drift`)
 ``sensors``          one call of the ship's lidar, swath sensor and image, and
                      their share of a step (:mod:`benchmarks.sensors`)
 ``scaling``          speed-up against Numba threads of the Hertz step, the native
@@ -62,7 +65,8 @@ import importlib
 
 #: the suites, in the order the documentation shows them
 SUITES = ("hertz", "hertz_phases", "harddisk", "observables", "itd", "environments", "vector",
-          "ship", "resting", "sensors", "scaling", "where_time_goes", "compare", "lammps_scaling")
+          "ship", "resting", "free_drift", "sensors", "scaling", "where_time_goes", "compare",
+          "lammps_scaling")
 
 __all__ = ["SUITES", "main"]
 

@@ -6,7 +6,8 @@ Rewrites the block between ``<!-- headline:start -->`` and
 floe-steps/s at Ā = 0.7 and jammed, each with its contacts per floe and a
 line on what the two regimes cost, the hard-disc engine's collisions/s and
 each environment's sustained steps/s, the native vector environments'
-steps/s and PPO's training steps/s on them, as far as records of full runs
+steps/s and PPO's training steps/s on them, ShipNavigation-v1 under the
+free-drift step, as far as records of full runs
 (not ``--quick``) exist, each with its date.
 """
 from __future__ import annotations
@@ -123,8 +124,22 @@ def _vector_rows(record: dict) -> list[list[str]]:
     return out
 
 
+def _free_drift_rows(record: dict) -> list[list[str]]:
+    """ShipNavigation-v1 under the free-drift step against the exact step,
+    one straight-line episode on one core."""
+    speed = record["data"].get("speed")
+    if not speed:
+        return []
+    s = speed["summary"]
+    e, f = s["exact"], s["fast"]
+    return [["`iceenvs/ShipNavigation-v1`, `free_drift=True`",
+             f"{f['rate']:.0f} steps/s, one core, over an episode ({e['rate']:.0f} with the exact "
+             f"step); {f['late_ms']:.1f} ms a step after step {speed['late_after']} "
+             f"({e['late_ms']:.1f})"]]
+
+
 _ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _environment_rows,
-         "vector": _vector_rows}
+         "vector": _vector_rows, "free_drift": _free_drift_rows}
 
 
 def headline_table(records: list[dict]) -> str:

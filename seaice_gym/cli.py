@@ -56,6 +56,7 @@ BENCH_SUITES = {
     "compare": "this tree against another revision, side by side",
     "lammps_scaling": "LAMMPS on MPI ranks against ours on threads, its scaling, a projection",
     "resting": "skipping the floes at rest: transit statistics on and off, env steps/s",
+    "free_drift": "the free-drift step against the exact one: paired episode statistics, env steps/s",
     "headline": "put the headline figures of the records into the README",
 }
 

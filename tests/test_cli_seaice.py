@@ -52,6 +52,7 @@ def test_each_subcommand_shows_its_entry_points_help(capsys, sub):
     (["bench", "hertz", "--help"], "--memory-floes"),
     (["bench", "scaling", "--help"], "--workloads"),
     (["bench", "where_time_goes", "--help"], "--episode-seed"),
+    (["bench", "free_drift", "--help"], "--late-after"),
     (["bench", "headline", "--help"], "--readme"),
 ])
 def test_the_help_is_the_entry_points_own(capsys, argv, shown):

@@ -24,7 +24,8 @@ SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: environments timed on a ship task, the pressured ship task and a
 #: wind-driven one; the long ship channel of the resting-floe benchmark; the
 #: ship tasks whose vector environments and training the scaling suite times;
-#: the ship task whose step and training the where_time_goes suite breaks down
+#: the ship task whose step and training the where_time_goes suite breaks down; the ship
+#: task whose episodes the free_drift suite runs with both engine steps
 EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                                              "iceenvs/ShipNavigation-v1",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
@@ -34,6 +35,7 @@ EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                "benchmarks/sensors.py": {"iceenvs/ShipNavigation-v1"},
                "benchmarks/scaling.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"},
                "benchmarks/where_time_goes.py": {"iceenvs/ShipNavigation-v1"},
+               "benchmarks/free_drift.py": {"iceenvs/ShipNavigation-v1"},
                "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 
 

@@ -11,6 +11,9 @@ repository) when the builder starts:
   workload of the scaling benchmark's record, shown with its tables;
 * ``figures/where_time_goes.png`` — the shares of a ShipNavigation-v1
   substep and of PPO training on it, from the where_time_goes record;
+* ``figures/free_drift.png`` — the ice impulse per metre of every field
+  under the fast step against the exact step, and the relative differences
+  of the means, from the free_drift record;
 * ``api/<module>.md`` — one autodoc page per public module;
 * ``include/`` — parts of hand-written pages: the lists of those pages in
   registry order (``environments_toc.md``, ``api_toc.md``), the tables of the
@@ -331,6 +334,103 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
     return True
 
 
+#: markers of the free_drift figure's policies (others get a square) and of its
+#: metrics (coloured apart from the concentrations of the other panel)
+_POLICY_MARKERS = {"straight": "o", "lattice": "^"}
+_METRIC_MARKERS = ("o", "s", "D", "v")
+
+
+def free_drift_figure(record: dict, path: Path) -> bool:
+    """Two panels of a free_drift record (``benchmarks.free_drift``): the
+    ice impulse per metre of every field under the fast step against the
+    exact step, beside the identity line; and per concentration, policy and
+    metric the difference of the means relative to the exact mean, with bars
+    of two standard errors of the paired differences and the band of the
+    relative tolerance, so that both criteria of the table show. A PNG at
+    ``path`` (rewritten only when it changes). Returns ``False``, writing
+    nothing, when the record has no statistics."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from benchmarks.free_drift import METRICS, RELATIVE_TOLERANCE, STANDARD_ERRORS
+
+    stats = record["data"].get("statistics")
+    if not stats or not stats.get("fields"):
+        return False
+    fields, rows = stats["fields"], stats["rows"]
+    concentrations = sorted({f["concentration"] for f in fields})
+    policies = list(dict.fromkeys(f["policy"] for f in fields))
+    colours = {a: f"C{k}" for k, a in enumerate(concentrations)}
+    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    FigureCanvasAgg(fig)
+    left, right = fig.subplots(1, 2, gridspec_kw=dict(width_ratios=(1.0, 1.35)))
+
+    scale = 1e3
+    values = []
+    for name in policies:
+        for a in concentrations:
+            mine = [f for f in fields if f["policy"] == name and f["concentration"] == a]
+            x = [f["exact"]["impulse_per_metre"] / scale for f in mine]
+            y = [f["fast"]["impulse_per_metre"] / scale for f in mine]
+            values += x + y
+            left.scatter(x, y, s=18, color=colours[a], marker=_POLICY_MARKERS.get(name, "s"),
+                         alpha=0.8, label=f"{name}, A = {a:g}")
+    top = 1.05 * max(values)
+    left.plot([0, top], [0, top], ":", color="0.3", lw=1, label="fast = exact")
+    left.set_xlim(0, top)
+    left.set_ylim(0, top)
+    left.set_aspect("equal")
+    left.set_xlabel("exact step [kN s/m]", fontsize=8)
+    left.set_ylabel("fast step [kN s/m]", fontsize=8)
+    left.set_title("ice impulse per metre, each field", fontsize=9)
+    left.tick_params(labelsize=7)
+    left.legend(fontsize=6, loc="upper left", ncol=2)
+
+    keys = [key for key, *_ in METRICS]
+    labels = {key: label for key, label, *_ in METRICS}
+    groups = [(a, name) for a in concentrations for name in policies]
+    width = 0.8 / len(keys)
+    band = 100 * RELATIVE_TOLERANCE
+    right.axhspan(-band, band, color="0.9", zorder=0,
+                  label=f"±{band:g} % of the exact mean")
+    right.axhline(0.0, color="0.4", lw=0.8)
+    for k, key in enumerate(keys):
+        xs, ys, errs = [], [], []
+        for g, (a, name) in enumerate(groups):
+            r = next((r for r in rows if r["concentration"] == a and r["policy"] == name
+                      and r["metric"] == key), None)
+            if r is None or not r["exact"]:
+                continue
+            xs.append(g - 0.4 + width * (k + 0.5))
+            ys.append(100 * r["relative"])
+            errs.append(100 * STANDARD_ERRORS * r["sem"] / abs(r["exact"]))
+        right.errorbar(xs, ys, yerr=errs, fmt=_METRIC_MARKERS[k % len(_METRIC_MARKERS)],
+                       ms=4, capsize=2, color=f"C{4 + k}", label=labels[key])
+        # the control beside it: the exact step against itself, nudged
+        cx, cy = [], []
+        for g, (a, name) in enumerate(groups):
+            r = next((r for r in stats.get("control", []) if r["concentration"] == a
+                      and r["policy"] == name and r["metric"] == key), None)
+            if r is None or not r["exact"]:
+                continue
+            cx.append(g - 0.4 + width * (k + 0.5))
+            cy.append(100 * r["relative"])
+        if cx:
+            right.scatter(cx, cy, s=16, marker=_METRIC_MARKERS[k % len(_METRIC_MARKERS)],
+                          facecolors="none", edgecolors=f"C{4 + k}", linewidths=0.8,
+                          label=f"{labels[key]}, control" if k == 0 else None)
+    right.set_xticks(range(len(groups)), [f"{a:g}\n{name}" for a, name in groups], fontsize=7)
+    right.set_xlim(-0.6, len(groups) - 0.4)
+    right.set_ylabel("(fast − exact) / exact [%]", fontsize=8)
+    right.set_title(f"difference of the means, ± {STANDARD_ERRORS:g} SE of the paired "
+                    f"differences", fontsize=9)
+    right.tick_params(axis="y", labelsize=7)
+    right.grid(True, axis="y", alpha=0.3)
+    right.legend(fontsize=7, loc="best")
+    save_png_if_changed(fig, path)
+    return True
+
+
 def generate_benchmarks(out: Path, directory: Path) -> None:
     from benchmarks.harness import load_records, render_markdown
 
@@ -353,6 +453,18 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
                 "training on it",
                 "Shares of the wall time: a late ShipNavigation-v1 engine substep (top) and PPO "
                 "training on its native vector environment (bottom), from the tables above.")
+        elif r["suite"] == "free_drift":
+            text = with_record_figure(
+                text, r, out, free_drift_figure,
+                "ice impulse per metre of every field under the fast step against the exact "
+                "step, and the relative differences of the means with their standard errors",
+                "Left: the ice impulse per metre of every field and policy under the fast step "
+                "against the exact step; the identity line is where they agree. Right: the "
+                "difference of the means of each metric relative to the exact mean, with bars "
+                "of two standard errors of the paired differences, beside the band of the "
+                "relative tolerance: a row of the table passes when its point lies in the band "
+                "and its bar crosses zero. Hollow markers: the same for the control, the exact "
+                "step against itself with the floes nudged by a rounding error.")
         parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
