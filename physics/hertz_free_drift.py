@@ -31,10 +31,12 @@ A floe is *free* for the window when the least distance between its line and
 each listed partner's, less both radii, exceeds ρ_i + ρ_j (the partner free)
 or ρ_i + E_j (engaged); its gap to the hull exceeds s_i W + H, and to each
 rigid wall s_i W. A floe that fails one test is engaged, and its partners are
-tested again against its budget. Pairs outside the Verlet list cannot touch
-while the list holds, and the list's expiry test covers the free floes
-through a bound (D_0 + S t)² on their distance from the list's centre, which
-is held fixed through the window. The engaged floes take the step of
+tested again against its budget. A pair of engaged floes is looked at only
+when their lines come within their two budgets. Pairs outside the Verlet
+list cannot touch while the list holds, and the list's expiry test covers
+the free floes through a bound (D_0 + S t)² on their distance from the
+list's centre, which is held fixed through the window. The engaged floes
+take the step of
 :func:`physics.hertz_resting.resting_steps`: the same arithmetic, over them
 and their pairs alone.
 
@@ -206,7 +208,8 @@ def classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt_kick, n_window,
     """The free and engaged floes of a window of ``n_window`` steps that
     begins now (module docstring), written to ``awake`` (flag 1: engaged, 0:
     free; ``order[:count[0]]`` the engaged floes, ``pending[:count[1]]`` the
-    free ones) and ``pairs`` (the live pairs: both floes engaged). Sets the
+    free ones) and ``pairs`` (the live pairs: both floes engaged, their lines
+    within their two budgets of each other). Sets the
     list's centre to the floes' mean displacement. ``table``: the floes'
     recurrences (:func:`drift_table`).
 
@@ -379,12 +382,15 @@ def classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt_kick, n_window,
     pairs.wide[0] = n_wide
     awake.count[0] = n_eng
     awake.count[1] = n_free
+    # the live pairs: two engaged floes whose lines come within their budgets
+    # (farther apart, they cannot touch while both keep to them)
     n_live = 0
     for i in range(n):
         if not flag[i]:
             continue
         for p in range(start[i], start[i + 1]):
-            if flag[nbr[p]]:
+            j = nbr[p]
+            if flag[j] and gap[p] <= lines[i, 4] + lines[j, 4] + margin:
                 pairs.live[n_live] = p
                 n_live += 1
     awake.count[2] = n_live
@@ -426,14 +432,28 @@ def sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, dt_k
         ok = iterate_free(floes, fbuf, tbuf, drive, box, awake, path, dt, dt_kick, n_done, ref)
         awake.count[1] = 0
         return ok
+    # floes of one thickness share μ and ν: their sums are taken once
+    last_mu = complex(math.nan, 0.0)
+    last_nu = math.nan
+    pw = t = qs = 0.0j
+    nu_k = 0.0
     for q in range(awake.count[1]):
         i = awake.pending[q]
         if floes.inv_mass[i] == 0.0:
             continue                        # a frozen floe keeps its state
         mu, c, nu = table[0][i], table[1][i], table[2][i]
+        if (vel[i, 0] == 0.0 and vel[i, 1] == 0.0 and omega[i] == 0.0 and fbuf[i, 0] == 0.0
+                and fbuf[i, 1] == 0.0 and tbuf[i] == 0.0 and c == 0.0):
+            path[i] += n_done * slack       # at rest, and nothing moves it: it stays
+            continue
         vx1, vy1, w1 = first_kick(i, floes, fbuf, tbuf, dt_kick)
         u1 = complex(vx1, vy1)
-        pw, t, qs = drift_sums(mu, n_done - 1)
+        if mu != last_mu:
+            pw, t, qs = drift_sums(mu, n_done - 1)
+            last_mu = mu
+        if nu != last_nu:
+            nu_k = nu ** (n_done - 1)
+            last_nu = nu
         u = pw * u1 + c * t
         shift = dt * u1 + dt * (u1 * mu * t + c * qs)
         x = pos[i, 0] + shift.real
@@ -442,7 +462,7 @@ def sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, dt_k
             x -= lx * math.floor(x / lx)
         if py:
             y -= ly * math.floor(y / ly)
-        w = w1 * nu ** (n_done - 1)
+        w = w1 * nu_k
         pos[i, 0] = x
         pos[i, 1] = y
         vel[i, 0] = u.real

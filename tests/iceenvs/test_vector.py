@@ -204,8 +204,9 @@ def _ship_reward(prev, action, now, **params):
     return float(now["surge"] - 1e-7 * now["step_impulse"])
 
 
-@pytest.mark.parametrize("kwargs", [{"obs_type": "dict"}, {"reward_fn": _ship_reward}],
-                         ids=["image observations", "own reward"])
+@pytest.mark.parametrize("kwargs", [{"obs_type": "dict"}, {"reward_fn": _ship_reward},
+                                    {"free_drift": True}],
+                         ids=["image observations", "own reward", "free-drift step"])
 def test_the_ship_paths_run_per_sub_environment_give_the_single_environment(kwargs):
     n = 2
     envs = make_vec(SHIP, n, **kwargs)
@@ -220,6 +221,8 @@ def test_the_ship_paths_run_per_sub_environment_give_the_single_environment(kwar
             np.testing.assert_allclose(reward[k], r, rtol=RTOL, atol=ATOL)
             for key in ("vector", "image") if isinstance(o, dict) else ():
                 np.testing.assert_allclose(obs[key][k], o[key], rtol=RTOL, atol=ATOL)
+    if kwargs.get("free_drift"):
+        assert all(e.sim.free_drift and e.sim.free_tally[3] > 0 for e in envs.unwrapped.envs)
     envs.close()
 
 
