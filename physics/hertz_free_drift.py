@@ -65,15 +65,15 @@ from numba import njit
 
 from .domain import minimum_image
 from .hertz_kernels import (KICK_FASTMATH, Kick, _NON_FINITE, _OK, _SHIP_LOG_FULL, begin_step,
-                            drift_bound, first_half, floe_drag, floe_rows, force_buffers,
-                            half_kick, kick_drift_floe, list_expired, max_keep_nan,
-                            min_image_step,
-                            order_key, from_order_key, pass_status, path_slack, rebuild_in_run,
-                            wall_overlap, wide_floes_pass)
+                            drift_bound, end_run, first_half, floe_drag, floe_rows,
+                            force_buffers, from_order_key, kick_drift_floe, list_expired,
+                            max_keep_nan, min_image_step, order_key, pass_status, path_slack,
+                            rebuild_in_run, rigid_drift_bound, wall_overlap, wide_floe_test,
+                            wide_floes_pass)
 from .hertz_resting import Awake, awake_wall_forces, live_pair_forces, pair_index
 from .hull import disc_hull_contact
-from .hull_contact import S_R, S_VX, S_VY, S_X, S_Y, S_FLOE_TRAVEL, hull_forces, \
-    set_world_hull, ship_closing_kick
+from .hull_contact import (S_FLOE_TRAVEL, S_X, S_Y, hull_forces, hull_point_speed,
+                           set_world_hull)
 
 __all__ = ["DEFAULT_WINDOW", "TALLY", "drift_sums", "run_steps_free"]
 
@@ -241,14 +241,12 @@ def classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt_kick, n_window,
     # the centre, the straight lines and the speed bounds
     sx = 0.0
     sy = 0.0
-    v_all = 0.0
     for i in range(n):
         sx += min_image_step(pos[i, 0] - ref[i, 0], lx, px)
         sy += min_image_step(pos[i, 1] - ref[i, 1], ly, py)
         abs_mu, abs_c, abs_mu1 = table[3][i, 0], table[3][i, 1], table[3][i, 2]
         vx, vy, _ = first_kick(i, floes, fbuf, tbuf, dt_kick)
         u = math.sqrt(vx * vx + vy * vy)
-        v_all = max(v_all, u)
         lines[i, 0] = pos[i, 0]
         lines[i, 1] = pos[i, 1]
         lines[i, 2] = vx
@@ -270,7 +268,7 @@ def classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt_kick, n_window,
     hull_speed = 0.0
     if ship.active:
         s = ship.state
-        hull_speed = math.sqrt(s[S_VX] ** 2 + s[S_VY] ** 2) + ship.reach * abs(s[S_R])
+        hull_speed = hull_point_speed(ship)
     big_h = (SPEED_MARGIN * hull_speed + SPEED_FLOOR) * span
     margin = 1e-9 + 1e-12 * (lx + ly) + path_slack(lx, ly) * n_window
     # the walls and the hull
@@ -424,7 +422,7 @@ def sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, dt_k
     pos, vel, omega = floes.pos, floes.vel, floes.omega
     lx, ly = box.lengths[0], box.lengths[1]
     px, py = box.periodic_x, box.periodic_y
-    step_length, slack = drift_bound_rigid(dt, lx, ly)
+    step_length, slack = rigid_drift_bound(dt, lx, ly)
     on = 1.0 if drive.active else 0.0
     k = drive.coefficients
     ok = True
@@ -505,12 +503,6 @@ def iterate_free(floes, fbuf, tbuf, drive, box, awake, path, dt, dt_kick, n_done
     return ok
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def drift_bound_rigid(dt, lx, ly):
-    """:func:`~physics.hertz_kernels.drift_bound` of a rigid box."""
-    return dt * (1.0 + 1e-12), path_slack(lx, ly)
-
-
 @njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy", _nrt=False)
 def engaged_pass(floes, ref, drive, kick, awake, path, lines, elapsed):
     """The kick–drift of the engaged floes
@@ -555,22 +547,14 @@ def engaged_wide_pass(pos, verlet, lx, ly, px, py, cx, cy, worst, live_wide):
     floes with a wide skin (``live_wide`` of :class:`WindowPairs`; the
     centre held through the window; the free ones are in the
     classification's bound)."""
-    ref, wide, wide_ref, weight = verlet.ref, verlet.wide, verlet.wide_ref, verlet.wide_weight
     for q in range(1, live_wide[0] + 1):
-        k = live_wide[q]
-        i = wide[k]
-        x = pos[i, 0]
-        y = pos[i, 1]
-        ex = min_image_step(x - wide_ref[k, 0], lx, px) - cx
-        ey = min_image_step(y - wide_ref[k, 1], ly, py) - cy
-        worst = max_keep_nan(worst, (ex * ex + ey * ey) * weight[k])
-        ref[i, 0] = x - cx
-        ref[i, 1] = y - cy
+        worst = max_keep_nan(worst, wide_floe_test(live_wide[q], pos, verlet, lx, ly, px, py,
+                                                   cx, cy, cx, cy))
     return worst
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def window_steps(step, end, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship,
+def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, ship,
                  work, awake, pairs, path, wall_due, fbuf, tbuf, table, lines, bounds, iterate):
     """The steps of one window, from ``step`` up to ``end`` at most (module
     docstring). ``bounds`` = (H, s_max of the free floes, D_0, S) of
@@ -602,9 +586,7 @@ def window_steps(step, end, n_steps, dt, time, floes, law, wall_law, drive, box,
             break
         lx, ly = kick.lx, kick.ly
         if ship.active:
-            s = ship.state
-            hull_path += dt * (math.sqrt(s[S_VX] * s[S_VX] + s[S_VY] * s[S_VY])
-                               + ship.reach * abs(s[S_R])) * (1.0 + 1e-12)
+            hull_path += dt * hull_point_speed(ship) * (1.0 + 1e-12)
         if n_free == 0:
             worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
             moved = False
@@ -719,7 +701,7 @@ def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, 
         n_engaged = awake.count[0]
         tally[0] += 1
         step, d, status, expired, log_full, lx, ly = window_steps(
-            step, end, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
+            step, end, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
             awake, pairs, path, wall_due, fbuf, tbuf, table, lines, bounds, iterate)
         done += d
         tally[2] += n_engaged * d
@@ -740,12 +722,7 @@ def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, 
         if log_full:
             status = _SHIP_LOG_FULL
             break
-    floes.force[:] = fbuf
-    floes.torque[:] = tbuf
-    if done > 0:
-        half_kick(floes, dt)
-        if ship.active:
-            ship_closing_kick(ship, dt)
+    end_run(floes, fbuf, tbuf, done, dt, ship)
     return done, status, n_rebuilds, verlet, n_engaged
 
 

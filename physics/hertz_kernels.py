@@ -329,7 +329,14 @@ def drift_bound(kick):
     the paths are not used)."""
     if kick.sx != 1.0 or kick.sy != 1.0:
         return 0.0, 0.0
-    return kick.dt * (1.0 + 1e-12), path_slack(kick.lx, kick.ly)
+    return rigid_drift_bound(kick.dt, kick.lx, kick.ly)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def rigid_drift_bound(dt, lx, ly):
+    """:func:`drift_bound` of a step Δt = ``dt`` in a rigid box of lengths
+    (lx, ly)."""
+    return dt * (1.0 + 1e-12), path_slack(lx, ly)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -980,18 +987,25 @@ def wide_floes_pass(pos, verlet, lx, ly, px, py, cx, cy, cx_new, cy_new, worst):
     decide the expiry). Its true displacement is measured here from
     ``wide_ref``, weighted by (s / s_i)², and merged into the largest.
     Returns the new largest squared (weighted) distance from the centre."""
-    ref, wide, wide_ref, weight = verlet.ref, verlet.wide, verlet.wide_ref, verlet.wide_weight
-    for k in range(wide.shape[0]):
-        i = wide[k]
-        x = pos[i, 0]
-        y = pos[i, 1]
-        ex = min_image_step(x - wide_ref[k, 0], lx, px) - cx
-        ey = min_image_step(y - wide_ref[k, 1], ly, py) - cy
-        e2 = (ex * ex + ey * ey) * weight[k]
-        worst = max_keep_nan(worst, e2)
-        ref[i, 0] = x - cx_new
-        ref[i, 1] = y - cy_new
+    for k in range(verlet.wide.shape[0]):
+        worst = max_keep_nan(worst, wide_floe_test(k, pos, verlet, lx, ly, px, py, cx, cy,
+                                                   cx_new, cy_new))
     return worst
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def wide_floe_test(k, pos, verlet, lx, ly, px, py, cx, cy, cx_new, cy_new):
+    """Wide floe k of :func:`wide_floes_pass`: its weighted squared
+    displacement from the centre (cx, cy), and its shadow reference set
+    from the new centre."""
+    i = verlet.wide[k]
+    x = pos[i, 0]
+    y = pos[i, 1]
+    ex = min_image_step(x - verlet.wide_ref[k, 0], lx, px) - cx
+    ey = min_image_step(y - verlet.wide_ref[k, 1], ly, py) - cy
+    verlet.ref[i, 0] = x - cx_new
+    verlet.ref[i, 1] = y - cy_new
+    return (ex * ex + ey * ey) * verlet.wide_weight[k]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -1005,6 +1019,19 @@ def half_kick(floes, dt):
         vel[i, 0] += h * force[i, 0] * inv_mass[i]
         vel[i, 1] += h * force[i, 1] * inv_mass[i]
         omega[i] += h * torque[i] * inv_inertia[i]
+
+
+@njit(cache=True, error_model="numpy")
+def end_run(floes, force, torque, done, dt, ship):
+    """The end of a run of ``done`` steps: the total force of its last step
+    (``force``, ``torque``) kept as the floes' forces, and the closing half
+    kick of the floes and the ship."""
+    floes.force[:] = force
+    floes.torque[:] = torque
+    if done > 0:
+        half_kick(floes, dt)
+        if ship.active:
+            ship_closing_kick(ship, dt)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1183,14 +1210,8 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
         if log_full:
             status = _SHIP_LOG_FULL
             break
-    # total force of the last step, and the closing half kick
     gather_cut(0, n, chunks, buffers.force, buffers.torque)
-    floes.force[:] = buffers.force
-    floes.torque[:] = buffers.torque
-    if done > 0:
-        half_kick(floes, dt)
-        if ship.active:
-            ship_closing_kick(ship, dt)
+    end_run(floes, buffers.force, buffers.torque, done, dt, ship)
     return done, status, n_rebuilds, verlet
 
 

@@ -57,10 +57,10 @@ from numba import njit
 from .domain import minimum_image
 from .hertz_kernels import (KICK_FASTMATH, _OK, _SHIP_LOG_FULL, apart_until, begin_step,
                             drift_bound, first_half, floe_drag, floe_rows, floe_walls,
-                            floe_walls_skipping, force_buffers, from_order_key, half_kick,
+                            floe_walls_skipping, force_buffers, from_order_key, end_run,
                             kick_drift_floe, list_expired, listed_pair, max_keep_nan, order_key,
                             pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
-from .hull_contact import C_CAND, hull_forces, ship_closing_kick
+from .hull_contact import C_CAND, hull_forces
 
 __all__ = ["Awake", "LivePairs", "run_steps_resting"]
 
@@ -494,11 +494,5 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
         if log_full:
             status = _SHIP_LOG_FULL
             break
-    # total force of the last step, and the closing half kick
-    floes.force[:] = fbuf
-    floes.torque[:] = tbuf
-    if done > 0:
-        half_kick(floes, dt)
-        if ship.active:
-            ship_closing_kick(ship, dt)
+    end_run(floes, fbuf, tbuf, done, dt, ship)
     return done, status, n_rebuilds, verlet, awake.count[0]

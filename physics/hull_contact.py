@@ -150,6 +150,14 @@ def inactive_bundle(law) -> ShipBundle:
 # The ship's motion
 # ---------------------------------------------------------------------------
 
+@njit(cache=True, inline="always", error_model="numpy")
+def hull_point_speed(ship):
+    """The speed of the hull's fastest point [m/s]: the centroid's speed
+    plus the yaw rate times the reach (a bound, for any corner)."""
+    s = ship.state
+    return math.sqrt(s[S_VX] * s[S_VX] + s[S_VY] * s[S_VY]) + ship.reach * abs(s[S_R])
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def ship_kick_drift(ship, dt_kick, dt):
     """First half of the ship's step: kick by ``dt_kick`` with the last
@@ -173,8 +181,7 @@ def ship_kick_drift(ship, dt_kick, dt):
         s[S_PSI] += dt * r
     s[S_X] += dt * s[S_VX]
     s[S_Y] += dt * s[S_VY]
-    s[S_HULL_TRAVEL] += dt * (math.sqrt(s[S_VX] * s[S_VX] + s[S_VY] * s[S_VY])
-                              + ship.reach * abs(s[S_R]))
+    s[S_HULL_TRAVEL] += dt * hull_point_speed(ship)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -300,7 +307,7 @@ def ship_floe_skins(ship, floes, skin, dt, lx, ly, px, py):
     set_world_hull(ship)
     s = ship.state
     x0, y0 = s[S_X], s[S_Y]
-    hull_speed = math.sqrt(s[S_VX] ** 2 + s[S_VY] ** 2) + abs(s[S_R]) * ship.reach
+    hull_speed = hull_point_speed(ship)
     near_skin = 4.0 * hull_speed * horizon
     for i in range(n):
         if inv_mass[i] == 0.0:
