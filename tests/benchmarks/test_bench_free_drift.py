@@ -5,17 +5,14 @@ tables and figure of it (a smoke test of the structure; the figures come
 from the full benchmark)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import numba
 import pytest
 
 from benchmarks import free_drift as fd, harness
-
-ROOT = Path(__file__).resolve().parents[2]
+from docs_extension import benchmarks_page
 
 
 def test_options_from_the_command_line(capsys):
@@ -170,15 +167,8 @@ def test_quick_run_writes_the_record_and_the_docs_show_it(tmp_path):
     text = harness.render_markdown(record)
     assert text.startswith(f"## {fd.TITLE}\n") and "### Does route choice pay" in text
 
-    pytest.importorskip("sphinx")
-    pytest.importorskip("matplotlib")
-    spec = importlib.util.spec_from_file_location("seaice_docs_under_test",
-                                                  ROOT / "docs" / "_ext" / "seaice_docs.py")
-    docs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(docs)
     out = tmp_path / "_generated"
-    docs.generate_benchmarks(out, tmp_path)
-    page = (out / "include" / "benchmarks.md").read_text(encoding="utf-8")
+    docs, page = benchmarks_page(tmp_path, out)
     figure = out / "figures" / "free_drift.png"
     assert figure.read_bytes().startswith(b"\x89PNG")
     assert "| A | policy | metric | mean, exact | mean, fast |" in page

@@ -4,19 +4,16 @@ the documentation draws the record's figure (a smoke test; the figures come
 from the full benchmark)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import numba
 import pytest
 
 from benchmarks import harness, scaling
+from docs_extension import docs_extension
 
 pytest.importorskip("stable_baselines3")
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_thread_counts_and_workloads_from_the_command_line():
@@ -92,16 +89,6 @@ def test_quick_run_times_every_workload_on_every_thread_count(tmp_path):
     assert text.startswith(f"## {scaling.TITLE}\n") and "### Speed-up over one thread" in text
 
 
-def _docs_extension():
-    pytest.importorskip("sphinx")
-    pytest.importorskip("matplotlib")
-    spec = importlib.util.spec_from_file_location("seaice_docs_under_test",
-                                                  ROOT / "docs" / "_ext" / "seaice_docs.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def _synthetic_record(workloads=("ceiling", "hertz-loose", "ppo-v0")):
     threads = [1, 2, 4]
     results = []
@@ -122,7 +109,7 @@ def _synthetic_record(workloads=("ceiling", "hertz-loose", "ppo-v0")):
 
 
 def test_docs_show_the_scaling_tables_and_figure(tmp_path):
-    docs = _docs_extension()
+    docs = docs_extension()
     records = tmp_path / "records"
     record = _synthetic_record()
     harness.write_record(record, records / "scaling.json")

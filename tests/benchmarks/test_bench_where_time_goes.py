@@ -4,19 +4,16 @@ parts add up and whose shares are fractions, and the documentation's tables
 and figure of it (a smoke test; the figures come from the full benchmark)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import numba
 import pytest
 
 from benchmarks import harness, where_time_goes as wtg
+from docs_extension import benchmarks_page
 
 pytest.importorskip("stable_baselines3")
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_parts_from_the_command_line(capsys):
@@ -92,15 +89,8 @@ def test_quick_run_writes_the_record(tmp_path):
     text = harness.render_markdown(record)
     assert text.startswith(f"## {wtg.TITLE}\n") and "### Time per substep" in text
 
-    pytest.importorskip("sphinx")
-    pytest.importorskip("matplotlib")
-    spec = importlib.util.spec_from_file_location("seaice_docs_under_test",
-                                                  ROOT / "docs" / "_ext" / "seaice_docs.py")
-    docs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(docs)
     out = tmp_path / "_generated"
-    docs.generate_benchmarks(out, tmp_path)
-    page = (out / "include" / "benchmarks.md").read_text(encoding="utf-8")
+    _, page = benchmarks_page(tmp_path, out)
     figure = out / "figures" / "where_time_goes.png"
     assert figure.read_bytes().startswith(b"\x89PNG")
     assert "| part | µs per substep | slowest round | share of the step |" in page
