@@ -11,7 +11,7 @@ from physics.domain import Box
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .rewards import ship_beset_reward
-from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, SLOW_TIME, ShipEnv, ship_facts, ship_features
 from .vector import vector_class
 
 __all__ = ["ShipBesetEnv", "ShipBesetVectorEnv", "MAX_EPISODE_STEPS"]
@@ -207,9 +207,11 @@ class ShipBesetEnv(ShipEnv):
             out[k] = env.episode["pressure_limit"], min(y.min(), env.width - y.max())
         return out
 
-    def _terminated(self, now):
-        return (self.slow_time >= self.episode["beset_time"]
-                or now["wall_clearance"] < WALL_MARGIN)
+    def _ended(self, cols, sums, task):
+        # fails: beset for beset_time, or the hull within WALL_MARGIN of a wall
+        succeeded, failed = super()._ended(cols, sums, task)
+        return succeeded, (failed | (sums[:, SLOW_TIME] >= task["beset_time"])
+                           | (cols["wall_clearance"] < WALL_MARGIN))
 
     def _frame_text(self):
         return super()._frame_text() + [

@@ -19,7 +19,9 @@ Subclasses say what the task is:
 
 * ``_ice(rng)`` — the floe field and the box of an episode, and the forcing;
 * ``_ship_start()`` — where the ship starts (position, heading);
-* ``_succeeded(now)`` and ``_terminated(now)`` — goal reached, failure;
+* ``_ended(cols, sums, task)`` — goal reached and failure, for a batch of
+  environments (a step is one batch, :class:`~iceenvs.ship_measures.ShipBatch`:
+  the single environment is a batch of one);
 * ``controls`` (the action set-ups the task offers) and the reward.
 
 Step loads (``info["physics"]``, for the last step; forces in the ship frame):
@@ -66,16 +68,16 @@ from physics import FloeField, HERMAN2013
 from physics.checks import check_range
 from physics.hertz import hull_contact_time
 
-from .base import HertzEnv
+from .base import HertzEnv, sanitise_action
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactivePlanner, StraightLinePolicy
-from .ship_measures import (METRICS, SUM_COLUMNS, ShipVectorEnv, as_measurement, measure_names,
-                            measure_ships, metric_values, update_metrics)
+from .ship_measures import (METRICS, SUM_COLUMNS, ShipBatch, ShipVectorEnv, as_measurement,
+                            measure_names, measure_ships, metric_values)
 from .ship_sensors import occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
-           "METRICS"]
+           "METRICS", "SLOW_TIME"]
 
 #: floe-size presets: (``sizes`` of :func:`physics.ship.transit_field`,
 #: log-normal (median diameter [m], σ of ln d))
@@ -95,6 +97,8 @@ CONTROLS = {
 }
 
 OBS_TYPES = ("vector", "image", "dict")
+#: the column of the time below the beset speed in a row of episode sums
+SLOW_TIME = SUM_COLUMNS.index("slow_time")
 
 def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
                **more) -> EnvFacts:
@@ -237,7 +241,9 @@ class ShipEnv(HertzEnv):
         #: the episode's sums and metrics (:data:`~iceenvs.ship_measures.SUM_COLUMNS`);
         #: a native vector environment makes it a row of its table
         self._sums = np.zeros(len(SUM_COLUMNS))
-        self._records_pending = False
+        #: the step as a batch of one (made at the first step)
+        self._one: ShipBatch | None = None
+        self._one_sums = None
         super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
         self.failure_reward = -float(self.reward_params["failure_penalty"])
@@ -387,7 +393,7 @@ class ShipEnv(HertzEnv):
         self._sums[:] = 0.0
         self._sums[[SUM_COLUMNS.index("x"), SUM_COLUMNS.index("y")]] = self._track[0]
         self._floes_hit = set()
-        self._records_pending = False
+        self._begun = False
         self.plan_overlay = None
         return sim
 
@@ -435,14 +441,26 @@ class ShipEnv(HertzEnv):
         environments ``envs`` of this class (a measurement's last columns)."""
         return np.zeros((len(envs), 0))
 
-    def _advanced(self):
-        # the step records are read with the measurement (measure_ships)
-        self._records_pending = True
-
     def _measure(self) -> dict:
-        raw = measure_ships([self], self._sums[None, :], advanced=self._records_pending)
-        self._records_pending = False
+        # the first measurement of an episode; a step measures in its batch
+        raw = measure_ships([self], self._sums[None, :], advanced=False)
         return as_measurement(self.measure_names, raw[0])
+
+    def step(self, action):
+        """One step: the step of a native vector environment's
+        sub-environments (:class:`~iceenvs.ship_measures.ShipBatch`), for a
+        batch of one."""
+        if not self._ready():
+            raise RuntimeError("call reset() before step()")
+        a, replaced = sanitise_action(action, self.action_space)
+        if self._one is None or self._one_sums is not self._sums:
+            self._one, self._one_sums = ShipBatch([self], self._sums[None, :]), self._sums
+        if not self._begun:
+            self._one.begin()
+            self._begun = True
+        obs, reward, terminated, info = self._one.step(a[None], np.array([replaced]))
+        obs = {key: value[0] for key, value in obs.items()} if isinstance(obs, dict) else obs[0]
+        return obs, float(reward[0]), bool(terminated[0]), False, info
 
     @property
     def slow_time(self) -> float:
@@ -473,14 +491,20 @@ class ShipEnv(HertzEnv):
         return metric_values(self._sums)
 
     def _info(self, now: dict) -> dict:
+        # the metrics as the step (its batch) left them
         info = super()._info(now)
-        if not (now is self._prev or self._steps == 0):
-            update_metrics(self._sums[None, :], now, self.goal_distance)
         info.update(self._metrics)
         return info
 
-    def _succeeded(self, now: dict) -> bool:
-        return bool(now["reached"])
+    def _ended(self, cols: dict, sums: np.ndarray, task: dict) -> tuple:
+        """(succeeded, failed), boolean arrays, of a batch of environments of
+        this class and configuration: ``cols`` the columns of their
+        measurements (name → array), ``sums`` their rows of episode sums
+        (:data:`SUM_COLUMNS`), ``task`` the columns of their episodes'
+        tasks. Every ship task succeeds when its ship reaches the goal line;
+        a task adds its own failures."""
+        succeeded = cols["reached"] > 0
+        return succeeded, np.zeros_like(succeeded)
 
     @property
     def ship(self):

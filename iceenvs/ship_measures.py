@@ -32,20 +32,23 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from gymnasium.vector import VectorEnv
 from gymnasium.vector.utils import create_empty_array
 from numba import njit, prange, types
 from numba.typed import List
 
+from physics.hertz import KernelLists
 from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import PHYSICS_ERRORS
 from .observations import observation_vectors
 from .ship_sensors import lidar_scan
-from .vector import HertzVectorEnv, put_row, set_row
+from .vector import HertzVectorEnv, batch_infos, drive, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
            "measure_names", "measure_ships", "ice_kinetic_energy", "measure_many", "step_sums",
-           "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipVectorEnv"]
+           "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipBatch",
+           "ShipVectorEnv"]
 
 #: the pose entries of a measurement (ship frame; the goal lies along +x)
 POSE = ("goal_distance", "goal_cos", "goal_sin", "channel_offset", "surge", "sway", "yaw_rate")
@@ -441,24 +444,42 @@ def as_measurement(names, row: np.ndarray) -> dict:
     return now
 
 
-class ShipVectorEnv(HertzVectorEnv):
-    """The native vector environment of a ship environment
-    (:class:`~iceenvs.vector.HertzVectorEnv` with the step's end made in
-    batch): after the engines advanced together, :func:`measure_ships`
-    measures every sub-environment at once, and the rewards (a built-in
-    reward is evaluated on columns), observations (one
-    :func:`~iceenvs.observations.observation_vectors` call), episode metrics
-    (:func:`update_metrics` on the table of sums) and the info (columns) of
-    all of them are made as arrays over the sub-environments. Only the
-    image observation, a reward function of one's own and the end-of-episode
-    tests run per sub-environment."""
+class ShipBatch:
+    """The step of a list of ship environments (of one class and
+    configuration) as one batch: what a ship environment's step does,
+    written once, for the native vector environment's sub-environments
+    (:class:`ShipVectorEnv`) and for the single environment, a batch of one
+    (:meth:`iceenvs.ship_env.ShipEnv.step`).
 
-    def __init__(self, num_envs: int = 1, **kwargs):
-        super().__init__(num_envs, **kwargs)
+    A step (:meth:`step`): the actions are applied and the engines advance
+    together (:func:`iceenvs.vector.drive`); :func:`measure_ships` measures
+    every environment at once; the rewards (a built-in reward is evaluated
+    on columns), the ends of the episodes (the environment class's
+    ``_ended``, on columns), the observations (one
+    :func:`~iceenvs.observations.observation_vectors` call), the episode
+    metrics (:func:`update_metrics` on the table of sums) and the info
+    (columns) are made as arrays over the environments. Only an image
+    observation and a reward function of one's own run per environment.
+
+    Parameters
+    ----------
+    envs : list of ShipEnv
+        The environments; each keeps its episode's sums in its row of
+        ``table``.
+    table : ndarray
+        (len(envs), len(:data:`SUM_COLUMNS`)) episode sums, updated in place.
+    lists : KernelLists, optional
+        The typed lists of the engines' compiled calls, kept from step to
+        step (:class:`physics.hertz.KernelLists`).
+    """
+
+    def __init__(self, envs, table: np.ndarray, lists: KernelLists | None = None):
+        self.envs = list(envs)
+        self.num_envs = len(self.envs)
+        self.table = table
+        self.lists = KernelLists() if lists is None else lists
         e0 = self.envs[0]
-        self._table = np.zeros((self.num_envs, len(SUM_COLUMNS)))
-        for k, env in enumerate(self.envs):
-            env._sums = self._table[k]
+        self.single_observation_space = e0.observation_space
         self._names = e0.measure_names
         self._column = {name: j for j, name in enumerate(self._names)}
         # the observation's features as columns of a measurement (time_left: computed)
@@ -467,16 +488,27 @@ class ShipVectorEnv(HertzVectorEnv):
         self._prev_raw = np.zeros((self.num_envs, len(self._names)))
         self._reward_kw: dict[str, np.ndarray] = {}
         self._task: dict = {}
+        self._task_keys: list[str] = []
         self._batch_reward = all(env.reward_fn is type(env).reward_fn for env in self.envs)
 
-    def reset(self, *, seed=None, options=None):
-        obs, info = super().reset(seed=seed, options=options)
-        self._task = _copied(info["task"])
-        for k in range(self.num_envs):
-            self._reset_row(k)
-        return obs, info
+    @property
+    def one(self) -> bool:
+        """A batch of one: a single environment, whose info is its own dict
+        (the row a vector info would hold for it)."""
+        return self.num_envs == 1
 
-    def _reset_row(self, k: int) -> None:
+    #: Gymnasium's builder of a vector info, which needs only ``num_envs``
+    _add_info = VectorEnv._add_info
+
+    def begin(self) -> None:
+        """After every environment began an episode (``reset``)."""
+        self._task = batch_infos([dict(env.episode) for env in self.envs])
+        self._task_keys = [key for key in self._task if not key.startswith("_")]
+        for k in range(self.num_envs):
+            self.begin_row(k)
+
+    def begin_row(self, k: int) -> None:
+        """After environment k began a new episode."""
         env = self.envs[k]
         self._prev_raw[k] = [env._prev[name] for name in self._names]
         for key, value in env._reward_kwargs().items():
@@ -484,7 +516,17 @@ class ShipVectorEnv(HertzVectorEnv):
         if self._task:
             self._task = set_row(self, self._task, dict(env.episode), k)
 
-    def _results(self, actions, replaced, errors) -> tuple:
+    def step(self, actions: np.ndarray, replaced: np.ndarray) -> tuple:
+        """One step of every environment with its sanitised action
+        ``actions[k]`` (``replaced[k]``: its entries that were not finite):
+        (observations, rewards, terminated, info), batched."""
+        return self.results(actions, replaced, drive(self.envs, actions, self.lists))
+
+    def results(self, actions, replaced, errors) -> tuple:
+        """(observations, rewards, terminated, info) of a step whose engines
+        ran (``errors[k]``: the physics failure of environment k, or None).
+        The info is a vector info (a dict of columns, each with its mask),
+        or for a batch of :attr:`one` the environment's info dict."""
         n = self.num_envs
         ok = np.array([k for k in range(n) if errors[k] is None], dtype=np.int64)
         obs = create_empty_array(self.single_observation_space, n)
@@ -492,8 +534,8 @@ class ShipVectorEnv(HertzVectorEnv):
         terminated = np.zeros(n, dtype=bool)
         infos: dict = {}
         if ok.size:
-            table = self._table if ok.size == n else self._table[ok]
-            group = [self.envs[k] for k in ok]
+            table = self.table if ok.size == n else self.table[ok]
+            group = self.envs if ok.size == n else [self.envs[k] for k in ok]
             try:
                 raw = measure_ships(group, table, advanced=True)
             except PHYSICS_ERRORS as err:          # every measured one fails with it
@@ -504,36 +546,39 @@ class ShipVectorEnv(HertzVectorEnv):
                 infos = self._measured(group, ok, raw, table, actions, replaced, obs, rewards,
                                        terminated)
                 if ok.size < n:
-                    self._table[ok] = table
+                    self.table[ok] = table
         for k in range(n):
             if errors[k] is not None:
                 o, rewards[k], terminated[k], _, info = self.envs[k]._failed_step(
                     errors[k], int(replaced[k]))
                 put_row(obs, k, o)
-                infos = set_row(self, infos, info, k)
+                infos = info if self.one else set_row(self, infos, info, k)
         return obs, rewards, terminated, infos
 
     def _measured(self, group, ok, raw, table, actions, replaced, obs, rewards, terminated):
-        """Rewards, ends, observations and the info of the sub-environments
+        """Rewards, ends, observations and the info of the environments
         ``ok`` (``group``) measured ``raw``; fills their rows of ``obs``,
         ``rewards`` and ``terminated`` and returns the info."""
         e0 = group[0]
         n = self.num_envs
-        cols = {name: raw[:, j] for j, name in enumerate(self._names)}
-        prev_raw = self._prev_raw[ok]
-        prev = {name: prev_raw[:, j] for j, name in enumerate(self._names)}
-        nows = [as_measurement(self._names, row) for row in raw]
-        if self._batch_reward:
-            kw = {key: value[ok] for key, value in self._reward_kw.items()}
+        full = ok.size == n
+        names = self._names
+        cols = dict(zip(names, raw.T))
+        prev_raw = self._prev_raw if full else self._prev_raw[ok]
+        task = {key: self._task[key] if full else self._task[key][ok] for key in self._task_keys}
+        nows = [as_measurement(names, row) for row in raw]
+        if self._batch_reward and not self.one:      # on columns
+            kw = self._reward_kw if full else {key: value[ok]
+                                               for key, value in self._reward_kw.items()}
+            prev = dict(zip(names, prev_raw.T))
             reward = np.asarray(e0.reward_fn(prev, actions[ok], cols, **kw), dtype=float)
             reward = np.broadcast_to(reward, ok.shape).copy()
-        else:
+        else:                                # per environment, on its measurement
             reward = np.array([env._reward(actions[k], now)
                                for env, k, now in zip(group, ok, nows)])
         bad = ~np.isfinite(reward)
-        failed = np.array([env._terminated(now) for env, now in zip(group, nows)],
-                          dtype=bool) | bad
-        succeeded = np.array([env._succeeded(now) for env, now in zip(group, nows)], dtype=bool)
+        succeeded, failed = e0._ended(cols, table, task)
+        failed = failed | bad
         rewards[ok] = np.where(failed, e0.failure_reward, reward)
         terminated[ok] = succeeded | failed
         update_metrics(table, cols, e0.goal_distance)
@@ -547,7 +592,7 @@ class ShipVectorEnv(HertzVectorEnv):
             obs[ok] = vectors
             for env, now, vector in zip(group, nows, vectors):
                 env._prev = now
-                env._obs = vector.copy()
+                env._obs = vector
         else:
             for env, k, now in zip(group, ok, nows):
                 env._prev = now
@@ -556,20 +601,50 @@ class ShipVectorEnv(HertzVectorEnv):
         for env in group:
             if env.render_mode == "human":
                 env.render()
-        # info: what each sub-environment's info holds, as columns
+        if self.one:                         # a single environment: its info dict
+            info = e0._info(nows[0])
+            info["nonfinite_action"] = int(replaced[0])
+            if bad[0]:
+                info["error"] = f"non-finite reward {reward[0]}"
+            return info
+        # info: what each environment's info holds, as columns
         physics = {name: raw[:, j].copy() for j, name in enumerate(self._names)}
         for name in INTEGER_MEASURES:
             physics[name] = physics[name].astype(np.int64)
         metrics = metric_columns(table)
         columns = {"physics": physics, "time": metrics["time"],
                    "steps": np.array([env._steps for env in group]),
-                   "task": {key: value[ok] for key, value in self._task.items()
-                            if not key.startswith("_")},
-                   **metrics, "nonfinite_action": replaced[ok]}
+                   "task": {key: value.copy() for key, value in task.items()}, **metrics,
+                   "nonfinite_action": replaced[ok]}
         infos = _spread(columns, ok, n)
         for i in np.flatnonzero(bad):
             infos = self._add_info(infos, {"error": f"non-finite reward {reward[i]}"}, ok[i])
         return infos
+
+
+class ShipVectorEnv(HertzVectorEnv):
+    """The native vector environment of a ship environment
+    (:class:`~iceenvs.vector.HertzVectorEnv` whose sub-environments step as
+    one :class:`ShipBatch`, the step the single environment takes as a
+    batch of one)."""
+
+    def __init__(self, num_envs: int = 1, **kwargs):
+        super().__init__(num_envs, **kwargs)
+        self._table = np.zeros((self.num_envs, len(SUM_COLUMNS)))
+        for k, env in enumerate(self.envs):
+            env._sums = self._table[k]
+        self._ship_batch = ShipBatch(self.envs, self._table, self._lists)
+
+    def reset(self, *, seed=None, options=None):
+        obs, info = super().reset(seed=seed, options=options)
+        self._ship_batch.begin()
+        return obs, info
+
+    def _reset_row(self, k: int) -> None:
+        self._ship_batch.begin_row(k)
+
+    def _results(self, actions, replaced, errors) -> tuple:
+        return self._ship_batch.results(actions, replaced, errors)
 
 
 def _copied(info: dict) -> dict:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from physics import HERMAN2013, FloeField
 from physics.domain import Box
 from physics.forcing import steady_drift
@@ -11,7 +13,7 @@ from physics.forcing import steady_drift
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
-from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, SLOW_TIME, ShipEnv, ship_facts, ship_features
 from .vector import vector_class
 
 __all__ = ["ShipNavigationEnv", "ShipNavigationVectorEnv", "MAX_EPISODE_STEPS"]
@@ -245,10 +247,14 @@ class ShipNavigationEnv(ShipEnv):
                               density=field.density)
         return field
 
-    def _terminated(self, now):
-        if self.mode == "dynamic" and self.slow_time >= self.episode["beset_time"]:
-            return True
-        return self.episode["channel_exit"] == "terminate" and abs(now["channel_offset"]) > 1.0
+    def _ended(self, cols, sums, task):
+        # fails: a dynamic ship beset for beset_time, or out of the channel
+        # when leaving it terminates
+        succeeded, failed = super()._ended(cols, sums, task)
+        if self.mode == "dynamic":
+            failed |= sums[:, SLOW_TIME] >= task["beset_time"]
+        failed |= (task["channel_exit"] == "terminate") & (np.abs(cols["channel_offset"]) > 1.0)
+        return succeeded, failed
 
 
 #: N :class:`ShipNavigationEnv` whose engines advance together (:mod:`iceenvs.vector`)

@@ -29,14 +29,15 @@ N dicts, one per sub-environment. ``render_env=k`` chooses the
 sub-environment that ``render()`` draws (``render_mode`` as in the single
 environment).
 
-The engine step runs in one compiled call. The end of the step is the
-environment's: :class:`HertzVectorEnv` has each sub-environment measure,
-score and observe with its own code, one after the other
+The engine step runs in one compiled call (:func:`drive`). The end of the
+step is the environment's: :class:`HertzVectorEnv` has each sub-environment
+measure, score and observe with its own code, one after the other
 (:class:`~iceenvs.base.ControlEnv`'s step in three parts), and an
-environment whose ``vector_base`` is a subclass makes it in batch (the ship
-environments: :class:`iceenvs.ship_measures.ShipVectorEnv`, measurements,
-rewards, observations, metrics and info as arrays over the
-sub-environments).
+environment whose ``vector_base`` is a subclass makes it in batch. The ship
+environments step as one :class:`iceenvs.ship_measures.ShipBatch`
+(measurements, rewards, ends of episodes, observations, metrics and info as
+arrays over the sub-environments), and their single environment steps as a
+batch of one: the step is written once.
 
 >>> import gymnasium as gym
 >>> import iceenvs  # noqa: F401
@@ -59,7 +60,7 @@ from physics.hertz import KernelLists, advance_together
 
 from .base import PHYSICS_ERRORS, HertzEnv, sanitise_actions
 
-__all__ = ["HertzVectorEnv", "batch_infos", "row_info", "set_row", "put_row", "vector_class"]
+__all__ = ["HertzVectorEnv", "drive", "batch_infos", "row_info", "set_row", "put_row", "vector_class"]
 
 
 class HertzVectorEnv(VectorEnv):
@@ -146,18 +147,7 @@ class HertzVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before step()")
         actions, replaced = sanitise_actions(self._checked_actions(actions),
                                              self.single_action_space)
-        errors: list[BaseException | None] = [None] * self.num_envs
-        for k, env in enumerate(self.envs):
-            env._took_action(actions[k])
-            try:
-                env._apply_action(actions[k])
-            except PHYSICS_ERRORS as err:
-                errors[k] = err
-        moving = [k for k in range(self.num_envs) if errors[k] is None]
-        for k, err in zip(moving, advance_together([self.envs[k].sim for k in moving],
-                                                   self.envs[0].control_interval,
-                                                   lists=self._lists)):
-            errors[k] = err
+        errors = drive(self.envs, actions, self._lists)
         obs, rewards, terminated, infos = self._results(actions, replaced, errors)
         truncated = np.zeros(self.num_envs, dtype=bool)
         if self.max_episode_steps is not None:
@@ -185,7 +175,6 @@ class HertzVectorEnv(VectorEnv):
             result = None
             if errors[k] is None:
                 try:
-                    env._advanced()
                     now = env._measure()
                 except PHYSICS_ERRORS as err:
                     errors[k] = err
@@ -247,6 +236,35 @@ class HertzVectorEnv(VectorEnv):
 
     def __repr__(self):
         return f"{type(self).__name__}(num_envs={self.num_envs})"
+
+
+def drive(envs: Sequence[HertzEnv], actions: np.ndarray,
+          lists: KernelLists | None = None) -> list[BaseException | None]:
+    """The first part of a step of the environments ``envs`` (of one class
+    and configuration, each with its episode running), which the native
+    vector environments and the single ship environments (a batch of one)
+    share: each counts the step and applies its sanitised action
+    ``actions[k]``, then their engines advance together by the control
+    interval (:func:`physics.hertz.advance_together`, with the typed lists
+    ``lists`` kept by the caller). Returns per environment ``None`` or the
+    physics error that ends its episode (in applying the action, or in the
+    engine)."""
+    errors: list[BaseException | None] = [None] * len(envs)
+    for k, env in enumerate(envs):
+        env._took_action(actions[k])
+        try:
+            env._apply_action(actions[k])
+        except PHYSICS_ERRORS as err:
+            errors[k] = err
+    moving = [k for k in range(len(envs)) if errors[k] is None]
+    if moving:
+        for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
+                                                   envs[0].control_interval, lists=lists)):
+            errors[k] = err
+    for k in moving:
+        if errors[k] is None:
+            envs[k]._advanced()
+    return errors
 
 
 def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:

@@ -786,6 +786,12 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
     if len({id(s) for s in sims}) != len(sims):
         raise ValueError("advance_together got the same simulation twice")
     check_range("duration", duration, 0.0, None)
+    if len(sims) == 1:                      # one simulation: its own step, without threads
+        try:
+            sims[0].advance(duration)
+        except SimulationError as err:
+            return [err]
+        return [None]
     left = [sim._steps_to_run(int(round(duration / sim.dt))) for sim in sims]
     status = [HertzStatus.OK] * len(sims)
     while True:
