@@ -38,6 +38,8 @@ from numba import njit, prange, types
 from numba.typed import List
 
 from physics.hertz import KernelLists
+from physics.hertz_batch import ICE_NEAR, ice_near_many
+from physics.hertz_kernels import ice_energy
 from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import PHYSICS_ERRORS
@@ -257,7 +259,8 @@ def _stacked(arrays: list, columns: int) -> np.ndarray:
     return full[0] if len(full) == 1 else np.concatenate(full)
 
 
-def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
+def measure_ships(envs, table: np.ndarray, *, advanced: bool,
+                  lists: KernelLists | None = None) -> np.ndarray:
     """The raw measurements of the ship environments ``envs`` (of one class
     and configuration, each with its episode running), one row each, the
     columns of ``envs[0].measure_names``.
@@ -267,6 +270,12 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
     added to the episode sums in ``table`` (M, len(:data:`SUM_COLUMNS`)),
     one row per environment, updated in place. Otherwise (the first
     measurement of an episode) the step loads are zero.
+
+    ``lists``: the typed lists of the engines' last batch run
+    (:func:`physics.hertz.advance_together`); where they still hold every
+    engine's state, the ice around all the hulls is measured in one
+    compiled call over them (:func:`physics.hertz_batch.ice_near_many`),
+    else engine by engine, with the same arithmetic.
     """
     e0 = envs[0]
     n = len(envs)
@@ -311,12 +320,7 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
             if env.render_mode is not None and rows[m].shape[0]:   # the path on the frames
                 env._track.append(table[m, [_SUM_X, _SUM_Y]].copy())
         _add_collisions(envs, table, loads, logs)
-    for m, (env, sim) in enumerate(zip(envs, sims)):
-        ice = sim.local_ice((motion[m, 0], motion[m, 1]), env.local_radius)
-        raw[m, loc:loc + 5] = (env._field_concentration, min(1.0, ice.floe_area / ice.area),
-                               2.0 * ice.n_contacts / ice.n_floes if ice.n_floes else 0.0,
-                               ice.pressure if ice.n_contacts else 0.0, sim.time)
-        raw[m, loc + 6] = ice_kinetic_energy(sim)
+    _local_ice(envs, sims, motion, lists, raw[:, loc:loc + len(LOCAL)])
     raw[:, loc + 5] = motion[:, 0] >= e0.goal_x
     if not advanced:
         table[:, _SUM_ICE_START] = raw[:, loc + 6]
@@ -325,15 +329,37 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool) -> np.ndarray:
     return raw
 
 
+def _local_ice(envs, sims, motion, lists, out) -> None:
+    """The columns of :data:`LOCAL` but ``reached`` into ``out``: the
+    episode's concentration, the ice within each environment's local radius
+    of its ship (:meth:`physics.HertzSimulation.local_ice`), the model time
+    and the kinetic energy of all the ice."""
+    e0 = envs[0]
+    box = sims[0].box
+    near = np.empty((len(sims), len(ICE_NEAR)))
+    kept = None if lists is None or len(sims) == 1 else lists.current(sims)
+    if kept is not None:                     # in one compiled call, parallel over the engines
+        ice_near_many(kept[0], kept[1], motion[:, :2], float(e0.local_radius), float(box.lx),
+                      float(box.ly), box.periodic[0], box.periodic[1], near)
+    else:
+        for m, sim in enumerate(sims):
+            near[m] = sim._ice_near((motion[m, 0], motion[m, 1]), e0.local_radius)
+    n_floes, r2, n_contacts, sxx, syy = (near[:, j] for j in (0, 1, 2, 3, 6))
+    area = math.pi * float(e0.local_radius) ** 2
+    out[:, 0] = [env._field_concentration for env in envs]
+    out[:, 1] = np.minimum(1.0, math.pi * r2 / area)
+    out[:, 2] = np.divide(2.0 * n_contacts, n_floes, out=np.zeros(len(sims)), where=n_floes > 0)
+    out[:, 3] = np.where(n_contacts > 0, 0.5 * (-sxx / area + -syy / area), 0.0)
+    out[:, 4] = [sim.time for sim in sims]
+    out[:, 6] = near[:, 7]
+
+
 def ice_kinetic_energy(sim) -> float:
     """Kinetic energy [J] of all the floes of ``sim``: Σ ½ m |v|² + ½ I ω²,
-    I = ½ m r² (a disc); frozen floes (infinite mass) do not move and count
-    nothing."""
-    m, v, r = sim.masses, sim.velocities, sim.radii
-    m = np.where(np.isfinite(m), m, 0.0)
-    w = sim.angular_velocities
-    return 0.5 * float(np.dot(m, v[:, 0] ** 2 + v[:, 1] ** 2)) \
-        + 0.25 * float(np.dot(m * r * r, w * w))
+    I = ½ m r² (a disc); frozen floes do not move and count nothing
+    (:func:`physics.hertz_kernels.ice_energy`)."""
+    f = sim._floes
+    return float(ice_energy(f.vel, f.omega, f.radius, f.inv_mass))
 
 
 def _per_env(envs, name: str) -> np.ndarray:
@@ -537,7 +563,7 @@ class ShipBatch:
             table = self.table if ok.size == n else self.table[ok]
             group = self.envs if ok.size == n else [self.envs[k] for k in ok]
             try:
-                raw = measure_ships(group, table, advanced=True)
+                raw = measure_ships(group, table, advanced=True, lists=self.lists)
             except PHYSICS_ERRORS as err:          # every measured one fails with it
                 for k in ok:
                     errors[k] = err

@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import weakref
 from contextlib import contextmanager
 
 import numba
@@ -402,10 +403,19 @@ class HertzSimulation(FloeProperties):
                 self._drag[:, col] = np.where(mobile, a, 0.0)
 
     def _drive(self) -> K.Drive:
-        """The forcing bundle of the kernels, with the wind and current now."""
+        """The forcing bundle of the kernels, with the wind and current now
+        (kept while the drag coefficients, the wind and the current stay)."""
         if self.forcing is None:
-            return K.make_drive(self._drag)
-        return K.make_drive(self._drag, self.forcing.wind, self.forcing.current)
+            key = (self._drag, 0.0, 0.0, 0.0, 0.0)
+        else:
+            (ax, ay), (wx, wy) = self.forcing.wind, self.forcing.current
+            key = (self._drag, float(ax), float(ay), float(wx), float(wy))
+        kept = self._kept_drive
+        if kept is None or kept[0] is not key[0] or kept[1:5] != key[1:]:
+            self._kept_drive = kept = key + (K.make_drive(self._drag, key[1:3], key[3:5]),)
+        return kept[5]
+
+    _kept_drive = None
 
     def _build_list(self):
         b = self.box
@@ -426,6 +436,28 @@ class HertzSimulation(FloeProperties):
         verlet = self._verlet._replace(hist=self._verlet.hist.copy())
         K.forces_serial(floes, self._law, self._wall_law, drive, self.box.kernel_box(self.time),
                         verlet, 0.0, force, torque)
+
+    # -- the Verlet list, which may live in a batch's typed list -------------
+    #: (typed list, index) where the simulation's current Verlet list lies
+    #: (:class:`KernelLists`), or None
+    _verlet_slot = None
+    #: that slot, while the list there is newer than the one read here
+    _verlet_home = None
+
+    @property
+    def _verlet(self) -> K.VerletList:
+        """The Verlet list (read from a batch's typed list, the first time
+        after a compiled batch run rebuilt it there)."""
+        home = self._verlet_home
+        if home is not None:
+            self._verlet_home = None
+            self._verlet_list = home[0][home[1]]
+        return self._verlet_list
+
+    @_verlet.setter
+    def _verlet(self, value: K.VerletList) -> None:
+        self._verlet_list = value
+        self._verlet_slot = self._verlet_home = None
 
     # -- running -------------------------------------------------------------
     @property
@@ -507,7 +539,10 @@ class HertzSimulation(FloeProperties):
         self.ship.drain()
         return left if status in (HertzStatus.OK, HertzStatus.SHIP_LOG_FULL) else 0
 
-    def _check_status(self, status: HertzStatus):
+    def _check_status(self, status: HertzStatus, finite: bool | None = None):
+        """Raise the :class:`SimulationError` of a run that ended with
+        ``status``; ``finite``: whether the compiled run found the floes'
+        and the ship's state finite (None: look here)."""
         if status is HertzStatus.CONCENTRATION_LIMIT:
             raise SimulationError(
                 f"the deforming box reached its concentration limit at t = {self.time:.6g} s "
@@ -519,10 +554,10 @@ class HertzSimulation(FloeProperties):
                 f"The time step may be too large for the impact speeds, the ice compressed far "
                 f"beyond jamming, or (for fast floes and long steps) the skin too small",
                 FailureReason.UNSTABLE, self.time)
-        if self.ship is not None and not np.all(np.isfinite(self.ship._bundle.state)):
-            status = HertzStatus.NON_FINITE
-        if status is HertzStatus.NON_FINITE or not (np.all(np.isfinite(self._pos))
-                                                   and np.all(np.isfinite(self._vel))):
+        if finite is None:
+            finite = (np.all(np.isfinite(self._pos)) and np.all(np.isfinite(self._vel))
+                      and (self.ship is None or np.all(np.isfinite(self.ship._bundle.state))))
+        if status is HertzStatus.NON_FINITE or not finite:
             raise SimulationError(
                 f"non-finite floe state at t = {self.time:.6g} s (step {self.n_steps}); "
                 f"the time step is probably too large for the impact speeds",
@@ -664,6 +699,18 @@ class HertzSimulation(FloeProperties):
         return LocalIce(n_floes, math.pi * r2, n_contacts,
                         np.array([[-sxx / area, -sxy / area], [-syx / area, -syy / area]]), area)
 
+    def _ice_near(self, centre, radius: float) -> np.ndarray:
+        """The row of :data:`physics.hertz_batch.ICE_NEAR` for the disc of
+        ``radius`` round ``centre``: what :func:`~physics.hertz_batch.ice_near_many`
+        computes for a batch, for this simulation alone."""
+        f, v, box = self._floes, self._verlet, self.box
+        row = np.empty(8)
+        row[:7] = K.ice_within(f.pos, f.vel, f.omega, f.radius, f.inv_mass, v.start, v.nbr,
+                               v.hist, self._law, float(box.lx), float(box.ly), box.periodic[0],
+                               box.periodic[1], float(centre[0]), float(centre[1]), float(radius))
+        row[7] = K.ice_energy(f.vel, f.omega, f.radius, f.inv_mass)
+        return row
+
     def fabric(self) -> Fabric:
         """Contact fabric (Z_c, Z_a, f_nr, ...) of the current contacts
         (see :func:`physics.observables.fabric`)."""
@@ -708,19 +755,26 @@ class KernelLists:
     Numba types a new list from its first item, in Python: for the nested
     bundles of a simulation that costs about half a millisecond each time a
     list is made, as much as a ship environment's engine step. Replacing
-    the items of a kept list costs some 20 µs each. One object per caller that
+    the items of a kept list costs some 10 µs each. One object per caller that
     advances the same kind of simulations again and again (a native vector
     environment) makes that saving; :func:`advance_together` makes a new
     one when given none.
+
+    A simulation's Verlet list stays in its slot between calls: a run that
+    rebuilds it leaves the new one there, and the simulation reads it only
+    when it needs it (see ``HertzSimulation._verlet``); a slot is refilled
+    only for another simulation, which first hands the list it held back to
+    its simulation.
     """
 
     def __init__(self):
         self._lists: dict[int, tuple] = {}
+        self._owners: dict[int, list] = {}
 
-    def filled(self, runs: list, verlets: list) -> tuple:
-        """Typed lists holding ``runs`` and ``verlets``: those of the last
-        call with as many items, with the items replaced, or new ones when
-        there are none or their item types differ."""
+    def filled(self, runs: list, sims: list) -> tuple:
+        """Typed lists holding ``runs`` and the Verlet lists of ``sims``:
+        those of the last call with as many items, with the items replaced,
+        or new ones when there are none or their item types differ."""
         from numba import typeof
         from numba.core.errors import NumbaError
         from numba.typed import List
@@ -731,15 +785,67 @@ class KernelLists:
             try:
                 for k in range(n):
                     kept[0][k] = runs[k]
-                    kept[1][k] = verlets[k]
+                    self._hold(n, k, sims[k])
                 return kept
             except (NumbaError, TypeError, ValueError, AssertionError):
                 pass     # items of another type (Numba fails to compile the cast): new lists
-        kept = (List.empty_list(typeof(runs[0])), List.empty_list(typeof(verlets[0])))
-        for run, verlet in zip(runs, verlets):
+            self._release(n)
+        kept = (List.empty_list(typeof(runs[0])), List.empty_list(typeof(sims[0]._verlet)))
+        for run, sim in zip(runs, sims):
             kept[0].append(run)
-            kept[1].append(verlet)
+            kept[1].append(sim._verlet)
+        # reading and replacing an item compile on first use: now, not in a later step
+        kept[0][0] = kept[0][0]
+        kept[1][0] = kept[1][0]
         self._lists[n] = kept
+        self._owners[n] = [None] * n
+        for k, sim in enumerate(sims):
+            self._own(n, k, sim)
+        return kept
+
+    def _hold(self, n: int, k: int, sim) -> None:
+        """Slot k of the lists of ``n`` items for ``sim``'s Verlet list."""
+        verlets = self._lists[n][1]
+        slot = sim._verlet_slot
+        if slot is not None and slot[0] is verlets and slot[1] == k:
+            return                                  # it is there already
+        self._hand_back(n, k)
+        verlets[k] = sim._verlet
+        self._own(n, k, sim)
+
+    def _own(self, n: int, k: int, sim) -> None:
+        self._owners[n][k] = weakref.ref(sim)
+        sim._verlet_slot = (self._lists[n][1], k)
+
+    def _hand_back(self, n: int, k: int) -> None:
+        """The simulation whose Verlet list lies in slot k takes it back."""
+        ref = self._owners[n][k]
+        sim = None if ref is None else ref()
+        if sim is not None and sim._verlet_slot is not None \
+                and sim._verlet_slot[0] is self._lists[n][1] and sim._verlet_slot[1] == k:
+            sim._verlet = sim._verlet               # read it, and forget the slot
+        self._owners[n][k] = None
+
+    def _release(self, n: int) -> None:
+        """Every simulation with a list in the lists of ``n`` items takes it back."""
+        for k in range(len(self._owners.get(n, ()))):
+            self._hand_back(n, k)
+
+    def current(self, sims: list):
+        """The typed lists (runs, Verlet lists) whose item k holds ``sims[k]``'s
+        state now, as the last :func:`advance_together` left them, or None
+        when they do not (a simulation filled in elsewhere, or one whose run
+        took more than one call)."""
+        kept = self._lists.get(len(sims))
+        if kept is None:
+            return None
+        owners = self._owners[len(sims)]
+        for k, sim in enumerate(sims):
+            slot = sim._verlet_slot
+            ref = owners[k]
+            if ref is None or ref() is not sim or slot is None or slot[0] is not kept[1] \
+                    or slot[1] != k:
+                return None
         return kept
 
 
@@ -794,6 +900,7 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         return [None]
     left = [sim._steps_to_run(int(round(duration / sim.dt))) for sim in sims]
     status = [HertzStatus.OK] * len(sims)
+    ok = [True] * len(sims)
     while True:
         todo = [k for k, n in enumerate(left) if n > 0]
         if not todo:
@@ -801,13 +908,14 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         args = [sims[k]._kernel_arguments(left[k]) for k in todo]
         n_steps = np.array([a[0] for a in args], dtype=np.int64)
         runs, verlets = (lists or KernelLists()).filled([a[1:] for a in args],
-                                                        [sims[k]._verlet for k in todo])
+                                                        [sims[k] for k in todo])
         dt = np.array([sims[k].dt for k in todo])
         time = np.array([sims[k].time for k in todo])
         mode = np.array([sims[k]._step_mode for k in todo], dtype=np.int64)
         window = np.array([sims[k].free_window for k in todo], dtype=np.int64)
         tally = np.stack([sims[k].free_tally for k in todo])
         done, stat, nreb, awake = (np.zeros(len(todo), dtype=np.int64) for _ in range(4))
+        finite = np.zeros(len(todo), dtype=np.bool_)
         # one simulation at a time to whichever thread is free: a ship
         # environment's step costs twenty times as much late in an episode,
         # among the floes its ship has woken, as early on, among floes at
@@ -815,19 +923,20 @@ def advance_together(sims, duration: float, *, lists: KernelLists | None = None)
         # simulations would leave threads waiting for the heaviest block
         with threads_within_cores(), numba.parallel_chunksize(1):
             run_many(n_steps, dt, time, mode, window, tally, runs, verlets, done, stat, nreb,
-                     awake)
+                     awake, finite)
         for m, k in enumerate(todo):
             sims[k].free_tally[:] = tally[m]
-            if nreb[m]:                     # a rebuilt list (reading an item costs 10 µs)
-                sims[k]._verlet = verlets[m]
+            ok[k] = bool(finite[m])
+            if nreb[m]:                     # a rebuilt list, read when needed (10 µs)
+                sims[k]._verlet_home = (verlets, m)
             if mode[m]:
                 sims[k].n_awake = int(awake[m])
             status[k] = HertzStatus(int(stat[m]))
             left[k] = sims[k]._after_run(int(done[m]), status[k], int(nreb[m]), left[k])
     errors = []
-    for sim, st in zip(sims, status):
+    for sim, st, finite_now in zip(sims, status, ok):
         try:
-            sim._check_status(st)
+            sim._check_status(st, finite_now)
         except SimulationError as err:
             errors.append(err)
         else:

@@ -1229,6 +1229,30 @@ def listed_contact(pos, vel, omega, radius, inv_mass, nbr, hist, law, lx, ly, px
 
 
 @njit(cache=True, error_model="numpy")
+def ice_energy(vel, omega, radius, inv_mass):
+    """Kinetic energy [J] of the mobile floes, translation and rotation:
+    Σ ½ m |v|² + ½ I ω² with I = ½ m r² (a disc) and m = 1 / ``inv_mass``;
+    a frozen floe (``inv_mass`` 0) counts nothing."""
+    e = 0.0
+    for i in range(radius.shape[0]):
+        if inv_mass[i] > 0.0:
+            w = radius[i] * omega[i]
+            e += (0.5 * (vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]) + 0.25 * w * w) \
+                / inv_mass[i]
+    return e
+
+
+@njit(cache=True, error_model="numpy")
+def state_finite(pos, vel):
+    """Whether every floe's position and velocity is finite."""
+    for i in range(pos.shape[0]):
+        if not (math.isfinite(pos[i, 0]) and math.isfinite(pos[i, 1])
+                and math.isfinite(vel[i, 0]) and math.isfinite(vel[i, 1])):
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def ice_within(pos, vel, omega, radius, inv_mass, start, nbr, hist, law, lx, ly, px, py, cx, cy,
                reach):
     """The ice within ``reach`` of the point (cx, cy) (minimum-image
