@@ -48,6 +48,9 @@ cores, each beside a loop that shows what the machine itself gives:
   with 64 sub-environments (`gymnasium.make_vec(...,
   vectorization_mode="vector_entry_point")`), stepped with seeded random
   actions, episodes reset as they end: env steps/s = 64 × vector steps / s;
+  after the rounds, one more segment on one thread times the share of the
+  step that runs outside the compiled calls that are parallel over the
+  sub-environments, and so bounds their speed-up (Amdahl);
 * **PPO training** (Stable-Baselines3, MLP policy, rollouts of 2048 steps over
   the sub-environments, minibatches of 128, 10 epochs) on the native vector
   environment of ShipNavigation-v0 with 64 sub-environments: training steps/s
@@ -243,11 +246,56 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
         return go
 
     def after(rounds):
+        numba.set_num_threads(1)
+        share = serial_share(*copies[0], n, steps)
         for env, _ in copies:
             env.close()
-        return {}
+        return share
 
     return [segment(k, *c) for k, c in zip(threads, copies)], dict(steps=steps), after
+
+
+#: the compiled calls of a native vector environment's step that run in
+#: parallel over its sub-environments: (module, name)
+PARALLEL_CALLS = (("physics.hertz", "run_many"), ("iceenvs.ship_measures", "measure_many"),
+                  ("iceenvs.ship_measures", "ice_near_many"))
+
+
+def serial_share(env, rng, n: int, steps: int) -> dict:
+    """The share of a native vector environment's step (``env``, ``n``
+    sub-environments, ``steps`` steps on one thread) spent outside the
+    compiled calls that run in parallel over the sub-environments
+    (:data:`PARALLEL_CALLS`): the Python that prepares, reads and ends the
+    step one sub-environment after the other, and the resets. By Amdahl's
+    law a step on p threads is at most 1 / (s + (1 − s) / p) times faster."""
+    import importlib
+
+    from .vector import _actions
+
+    spent = [0.0]
+    saved = []
+    for module, name in PARALLEL_CALLS:
+        owner = importlib.import_module(module)
+        fn = getattr(owner, name)
+        saved.append((owner, name, fn))
+
+        def timed(*args, _fn=fn):
+            t0 = time.perf_counter()
+            out = _fn(*args)
+            spent[0] += time.perf_counter() - t0
+            return out
+        setattr(owner, name, timed)
+    try:
+        space = env.single_action_space
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            env.step(_actions(space, rng, n))
+        wall = time.perf_counter() - t0
+    finally:
+        for owner, name, fn in saved:
+            setattr(owner, name, fn)
+    return dict(serial_share=max(0.0, 1.0 - spent[0] / wall),
+                serial_ms=1e3 * (wall - spent[0]) / (n * steps))
 
 
 def _ppo_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
@@ -502,6 +550,32 @@ def speedup_table(results: list[dict], threads: list[int], rounds: int, cores: i
                          body, "\n\n".join(notes))
 
 
+def serial_table(results: list[dict]) -> dict | None:
+    """The serial share of each native vector environment's step and the
+    speed-ups it allows (Amdahl), or None without them."""
+    rows = []
+    for res in results:
+        if "serial_share" not in res:
+            continue
+        s = res["serial_share"]
+        rows.append([res["label"], f"{100 * s:.1f} %", f"{res['serial_ms'] * 1e3:.0f}",
+                     f"{1 / (s + (1 - s) / 16):.1f}", f"{1 / (s + (1 - s) / 64):.1f}"])
+    if not rows:
+        return None
+    return harness.table(
+        "Native vector environments: the part of a step that runs one sub-environment "
+        "after the other (one thread)",
+        ["workload", "serial share s", "µs per env step", "most speed-up on 16 threads",
+         "on 64 threads"], rows,
+        "The serial share is the step's time outside the compiled calls that run in parallel "
+        "over the sub-environments (the engines' run_many, the step records and lidar of "
+        "measure_many and the local ice of ice_near_many): the Python that applies the "
+        "actions, prepares and reads the engines, measures, scores, observes, builds the "
+        "info and resets the episodes that end, one sub-environment after the other. By "
+        "Amdahl's law p threads make a step at most 1 / (s + (1 − s) / p) times faster, "
+        "before the memory-bound ceiling takes its share.")
+
+
 def main(argv=None, prog: str | None = None) -> int:
     p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--threads", default=None,
@@ -569,6 +643,9 @@ def main(argv=None, prog: str | None = None) -> int:
     cores = usable_cores()
     tables = [rates_table(results, threads, st["rounds"]),
               speedup_table(results, threads, st["rounds"], cores)]
+    serial = serial_table(results)
+    if serial is not None:
+        tables.append(serial)
     settings = {k: v for k, v in st.items() if k != "threads"}
     record = harness.make_record(
         SUITE, TITLE, DESCRIPTION, harness.command_line(SUITE, argv), tables,

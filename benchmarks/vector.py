@@ -214,15 +214,23 @@ class _EngineClock:
                        (iceenvs.vector, "advance_together", iceenvs.vector.advance_together)]
         advance, together = (saved[2] for saved in self._saved)
 
+        inside = [False]            # advance_together of one simulation calls its advance
+
         def timed_advance(sim, duration):
+            if inside[0]:
+                return advance(sim, duration)
             t0 = time.perf_counter()
             advance(sim, duration)
             self.seconds += time.perf_counter() - t0
             self._count([sim], duration)
 
         def timed_together(sims, duration, **kwargs):
+            inside[0] = True
             t0 = time.perf_counter()
-            errors = together(sims, duration, **kwargs)
+            try:
+                errors = together(sims, duration, **kwargs)
+            finally:
+                inside[0] = False
             self.seconds += time.perf_counter() - t0
             self._count(sims, duration)
             return errors

@@ -78,8 +78,15 @@ def test_quick_run_times_every_workload_on_every_thread_count(tmp_path):
     assert ppo["torch_threads"] == 1
     hertz = [r for r in data["results"] if r["workload"].startswith("hertz")]
     assert all(r["contacts_per_floe"] >= 0.0 and r["rebuilds"] >= 0.0 for r in hertz)
+    vector = [r for r in data["results"] if r["workload"].startswith("vector")]
+    # the Python around the parallel calls is a share of the step, neither none nor all
+    assert all(0.0 < r["serial_share"] < 1.0 and r["serial_ms"] > 0.0 for r in vector)
     columns = ["1 thread"] + [f"{k} threads" for k in threads[1:]]
-    rates, speedups = record["tables"]
+    rates, speedups, serial = record["tables"]
+    assert [row[0] for row in serial["rows"]] == [r["label"] for r in vector]
+    for row, res in zip(serial["rows"], vector):
+        s = res["serial_share"]   # Amdahl: between 1 and 1/s, and at most p
+        assert 1.0 <= float(row[3]) <= min(16.0, 1.0 / s) + 0.05
     assert rates["columns"] == ["workload", "unit"] + columns
     assert speedups["columns"] == ["workload"] + columns
     assert len(rates["rows"]) == len(speedups["rows"]) == len(scaling.WORKLOADS)
