@@ -48,10 +48,17 @@ def unbatch_info(info: dict, n: int) -> list[dict[str, Any]]:
         if key.startswith("_"):
             continue
         mask = info.get("_" + key)
-        parts = unbatch_info(value, n) if isinstance(value, dict) else value
-        for i in range(n):
-            if mask is not None and not mask[i]:
-                continue
+        if isinstance(value, dict):
+            parts = unbatch_info(value, n)
+        elif isinstance(value, np.ndarray) and value.ndim == 1 and value.dtype != object:
+            parts = value.tolist()          # a column at once, as Python numbers
+        else:
+            parts = value
+        if mask is None or mask.all():
+            for row, v in zip(out, parts):
+                row[key] = v.item() if isinstance(v, np.generic) else v
+            continue
+        for i in np.flatnonzero(mask).tolist():
             v = parts[i]
             out[i][key] = v.item() if isinstance(v, np.generic) else v
     return out
