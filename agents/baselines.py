@@ -19,6 +19,7 @@ name              policy
 ``straight``      ship environments: full speed straight to the goal line
 ``reactive``      ship environments: steer for the least obstructed lidar sector
 ``lattice``       ship environments: the lattice planner of :mod:`agents.planners`
+``module:Class``  a policy of one's own (:mod:`agents.policy`)
 ================  ==========================================================
 
 >>> env = gymnasium.make("iceenvs/Convergence-v0")
@@ -36,6 +37,8 @@ import numpy as np
 
 from iceenvs.controllers import Controller
 from iceenvs.facts import env_facts
+
+from .policy import is_reference, make_policy
 
 __all__ = ["Baseline", "RandomPolicy", "ZeroPolicy", "ConstantPolicy", "GENERIC", "baseline_names",
            "make_baseline", "load_results", "best_action"]
@@ -196,8 +199,9 @@ def baseline_names(env_id: str | None = None) -> list[str]:
 
 
 def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
-    """The baseline ``name`` for ``env``: a generic one (:data:`GENERIC`) or
-    one of the environment's controllers (its facts' ``controllers``);
+    """The baseline ``name`` for ``env``: a generic one (:data:`GENERIC`),
+    one of the environment's controllers (its facts' ``controllers``) or a
+    policy class named by reference (``module:Class``, :mod:`agents.policy`);
     ``kwargs`` go to its constructor (``action=`` for ``"constant"``).
 
     Raises
@@ -207,6 +211,8 @@ def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
     """
     if name in GENERIC:
         return GENERIC[name](env, seed, **kwargs)
+    if is_reference(name):                  # a policy of one's own: module:Class
+        return make_policy(name, env, seed, **kwargs)
     env_id = _env_id(env)
     controllers = {**env_facts(env_id).controllers, **_planners(env_id)} \
         if env_id is not None else {}

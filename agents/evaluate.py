@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -128,8 +129,11 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p.add_argument("--baselines", default="random,zero,heuristic",
                    help="comma-separated baselines to compare with ('' for none): "
                         + ", ".join(GENERIC) + " and the environment's own controllers "
-                        "(heuristic, and straight, reactive for the ship environments)")
-    p.add_argument("--baseline", help="evaluate this baseline alone (with --env)")
+                        "(heuristic, and straight, reactive for the ship environments), or "
+                        "a policy of one's own, module:Class or path/to/file.py:Class "
+                        "(agents.policy)")
+    p.add_argument("--baseline", help="evaluate this baseline (or module:Class) alone "
+                                      "(with --env)")
     p.add_argument("--env", type=registered_env_id, metavar="ID",
                    help="environment id for --baseline (module:id for an environment that "
                         "module registers)")
@@ -209,6 +213,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     from .baselines import ConstantPolicy, baseline_names, make_baseline
     from .constant import format_action
     from .envs import make_checked_env, parse_key_values
+    from .policy import is_reference
+    from .rollouts import policy_recipe
 
     parser = build_parser(prog)
     args = parser.parse_args(argv)
@@ -234,7 +240,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         if args.env is None:
             parser.error(f"--baseline needs --env, one of: {', '.join(registered_ids())}")
         env_id, base_kwargs = args.env, {}
-        out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{args.baseline}"
+        label = re.sub(r"[^A-Za-z0-9_.-]+", "_", args.baseline.rpartition("/")[2]).strip("_")
+        out = args.out or Path("runs") / "agents" / f"baseline_{env_name(env_id)}_{label}"
     else:
         if args.run_dir is None:
             parser.error("give a RUN_DIR, or --baseline NAME --env ID")
@@ -248,10 +255,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         out = args.out or (args.run_dir if args.checkpoint is None
                            else args.run_dir / f"checkpoint_{args.checkpoint}")
     valid = baseline_names(env_id)
-    unknown = [n for n in names if n not in valid]
+    unknown = [n for n in names if n not in valid and not is_reference(n)]
     if unknown:
         parser.error(f"unknown baselines {unknown} for {env_id}; valid baselines: "
-                     f"{', '.join(valid)}")
+                     f"{', '.join(valid)}, or a policy of one's own as module:Class or "
+                     f"path/to/file.py:Class")
     try:
         env_kwargs = parse_key_values(args.env_kwargs, into=base_kwargs)
         env = make_checked_env(env_id, env_kwargs, seed=args.seed)
@@ -284,8 +292,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
                 labels[name] = f"constant {format_action(policies[name].action)}"
                 recipes[name] = ("baseline", name, dict(action=policies[name].action))
             else:
-                policies[name] = make_baseline(name, env, seed=args.seed)
-                recipes[name] = ("baseline", name, {})
+                try:
+                    recipes[name] = policy_recipe(name)
+                    policies[name] = make_baseline(name, env, seed=args.seed)
+                except ValueError as err:
+                    parser.error(str(err))
         if args.processes > 1:
             results = evaluate_in_processes(env_id, env_kwargs, recipes, episodes=args.episodes,
                                             seed=args.seed, processes=args.processes,

@@ -20,7 +20,7 @@ metre and return against concentration)::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
-        [--policies NAMES] [--trained NAME=RUN_DIR[@STEPS] ...]
+        [--policies NAMES|module:Class] [--trained NAME=RUN_DIR[@STEPS] ...]
         [--merge [--replace NAMES]]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
@@ -332,7 +332,9 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--seed", type=int, default=10_000, help="seed of field 0 (10000)")
     p.add_argument("--policies", default=None,
                    help="comma-separated baselines (default: the environment's planners, "
-                        "such as straight,reactive,swath,lattice on ShipNavigation-v1)")
+                        "such as straight,reactive,swath,lattice on ShipNavigation-v1) and "
+                        "policies of one's own, module:Class or path/to/file.py:Class "
+                        "(?key=value&... for their arguments; agents.policy)")
     p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR[@STEPS]",
                    help="a trained policy (agents.train's run directory; @STEPS: its checkpoint "
                         "at STEPS steps), repeatable")
@@ -401,7 +403,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     from .baselines import baseline_names
     from .envs import make_checked_env, parse_key_values
     from .planners import PLANNERS
-    from .rollouts import run_agent_kwargs, trained_argument
+    from .policy import is_reference
+    from .rollouts import policy_recipe, run_agent_kwargs, trained_argument
 
     if args.episodes < 2:
         parser.error("--episodes must be at least 2 (standard errors)")
@@ -420,11 +423,15 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     policies = ([p.strip() for p in args.policies.split(",") if p.strip()]
                 if args.policies is not None else default_policies(args.env))
     for name in policies:
-        if name not in valid:
-            parser.error(f"unknown policy {name!r} for {args.env}; valid: {', '.join(valid)}")
+        if name not in valid and not is_reference(name):
+            parser.error(f"unknown policy {name!r} for {args.env}; valid: {', '.join(valid)}, "
+                         f"or a policy of one's own as module:Class or path/to/file.py:Class")
     if "straight" not in policies:
         policies.insert(0, "straight")
-    recipes = {name: ("baseline", name, {}) for name in policies}
+    try:
+        recipes = {name: policy_recipe(name) for name in policies}
+    except ValueError as err:
+        parser.error(str(err))
     for item in args.trained:
         try:
             name, run_dir, steps = trained_argument(item, args.env)
@@ -465,6 +472,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p != "straight" and p in planner_names],
+        own_policies=[p for p in recipes if is_reference(p)],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
         host=host_signature(),
         date=datetime.date.today().isoformat(),

@@ -214,6 +214,7 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     :func:`run_episode`."""
     from .baselines import make_baseline
     from .envs import make_checked_env
+    from .policy import make_policy
 
     if not _WORKER:
         import torch
@@ -228,9 +229,24 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     policies = _WORKER["policies"]
     if (key, name) not in policies:
         kind, target, kwargs = recipe
-        policies[key, name] = (TrainedPolicy(target, **kwargs) if kind == "trained" else
-                               make_baseline(target, env, seed=env_seed, **kwargs))
+        if kind == "trained":
+            policies[key, name] = TrainedPolicy(target, **kwargs)
+        elif kind == "policy":                      # imported here, from its search path
+            policies[key, name] = make_policy(target, env, seed=env_seed, **kwargs)
+        else:
+            policies[key, name] = make_baseline(target, env, seed=env_seed, **kwargs)
     return run_episode(env, policies[key, name], episode_seed, env_facts(env_id).main_metric)
+
+
+def policy_recipe(name: str) -> tuple:
+    """The recipe of a baseline's name, or of a policy of one's own
+    (``module:Class``, checked here: :func:`agents.policy.check_reference`),
+    for :func:`evaluate_in_processes`."""
+    from .policy import check_reference, is_reference, search_path
+
+    if is_reference(name):
+        return ("policy", check_reference(name), {"search": search_path(name)})
+    return ("baseline", name, {})
 
 
 def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
@@ -240,8 +256,9 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
     ``reset(seed=seed + k)`` and the policies are deterministic or, like
     the random baseline, re-seeded with each episode.
 
-    ``recipes`` maps a policy name to ``("trained", run_dir, {})`` or
-    ``("baseline", baseline_name, constructor_kwargs)``; every worker builds
+    ``recipes`` maps a policy name to ``("trained", run_dir, {})``,
+    ``("baseline", baseline_name, constructor_kwargs)`` or ``("policy",
+    reference, {"search": directories})`` (:func:`policy_recipe`); every worker builds
     its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
     reset with ``seed``; a trained run's with its :data:`AGENT_KWARGS`) and
     policies from them."""
