@@ -13,7 +13,8 @@ Route choice *pays* at a concentration when the best planner meets at
 most 0.7 times the straight line's ice impulse per metre (the ratio of
 the means over the fields), sailing at most 10 % further.
 
-Output in ``--out`` (default ``docs/agents/leaderboard``):
+Output in ``--out`` (default ``runs/leaderboard``; the documented board is
+``--out docs/agents/leaderboard``):
 ``leaderboard.md`` (the tables, with command, machine and date),
 ``leaderboard.json`` (every episode) and ``leaderboard.png`` (impulse per
 metre and return against concentration)::
@@ -43,7 +44,7 @@ __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_mar
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
 DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
-DEFAULT_OUT = Path("docs/agents/leaderboard")
+DEFAULT_OUT = Path("runs/leaderboard")
 #: the metrics normalised by the straight line's on the same field
 NORMALISED = ("impulse_per_metre", "energy_to_ice", "mean_impulse", "max_impulse", "path_length")
 #: the metrics of the main table: (logged name, header, scale, unit)

@@ -15,7 +15,8 @@ policy when a controller that reacts to what it senses (the hand-written
 one, a planner or a trained policy) beats every constant action by more
 than two standard errors; the table says which.
 
-Output in ``--out`` (default ``docs/agents/tasks``): ``tasks.md`` (the
+Output in ``--out`` (default ``runs/agents/tasks``; the documented tables are
+``--out docs/agents/tasks``): ``tasks.md`` (the
 table, with command, machine and date), ``tasks.json`` (every number)
 and ``constant_<env>.json`` per environment (the whole search; reused
 with ``--reuse`` so that a table can be remade without searching again)::
@@ -42,7 +43,7 @@ from pathlib import Path
 __all__ = ["analyse", "task_table", "main"]
 
 EVAL_SEED = 10_000
-DEFAULT_OUT = Path("docs/agents/tasks")
+DEFAULT_OUT = Path("runs/agents/tasks")
 
 
 def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int,

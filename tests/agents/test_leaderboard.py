@@ -168,3 +168,13 @@ def test_a_trained_runs_control_is_read_and_reported(tmp_path):
         env.close()
     np.testing.assert_allclose([e["ret"] for e in report["episodes_detail"]["0.2"]["ppo"]],
                                alone, rtol=1e-9)
+
+
+def test_default_outputs_stay_out_of_the_docs():
+    """A first run writes under runs/; the documented records are written
+    only when --out names them."""
+    from agents import evaluate, tasks
+
+    for out in (leaderboard.build_parser().get_default("out"), tasks.DEFAULT_OUT):
+        assert out.parts[0] == "runs", out
+    assert evaluate.build_parser().get_default("out") is None      # the run's own directory
