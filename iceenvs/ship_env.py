@@ -133,7 +133,8 @@ def ship_features(sectors: int, lidar_range: float) -> tuple[Feature, ...]:
         Feature("goal_sin", "sine of it (positive: the goal lies to port)", "-", "none",
                 -1.0, 1.0),
         Feature("channel_offset", "distance of the centroid from the channel's centre line "
-                "over the channel's half-width (|x| > 1: outside)", "-", "none", -3.0, 3.0),
+                "over the channel's half-width, positive to port of it, y above it (|x| > 1: "
+                "outside)", "-", "none", -3.0, 3.0),
         Feature("surge", "surge speed u (ship frame, forward)", "m/s", "/ 1 m/s", -10.0, 10.0),
         Feature("sway", "sway speed v (ship frame, to port)", "m/s", "/ 1 m/s", -10.0, 10.0),
         Feature("yaw_rate", "yaw rate r (anticlockwise)", "rad/s", "/ 0.1 rad/s", -10.0, 10.0),
