@@ -528,12 +528,6 @@ class FloeEnv(ControlEnv):
 
     def _advance(self) -> None:
         self.sim.advance(self.control_interval)
-        self._advanced()
-
-    def _advanced(self) -> None:
-        """Read what the engine did in the control interval just run (after
-        ``sim.advance``, or the engines of a vector environment advanced
-        together)."""
 
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):

@@ -39,7 +39,6 @@ from numba.typed import List
 
 from physics.hertz import KernelLists
 from physics.hertz_batch import ICE_NEAR, ice_near_many
-from physics.hertz_kernels import ice_energy
 from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import PHYSICS_ERRORS
@@ -48,7 +47,7 @@ from .ship_sensors import lidar_scan
 from .vector import HertzVectorEnv, batch_infos, drive, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
-           "measure_names", "measure_ships", "ice_kinetic_energy", "measure_many", "step_sums",
+           "measure_names", "measure_ships", "measure_many", "step_sums",
            "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipBatch",
            "ShipVectorEnv"]
 
@@ -352,14 +351,6 @@ def _local_ice(envs, sims, motion, lists, out) -> None:
     out[:, 3] = np.where(n_contacts > 0, 0.5 * (-sxx / area + -syy / area), 0.0)
     out[:, 4] = [sim.time for sim in sims]
     out[:, 6] = near[:, 7]
-
-
-def ice_kinetic_energy(sim) -> float:
-    """Kinetic energy [J] of all the floes of ``sim``: Σ ½ m |v|² + ½ I ω²,
-    I = ½ m r² (a disc); frozen floes do not move and count nothing
-    (:func:`physics.hertz_kernels.ice_energy`)."""
-    f = sim._floes
-    return float(ice_energy(f.vel, f.omega, f.radius, f.inv_mass))
 
 
 def _per_env(envs, name: str) -> np.ndarray:
@@ -671,11 +662,6 @@ class ShipVectorEnv(HertzVectorEnv):
 
     def _results(self, actions, replaced, errors) -> tuple:
         return self._ship_batch.results(actions, replaced, errors)
-
-
-def _copied(info: dict) -> dict:
-    return {key: _copied(value) if isinstance(value, dict) else value.copy()
-            for key, value in info.items()}
 
 
 def _spread(columns: dict, rows: np.ndarray, n: int) -> dict:

@@ -261,9 +261,6 @@ def drive(envs: Sequence[HertzEnv], actions: np.ndarray,
         for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
                                                    envs[0].control_interval, lists=lists)):
             errors[k] = err
-    for k in moving:
-        if errors[k] is None:
-            envs[k]._advanced()
     return errors
 
 

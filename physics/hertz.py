@@ -803,14 +803,17 @@ class KernelLists:
             self._own(n, k, sim)
         return kept
 
+    def _holds(self, n: int, k: int, sim) -> bool:
+        """Whether slot k of the lists of ``n`` items holds ``sim``'s Verlet list."""
+        slot = sim._verlet_slot
+        return slot is not None and slot[0] is self._lists[n][1] and slot[1] == k
+
     def _hold(self, n: int, k: int, sim) -> None:
         """Slot k of the lists of ``n`` items for ``sim``'s Verlet list."""
-        verlets = self._lists[n][1]
-        slot = sim._verlet_slot
-        if slot is not None and slot[0] is verlets and slot[1] == k:
+        if self._holds(n, k, sim):
             return                                  # it is there already
         self._hand_back(n, k)
-        verlets[k] = sim._verlet
+        self._lists[n][1][k] = sim._verlet
         self._own(n, k, sim)
 
     def _own(self, n: int, k: int, sim) -> None:
@@ -821,8 +824,7 @@ class KernelLists:
         """The simulation whose Verlet list lies in slot k takes it back."""
         ref = self._owners[n][k]
         sim = None if ref is None else ref()
-        if sim is not None and sim._verlet_slot is not None \
-                and sim._verlet_slot[0] is self._lists[n][1] and sim._verlet_slot[1] == k:
+        if sim is not None and self._holds(n, k, sim):
             sim._verlet = sim._verlet               # read it, and forget the slot
         self._owners[n][k] = None
 
@@ -836,15 +838,12 @@ class KernelLists:
         state now, as the last :func:`advance_together` left them, or None
         when they do not (a simulation filled in elsewhere, or one whose run
         took more than one call)."""
-        kept = self._lists.get(len(sims))
+        n = len(sims)
+        kept = self._lists.get(n)
         if kept is None:
             return None
-        owners = self._owners[len(sims)]
-        for k, sim in enumerate(sims):
-            slot = sim._verlet_slot
-            ref = owners[k]
-            if ref is None or ref() is not sim or slot is None or slot[0] is not kept[1] \
-                    or slot[1] != k:
+        for k, (ref, sim) in enumerate(zip(self._owners[n], sims)):
+            if ref is None or ref() is not sim or not self._holds(n, k, sim):
                 return None
         return kept
 
