@@ -638,12 +638,8 @@ def main(argv=None, prog: str | None = None) -> int:
                    help=f"env steps before the late part of the timed episode "
                         f"(default {DEFAULTS['late_after']})")
     args, argv = harness.parse(p, argv)
-    st = dict(DEFAULTS)
-    if args.quick:
-        st.update(QUICK)
-    for key in ("seeds", "seed", "workers", "speed_seed", "rounds", "late_after"):
-        if getattr(args, key) is not None:
-            st[key] = getattr(args, key)
+    st = harness.settings(args, DEFAULTS, QUICK, ("seeds", "seed", "workers", "speed_seed",
+                                                  "rounds", "late_after"))
     if st["seeds"] < 2:
         p.error(f"--seeds must be at least 2 (standard errors), got {st['seeds']}")
     if min(st["workers"], st["rounds"]) < 1 or st["late_after"] < 0:

@@ -485,6 +485,17 @@ def parse(parser: argparse.ArgumentParser, argv) -> tuple[argparse.Namespace, li
     return parser.parse_args(argv), argv
 
 
+def settings(args: argparse.Namespace, defaults: dict, quick: dict,
+             keys: Sequence[str]) -> dict:
+    """A suite's settings: ``defaults``, updated by ``quick`` under
+    ``--quick``, then by each option of ``keys`` given on the command line."""
+    st = dict(defaults)
+    if args.quick:
+        st.update(quick)
+    st.update({key: getattr(args, key) for key in keys if getattr(args, key) is not None})
+    return st
+
+
 def table(title: str, columns: Sequence[str], rows: Sequence[Sequence], notes: str = "") -> dict:
     """One table of a record.
 

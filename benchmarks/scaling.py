@@ -609,13 +609,9 @@ def main(argv=None, prog: str | None = None) -> int:
                    help=f"where the prepared floe fields are kept "
                         f"(default {harness.in_checkout(harness.CACHE_DIR)})")
     args, argv = harness.parse(p, argv)
-    st = dict(DEFAULTS)
-    if args.quick:
-        st.update(QUICK)
-    for key in ("rounds", "floes", "large_floes", "steps", "ceiling_floes", "ceiling_steps",
-                "envs", "vector_steps", "ppo_steps"):
-        if getattr(args, key) is not None:
-            st[key] = getattr(args, key)
+    st = harness.settings(args, DEFAULTS, QUICK, ("rounds", "floes", "large_floes", "steps",
+                                                  "ceiling_floes", "ceiling_steps", "envs",
+                                                  "vector_steps", "ppo_steps"))
     if min(st[k] for k in ("rounds", "steps", "ceiling_steps", "envs", "vector_steps",
                            "ppo_steps")) < 1:
         p.error("--rounds, --steps, --ceiling-steps, --envs, --vector-steps and --ppo-steps "

@@ -408,13 +408,9 @@ def main(argv=None, prog: str | None = None) -> int:
     parser.add_argument("--no-ppo", action="store_true", help="skip the PPO runs")
     parser.add_argument("--seed", type=int, default=0, help="seed of the episodes and actions")
     args, argv = harness.parse(parser, argv)
-    st = dict(seconds=5.0, rounds=3, sizes=DEFAULT_SIZES, ppo_envs=16, ppo_steps=8192,
-              small=False, fresh=True)
-    if args.quick:
-        st.update(QUICK)
-    for key in ("seconds", "rounds", "sizes", "ppo_envs", "ppo_steps"):
-        if getattr(args, key) is not None:
-            st[key] = getattr(args, key)
+    st = harness.settings(args, dict(seconds=5.0, rounds=3, sizes=DEFAULT_SIZES, ppo_envs=16,
+                                     ppo_steps=8192, small=False, fresh=True), QUICK,
+                          ("seconds", "rounds", "sizes", "ppo_envs", "ppo_steps"))
     if st["seconds"] <= 0 or st["rounds"] < 1 or min(st["sizes"]) < 1 or st["ppo_envs"] < 1 \
             or st["ppo_steps"] < 1:
         parser.error("--seconds must be positive; --rounds, --sizes, --ppo-envs and "

@@ -524,12 +524,8 @@ def main(argv=None, prog: str | None = None) -> int:
                    help="training steps of each timed learn (default 4096)")
     p.add_argument("--seed", type=int, default=0, help="seed of PPO and its environments")
     args, argv = harness.parse(p, argv)
-    st = dict(DEFAULTS)
-    if args.quick:
-        st.update(QUICK)
-    for key in ("steps", "rounds", "every", "trajectory_steps", "envs", "ppo_steps"):
-        if getattr(args, key) is not None:
-            st[key] = getattr(args, key)
+    st = harness.settings(args, DEFAULTS, QUICK, ("steps", "rounds", "every",
+                                                  "trajectory_steps", "envs", "ppo_steps"))
     if min(st["steps"], st["rounds"], st["every"], st["envs"], st["ppo_steps"]) < 1:
         p.error("--steps, --rounds, --every, --envs and --ppo-steps must be at least 1")
     if st["trajectory_steps"] is not None and st["trajectory_steps"] < 1:
