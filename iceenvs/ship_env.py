@@ -574,7 +574,101 @@ class ShipEnv(HertzEnv):
     plan_overlay = None
 
     # -- frames ------------------------------------------------------------------------
+    #: how far [m] the "follow" view reaches behind the ship and ahead of it
+    view_behind = 100.0
+    view_ahead = 300.0
+    #: the largest plot [px] (width, height) of each view (:meth:`view_box`)
+    VIEW_PLOTS = {"follow": (960, 600), "overview": (1240, 600)}
+    _view = None
+
+    @property
+    def view(self) -> str | None:
+        """What the frames show: ``"follow"``, a window that follows the
+        ship (:attr:`view_behind` behind it to :attr:`view_ahead` ahead,
+        the box's whole width across); ``"overview"``, the whole box — both
+        to scale with axes in metres, a scale bar and the floes coloured by
+        thickness class (:meth:`_view_frame`); None, the whole box with the
+        floes coloured by speed (the frames of ShipNavigation-v0 and
+        ShipBeset-v0)."""
+        return self._view
+
+    @view.setter
+    def view(self, value) -> None:
+        from .rendering import VIEWS
+
+        if value is not None and (not isinstance(value, str) or value not in VIEWS):
+            raise ValueError(f"view must be one of {VIEWS} or None, got {value!r}")
+        self._view = value
+
+    def _set_view_reach(self, behind, ahead) -> None:
+        """Check and set :attr:`view_behind` and :attr:`view_ahead` [m]."""
+        check_range("view_behind", behind, 0.0, None)
+        check_range("view_ahead", ahead, 0.0, None)
+        if not behind + ahead > 0:
+            raise ValueError(f"view_behind + view_ahead must be positive, got {behind!r} + "
+                             f"{ahead!r}")
+        self.view_behind, self.view_ahead = float(behind), float(ahead)
+
+    def view_box(self):
+        """The :class:`~iceenvs.rendering.ViewBox` of the frames of
+        :attr:`view` now (where a point of the box lies in the frame: its
+        plot is at the top left of the frame)."""
+        from .rendering import view_box, view_window
+
+        view = self.view or "overview"
+        sim = self.sim
+        window = view_window(view, (sim.box.lx, sim.box.ly), float(sim.ship.position[0]),
+                             behind=self.view_behind, ahead=self.view_ahead)
+        width, height = self.VIEW_PLOTS[view]
+        return view_box(window, max_width=width, max_height=height)
+
+    def _thickness_classes(self):
+        """The thicknesses [m] of the floes' classes, for the frames' colours
+        (default: the distinct thicknesses of the episode's floes)."""
+        return None
+
+    def _view_frame(self) -> np.ndarray:
+        """The frame of the views "follow" and "overview" (:attr:`view`)."""
+        from .rendering import (CHAIN, CHANNEL, GOAL, HULL, LEAD, OUTSIDE, ROUTE, TRACK,
+                                annotate, draw_view, thickness_colours)
+
+        sim = self.sim
+        c = sim.contacts()
+        box = self.view_box()
+        lx, ly = sim.box.lx, sim.box.ly
+        colours, legend = thickness_colours(sim.field.thickness, self._thickness_classes())
+        leads = tuple(getattr(self, "leads", ()))
+        y0 = self.centre_y - 0.5 * self.channel_width
+        channel = (y0, y0 + self.channel_width)
+        if self.view == "follow":
+            title = (f"following the ship: {self.view_behind:g} m behind it to "
+                     f"{self.view_ahead:g} m ahead")
+        else:
+            title = f"the whole channel, {lx:g} m × {ly:g} m"
+        picture = draw_view(box, sim.positions, sim.radii, (lx, ly), periodic=sim.box.periodic,
+                            floe_colours=colours, contact_i=c.i, contact_j=c.j,
+                            contact_force=c.normal_force, hull_vertices=sim.ship.vertices,
+                            track=np.array(self._track), goal_x=self.goal_x, channel=channel,
+                            route=self.plan_overlay, leads=leads,
+                            ice_band=getattr(sim.box, "band", None), title=title)
+        if leads:
+            legend.append((LEAD, "lead (open water at the start)", "band"))
+        legend += [(HULL, "ship", "band"), (TRACK, "ship's track", "line")]
+        if self.plan_overlay is not None:
+            legend.append((ROUTE, "planned course", "line"))
+        legend += [(GOAL, "goal line", "line"), (CHAIN, "contact force (wider: stronger)", "line")]
+        if self.channel_width < ly:
+            legend.append((CHANNEL, "channel edge", "line"))
+        walled = [(box.x0 < 0.0 or box.x1 > lx) and not sim.box.periodic[0],
+                  (box.y0 < 0.0 or box.y1 > ly) and not sim.box.periodic[1]]
+        if any(walled):                       # the window reaches beyond a wall
+            legend.append((OUTSIDE, "beyond a wall", "band"))
+        return annotate(picture, legend=legend, arrow=self._frame_arrow(),
+                        text=self._frame_text(), side="bottom")
+
     def _frame(self) -> np.ndarray:
+        if self.view is not None:
+            return self._view_frame()
         from .rendering import annotate, draw_floes, draw_ship
 
         sim = self.sim

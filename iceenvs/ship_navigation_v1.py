@@ -252,7 +252,16 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     the last is fan × (rays − 1) / rays), `swath_bands=(0, 100, 250)` [m],
     `swath_frame="heading"` (the fan's centre: `"heading"` or
     `"goal"`) and `swath_edge=False` (True: each course's room in the
-    channel joins the observation).
+    channel joins the observation). The frames (`render_mode="rgb_array"`
+    or `"human"`) show `view="follow"` (default: a window that follows the
+    ship, `view_behind=100.0` [m] behind it to `view_ahead=300.0` [m]
+    ahead, the channel's whole width across) or `view="overview"` (the
+    whole channel), to scale with axes in metres and a scale bar, the floes
+    coloured by thickness class, the leads shaded, the contact forces, the
+    track and the course a planner shows
+    (:attr:`iceenvs.ship_env.ShipEnv.plan_overlay`); `view=None` gives
+    v0's frame (the whole box, floes coloured by speed).
+    The attribute `view` of the environment switches between them.
 
     ## Version History
     * v1: a field comparable to AUTO-IceNav's (v0 stays registered,
@@ -271,7 +280,11 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                  channel_width: float = 200.0, goal_distance: float = 1100.0,
                  lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,
                  swath_fan: float = 0.5 * math.pi, swath_bands=SWATH_BANDS,
-                 swath_frame: str = "heading", swath_edge: bool = False, **kwargs):
+                 swath_frame: str = "heading", swath_edge: bool = False,
+                 view: str = "follow", view_behind: float = 100.0, view_ahead: float = 300.0,
+                 **kwargs):
+        self.view = view
+        self._set_view_reach(view_behind, view_ahead)
         self.swath_rays = _integer(0, 64)("swath_rays", swath_rays)
         check_range("swath_fan", swath_fan, 0.0, math.pi, low_open=True)
         self.swath_fan = float(swath_fan)
@@ -310,6 +323,15 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             turn = self.episode["max_course"]
             action = np.array([self.guarded_course(float(action[0]) * turn) / turn])
         super()._apply_action(action)
+
+    def _thickness_classes(self):
+        """The episode's thickness classes [m]: the thin ice, and the thick
+        class when floes may be of it (the frames colour each floe by its
+        class, so that thick floes keep their colour in a field of them alone)."""
+        e = self.episode
+        if e["thick_fraction"] > 0:
+            return (e["ice_thickness"], e["thick_thickness"])
+        return (e["ice_thickness"],)
 
     def default_reward_params(self) -> dict:
         return dict(super().default_reward_params(), impulse_scale=2.5e5, impulse_cap=10.0,

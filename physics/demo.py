@@ -10,15 +10,18 @@
    them carry little. The demo prints the contacts per floe and checks the
    force balance of the pack at rest: the sum of all contact forces (the
    floe–floe forces cancel pairwise, so it is the push of the walls) must
-   cancel the wind force on the ice, Σ a |u_a| u_a. It draws the floes and
-   the contact-force network (line width ∝ normal force, wall contacts
+   cancel the wind force on the ice, Σ a |u_a| u_a. It draws the floes,
+   the walls, the wind and the contact-force network (line width ∝ normal
+   force, with a legend of the widths of a few forces; wall contacts
    included).
 2. A ship transit. The platform supply vessel of :func:`physics.ship.psv_ship`
    (76 m × 18 m) sails at a prescribed 2 m/s through a 200 m band of
    floes at Ā = 0.5 in a 500 m × 150 m transit channel (the README's
    example). The demo prints the ice loads (:meth:`HertzSimulation.ship_loads`
-   after the bow has reached the ice) and draws the floes, the hull and its
-   track beside the ice resistance against time.
+   after the bow has reached the ice; the ± of the mean resistance is its
+   standard error, from the means of 20 consecutive blocks of time) and
+   draws the floes, the hull and its track beside the ice resistance
+   against time.
 
 Both runs take seconds once the kernels are compiled (``python -m
 iceenvs.warmup``).
@@ -38,8 +41,8 @@ from .hertz import HertzSimulation, hertz_time_step
 from .params import HERMAN2013
 from .ship import TransitBox, psv_ship, transit_field
 
-__all__ = ["force_chains", "wall_force", "wind_force", "draw", "ship_transit",
-           "draw_transit", "main"]
+__all__ = ["force_chains", "wall_force", "wind_force", "draw", "chain_width", "chain_samples",
+           "ship_transit", "draw_transit", "error_meaning", "main"]
 
 #: the transit of the README: channel, ice band, concentration, ship start and speed
 TRANSIT = dict(length=500.0, width=150.0, band=(150.0, 350.0), concentration=0.5,
@@ -124,16 +127,55 @@ def wall_force(sim: HertzSimulation) -> np.ndarray:
     return total.sum(axis=0)
 
 
+def _force_text(f: float) -> str:
+    """A force [N] in N, kN or MN."""
+    for unit, scale in (("MN", 1e6), ("kN", 1e3)):
+        if abs(f) >= scale:
+            return f"{f / scale:g} {unit}"
+    return f"{f:g} N"
+
+
+def _round_down(x: float) -> float:
+    """The largest of 1, 2 and 5 times a power of ten not above ``x`` (> 0)."""
+    power = 10.0 ** np.floor(np.log10(x))
+    return max(m * power for m in (1.0, 2.0, 5.0) if m * power <= x * (1 + 1e-9))
+
+
+#: a chain line's width [pt] at zero force and its growth up to the largest force
+CHAIN_WIDTH = (0.3, 3.0)
+
+
+def chain_width(force, largest: float) -> np.ndarray:
+    """Width [pt] of the line of a contact carrying ``force`` [N] in a
+    picture whose largest contact force is ``largest`` [N]: proportional
+    to the force, from 0.3 pt at none to 3.3 pt at the largest."""
+    return CHAIN_WIDTH[0] + CHAIN_WIDTH[1] * np.asarray(force, dtype=float) / largest
+
+
+def chain_samples(largest: float) -> list[float]:
+    """Two or three round forces [N] up to ``largest`` whose line widths
+    the legend of :func:`draw` shows."""
+    samples = []
+    for part in (1.0, 0.3, 0.05):
+        f = _round_down(part * largest)
+        if not samples or f < 0.6 * samples[-1]:
+            samples.append(f)
+    return samples
+
+
 def draw(sim: HertzSimulation, path: Path, title: str) -> None:
     """Floes coloured by speed, contact forces as lines between centres
     and, in a box with walls, from the centre to the wall (width
-    proportional to the normal force)."""
+    proportional to the normal force; the legend shows the widths of a few
+    round forces), the walls (hatched beyond them) and the wind (an arrow
+    with its speed)."""
     plt = _pyplot()
     from matplotlib.collections import LineCollection, PatchCollection
-    from matplotlib.patches import Circle
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle, FancyBboxPatch, Patch, Rectangle
 
     speed = np.hypot(*sim.velocities.T)
-    fig, ax = plt.subplots(figsize=(7.5, 7))
+    fig, ax = plt.subplots(figsize=(7.5, 7.2))
     patches = [Circle(xy, r) for xy, r in zip(sim.positions, sim.radii)]
     coll = PatchCollection(patches, cmap="viridis", linewidths=0.2, edgecolors="k")
     coll.set_array(speed)
@@ -154,11 +196,56 @@ def draw(sim: HertzSimulation, path: Path, title: str) -> None:
         segments.append(np.stack([a, tip], axis=1))
         forces.append(f[on])
     segments, forces = np.concatenate(segments), np.concatenate(forces)
-    if forces.size:
+    handles = []
+    if forces.size and forces.max() > 0:
+        largest = float(forces.max())
         ax.add_collection(LineCollection(segments, colors="crimson",
-                                         linewidths=0.3 + 3.0 * forces / forces.max()))
+                                         linewidths=chain_width(forces, largest)))
+        handles += [Line2D([], [], color="crimson", lw=float(chain_width(f, largest)),
+                           label=f"contact force {_force_text(f)}")
+                    for f in chain_samples(largest)]
     _frame(ax, sim.box, title)
-    fig.colorbar(coll, ax=ax, label="floe speed [m/s]", shrink=0.8)
+    box = sim.box
+    margin = 0.04 * max(box.lx, box.ly)
+    walls = [(axis, at) for axis, periodic in enumerate(box.periodic) if not periodic
+             for at in (0.0, (box.lx, box.ly)[axis])]
+    for axis, at in walls:
+        beyond = -margin if at == 0.0 else at
+        if axis == 0:
+            ax.add_patch(Rectangle((beyond, 0.0), margin, box.ly, fc="0.85", ec="0.4",
+                                   hatch="//", lw=0))
+            ax.axvline(at, color="0.15", lw=3)
+        else:
+            ax.add_patch(Rectangle((0.0, beyond), box.lx, margin, fc="0.85", ec="0.4",
+                                   hatch="//", lw=0))
+            ax.axhline(at, color="0.15", lw=3)
+    if walls:
+        ax.set_xlim(-margin if not box.periodic[0] else 0.0,
+                    box.lx + (margin if not box.periodic[0] else 0.0))
+        ax.set_ylim(-margin if not box.periodic[1] else 0.0,
+                    box.ly + (margin if not box.periodic[1] else 0.0))
+        handles.append(Patch(fc="0.85", ec="0.15", hatch="//", label="rigid wall"))
+    wind = np.asarray(sim.forcing.wind, dtype=float)
+    wind_speed = float(np.hypot(*wind))
+    if wind_speed > 0:
+        u = wind / wind_speed
+        centre = np.array([0.1, 0.93])                      # axes fraction, upper left
+        ax.add_patch(FancyBboxPatch((0.02, 0.825), 0.16, 0.165, boxstyle="round,pad=0.005",
+                                    transform=ax.transAxes, fc="white", ec="navy", lw=0.8,
+                                    alpha=0.9, zorder=4))
+        ax.annotate("", xy=centre + 0.06 * u, xytext=centre - 0.06 * u, xycoords="axes fraction",
+                    arrowprops=dict(arrowstyle="-|>,head_width=0.5,head_length=0.9",
+                                    color="navy", lw=2.5), zorder=5)
+        ax.text(centre[0], centre[1] - 0.07, f"wind {wind_speed:g} m/s", ha="center", va="top",
+                transform=ax.transAxes, fontsize=9, color="navy", zorder=5)
+    if handles:
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09),
+                  ncol=len(handles), fontsize=8, frameon=False,
+                  title="line width ∝ normal force", title_fontsize=8)
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+
+    bar = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.15)
+    fig.colorbar(coll, cax=bar, label="floe speed [m/s]")
     fig.tight_layout()
     _save(fig, path)
 
@@ -171,6 +258,13 @@ def ship_transit(seed: int | None = 1) -> HertzSimulation:
                                length=t["length"], width=t["width"], seed=seed)
     ship = psv_ship(position=t["position"], speed=t["speed"])
     return HertzSimulation(field, box, HERMAN2013.contact, dt=t["dt"], ship=ship)
+
+
+def error_meaning(samples: int) -> str:
+    """What the ± of a mean ice resistance of :meth:`HertzSimulation.ship_loads`
+    over ``samples`` engine steps is (:meth:`physics.ship.ShipState.statistics`):
+    the standard error of the mean, from the means of consecutive blocks."""
+    return f"standard error of the mean, from {min(20, samples)} consecutive time blocks"
 
 
 def draw_transit(sim: HertzSimulation, path: Path, title: str, *,
@@ -227,10 +321,11 @@ def draw_transit(sim: HertzSimulation, path: Path, title: str, *,
             ax2.axhline(loads.resistance / 1e3, color="crimson", ls=":", lw=1,
                         label=f"mean resistance after {loads_start:g} s: "
                               f"{loads.resistance / 1e3:.1f} ± "
-                              f"{loads.resistance_error / 1e3:.1f} kN")
+                              f"{loads.resistance_error / 1e3:.1f} kN\n"
+                              f"(± {error_meaning(int(np.sum(t > loads_start)))})")
     ax2.set_xlabel("time [s]")
     ax2.set_ylabel("force, means over 1 s [kN]")
-    ax2.legend(fontsize=7, loc="upper right")
+    ax2.legend(fontsize=7, loc="upper left")
     ax2.set_title("ice loads on the hull", fontsize=9)
     fig.tight_layout()
     _save(fig, path)
@@ -303,7 +398,7 @@ def main(argv=None, prog: str = "python -m physics.demo") -> int:
           f"drag and inertia of floes still moving)")
     png = args.out / "force_chains.png"
     draw(sim, png, f"{sim.n_floes} floes, wind {args.wind:g} m/s along +x, t = {sim.time:.0f} s; "
-                   f"red: contact forces")
+                   f"red lines: contact forces")
     print(f"   picture: {png}", flush=True)
 
     if args.ship_duration > 0:
@@ -317,8 +412,10 @@ def main(argv=None, prog: str = "python -m physics.demo") -> int:
               f"{args.ship_duration:g} model s = {steps} steps of {sim.dt:g} s in {seconds:.1f} s")
         if sim.time > LOADS_START:
             loads = sim.ship_loads(start=LOADS_START)
+            samples = int(np.sum(sim.ship.records()["time"] > LOADS_START))
             print(f"   after {LOADS_START:g} s: {loads.distance:.0f} m sailed, mean ice resistance "
-                  f"{loads.resistance / 1e3:.1f} ± {loads.resistance_error / 1e3:.1f} kN, "
+                  f"{loads.resistance / 1e3:.1f} ± {loads.resistance_error / 1e3:.1f} kN "
+                  f"(± {error_meaning(samples)}), "
                   f"{loads.collisions} collisions with {loads.collided_floes} floes, largest "
                   f"impulse {loads.max_impulse / 1e3:.0f} kN s, {loads.energy_to_ice / 1e6:.2f} MJ "
                   f"given to the ice")

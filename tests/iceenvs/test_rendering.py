@@ -435,3 +435,259 @@ def test_window_shows_a_frame_and_closes_twice(monkeypatch):
         window.close()
     window.close()
     assert window.screen is None
+
+
+# -- the view of a channel: draw_view, thickness_colours, annotate(side="bottom") ------------
+from iceenvs.rendering import (  # noqa: E402
+    HULL, LEAD, OUTSIDE, THICKNESS_COLOURS, ViewBox, draw_view, thickness_colours, view_box,
+    view_window,
+)
+from physics.ice_fields import Lead  # noqa: E402
+
+
+def test_view_box_keeps_one_scale_and_maps_y_up():
+    box = view_box((-50.0, 350.0, 0.0, 200.0), max_width=800, max_height=600)
+    assert box.scale == pytest.approx(2.0)
+    assert (box.width, box.height) == (800, 400)
+    tall = view_box((0.0, 100.0, 0.0, 400.0), max_width=800, max_height=600)
+    assert tall.height == 600 and tall.width == 150          # the height limits the scale
+    (c0, r0), (c1, r1) = box.pixels([(-50.0, 200.0), (350.0, 0.0)])
+    assert (c0, r0) == (box.left, box.top)
+    assert (c1, r1) == (box.left + 800, box.top + 400)
+
+
+def test_a_floe_is_a_disc_at_its_true_size_and_clipped_at_the_window():
+    box = view_box((0.0, 100.0, 0.0, 50.0), max_width=400)              # 4 px/m
+    picture = draw_view(box, [[50.0, 25.0], [0.0, 25.0]], [5.0, 5.0], (100.0, 50.0),
+                        periodic=(True, True))
+    assert picture.shape == (box.picture_size[1], box.picture_size[0], 3)
+    plot = picture[box.plot]
+    ice = is_colour(plot, THICKNESS_COLOURS[0])
+    middle = ice[:, 100:300].sum()
+    assert abs(middle - math.pi * 20 ** 2) < 0.1 * math.pi * 20 ** 2    # r = 5 m = 20 px
+    # the floe at x = 0 shows its halves at both ends (periodic), none in the margins
+    assert ice[:, :30].sum() > 300 and ice[:, -30:].sum() > 300
+    margins = picture.copy()
+    margins[box.plot] = 0
+    assert not is_colour(margins, THICKNESS_COLOURS[0]).any()
+
+
+def test_walls_shade_what_lies_beyond_them():
+    box = view_box((-50.0, 150.0, 0.0, 50.0), max_width=400)            # 2 px/m
+    plot = draw_view(box, np.zeros((0, 2)), np.zeros(0), (500.0, 50.0))[box.plot]
+    outside = is_colour(plot, OUTSIDE)
+    assert outside[:, :95].mean() > 0.95                                 # x < 0
+    assert not outside[:, 105:].any()
+
+
+def test_a_lead_is_shaded_within_the_band_and_wraps_across_a_periodic_y():
+    box = view_box((0.0, 400.0, 0.0, 200.0), max_width=800)             # 2 px/m
+    lead = Lead(200.0, 190.0, 0.25 * math.pi, 20.0, 200.0)
+    picture = draw_view(box, np.zeros((0, 2)), np.zeros(0), (400.0, 200.0),
+                        periodic=(False, True), leads=(lead,), ice_band=(100.0, 300.0))
+    shaded = is_colour(picture[box.plot], LEAD)
+    (c, r), = box.pixels([(200.0, 190.0)]).astype(int) - (box.left, box.top)
+    assert shaded[r - 3:r + 4, c - 3:c + 4].all()                        # on the centre line
+    (c, r), = box.pixels([(230.0, 20.0)]).astype(int) - (box.left, box.top)
+    assert shaded[r - 3:r + 4, c - 3:c + 4].all()                        # its image below y = 0
+    assert not shaded[:, :195].any() and not shaded[:, 605:].any()      # only in the band
+    no_lead = draw_view(box, np.zeros((0, 2)), np.zeros(0), (400.0, 200.0))
+    assert not is_colour(no_lead, LEAD).any()
+
+
+def test_hull_and_axes_are_drawn():
+    box = view_box((0.0, 200.0, 0.0, 100.0), max_width=400)
+    hull = np.array([[90.0, 45.0], [110.0, 45.0], [110.0, 55.0], [90.0, 55.0]])
+    picture = draw_view(box, np.zeros((0, 2)), np.zeros(0), (200.0, 100.0), hull_vertices=hull)
+    rows, cols = np.nonzero(is_colour(picture, HULL))
+    assert abs(cols.mean() - box.pixels([(100.0, 50.0)])[0, 0]) < 1.5
+    assert abs(rows.mean() - box.pixels([(100.0, 50.0)])[0, 1]) < 1.5
+    below = picture[box.top + box.height + 2:]                          # tick labels under the plot
+    assert (~is_colour(below, PANEL_BACKGROUND)).sum() > 100
+
+
+def test_thickness_colours_by_class_with_a_legend_of_the_classes_present():
+    colours, legend = thickness_colours([1.2, 3.0, 1.2], classes=(1.2, 3.0))
+    assert [tuple(c) for c in colours] == [THICKNESS_COLOURS[0], THICKNESS_COLOURS[1],
+                                           THICKNESS_COLOURS[0]]
+    assert [text for _, text in legend] == ["ice 1.2 m thick", "ice 3.0 m thick"]
+    colours, legend = thickness_colours([3.0, 3.0], classes=(1.2, 3.0))
+    assert {tuple(c) for c in colours} == {THICKNESS_COLOURS[1]}       # the thick class alone
+    assert len(legend) == 1 and "3.0 m" in legend[0][1]
+    colours, legend = thickness_colours([1.0, 1.0])
+    assert {tuple(c) for c in colours} == {THICKNESS_COLOURS[0]} and len(legend) == 1
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: view_window("side", (100.0, 50.0), 10.0), "follow"),
+    (lambda: view_window("follow", (100.0, 50.0), 10.0, behind=-1.0), "behind"),
+    (lambda: view_box((0.0, 0.0, 0.0, 1.0)), "window"),
+    (lambda: ViewBox(0.0, 1.0, 0.0, 1.0, -2.0), "scale"),
+    (lambda: draw_view("box", np.zeros((0, 2)), np.zeros(0), (1.0, 1.0)), "ViewBox"),
+    (lambda: draw_view(view_box((0.0, 1.0, 0.0, 1.0)), [[0.5, 0.5]], [0.1], (1.0, 1.0),
+                       floe_colours=np.zeros((2, 3), dtype=np.uint8)), "floe_colours"),
+    (lambda: draw_view(view_box((0.0, 1.0, 0.0, 1.0)), np.zeros((0, 2)), np.zeros(0),
+                       (1.0, 1.0), ice_band=(2.0, 1.0)), "ice_band"),
+    (lambda: draw_view(view_box((0.0, 1.0, 0.0, 1.0)), np.zeros((0, 2)), np.zeros(0),
+                       (1.0, 1.0), leads=[(1.0, 2.0)]), "lead 0"),
+    (lambda: draw_view(view_box((0.0, 1.0, 0.0, 1.0)), np.zeros((0, 2)), np.zeros(0),
+                       (1.0, 1.0), leads=[Lead(0.5, 0.5, 0.0, -1.0)]), "positive width"),
+    (lambda: thickness_colours([1.0], classes=(-1.0,)), "classes"),
+    (lambda: annotate(np.zeros((4, 4, 3), dtype=np.uint8), side="left"), "side"),
+    (lambda: annotate(np.zeros((4, 4, 3), dtype=np.uint8), legend=[((1, 2, 3), "a", "star")]),
+     "kind"),
+])
+def test_view_functions_reject_bad_input(call, name):
+    with pytest.raises(ValueError, match=name):
+        call()
+
+
+def test_annotate_bottom_puts_a_strip_under_the_picture():
+    pic = one_floe(50.0, 50.0, size=600)
+    frame = annotate(pic, text=["t = 0 s", "A = 0.5"], arrow=(1.0, 0.0), side="bottom",
+                     legend=[((255, 0, 0), "a", "line"), ((0, 255, 0), "b", "band")])
+    assert frame.shape[1] == 600 and frame.shape[0] > 600
+    assert np.array_equal(frame[:600], pic)
+    strip = frame[600:]
+    assert is_colour(strip, (255, 0, 0)).sum() > 10 and is_colour(strip, (0, 255, 0)).sum() > 10
+    assert is_colour(strip, ARROW_CIRCLE).any()
+
+
+# -- ShipNavigation-v1's frames ------------------------------------------------------------
+V1 = "iceenvs/ShipNavigation-v1"
+
+
+def v1_env(**kwargs):
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401
+    from iceenvs.facts import env_facts
+
+    return gym.make(V1, render_mode="rgb_array", **{**env_facts(V1).small, **kwargs})
+
+
+def hull_column(frame, box):
+    rows, cols = np.nonzero(is_colour(frame[box.plot], HULL))
+    assert cols.size > 100
+    return cols.mean()
+
+
+def test_follow_view_keeps_the_ship_in_place_and_moves_the_ice():
+    env = v1_env(leads=0)
+    try:
+        env.reset(seed=1)
+        u = env.unwrapped
+        box0 = u.view_box()
+        first, x0 = env.render(), float(u.sim.ship.position[0])
+        for _ in range(5):
+            env.step(np.zeros(1))
+        box1 = u.view_box()
+        second, x1 = env.render(), float(u.sim.ship.position[0])
+    finally:
+        env.close()
+    assert first.shape == second.shape
+    assert x1 - x0 > 15.0                                  # the ship sailed 20 m ...
+    assert abs(hull_column(first, box0) - hull_column(second, box1)) < 3.0   # ... in place
+    # the ice moved left by the distance sailed
+    shift = int(round((x1 - x0) * box0.scale))
+    ice0 = is_colour(first[box0.plot], THICKNESS_COLOURS[0])
+    ice1 = is_colour(second[box1.plot], THICKNESS_COLOURS[0])
+    assert ice0.sum() > 1000
+
+    def overlap(a, b):
+        return (a & b).sum() / max(1, min(a.sum(), b.sum()))
+
+    assert overlap(ice0[:, shift:], ice1[:, :-shift]) > 0.9
+    assert overlap(ice0, ice1) < 0.8
+
+
+def test_v1_frame_shades_its_leads():
+    env = v1_env(leads=2)
+    try:
+        env.reset(seed=2)
+        u = env.unwrapped
+        u.view = "overview"                                    # every lead in the window
+        frame, box = env.render(), u.view_box()
+        leads = u.leads
+    finally:
+        env.close()
+    shaded = is_colour(frame[box.plot], LEAD)
+    assert len(leads) == 2 and shaded.sum() > 500
+    for lead in leads:
+        (c, r), = box.pixels([(lead.x, lead.y)]).astype(int) - (box.left, box.top)
+        assert shaded[max(r - 2, 0):r + 3, max(c - 2, 0):c + 3].mean() > 0.5
+    env = v1_env(leads=0, view="overview")
+    try:
+        env.reset(seed=2)
+        assert not is_colour(env.render(), LEAD).any()
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("fraction", [0.0, 1.0])
+def test_v1_frame_colours_the_thick_class(fraction):
+    env = v1_env(thick_fraction=fraction)
+    try:
+        env.reset(seed=3)
+        frame, box = env.render(), env.unwrapped.view_box()
+    finally:
+        env.close()
+    thick = is_colour(frame, THICKNESS_COLOURS[1])
+    thin = is_colour(frame[box.plot], THICKNESS_COLOURS[0])
+    if fraction:
+        assert thick[box.plot].sum() > 500 and not thin.any()
+    else:
+        assert thin.sum() > 500 and not thick.any()
+
+
+def test_v1_overview_fills_the_frame_with_the_channel():
+    env = v1_env(view="overview")
+    try:
+        env.reset(seed=4)
+        u = env.unwrapped
+        frame, box = env.render(), u.view_box()
+        x, y = (float(v) for v in u.sim.ship.position)
+        length, width = u.sim.box.lx, u.sim.box.ly
+        u.view = "follow"
+        follow = env.render()
+    finally:
+        env.close()
+    assert (box.x0, box.x1, box.y0, box.y1) == (0.0, length, 0.0, width)
+    assert box.width / box.height == pytest.approx(length / width, rel=0.02)
+    assert box.width >= 0.85 * frame.shape[1] and frame.shape[1] > frame.shape[0]
+    c, r = box.pixels([(x, y)])[0]
+    assert abs(hull_column(frame, box) + box.left - c) < 3.0   # the ship where it is
+    assert follow.shape != frame.shape
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(view="side"), "follow"), (dict(view=3), "view"), (dict(view_behind=-5.0), "view_behind"),
+    (dict(view_ahead=float("nan")), "view_ahead"),
+    (dict(view_behind=0.0, view_ahead=0.0), "view_ahead"),
+])
+def test_v1_bad_view_arguments_raise(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        v1_env(**kwargs)
+
+
+def test_v1_view_attribute_is_checked():
+    env = v1_env()
+    try:
+        with pytest.raises(ValueError, match="overview"):
+            env.unwrapped.view = "sideways"
+        assert env.unwrapped.view == "follow"
+    finally:
+        env.close()
+
+
+def test_window_takes_the_size_of_a_new_frame(monkeypatch):
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    monkeypatch.setenv("SDL_AUDIODRIVER", "dummy")
+    window = Window("test", 64, 64, fps=1000)
+    try:
+        window.show(one_floe(50.0, 50.0, size=64))
+        wide = one_floe(50.0, 50.0, box=(200.0, 100.0), size=96)
+        window.show(wide)
+        assert window.screen.get_size() == (96, 48)
+    finally:
+        window.close()

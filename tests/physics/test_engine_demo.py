@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physics.demo import (draw, draw_transit, force_chains, main, ship_transit, wall_force,
-                          wind_force)
+import physics.demo as demo
+from physics.demo import (chain_samples, chain_width, draw, draw_transit, error_meaning,
+                          force_chains, main, ship_transit, wall_force, wind_force)
 
 
 def test_walls_hold_the_wind_force_once_the_pack_is_at_rest():
@@ -43,6 +44,53 @@ def test_force_network_and_transit_figures_are_written(tmp_path):
     draw_transit(sim, tmp_path / "transit.png", "transit")
     for name in ("chains.png", "transit.png"):
         assert (tmp_path / name).stat().st_size > 10_000
+
+
+def test_chain_legend_samples_are_round_forces_up_to_the_largest():
+    assert chain_samples(5300.0) == [5000.0, 1000.0, 200.0]
+    assert chain_samples(1.0) == [1.0, 0.2, 0.05]
+    for largest in (7.3, 980.0, 2.1e6):
+        samples = chain_samples(largest)
+        assert 2 <= len(samples) <= 3 and samples[0] <= largest
+        assert all(b < a for a, b in zip(samples, samples[1:]))
+    widths = chain_width(np.array([0.0, 500.0, 1000.0]), 1000.0)
+    assert widths[0] > 0 and widths[2] - widths[1] == pytest.approx(widths[1] - widths[0])
+
+
+def kept_figures(monkeypatch):
+    """The figures the demo draws, kept instead of saved."""
+    figures = []
+    monkeypatch.setattr(demo, "_save", lambda fig, path: figures.append(fig))
+    return figures
+
+
+def texts(fig):
+    return [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text"))]
+
+
+def test_force_chain_figure_shows_the_wind_the_walls_and_what_a_width_means(monkeypatch):
+    figures = kept_figures(monkeypatch)
+    sim = force_chains(30, 0.8, 12.0, seed=2)
+    sim.advance(40.0)                               # the floes have met (about 25 s)
+    assert len(sim.contacts()) > 0
+    draw(sim, "chains.png", "30 floes")
+    words = texts(figures[0])
+    assert "wind 12 m/s" in words
+    assert "rigid wall" in words
+    assert any(w.startswith("contact force") and w.endswith("N") for w in words)
+    assert any("∝ normal force" in w for w in words)
+
+
+def test_transit_figure_says_what_the_error_of_the_mean_resistance_is(monkeypatch):
+    assert "standard error of the mean" in error_meaning(500)
+    assert "20 consecutive time blocks" in error_meaning(500)
+    assert "7 consecutive" in error_meaning(7)
+    figures = kept_figures(monkeypatch)
+    sim = ship_transit(seed=1)
+    sim.advance(60.0)
+    draw_transit(sim, "transit.png", "transit")
+    label = next(w for w in texts(figures[0]) if w.startswith("mean resistance"))
+    assert "±" in label and "standard error of the mean" in label
 
 
 def test_command_prints_the_contacts_and_draws_both_figures(tmp_path, capsys):
