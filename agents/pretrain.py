@@ -41,6 +41,16 @@ The hyperparameter is a mapping, e.g. in ``agents/hyperparams/ppo.yaml``::
 
 ``pretrain.yaml`` in the run directory records the number of decisions,
 the fit of actor and critic and the seconds each part took.
+
+**Within a time budget.** Under ``agents.train --minutes M`` the warm start
+belongs to the budget: it may take at most ``share`` (default 0.5) of it,
+counted from the start of the run. The demonstrations stop when the next
+episode would not end within 85 % of that share (at least one episode is
+sailed), and the fit stops between epochs when the share is spent; PPO gets
+the rest of the budget. A budget whose share cannot hold one episode of the
+teacher is refused with the budget that would (:class:`BudgetTooShort`).
+``pretrain.yaml`` then records how many of the ``episodes`` were sailed and
+how many epochs were fitted.
 """
 from __future__ import annotations
 
@@ -48,12 +58,20 @@ import time
 
 import numpy as np
 
-__all__ = ["PRETRAIN_DEFAULTS", "pretrain_settings", "Demonstrations", "collect", "prime_normalization",
+__all__ = ["PRETRAIN_DEFAULTS", "BudgetTooShort", "pretrain_settings", "Demonstrations", "collect", "prime_normalization",
            "fit_policy", "BehaviourAnchor", "pretrain"]
 
 #: settings of ``pretrain`` that may be left out
 PRETRAIN_DEFAULTS = {"episodes": 60, "seed": 30000, "epochs": 50, "batch_size": 256,
-                     "learning_rate": 1.0e-3, "anchor": 0.0}
+                     "learning_rate": 1.0e-3, "anchor": 0.0, "share": 0.5}
+#: part of the warm start's share of a budget that the demonstrations may use
+#: (the rest is the fit's)
+COLLECT_PART = 0.85
+
+
+class BudgetTooShort(ValueError):
+    """A time budget whose share for the warm start cannot hold one episode
+    of the teacher; the message names the budget that would."""
 
 
 def pretrain_settings(value) -> dict | None:
@@ -90,15 +108,22 @@ def pretrain_settings(value) -> dict | None:
             or not settings["anchor"] >= 0:
         raise ValueError(f"pretrain anchor must be a number >= 0, got {settings['anchor']!r}")
     settings["anchor"] = float(settings["anchor"])
+    share = settings["share"]
+    if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0 < share < 1:
+        raise ValueError(f"pretrain share (of a --minutes budget) must be a number in (0, 1), "
+                         f"got {share!r}")
+    settings["share"] = float(share)
     return settings
 
 
 class Demonstrations:
     """A teacher's decisions: raw observations ``obs`` (n, …), actions
     ``actions`` (n, k), rewards ``rewards`` (n,) and ``episode_starts``
-    (n,), True at the first step of each episode."""
+    (n,), True at the first step of each episode; ``episodes`` is their
+    number."""
 
     def __init__(self, obs, actions, rewards, episode_starts):
+        self.episodes = int(np.count_nonzero(episode_starts))
         self.obs = np.asarray(obs, dtype=np.float32)
         self.actions = np.asarray(actions, dtype=np.float32)
         self.rewards = np.asarray(rewards, dtype=np.float64)
@@ -131,9 +156,15 @@ class Demonstrations:
 
 
 def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: int,
-            progress: bool = False) -> Demonstrations:
+            progress: bool = False, deadline: float | None = None) -> Demonstrations:
     """Sail ``episodes`` episodes of ``teacher`` (a baseline name) on
-    ``gymnasium.make(env_id, **env_kwargs)``, seeded ``seed + k``."""
+    ``gymnasium.make(env_id, **env_kwargs)``, seeded ``seed + k``.
+
+    With ``deadline`` (a ``time.perf_counter`` value), no episode is begun
+    that would not end by then at the mean pace of those sailed so far;
+    the first is always sailed, and :class:`BudgetTooShort` is raised when
+    it ends past the deadline. ``Demonstrations.episodes`` says how many
+    were sailed."""
     import gymnasium as gym
     from tqdm.auto import tqdm
 
@@ -143,8 +174,14 @@ def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: in
     try:
         policy = make_baseline(teacher, env, seed=seed)
         obs_list, actions, rewards, starts = [], [], [], []
-        for k in tqdm(range(episodes), desc=f"{teacher} demonstrations", unit="episode",
-                      disable=not progress):
+        began, sailed = time.perf_counter(), 0
+        bar = tqdm(range(episodes), desc=f"{teacher} demonstrations", unit="episode",
+                   disable=not progress)
+        for k in bar:
+            if deadline is not None and sailed:
+                now = time.perf_counter()
+                if now + (now - began) / sailed > deadline:
+                    break
             obs, _ = env.reset(seed=seed + k)
             policy.reset(seed + k)
             done, first = False, True
@@ -156,9 +193,17 @@ def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: in
                 obs, reward, terminated, truncated, _ = env.step(action)
                 rewards.append(float(reward))
                 done, first = terminated or truncated, False
+            sailed += 1
+            if deadline is not None and sailed == 1 and time.perf_counter() > deadline:
+                took = time.perf_counter() - began
+                raise BudgetTooShort(f"one {teacher} episode took {took:.0f} s, more than the "
+                                     f"warm start's share of the budget")
+        bar.close()
     finally:
         env.close()
-    return Demonstrations(obs_list, actions, rewards, starts)
+    demos = Demonstrations(obs_list, actions, rewards, starts)
+    demos.episodes = sailed
+    return demos
 
 
 def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> None:
@@ -179,36 +224,44 @@ def _action_mse(policy, obs, actions):
 
 
 def _fit(params, loss_of, n: int, epochs: int, batch_size: int, learning_rate: float,
-         generator) -> None:
+         generator, deadline: float | None = None) -> int:
     """Adam on ``loss_of(batch_indices)`` over ``epochs`` passes of shuffled
-    batches."""
+    batches, or fewer when ``deadline`` (a ``time.perf_counter`` value)
+    passes (at least one); returns the passes made."""
     import torch
 
     optimizer = torch.optim.Adam(params, lr=learning_rate)
-    for _ in range(epochs):
+    for done in range(epochs):
+        if done and deadline is not None and time.perf_counter() > deadline:
+            return done
         for batch in torch.randperm(n, generator=generator).split(batch_size):
             loss = loss_of(batch)
             optimizer.zero_grad()
             loss.backward()
             optimizer.step()
+    return epochs
 
 
 def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray | None, *,
-               epochs: int, batch_size: int, learning_rate: float, seed: int) -> dict:
+               epochs: int, batch_size: int, learning_rate: float, seed: int,
+               deadline: float | None = None) -> dict:
     """Fit an SB3 actor-critic ``policy`` on (already normalised) ``obs``:
     the mean of its action distribution to ``actions`` and, when given,
     its value to ``values``.
 
     Only the actor's parameters (features, actor layers, action head)
     are trained for the actions, and only the critic's (value layers and
-    head) for the values; the log standard deviation is left alone.
+    head) for the values; the log standard deviation is left alone. With
+    ``deadline`` (a ``time.perf_counter`` value) each fit stops between
+    epochs when its part of the time left has passed (the actor's half,
+    then the critic's).
 
     Returns
     -------
     dict
-        ``action_mse``, ``action_variance`` and, with values,
-        ``value_mse`` and ``value_variance``, on the whole data after the
-        fit.
+        ``action_mse``, ``action_variance``, ``actor_epochs`` and, with
+        values, ``value_mse``, ``value_variance`` and ``critic_epochs``, on
+        the whole data after the fit.
     """
     import torch
 
@@ -219,9 +272,12 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
 
     actor = [*policy.pi_features_extractor.parameters(),
              *policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
-    _fit(actor, lambda b: _action_mse(policy, x[b], y[b]), len(x), epochs, batch_size,
-         learning_rate, generator)
-    report = {}
+    actor_deadline = None
+    if deadline is not None:
+        now = time.perf_counter()
+        actor_deadline = now + 0.5 * (deadline - now) if values is not None else deadline
+    report = {"actor_epochs": _fit(actor, lambda b: _action_mse(policy, x[b], y[b]), len(x),
+                                   epochs, batch_size, learning_rate, generator, actor_deadline)}
     with torch.no_grad():
         report["action_mse"] = float(_action_mse(policy, x, y))
         report["action_variance"] = float(y.var(unbiased=False))
@@ -230,8 +286,9 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
         critic = [*policy.mlp_extractor.value_net.parameters(), *policy.value_net.parameters()]
         if not policy.share_features_extractor:
             critic += list(policy.vf_features_extractor.parameters())
-        _fit(critic, lambda b: ((policy.predict_values(x[b]) - v[b]) ** 2).mean(), len(x),
-             epochs, batch_size, learning_rate, generator)
+        report["critic_epochs"] = _fit(
+            critic, lambda b: ((policy.predict_values(x[b]) - v[b]) ** 2).mean(), len(x),
+            epochs, batch_size, learning_rate, generator, deadline)
         with torch.no_grad():
             report["value_mse"] = float(((policy.predict_values(x) - v) ** 2).mean())
             report["value_variance"] = float(v.var(unbiased=False))
@@ -302,25 +359,29 @@ class BehaviourAnchor:
 
 
 def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: float,
-             progress: bool = False) -> dict:
+             progress: bool = False, deadline: float | None = None) -> dict:
     """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
     training stack ``env`` from the demonstrations of ``settings["teacher"]``
     (steps 1-5 of the module's description).
 
     With ``settings["anchor"]`` > 0, a :class:`BehaviourAnchor` on the
-    same demonstrations is left on the model's optimiser for PPO.
+    same demonstrations is left on the model's optimiser for PPO. With
+    ``deadline`` (a ``time.perf_counter`` value: the end of the warm
+    start's share of a budget) the demonstrations end by
+    :data:`COLLECT_PART` of the time left and the fit by the deadline.
 
     Returns
     -------
     dict
-        The settings, ``decisions``, the fit (:func:`fit_policy`) and
-        ``collect_seconds`` and ``fit_seconds``.
+        The settings, ``decisions``, ``episodes_sailed``, the fit
+        (:func:`fit_policy`) and ``collect_seconds`` and ``fit_seconds``.
     """
     from stable_baselines3.common.vec_env import VecNormalize
 
     start = time.perf_counter()
+    collect_by = None if deadline is None else start + COLLECT_PART * (deadline - start)
     demos = collect(env_id, env_kwargs, settings["teacher"], settings["episodes"],
-                    settings["seed"], progress=progress)
+                    settings["seed"], progress=progress, deadline=collect_by)
     collected = time.perf_counter()
     obs, scale = demos.obs, 1.0
     norm = env if isinstance(env, VecNormalize) else None
@@ -331,10 +392,11 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
             scale = float(np.sqrt(norm.ret_rms.var + norm.epsilon))
     report = fit_policy(model.policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
                         epochs=settings["epochs"], batch_size=settings["batch_size"],
-                        learning_rate=float(settings["learning_rate"]), seed=settings["seed"])
+                        learning_rate=float(settings["learning_rate"]), seed=settings["seed"],
+                        deadline=deadline)
     if settings["anchor"] > 0:
         BehaviourAnchor(model, demos, norm, settings["anchor"], settings["batch_size"],
                         seed=settings["seed"] + 1)
-    return {**settings, "decisions": len(demos), **report,
+    return {**settings, "decisions": len(demos), "episodes_sailed": demos.episodes, **report,
             "collect_seconds": round(collected - start, 1),
             "fit_seconds": round(time.perf_counter() - collected, 1)}

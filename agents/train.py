@@ -23,8 +23,11 @@ this call created is removed, and in a directory that existed before
 raised again. An error while learning loses nothing learnt: the model so
 far is saved as the checkpoint at its number of steps (evaluate it as
 ``RUN_DIR@STEPS``), and the error is raised again. ``--minutes`` stops
-learning after that much wall-clock time and saves the model as at the
-end.
+learning after that much wall-clock time, counted from the making of the
+environments, and saves the model as at the end; a warm start
+(:mod:`agents.pretrain`) takes at most its ``share`` of the budget, and a
+budget too short for it is refused (exit status 2) with the shortest that
+is not.
 
 The run directory (default ``runs/agents/<env-name>_<algo>_<seed>``)
 holds ``model.zip``, ``vecnormalize.pkl`` (when the observations or
@@ -130,8 +133,11 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                         "other here); auto (default): for several, native where the environment "
                         "has one, else subproc; dummy for one")
     p.add_argument("--minutes", type=float, default=None,
-                   help="stop after this much wall-clock training time and save the model "
-                        "as at the end (default: no limit)")
+                   help="stop after this much wall-clock time, from the making of the "
+                        "environments and warm start included, and save the model as at the "
+                        "end (default: no limit); a warm start takes at most its share "
+                        "(pretrain share, default 0.5) and a budget too short for it is "
+                        "refused")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p
@@ -435,23 +441,52 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path,
 
 
 # -- step 7b: warm start ------------------------------------------------------------------------
-def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path) -> dict | None:
+def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path,
+               started: float | None = None) -> dict | None:
     """Fit the policy to a planner's decisions when ``hp["pretrain"]`` asks
     for it (:mod:`agents.pretrain`), write ``pretrain.yaml`` and, when
-    checkpointing, the checkpoint at 0 steps (the clone before PPO)."""
+    checkpointing, the checkpoint at 0 steps (the clone before PPO).
+
+    Under ``--minutes`` the warm start ends by its ``share`` of the budget,
+    counted from ``started`` (a ``time.perf_counter`` value; default now);
+    a budget too short for one demonstration is refused with the shortest
+    that holds one (:class:`agents.pretrain.BudgetTooShort`)."""
     if not hp.get("pretrain"):
         return None
-    from .pretrain import pretrain
+    from .pretrain import COLLECT_PART, BudgetTooShort, pretrain
 
-    report = pretrain(model, env, args.env, hp["env_kwargs"], hp["pretrain"],
-                      gamma=float(hp.get("gamma", 0.99)), progress=not args.no_progress)
+    settings = hp["pretrain"]
+    started = time.perf_counter() if started is None else started
+    deadline = None
+    plan = f"warm start: {settings['episodes']} episodes of {settings['teacher']}"
+    if args.minutes is not None:
+        budget = 60.0 * args.minutes
+        deadline = started + settings["share"] * budget
+        plan = (f"warm start: up to {settings['episodes']} episodes of {settings['teacher']}, "
+                f"within {settings['share'] * budget:.0f} s ({settings['share']:.0%}) of the "
+                f"{args.minutes:g}-minute budget; PPO gets the rest")
+    print(plan, flush=True)
+    try:
+        report = pretrain(model, env, args.env, hp["env_kwargs"], settings,
+                          gamma=float(hp.get("gamma", 0.99)), progress=not args.no_progress,
+                          deadline=deadline)
+    except BudgetTooShort as err:
+        # the share must hold the set-up so far and one episode, in COLLECT_PART of it
+        needed = (time.perf_counter() - started) / COLLECT_PART / settings["share"]
+        raise BudgetTooShort(f"--minutes {args.minutes:g} is too short for the warm start: "
+                             f"{err}; give at least --minutes {math.ceil(needed / 6) / 10:g}, "
+                             f"or train without it (--hyperparams pretrain=null)") from None
+    if args.minutes is not None:
+        report["budget_seconds"] = round(60.0 * args.minutes, 1)
     with open(run_dir / "pretrain.yaml", "w") as fh:
         yaml.safe_dump(report, fh, sort_keys=True)
     if args.save_freq > 0:
         save(model, env, run_dir, 0)      # the clone before PPO: RUN_DIR@0
-    print(f"warm start from {report['teacher']}: {report['decisions']} decisions in "
-          f"{report['collect_seconds']:.0f} s; action mean squared error "
-          f"{report['action_mse']:.3g} (variance {report['action_variance']:.3g})")
+    print(f"warm start from {report['teacher']}: {report['episodes_sailed']} of "
+          f"{report['episodes']} episodes, {report['decisions']} decisions in "
+          f"{report['collect_seconds']:.0f} s, fitted in {report['fit_seconds']:.0f} s; action "
+          f"mean squared error {report['action_mse']:.3g} (variance "
+          f"{report['action_variance']:.3g})", flush=True)
     return report
 
 
@@ -500,6 +535,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
     """Command-line entry point (``prog``: the command's name in the help);
     returns the run directory."""
     from .envs import check_env_kwargs
+    from .pretrain import BudgetTooShort
 
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(prog)
@@ -528,11 +564,13 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
         env, eval_env = make_envs(args, hp)
         model = make_model(args, hp, env, run_dir)
         callbacks = make_callbacks(args, hp, eval_env, run_dir,
-                                   started=started if hp.get("pretrain") else None)
-        warm_start(args, hp, model, env, run_dir)
-    except BaseException:
+                                   started=started)
+        warm_start(args, hp, model, env, run_dir, started)
+    except BaseException as exc:
         _close(env, eval_env, model.logger if model is not None else None)
         discard_run_dir(run_dir, created)
+        if isinstance(exc, BudgetTooShort):
+            parser.error(str(exc))
         raise
     try:
         try:

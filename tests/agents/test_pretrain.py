@@ -156,3 +156,60 @@ def test_a_warm_started_run_starts_from_the_planner(tmp_path):
     clone = TrainedPolicy(f"{run}", checkpoint=0).predict(demos.obs)[0]
     error = np.mean((clone - demos.actions) ** 2)
     assert error < np.mean((demos.actions - demos.actions.mean()) ** 2)
+
+
+SHORT_FIELD = {"control": "course", "swath_frame": "goal", "swath_edge": True,
+               "course_guard": 150, "goal_distance": 200.0, "length": 500.0, "leads": 0}
+
+
+def _budgeted_run(tmp_path, minutes: float, episodes: int):
+    return ["--env", "iceenvs/ShipNavigation-v1", "--algo", "ppo", "--n-envs", "1",
+            "--seed", "1", "--out", str(tmp_path / "run"), "--eval-freq", "0",
+            "--save-freq", "0", "--no-progress", "--minutes", f"{minutes:g}",
+            "--hyperparams", "n_steps=32", "batch_size=32",
+            f"pretrain={{teacher: swath, episodes: {episodes}, epochs: 2000}}",
+            "--env-kwargs", *(f"{k}={v}" for k, v in SHORT_FIELD.items())]
+
+
+def test_a_minutes_budget_holds_the_warm_start_and_the_training(tmp_path, capsys):
+    """A warm start asked for 10 000 episodes and 2000 epochs under a
+    12-second budget: it sails some episodes and stops the fit within its
+    half of the budget, PPO trains on to the budget, and the whole run,
+    from the making of the environments to the saved model, keeps it (the
+    slack is for what follows the last step: saving and closing)."""
+    import time
+
+    budget = 12.0
+    t0 = time.perf_counter()
+    run = train.main(_budgeted_run(tmp_path, budget / 60, 10_000))
+    wall = time.perf_counter() - t0
+    report = yaml.safe_load((run / "pretrain.yaml").read_text())
+    assert 1 <= report["episodes_sailed"] < report["episodes"] == 10_000
+    assert report["actor_epochs"] < 2000 and report["critic_epochs"] < 2000
+    assert report["budget_seconds"] == budget
+    # the share is 6 s; an episode of this field takes well under a second
+    assert report["collect_seconds"] + report["fit_seconds"] < 0.5 * budget + 2.0
+    out = capsys.readouterr().out
+    assert "within 6 s (50%) of the 0.2-minute budget" in out
+    assert "training stopped by its budget of 0.2 minutes" in out
+    assert (run / "model.zip").is_file()
+    # main also checks the arguments on one environment before the budget starts
+    assert wall < budget + 10.0, wall
+
+
+def test_a_budget_too_short_for_the_warm_start_is_refused(tmp_path, capsys):
+    """One demonstration does not fit in half of 0.03 s: exit status 2,
+    the shortest budget that would do, and no run directory left."""
+    with pytest.raises(SystemExit) as exit_info:
+        train.main(_budgeted_run(tmp_path, 0.0005, 5))
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "too short for the warm start" in err and "give at least --minutes" in err
+    assert "pretrain=null" in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_the_share_of_the_budget_is_checked():
+    with pytest.raises(ValueError, match=r"share .* in \(0, 1\)"):
+        pretrain_settings({"teacher": "swath", "share": 1.0})
+    assert pretrain_settings({"teacher": "swath", "share": 0.25})["share"] == 0.25
