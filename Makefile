@@ -12,7 +12,7 @@ TORCH_PIN := torch==2.13.0
 # `make lock` regenerates it from a fresh install of the newest releases.
 CONSTRAINTS := constraints.txt
 
-.PHONY: setup lock demo test lint test-slow bench validate crosscheck docs clean
+.PHONY: setup lock demo test lint test-slow bench records validate crosscheck docs clean
 
 setup: $(STAMP)
 
@@ -56,21 +56,20 @@ lint: setup
 test-slow: setup
 	$(PY) -m pytest -q -m slow
 
+# every benchmark suite but the LAMMPS one, on this machine; the records go
+# to runs/benchmarks/ and leave the documented ones alone
+BENCH_SUITES := hertz hertz_phases harddisk observables itd environments vector ship resting \
+	free_drift sensors scaling where_time_goes
 bench: setup
-	$(PY) -m benchmarks.hertz
-	$(PY) -m benchmarks.hertz_phases
-	$(PY) -m benchmarks.harddisk
-	$(PY) -m benchmarks.observables
-	$(PY) -m benchmarks.itd
-	$(PY) -m benchmarks.environments
-	$(PY) -m benchmarks.vector
-	$(PY) -m benchmarks.ship
-	$(PY) -m benchmarks.resting
-	$(PY) -m benchmarks.free_drift
-	$(PY) -m benchmarks.sensors
-	$(PY) -m benchmarks.scaling
-	$(PY) -m benchmarks.where_time_goes
+	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite || exit 1; done
+
+# the records the documentation shows: every suite written with --docs to
+# docs/benchmarks/, the README's headline figures from them, and the
+# generated observation page
+records: setup
+	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite --docs || exit 1; done
 	$(PY) -m benchmarks.headline
+	$(PY) -m iceenvs.observation_page
 
 docs: setup
 	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html

@@ -48,11 +48,13 @@ suite                what is timed
                      to 10⁶ floes on a cluster (:mod:`benchmarks.lammps_scaling`)
 ===================  ==============================================================
 
-Every suite writes one JSON record to ``docs/benchmarks/<suite>.json`` of
+Every suite writes one JSON record to ``runs/benchmarks/<suite>.json`` of
 the checkout, whatever the working directory
-(:func:`benchmarks.harness.write_record`), which the documentation renders
-(:func:`benchmarks.harness.render_markdown`);
-``python -m benchmarks.headline`` puts the headline figures into the README.
+(:func:`benchmarks.harness.write_record`); with ``--docs`` it writes the
+record the documentation shows and renders
+(:func:`benchmarks.harness.render_markdown`), ``docs/benchmarks/<suite>.json``,
+as ``make records`` does for every suite. ``python -m benchmarks.headline``
+puts the headline figures of the documented records into the README.
 Every suite takes ``--quick``, a run small enough for the tests.
 
 This package imports neither :mod:`physics` nor :mod:`iceenvs` on import:

@@ -312,7 +312,7 @@ def main(argv=None, prog: str | None = None) -> int:
         record = harness.make_record(SUITE, STIFFNESS_TITLE, STIFFNESS_DESCRIPTION, command,
                                      [stiffness_table(rows)], dict(rows=rows),
                                      time.perf_counter() - t0)
-        args.no_json = args.no_json or not any(a.startswith("--json") for a in argv)
+        args.no_json = args.no_json or not any(a.startswith(("--json", "--docs")) for a in argv)
         harness.finish(args, record)
         return 0
     ids = resolve_ids(args.ids, ENV_IDS) if args.ids else list(ENV_IDS)

@@ -56,8 +56,11 @@ PROCESSES = 3
 #: the source checkout the suites come with (they are not installed), whatever
 #: the working directory
 ROOT = Path(__file__).resolve().parent.parent
-#: where the records go: docs/benchmarks of the checkout
-DEFAULT_DIR = ROOT / "docs" / "benchmarks"
+#: where a suite writes its record by default: runs/benchmarks of the checkout
+DEFAULT_DIR = ROOT / "runs" / "benchmarks"
+#: the records the documentation shows: docs/benchmarks of the checkout,
+#: written only when asked for (``--docs``, ``make records``)
+DOCS_DIR = ROOT / "docs" / "benchmarks"
 #: where the prepared floe fields are kept: .bench_cache of the checkout
 CACHE_DIR = ROOT / ".bench_cache"
 #: keys of every record, in the order they are written
@@ -462,7 +465,8 @@ def suite_parser(suite: str, description: str,
 
 
 def add_common_options(parser: argparse.ArgumentParser, suite: str) -> None:
-    """``--quick``, ``--json PATH`` and ``--no-json``."""
+    """``--quick``, ``--json PATH``, ``--docs`` (the record the
+    documentation shows, :data:`DOCS_DIR`) and ``--no-json``."""
     parser.add_argument("--quick", action="store_true",
                         help="a small run that only checks that everything works (its figures "
                              "mean nothing)")
@@ -470,6 +474,10 @@ def add_common_options(parser: argparse.ArgumentParser, suite: str) -> None:
     out.add_argument("--json", type=Path, default=DEFAULT_DIR / f"{suite}.json",
                      help=f"where to write the record (default "
                           f"{in_checkout(DEFAULT_DIR / f'{suite}.json')})")
+    out.add_argument("--docs", dest="json", action="store_const",
+                     const=DOCS_DIR / f"{suite}.json",
+                     help=f"write the record that the documentation shows, "
+                          f"{in_checkout(DOCS_DIR / f'{suite}.json')} (as make records does)")
     out.add_argument("--no-json", action="store_true", help="write no record")
 
 
@@ -575,7 +583,7 @@ def write_record(record: dict, path: str | os.PathLike) -> Path:
     return path
 
 
-def load_records(directory: str | os.PathLike = DEFAULT_DIR) -> list[dict]:
+def load_records(directory: str | os.PathLike = DOCS_DIR) -> list[dict]:
     """The records of ``directory`` (files ``<suite>.json``), in the order
     of :data:`benchmarks.SUITES`; suites without a file are left out."""
     directory = Path(directory)

@@ -156,11 +156,11 @@ def headline_table(records: list[dict]) -> str:
         if record["suite"] == "hertz":
             notes.append(_hertz_note(record))
     if not rows:
-        return "No benchmark records yet: `make bench` measures them."
+        return "No benchmark records yet: `make records` measures them."
     lines = ["| benchmark | figure | measured |", "|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     lines += [line for note in notes if note for line in ("", note)]
-    lines += ["", f"Measured on {', '.join(dict.fromkeys(machines))} with `make bench`; "
+    lines += ["", f"Measured on {', '.join(dict.fromkeys(machines))} with `make records`; "
                   f"commands, machines and every table are on the "
                   f"[Benchmarks]({BENCHMARKS_PAGE}) page."]
     return "\n".join(lines)
@@ -188,7 +188,7 @@ def main(argv=None, prog: str | None = None) -> int:
     p = argparse.ArgumentParser(prog=prog or "python -m benchmarks.headline",
                                 description=__doc__.split("\n\n")[1],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    readme, records = harness.ROOT / "README.md", harness.DEFAULT_DIR
+    readme, records = harness.ROOT / "README.md", harness.DOCS_DIR
     p.add_argument("--readme", type=Path, default=readme,
                    help=f"the file to rewrite (default {harness.in_checkout(readme)})")
     p.add_argument("--records", type=Path, default=records,

@@ -467,7 +467,7 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
                 "step against itself with the floes nudged by a rounding error.")
         parts.append(text)
     if not parts:
-        parts = ["No benchmark records yet: `make bench` writes them to `docs/benchmarks/`.\n"]
+        parts = ["No benchmark records yet: `make records` writes them to `docs/benchmarks/`.\n"]
     write_if_changed(out / "include" / "benchmarks.md", "\n".join(parts))
 
 

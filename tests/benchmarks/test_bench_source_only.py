@@ -44,9 +44,12 @@ def test_records_cache_and_readme_default_to_the_checkout_from_anywhere(tmp_path
     monkeypatch.chdir(tmp_path)
     assert harness.ROOT.resolve() == ROOT
     args = harness.suite_parser("itd", "").parse_args([])
-    assert args.json.resolve() == ROOT / "docs" / "benchmarks" / "itd.json"
+    assert args.json.resolve() == ROOT / "runs" / "benchmarks" / "itd.json"
+    documented = harness.suite_parser("itd", "").parse_args(["--docs"])
+    assert documented.json.resolve() == ROOT / "docs" / "benchmarks" / "itd.json"
     assert harness.CACHE_DIR.resolve() == ROOT / ".bench_cache"
     help_text = " ".join(harness.suite_parser("itd", "").format_help().split())
+    assert "runs/benchmarks/itd.json of the checkout" in help_text
     assert "docs/benchmarks/itd.json of the checkout" in help_text
     assert str(tmp_path) not in help_text and str(ROOT) not in help_text
     with pytest.raises(SystemExit):
