@@ -58,8 +58,9 @@ import time
 
 import numpy as np
 
-__all__ = ["PRETRAIN_DEFAULTS", "BudgetTooShort", "pretrain_settings", "Demonstrations", "collect", "prime_normalization",
-           "fit_policy", "BehaviourAnchor", "pretrain"]
+__all__ = ["PRETRAIN_DEFAULTS", "COLLECT_PART", "BudgetTooShort", "pretrain_settings",
+           "Demonstrations", "collect", "prime_normalization", "fit_policy", "BehaviourAnchor",
+           "pretrain"]
 
 #: settings of ``pretrain`` that may be left out
 PRETRAIN_DEFAULTS = {"episodes": 60, "seed": 30000, "epochs": 50, "batch_size": 256,
