@@ -21,14 +21,31 @@ baseline), or else of a search run here with the defaults of
 :func:`agents.constant.search_constant_actions`, on episodes seeded apart
 from the evaluation episodes. Its row in the table names the action.
 
-Output (in ``--out``, default the run directory): ``evaluation.md`` (a
-Markdown table of mean ± std and standard error of the return and of the
-final physics metrics, printed as well), ``evaluation.json`` (every
-episode's return, final metrics, and rewards and main physics metric per
-step) and ``evaluation.png`` (reward and the task's main physics metric
-against step, per policy). The policy beats a
-baseline when the mean of the paired differences of return exceeds two
-standard errors of that mean.
+Output (in ``--out``, default the run directory): ``evaluation.md``
+(printed as well), ``evaluation.json`` and ``evaluation.png``.
+
+``evaluation.md`` is for people: the mean ± standard error of the mean of
+the return and of the final physics metrics, each with a readable header
+in its display unit (:data:`agents.metrics.METRIC_UNITS`: an impulse per
+metre in kN s/m, energies in MJ), three significant figures for the
+mean and two for the error, without exponents. The return, the success
+and the task's main metrics come first; where they do not fit in one
+table, the other metrics follow in a second, one column per policy.
+Under the tables: the task parameters drawn per episode (the values
+drawn; episode k of every policy draws the same), those the environment
+arguments fixed, and for a ship environment how to play the
+leaderboard's fields (``--env-kwargs concentration=A`` with the default
+seed: episode k is field k of :mod:`agents.leaderboard` at concentration
+A). Then the paired differences of the return and of the compared
+metric.
+
+``evaluation.json`` is the record, in SI units: the summaries (mean, std,
+standard error), the comparisons, and every episode's return, final
+metrics, drawn task parameters (``task``), and rewards and main physics
+metric per step. ``evaluation.png`` draws the reward and the task's main
+physics metric against step, per policy, with each episode's target
+where the task has one. The policy beats a baseline when the mean of the
+paired differences of return exceeds two standard errors of that mean.
 """
 from __future__ import annotations
 
@@ -42,52 +59,189 @@ import numpy as np
 
 from iceenvs.facts import env_facts
 
-from .metrics import env_name
+from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, metric_header,
+                      metric_unit, scaled, significant)
 from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
                        rounded, run_episode, summarise)
 
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
-           "compare", "markdown_table", "plot_trajectories", "main"]
+           "compare", "markdown_table", "table_columns", "task_report", "task_lines",
+           "plot_trajectories", "main"]
+
+
+#: the most quantity columns of one table; with more, the metrics that are
+#: not among the first follow in a second table, one column per policy
+MAX_COLUMNS = 9
+
+
+def table_columns(env_id: str, keys) -> tuple[list[str], list[str]]:
+    """The quantities of the main table and those of the second: the
+    return, then the success, the task's main metric, its target, the
+    compared metric and :data:`agents.metrics.HEADLINE` where logged (a
+    final value that is only the last step's excepted), then the rest; all
+    in one table when they fit in :data:`MAX_COLUMNS` columns."""
+    keys = list(keys)
+    facts = env_facts(env_id)
+    first = ["return", "success", facts.main_metric, *TARGET_METRICS,
+             *(facts.compared_metric or ())[:1], *HEADLINE]
+    first = [k for k in dict.fromkeys(first) if k in keys and k not in LAST_STEP]
+    first = first[:MAX_COLUMNS]
+    rest = [k for k in keys if k not in first]
+    if len(keys) <= MAX_COLUMNS:          # one table, the episode length last
+        return first + sorted(rest, key=lambda k: k == "length"), []
+    return first, rest
+
+
+def _cell(name: str, s: dict | None) -> str:
+    """Mean ± standard error of a summary entry, in the display unit."""
+    if not s:
+        return "–"
+    return format_pm(scaled(name, s["mean"]), scaled(name, s["sem"]))
+
+
+def _short(name: str, value: float) -> str:
+    """``value`` of ``name`` in its display unit, three significant figures
+    at most, without trailing zeros."""
+    text = significant(scaled(name, value))
+    return text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def _range_text(name: str, low: float, high: float) -> str:
+    if low == high:
+        return _short(name, low)
+    return f"{_short(name, low)} to {_short(name, high)}"
+
+
+def task_lines(task: dict, episodes: int, seed: int) -> list[str]:
+    """The Markdown lines that say which task parameters were drawn per
+    episode (with the range of the values drawn), which the environment
+    arguments fixed, and how to play the leaderboard's fields
+    (:func:`task_report`)."""
+    lines = []
+    drawn = task.get("drawn") or {}
+    if drawn:
+        items = []
+        for name, d in drawn.items():
+            text = f"{metric_header(name)} {_range_text(name, d['min'], d['max'])}"
+            if d["min"] == d["max"] and episodes > 1:
+                text += " in every episode"
+            if d.get("range") is not None:
+                low, high = d["range"]
+                text += f" (drawn from {_short(name, low)} to {_short(name, high)})"
+            items.append(text)
+        lines += [f"Task parameters drawn per episode (the same draws for every policy: "
+                  f"episode k of each is seeded {seed} + k): " + "; ".join(items) + ".", ""]
+    fixed = task.get("fixed") or {}
+    if fixed:
+        lines += ["Fixed for every episode by the environment arguments: " + ", ".join(
+            f"{name} = {value:g}" if isinstance(value, (int, float)) else name
+            for name, value in fixed.items()) + ".", ""]
+    if task.get("leaderboard"):
+        concentration = fixed.get("concentration")
+        lines.append("The leaderboard (`python -m agents.leaderboard`) fixes the concentration "
+                     "per row: `--env-kwargs concentration=A` with the default `--seed 10000` "
+                     "(and the leaderboard's other environment arguments, none by default) "
+                     "plays its fields at concentration A, episode k being field k.")
+        if isinstance(concentration, (int, float)) and seed == 10_000:
+            fields = "its field 0" if episodes == 1 else f"its fields 0 to {episodes - 1}"
+            other = " ".join(f"{k}={v}" for k, v in (task.get("other_kwargs") or {}).items())
+            lines[-1] += (f" These episodes are {fields} at A = {concentration:g} of "
+                          + (f"a leaderboard run with `--env-kwargs {other}`." if other
+                             else "the default leaderboard."))
+        lines.append("")
+    return lines
 
 
 def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
                    seed: int, labels: dict | None = None,
-                   metric_comparisons: dict | None = None) -> str:
+                   metric_comparisons: dict | None = None, task: dict | None = None) -> str:
     """The comparison as Markdown: one row per policy, one column per
-    quantity (mean ± std, standard error in brackets); ``labels`` maps a
-    policy name to the text of its rows (default: the name)."""
+    quantity (mean ± standard error of the mean, in the display units of
+    :data:`agents.metrics.METRIC_UNITS`), the quantities that do not fit
+    in a second table (one column per policy), then the task parameters
+    drawn or fixed (``task``: :func:`task_report`) and the paired
+    comparisons; ``labels`` maps a policy name to the text of its rows
+    (default: the name)."""
     labels = labels or {}
-    keys = list(next(iter(summaries.values())))
+    first, rest = table_columns(env_id, next(iter(summaries.values())))
     lines = [f"## Evaluation on `{env_id}`", "",
-             f"{episodes} episodes per policy, episode k seeded {seed} + k; mean ± std "
-             f"[standard error] of the return and of the final physics metrics.", "",
-             "| policy | " + " | ".join(keys) + " |",
-             "|---|" + "---|" * len(keys)]
+             f"{episodes} episodes per policy, episode k seeded {seed} + k, the same episodes "
+             f"for every policy. Each cell is the mean ± the standard error of the mean over "
+             f"the episodes (the standard deviation over the episodes is "
+             f"√{episodes} times it; both are in `evaluation.json`, in SI units); the physics "
+             f"metrics are their values at the end of the episode.", "",
+             "| policy | " + " | ".join(metric_header(k) for k in first) + " |",
+             "|---|" + "---|" * len(first)]
     for name, summary in summaries.items():
-        cells = [f"{summary[k]['mean']:.4g} ± {summary[k]['std']:.3g} [{summary[k]['sem']:.2g}]"
-                 for k in keys]
+        cells = [_cell(k, summary.get(k)) for k in first]
         lines.append(f"| {labels.get(name, name)} | " + " | ".join(cells) + " |")
+    if rest:
+        names = list(summaries)
+        lines += ["", "The other final metrics (mean ± standard error):", "",
+                  "| metric | " + " | ".join(labels.get(n, n) for n in names) + " |",
+                  "|---|" + "---|" * len(names)]
+        for k in rest:
+            lines.append(f"| {metric_header(k)} | "
+                         + " | ".join(_cell(k, summaries[n].get(k)) for n in names) + " |")
+    lines.append("")
+    lines += task_lines(task or {}, episodes, seed)
     if comparisons:
-        lines += ["", "Return of the policy minus the baseline's, paired by seed "
-                  "(mean [standard error of the difference]):", "",
-                  "| baseline | difference | beaten by > 2 standard errors |", "|---|---|---|"]
+        lines += ["Return of the policy minus the baseline's, paired by seed "
+                  "(mean ± standard error of the difference):", "",
+                  "| baseline | return difference | beaten by > 2 standard errors |",
+                  "|---|---|---|"]
         for name, c in comparisons.items():
-            lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
+            lines.append(f"| {labels.get(name, name)} | {format_pm(c['diff'], c['sem'])} | "
                          f"{'yes' if c['beats'] else 'no'} |")
+        lines.append("")
     if metric_comparisons:
         metric, lower = env_facts(env_id).compared_metric
-        lines += ["", f"Final `{metric}` of the policy minus the baseline's, paired by seed "
-                  f"({'lower' if lower else 'higher'} is better):", "",
-                  "| baseline | difference | better by > 2 standard errors |", "|---|---|---|"]
+        lines += [f"Final {metric_unit(metric).header} of the policy minus the baseline's, "
+                  f"paired by seed ({'lower' if lower else 'higher'} is better; mean ± "
+                  f"standard error of the difference):", "",
+                  f"| baseline | difference of the {metric_header(metric)} | "
+                  f"better by > 2 standard errors |", "|---|---|---|"]
         for name, c in metric_comparisons.items():
-            lines.append(f"| {labels.get(name, name)} | {c['diff']:.4g} [{c['sem']:.2g}] | "
+            lines.append(f"| {labels.get(name, name)} | "
+                         f"{format_pm(scaled(metric, c['diff']), scaled(metric, c['sem']))} | "
                          f"{'yes' if c['beats'] else 'no'} |")
-    return "\n".join(lines) + "\n"
+        lines.append("")
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def task_report(env, env_kwargs: dict, results: dict) -> dict:
+    """What the episodes' task was: ``drawn`` (per parameter drawn anew each
+    episode, the least and largest value drawn and the range it is drawn
+    from where the environment has one), ``fixed`` (the parameters that
+    the environment draws unless its arguments fix them, as
+    ``env_kwargs`` did), ``leaderboard`` (a ship environment whose
+    fields the leaderboard plays at fixed concentrations) and
+    ``other_kwargs`` (``env_kwargs`` but the concentration: those of the
+    leaderboard run whose fields these episodes are)."""
+    from iceenvs.ship_env import ShipEnv
+
+    base = env.unwrapped
+    given = getattr(base, "task", None) or {}
+    episodes = next(iter(results.values()))
+    drawn = {}
+    for name in dict.fromkeys(k for e in episodes for k in e.get("task", {})):
+        values = [e["task"][name] for e in episodes if name in e.get("task", {})]
+        rng = given.get(f"{name}_range")
+        drawn[name] = dict(min=min(values), max=max(values),
+                           range=[float(r) for r in rng] if rng is not None else None)
+    drawable = [*getattr(base, "drawn", ()),
+                *(p.name for p in getattr(base, "task_parameters", ()) if p.default is None)]
+    fixed = {name: env_kwargs[name] for name in dict.fromkeys(drawable) if name in env_kwargs}
+    ship = isinstance(base, ShipEnv) and "concentration" in given
+    other = {k: v for k, v in env_kwargs.items() if k != "concentration"}
+    return dict(drawn=drawn, fixed=fixed, leaderboard=ship, other_kwargs=other)
 
 
 def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
-    """Reward and the main physics metric against step, one colour per
-    policy (thin lines: episodes, thick: the mean over episodes)."""
+    """Reward and the main physics metric (in its display unit) against
+    step, one colour per policy (thin lines: episodes, thick: the mean
+    over episodes); on the metric's panel, each episode's target where the
+    task logs one (:data:`agents.metrics.TARGET_METRICS`), dashed grey."""
     from physics.scenarios import plots
 
     plt = plots.pyplot()
@@ -100,17 +254,45 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
             n = max(len(e[key]) for e in episodes)
             grid = np.full((len(episodes), n), np.nan)
             for i, e in enumerate(episodes):
-                ax.plot(e[key], color=colour, alpha=0.2, lw=0.7)
-                grid[i, :len(e[key])] = e[key]
+                values = np.asarray(e[key], dtype=float)
+                if key == "trace" and metric:
+                    values = scaled(metric, values)
+                ax.plot(values, color=colour, alpha=0.2, lw=0.7)
+                grid[i, :len(values)] = values
             with np.errstate(all="ignore"):
                 mean = np.nanmean(grid, axis=0) if np.isfinite(grid).any() else grid[0]
             ax.plot(mean, color=colour, lw=2, label=name if j == 0 else None)
+    targets = _episode_targets(results)
+    if targets and metric:
+        drawn = any(name in e.get("task", {}) for eps in results.values() for e in eps
+                    for name in TARGET_METRICS)
+        for i, (length, value) in enumerate(targets.values()):
+            axes[1].hlines(scaled(metric, value), 0, max(length - 1, 1), colors="0.4", lw=0.8,
+                           linestyles="--", zorder=1,
+                           label=None if i else ("target (drawn per episode)" if drawn
+                                                 else "target"))
+        axes[1].legend(loc="best", fontsize="small")
     axes[0].set_ylabel("reward")
     axes[0].legend(loc="best", fontsize="small")
-    axes[1].set_ylabel(metric or "physics metric")
+    axes[1].set_ylabel(metric_header(metric) if metric else "physics metric")
     axes[1].set_xlabel("step")
     fig.suptitle(env_id)
     plots.savefig(fig, path, dpi=100)
+
+
+def _episode_targets(results: dict) -> dict:
+    """``{seed: (longest length, target)}`` of the episodes whose final
+    metrics hold a target of the main metric (the same per seed for every
+    policy)."""
+    out = {}
+    for episodes in results.values():
+        for e in episodes:
+            value = next((e["final"][t] for t in TARGET_METRICS if t in e["final"]), None)
+            if value is None or not np.isfinite(value):
+                continue
+            length = out.get(e["seed"], (0, value))[0]
+            out[e["seed"]] = (max(length, len(e["trace"])), value)
+    return out
 
 
 def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentParser:
@@ -304,6 +486,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         else:
             results = evaluate(env, policies, episodes=args.episodes, seed=args.seed,
                                progress=not args.no_progress)
+        task = task_report(env, env_kwargs, results)
     finally:
         env.close()
     facts = env_facts(env_id)
@@ -317,16 +500,17 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
             metric_comparisons = {n: compare(results[first], results[n], metric, lower)
                                   for n in names}
     table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels,
-                           metric_comparisons)
+                           metric_comparisons, task)
     print(table)
     out.mkdir(parents=True, exist_ok=True)
     (out / "evaluation.md").write_text(table)
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
                   metric_comparisons=metric_comparisons,
-                  main_metric=facts.main_metric,
+                  main_metric=facts.main_metric, task=task,
                   episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
                                             terminated=e["terminated"], final=e["final"],
+                                            task=e.get("task", {}),
                                             rewards=rounded(e["rewards"]),
                                             trace=rounded(e["trace"]))
                                        for e in eps] for n, eps in results.items()})

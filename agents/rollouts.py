@@ -24,7 +24,7 @@ import yaml
 
 from iceenvs.facts import env_facts
 
-__all__ = ["TrainedPolicy", "trained_argument", "run_episode", "evaluate",
+__all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
            "evaluate_in_processes", "rounded", "stats", "summarise", "compare",
            "AGENT_KWARGS", "run_agent_kwargs"]
 
@@ -135,11 +135,31 @@ def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, in
     return name, run_dir, int(steps) if at else None
 
 
+def episode_task(env, info: dict) -> dict[str, float]:
+    """The task parameters drawn for this episode and their values, as
+    floats: those the environment's arguments leave at ``None`` ("drawn
+    every episode") that the reset's ``info["task"]`` holds as a number.
+    Empty for an environment without task parameters in its info."""
+    task = info.get("task") or {}
+    given = getattr(env.unwrapped, "task", None)
+    if not isinstance(given, dict):
+        return {}
+    out = {}
+    for name, value in given.items():
+        drawn = task.get(name)
+        if value is None and isinstance(drawn, (int, float, np.integer, np.floating)) \
+                and not isinstance(drawn, bool):
+            out[name] = float(drawn)
+    return out
+
+
 def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     """One episode from ``reset(seed=seed)``: return, length, final physics
-    metrics and the per-step rewards and main metric."""
+    metrics, the per-step rewards and main metric, and the task
+    parameters drawn for the episode (``task``: :func:`episode_task`)."""
     logged_metrics = env_facts(env.spec.id).logged_metrics
     obs, info = env.reset(seed=seed)
+    task = episode_task(env, info)
     policy.reset(seed)
     rewards, trace = [], []
     final = logged_metrics(info)
@@ -157,7 +177,7 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
             break
     out = dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
                terminated=bool(terminated), final=final, rewards=rewards, trace=trace,
-               decision_ms=1e3 * thinking / max(len(rewards), 1))
+               decision_ms=1e3 * thinking / max(len(rewards), 1), task=task)
     plans = getattr(policy, "decision_times", None)
     if plans:
         out["plan_ms"] = 1e3 * float(np.mean(plans))
