@@ -14,7 +14,7 @@ and a trained run (:class:`agents.rollouts.TrainedPolicy`) keep it.
 
 A policy of one's own is named where a baseline's name is taken
 (``agents.leaderboard --policies``, ``agents.evaluate --baseline`` and
-``--baselines``) by a reference:
+``--baselines``, ``agents.tasks --policies``) by a reference:
 
 * ``module:Class`` — a class of an importable module;
 * ``path/to/file.py:Class`` — a class of a Python file;

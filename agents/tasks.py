@@ -9,8 +9,11 @@ hand-written policies on the same ``--episodes`` seeded episodes
 (episode k seeded ``--seed`` + k), and the paired difference of the
 hand-written controller's return over the best constant action's. A ship
 environment's row adds its other controllers (the straight line) and its
-planners (:mod:`agents.planners`, which read the ice), and any trained
-policy given with ``--trained``. A task needs a
+planners (:mod:`agents.planners`, which read the ice), any trained
+policy given with ``--trained`` and any other policy given with
+``--policies``: a baseline's name or a policy of one's own,
+``module:Class`` or ``path/to/file.py:Class?key=value``
+(:mod:`agents.policy`), played in every environment of ``--ids``. A task needs a
 policy when a controller that reacts to what it senses (the hand-written
 one, a planner or a trained policy) beats every constant action by more
 than two standard errors; the table says which.
@@ -23,7 +26,7 @@ with ``--reuse`` so that a table can be remade without searching again)::
 
     python -m agents.tasks [--ids Convergence-v0 ...] [--episodes 20] [--grid 9]
         [--seeds 5] [--processes 2] [--out DIR] [--reuse] [--keep]
-        [--trained NAME=RUN_DIR[@STEPS] ...]
+        [--trained NAME=RUN_DIR[@STEPS] ...] [--policies NAME_OR_MODULE:CLASS,...]
     python -m agents.tasks --render [--out DIR]     # tasks.md again from tasks.json
 
 ``--keep`` keeps the rows of the environments not run from ``--out``'s
@@ -48,11 +51,13 @@ DEFAULT_OUT = Path("runs/agents/tasks")
 
 def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int,
             out: Path, reuse: bool = False, progress: bool = True,
-            trained: dict | None = None) -> dict:
+            trained: dict | None = None, extra: list[str] | tuple = ()) -> dict:
     """The constant-action search and the baselines of one environment;
     returns a dict of the numbers (see :func:`task_table`). ``trained``:
     ``{name: (run_dir, checkpoint or None)}`` of trained policies of this
-    environment to evaluate beside them."""
+    environment to evaluate beside them; ``extra``: further policies, a
+    baseline's name or a reference ``module:Class``
+    (:func:`agents.baselines.make_baseline`)."""
     import gymnasium as gym
 
     import iceenvs  # noqa: F401
@@ -90,17 +95,20 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
             policies[name] = make_baseline(name, env, EVAL_SEED)
         for name, (run_dir, checkpoint) in (trained or {}).items():
             policies[name] = TrainedPolicy(run_dir, checkpoint)
+        extra = [name for name in extra if name not in policies]
+        for name in extra:
+            policies[name] = make_baseline(name, env, EVAL_SEED)
         runs = evaluate(env, policies, episodes=episodes, seed=EVAL_SEED, progress=progress)
     finally:
         env.close()
     summaries = {name: summarise(eps)["return"] for name, eps in runs.items()}
     over = {name: compare(runs[name], runs["constant"])
-            for name in ["heuristic", *planners, *(trained or {})]}
+            for name in ["heuristic", *planners, *(trained or {}), *extra]}
     return dict(id=env_id, best_action=list(results[0]["action"]),
                 search_mean=results[0]["mean"], n_actions=len(results),
                 returns=summaries,
                 heuristic_minus_constant=over["heuristic"],
-                planners=planners, trained=list(trained or {}), over_constant=over,
+                planners=planners, trained=list(trained or {}), own=extra, over_constant=over,
                 steps=int(gym.spec(env_id).max_episode_steps),
                 seconds=time.perf_counter() - t0, search_seconds=t_search)
 
@@ -111,7 +119,7 @@ def task_table(rows: list[dict]) -> str:
 
     lines = ["| id | steps per episode | best constant action (of) | constant | zero | random | "
              "controller | controller − constant [SE] | other controllers − constant [SE] | "
-             "trained − constant [SE] | needs a policy |",
+             "trained and own − constant [SE] | needs a policy |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ret = r["returns"]
@@ -131,7 +139,7 @@ def task_table(rows: list[dict]) -> str:
                      f"({r['n_actions']}) | {cell('constant')} | {cell('zero')} | "
                      f"{cell('random')} | {cell('heuristic')} | {c['diff']:+.1f} "
                      f"[{c['sem']:.2g}] | {diffs(r.get('planners', []))} | "
-                     f"{diffs(r.get('trained', []))} | {verdict} |")
+                     f"{diffs([*r.get('trained', []), *r.get('own', [])])} | {verdict} |")
     return "\n".join(lines) + "\n"
 
 
@@ -146,7 +154,8 @@ def _document(saved: dict) -> str:
             f"hand-written controller of `agents.baselines`; its difference from the best "
             f"constant action is paired by seed, as are those of the other controllers and planners "
             f"(ship environments: the straight line, and the lattice planner, which reads the "
-            f"ice) and of the trained policies. \"Needs a policy\" names the "
+            f"ice) and of the trained policies and policies of one's own. \"Needs a policy\" "
+            f"names the "
             f"policies that beat the best constant action by more than two standard errors."
             f"\n\n`{saved['command']}` ({saved['machine']}, "
             f"{saved['date']})\n\n" + task_table(saved["rows"]))
@@ -176,6 +185,11 @@ def main(argv: list[str] | None = None) -> list[dict]:
                    metavar="NAME=RUN_DIR[@STEPS]",
                    help="a trained policy (agents.train's run directory, of one of --ids; "
                         "@STEPS: its checkpoint at STEPS steps), repeatable")
+    p.add_argument("--policies", default="", metavar="NAME,MODULE:CLASS,...",
+                   help="further policies, comma-separated, played in every environment of "
+                        "--ids: a baseline's name or a policy of one's own, module:Class or "
+                        "path/to/file.py:Class (?key=value&... for its arguments; "
+                        "agents.policy)")
     raw = sys.argv[1:] if argv is None else argv
     args = p.parse_args(raw)
     if args.render:
@@ -189,6 +203,7 @@ def main(argv: list[str] | None = None) -> list[dict]:
     if args.grid < 2:
         p.error("--grid must be >= 2")
     trained = _trained_runs(p, args.trained, args.ids)
+    own = _own_policies(p, args.policies, args.ids)
     old = None
     if args.keep:
         path = args.out / "tasks.json"
@@ -206,7 +221,7 @@ def main(argv: list[str] | None = None) -> list[dict]:
         rows.append(analyse(f"iceenvs/{name}", episodes=args.episodes, grid=args.grid,
                             seeds=args.seeds, processes=args.processes, out=args.out,
                             reuse=args.reuse, progress=not args.no_progress,
-                            trained=trained.get(name)))
+                            trained=trained.get(name), extra=own))
         print(task_table(rows[-1:]), flush=True)
     import numba
 
@@ -245,6 +260,30 @@ def _trained_runs(parser, items, ids) -> dict:
             parser.error(f"--trained {item}: the run is of {env}, which is not among --ids")
         out.setdefault(env, {})[name] = (run_dir, steps)
     return out
+
+
+def _own_policies(parser, text: str, ids) -> list[str]:
+    """The names of ``--policies``, each a baseline of every environment of
+    ``ids`` or a reference whose class imports; a bad one exits with the
+    reason."""
+    from .baselines import baseline_names
+    from .policy import check_reference, is_reference
+
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    for name in names:
+        if is_reference(name):
+            try:
+                check_reference(name)
+            except ValueError as err:
+                parser.error(f"--policies: {err}")
+            continue
+        for env in ids:
+            valid = baseline_names(f"iceenvs/{env}")
+            if name not in valid:
+                parser.error(f"--policies: unknown policy {name!r} for {env}; valid: "
+                             f"{', '.join(valid)}, or a policy of one's own as module:Class "
+                             f"or path/to/file.py:Class")
+    return names
 
 
 if __name__ == "__main__":

@@ -83,3 +83,49 @@ def test_trained_and_keep_arguments_are_checked(tmp_path):
         tasks.main(base + ["--trained", f"ppo={run}"])
     with pytest.raises(SystemExit):
         tasks.main(base + ["--trained", f"ppo={run}@latest"])
+
+
+OWN_POLICY = """
+import numpy as np
+
+class Still:
+    '''The all-zero action, written as a policy of one's own.'''
+    def __init__(self, env, seed=0, scale=1.0):
+        self.shape, self.scale = env.action_space.shape, float(scale)
+
+    def reset(self, seed=None):
+        pass
+
+    def predict(self, obs, deterministic=True):
+        return self.scale * np.zeros(self.shape, dtype=np.float32), None
+"""
+
+
+def test_a_policy_of_ones_own_joins_the_row(tmp_path):
+    """--policies plays a class of a file beside the baselines, on the same
+    episodes: written as the zero action, it returns what ``zero`` does,
+    episode by episode, and its difference from the best constant action is
+    in the row and the table."""
+    path = tmp_path / "still.py"
+    path.write_text(OWN_POLICY)
+    ref = f"{path}:Still?scale=1"
+    row, = tasks.main(ARGS + ["--out", str(tmp_path / "out"), "--policies", f"{ref},zero"])
+    assert row["own"] == [ref]                        # zero is already in the row
+    assert row["returns"][ref]["mean"] == pytest.approx(row["returns"]["zero"]["mean"],
+                                                        rel=1e-12)
+    assert row["over_constant"][ref]["diff"] == pytest.approx(
+        row["returns"][ref]["mean"] - row["returns"]["constant"]["mean"])
+    assert f"{ref}: " in (tmp_path / "out" / "tasks.md").read_text()
+
+
+@pytest.mark.parametrize("policies, words", [
+    ("no_such_module:Policy", "no_such_module"),
+    ("agents.baselines:NoSuchClass", "NoSuchClass"),
+    ("lattice", "unknown policy 'lattice' for ThicknessDistribution-v0"),
+])
+def test_bad_policies_are_refused_before_anything_runs(tmp_path, capsys, policies, words):
+    with pytest.raises(SystemExit) as exit_info:
+        tasks.main(ARGS + ["--out", str(tmp_path / "out"), "--policies", policies])
+    assert exit_info.value.code == 2
+    assert words in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
