@@ -64,11 +64,12 @@ bench: setup
 	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite || exit 1; done
 
 # the records the documentation shows: every suite written with --docs to
-# docs/benchmarks/, the README's headline figures from them, and the
-# generated observation page
+# docs/benchmarks/, the README's headline figures from them, the cross-check
+# report and the generated observation page
 records: setup
 	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite --docs || exit 1; done
 	$(PY) -m benchmarks.headline
+	$(PY) -m physics.crosscheck all --out docs/crosscheck --force
 	$(PY) -m iceenvs.observation_page
 
 docs: setup
@@ -78,7 +79,7 @@ validate: setup
 	$(PY) -m physics.validate
 
 crosscheck: setup
-	$(PY) -m physics.crosscheck all --out docs/crosscheck --force
+	$(PY) -m physics.crosscheck all --out runs/crosscheck --force
 
 clean:
 	rm -rf $(VENV) .lock-venv build *.egg-info .pytest_cache

@@ -342,7 +342,8 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make keywords (YAML values)")
     p.add_argument("--processes", type=int, default=2, help="worker processes (2)")
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output ({DEFAULT_OUT})")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT,
+                   help=f"output directory (default {DEFAULT_OUT})")
     p.add_argument("--render", action="store_true",
                    help="write the table and the plot again from the JSON in --out")
     p.add_argument("--merge", action="store_true",

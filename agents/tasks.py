@@ -173,7 +173,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
     p.add_argument("--grid", type=int, default=9, help="constant actions per dimension (9)")
     p.add_argument("--seeds", type=int, default=5, help="search episodes per action (5)")
     p.add_argument("--processes", type=int, default=2, help="search processes (2)")
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output ({DEFAULT_OUT})")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT,
+                   help=f"output directory (default {DEFAULT_OUT})")
     p.add_argument("--reuse", action="store_true",
                    help="reuse the constant-action searches found in --out")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")

@@ -8,7 +8,7 @@ Commands
 ``lammps``   the Hertz engine against LAMMPS
 ``list``     what each group compares
 
-Options: ``--out DIR`` (default ``crosscheck-report``), ``--quick`` (smaller
+Options: ``--out DIR`` (default ``runs/crosscheck``), ``--quick`` (smaller
 systems, same tolerances; about a minute), ``--seed S``, ``--force`` (replace
 an existing report directory), ``--no-progress``.
 
@@ -156,8 +156,9 @@ def main(argv=None, prog: str = "python -m physics.crosscheck") -> int:
         description="Cross-check the floe engines against pymunk and LAMMPS.")
     parser.add_argument("command", choices=["all", *GROUPS, "list"],
                         help="which comparisons to run ('list' describes them)")
-    parser.add_argument("--out", type=Path, default=Path("crosscheck-report"),
-                        help="report directory (default: crosscheck-report)")
+    parser.add_argument("--out", type=Path, default=Path("runs/crosscheck"),
+                        help="report directory (default: runs/crosscheck; the documented "
+                             "report is docs/crosscheck, as make records writes it)")
     parser.add_argument("--quick", action="store_true",
                         help="smaller systems, same tolerances (about a minute)")
     parser.add_argument("--seed", type=int, default=0, help="seed of every random set-up")
