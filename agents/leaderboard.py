@@ -40,6 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .metrics import METRIC_UNITS
+
 __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "plot_board", "main",
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
@@ -47,15 +49,11 @@ DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
 DEFAULT_OUT = Path("runs/leaderboard")
 #: the metrics normalised by the straight line's on the same field
 NORMALISED = ("impulse_per_metre", "energy_to_ice", "mean_impulse", "max_impulse", "path_length")
-#: the metrics of the main table: (logged name, header, scale, unit)
-SHOWN = (("impulse_per_metre", "ice impulse per metre", 1e3, "kN s/m"),
-         ("energy_to_ice", "energy to the ice", 1e6, "MJ"),
-         ("path_length", "path", 1.0, "m"),
-         ("collisions", "collisions", 1.0, ""),
-         ("collided_floes", "floes hit", 1.0, ""),
-         ("mean_impulse", "mean impulse", 1e3, "kN s"),
-         ("max_impulse", "max impulse", 1e6, "MN s"),
-         ("mean_mass_hit", "mean mass hit", 1e3, "t"))
+#: the metrics of the main table, shown as :data:`agents.metrics.METRIC_UNITS`
+#: says: (logged name, header, scale, unit)
+SHOWN = tuple((name, METRIC_UNITS[name].header, METRIC_UNITS[name].scale, METRIC_UNITS[name].unit)
+              for name in ("impulse_per_metre", "energy_to_ice", "path_length", "collisions",
+                           "collided_floes", "mean_impulse", "max_impulse", "mean_mass_hit"))
 #: route choice pays when the best planner's impulse per metre is at most this
 #: times the straight line's ...
 ROUTE_CHOICE_RATIO = 0.7

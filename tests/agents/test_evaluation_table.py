@@ -90,8 +90,10 @@ def test_si_units_are_those_the_environment_documents(env_id):
 def test_the_leaderboard_shows_its_metrics_in_the_same_units():
     from agents.leaderboard import SHOWN
 
+    assert [row[0] for row in SHOWN][:2] == ["impulse_per_metre", "energy_to_ice"]
     for name, header, scale, unit in SHOWN:
         assert METRIC_UNITS[name][:3] == (header, unit, scale), name
+    assert ("impulse_per_metre", "ice impulse per metre", 1e3, "kN s/m") in SHOWN
 
 
 def test_cells_have_significant_figures_and_no_exponent():
