@@ -5,6 +5,7 @@
         [--env-kwargs key=value ...] [--processes N] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
         [--env-kwargs key=value ...] [--constant FILE.json]
+    python -m agents.evaluate --render DIR     # the table and plot again from DIR's JSON
 
 Episode k of every policy starts from ``reset(seed=S + k)``. The trained
 policy sees observations normalised with the run's saved statistics
@@ -332,7 +333,36 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
                    help="worker processes that share the episodes (default 1: this process); "
                         "the results do not depend on it")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument("--render", type=Path, default=None, metavar="DIR",
+                   help="only write DIR/evaluation.md and evaluation.png again from "
+                        "DIR/evaluation.json (e.g. a record written by an older version)")
     return p
+
+
+def render(out: Path) -> str:
+    """Write ``evaluation.md`` and ``evaluation.png`` of ``out`` again from
+    its ``evaluation.json``, with the table and plot of this version;
+    returns the table. The paired comparisons of the compared metric are
+    computed from the episodes when the record lacks them."""
+    from .constant import format_action
+
+    report = json.loads((Path(out) / "evaluation.json").read_text())
+    env_id, detail = report["env"], report["episodes_detail"]
+    comparisons = report.get("comparisons") or {}
+    metric_comparisons = report.get("metric_comparisons")
+    facts = env_facts(env_id)
+    if metric_comparisons is None and comparisons and facts.compared_metric is not None:
+        metric, lower = facts.compared_metric
+        first = detail[next(iter(report["summaries"]))]
+        metric_comparisons = {n: compare(first, detail[n], metric, lower) for n in comparisons}
+    labels = {}
+    if report.get("constant") and "constant" in report["summaries"]:
+        labels["constant"] = f"constant {format_action(report['constant']['action'])}"
+    table = markdown_table(env_id, report["summaries"], comparisons, report["episodes"],
+                           report["seed"], labels, metric_comparisons, report.get("task"))
+    (Path(out) / "evaluation.md").write_text(table)
+    plot_trajectories(env_id, detail, Path(out) / "evaluation.png")
+    return table
 
 
 def _disjoint_seed(first: int, count: int, avoid_first: int, avoid_count: int) -> int:
@@ -400,6 +430,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
 
     parser = build_parser(prog)
     args = parser.parse_args(argv)
+    if args.render is not None:
+        if not (args.render / "evaluation.json").is_file():
+            parser.error(f"--render: {args.render / 'evaluation.json'} does not exist")
+        print(render(args.render))
+        return json.loads((args.render / "evaluation.json").read_text())["summaries"]
     if args.episodes < 1:
         parser.error("--episodes must be >= 1")
     if args.processes < 1:

@@ -204,6 +204,13 @@ def test_evaluation_reports_the_drawn_and_fixed_task_and_plots_the_targets(tmp_p
     dashed = [c for c in ax.collections if c.get_linestyle()[0][1] is not None]
     assert sorted(seg[0][1] for c in dashed for seg in c.get_segments()) == sorted(targets)
 
+    # the table again from the record alone: the same text
+    (tmp_path / "a" / "evaluation.md").unlink()
+    evaluate_main(["--render", str(tmp_path / "a")])
+    assert (tmp_path / "a" / "evaluation.md").read_text() == table
+    with pytest.raises(SystemExit):
+        evaluate_main(["--render", str(tmp_path / "nothing")])
+
     evaluate_main(["--baseline", "heuristic", "--env", CONVERGENCE, "--episodes", "2",
                    "--no-progress", "--out", str(tmp_path / "b"), "--env-kwargs", *kwargs,
                    "target=0.8"])
@@ -211,7 +218,7 @@ def test_evaluation_reports_the_drawn_and_fixed_task_and_plots_the_targets(tmp_p
     assert "by the environment arguments: target = 0.8." in table
     report = json.loads((tmp_path / "b" / "evaluation.json").read_text())
     assert list(report["task"]["drawn"]) == ["concentration"]
-    legend = figures[1].axes[1].get_legend()
+    legend = figures[-1].axes[1].get_legend()
     assert [t.get_text() for t in legend.get_texts()] == ["target"]
     for fig in figures:
         plots.pyplot().close(fig)
