@@ -5,7 +5,8 @@
         [--env-kwargs key=value ...] [--processes N] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
         [--env-kwargs key=value ...] [--constant FILE.json]
-    python -m agents.evaluate --render DIR     # the table and plot again from DIR's JSON
+    python -m agents.evaluate --render DIR
+        (the table and the plot again from DIR's evaluation.json)
 
 Episode k of every policy starts from ``reset(seed=S + k)``. The trained
 policy sees observations normalised with the run's saved statistics
