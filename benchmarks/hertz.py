@@ -152,7 +152,7 @@ def warm_sim(path: str, dt: float, parallel: bool) -> HertzSimulation:
     return sim
 
 
-def _segment_rate(sim: HertzSimulation, steps: int) -> float:
+def segment_rate(sim: HertzSimulation, steps: int) -> float:
     """Floe-steps per second of ``steps`` steps."""
     t0 = time.perf_counter()
     sim.step(steps)
@@ -178,7 +178,7 @@ def time_configs(configs: list, sims: list, steps: int, rounds: int = REPEATS) -
     def segment(threads, sim):
         def go():
             numba.set_num_threads(threads)
-            return _segment_rate(sim, steps)
+            return segment_rate(sim, steps)
         return go
 
     return harness.interleaved_rounds([segment(threads, sim) for (_, _, threads), sim
@@ -222,7 +222,7 @@ def _pinned_child(path: str, steps: int, dt: float) -> dict:
     """The rates of ``REPEATS`` segments of ``steps`` steps of the serial
     kernels (in a process pinned to one core)."""
     sim = warm_sim(path, dt, parallel=False)
-    return dict(rates=[_segment_rate(sim, steps) for _ in range(REPEATS)])
+    return dict(rates=[segment_rate(sim, steps) for _ in range(REPEATS)])
 
 
 def core_speeds(path: Path, dt: float, steps: int) -> dict:

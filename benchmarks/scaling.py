@@ -190,7 +190,7 @@ def _hertz_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
     (:func:`benchmarks.hertz.warm_sim`); the timed segments: ``steps``
     steps. Also returns a function that gives the contacts per floe and the
     list rebuilds per segment after the timing."""
-    from .hertz import _segment_rate, warm_sim
+    from .hertz import segment_rate, warm_sim
 
     sims = []
     for k in threads:
@@ -201,7 +201,7 @@ def _hertz_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
     def segment(k, sim):
         def go():
             numba.set_num_threads(k)
-            return _segment_rate(sim, spec["steps"])
+            return segment_rate(sim, spec["steps"])
         return go
 
     def after(rounds):
@@ -221,7 +221,7 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
 
     import iceenvs  # noqa: F401  (registers the ids)
 
-    from .vector import _actions
+    from .vector import random_actions
 
     n, steps = spec["n"], spec["steps"]
     copies = []
@@ -232,7 +232,7 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
         env.reset(seed=spec["seed"])
         rng = np.random.default_rng(spec["seed"])
         for _ in range(VECTOR_WARMUP):
-            env.step(_actions(env.single_action_space, rng, n))
+            env.step(random_actions(env.single_action_space, rng, n))
         copies.append((env, rng))
 
     def segment(k, env, rng):
@@ -241,7 +241,7 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
             space = env.single_action_space
             t0 = time.perf_counter()
             for _ in range(steps):
-                env.step(_actions(space, rng, n))
+                env.step(random_actions(space, rng, n))
             return n * steps / (time.perf_counter() - t0)
         return go
 
@@ -270,7 +270,7 @@ def serial_share(env, rng, n: int, steps: int) -> dict:
     law a step on p threads is at most 1 / (s + (1 − s) / p) times faster."""
     import importlib
 
-    from .vector import _actions
+    from .vector import random_actions
 
     spent = [0.0]
     saved = []
@@ -289,7 +289,7 @@ def serial_share(env, rng, n: int, steps: int) -> dict:
         space = env.single_action_space
         t0 = time.perf_counter()
         for _ in range(steps):
-            env.step(_actions(space, rng, n))
+            env.step(random_actions(space, rng, n))
         wall = time.perf_counter() - t0
     finally:
         for owner, name, fn in saved:

@@ -51,7 +51,8 @@ MODES = ("single", "sync", "subproc", "native")
 ROLLOUT = 2048
 
 
-def _actions(space, rng, n):
+def random_actions(space, rng, n):
+    """``n`` actions drawn uniformly from the box ``space`` with ``rng``."""
     return rng.uniform(space.low, space.high, (n,) + space.shape).astype(space.dtype)
 
 
@@ -81,7 +82,7 @@ def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
         space = env.action_space
 
         def step():
-            _, _, term, trunc, _ = env.step(_actions(space, rng, 1)[0])
+            _, _, term, trunc, _ = env.step(random_actions(space, rng, 1)[0])
             if term or trunc:
                 env.reset()
             return 1
@@ -105,7 +106,7 @@ def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
             space = env.single_action_space
 
         def step():
-            env.step(_actions(space, rng, n))
+            env.step(random_actions(space, rng, n))
             return n
     _warm_up(step, seconds)
     steps = 0

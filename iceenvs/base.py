@@ -59,9 +59,11 @@ from .observations import FLOE_FEATURES, Feature, observation_vectors
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "sanitise_actions", "choice", "scaled_contact", "hertz_time_step",
-           "REWARD_RANGE", "TIME_FEATURE", "task_table", "MAX_WIND", "PHYSICS_ERRORS"]
+           "REWARD_RANGE", "TIME_FEATURE", "task_table", "revised_task", "MAX_WIND", "PHYSICS_ERRORS"]
 
-#: every per-step reward of the built-in tasks lies in this range
+#: the reward range of the floe tasks, the default of
+#: :attr:`ControlEnv.reward_bounds`; a task whose rewards leave it (the ship
+#: tasks) declares its own bounds beside its reward
 REWARD_RANGE = (0.0, 1.0)
 #: the errors of a step that are physics failures: they end the episode
 #: (``info["error"]``) instead of reaching the caller
@@ -165,6 +167,24 @@ def choice(*options: str) -> Callable[[str, Any], Any]:
     return check
 
 
+def revised_task(params, changed: dict | None = None, defaults: dict | None = None,
+                 added=()) -> tuple:
+    """Another task's parameters ``params`` revised for a task that builds
+    on it: ``changed`` maps a name to its new ``(meaning, check)``,
+    ``defaults`` a name to its new default, and ``added`` parameters come
+    last. Raises ``ValueError`` for a name ``params`` does not have."""
+    changed, defaults = dict(changed or {}), dict(defaults or {})
+    names = {p.name for p in params}
+    unknown = sorted((set(changed) | set(defaults)) - names)
+    if unknown:
+        raise ValueError(f"no task parameters {unknown} to revise; there are {sorted(names)}")
+    out = []
+    for p in params:
+        meaning, check = changed.get(p.name, (p.meaning, p.check))
+        out.append(TaskParameter(p.name, defaults.get(p.name, p.default), meaning, check))
+    return tuple(out) + tuple(added)
+
+
 def task_table(params) -> str:
     """The "Task parameters" section of an environment's docstring: how to
     set them, then their Markdown table."""
@@ -188,7 +208,7 @@ class ControlEnv(gym.Env):
     ``_measure`` (raw SI dict) → ``_reward`` → observation ``_vector`` and
     ``_info``. A physics failure (FloatingPointError, RuntimeError,
     ValueError), a non-finite reward or the task's failure
-    (``_terminated``) ends the episode with ``failure_reward`` (0) and,
+    (``_terminated``) ends the episode with ``failure_reward`` and,
     for a physics failure or a non-finite reward, ``info["error"]``; a
     task done (``_succeeded``, a goal reached) ends it with the step's
     reward.
@@ -198,9 +218,18 @@ class ControlEnv(gym.Env):
     Subclasses build their model in ``reset`` and then call
     ``_begin_episode``; they provide the hooks named above, ``_ready`` (a
     model exists) and ``_frame`` (an RGB array).
+
+    The reward contract: every step's reward, a failure's included, lies in
+    :attr:`reward_bounds`. A task declares both with its reward: the floe
+    tasks keep the defaults ([0, 1], a failure paid 0); a task whose reward
+    leaves them overrides ``reward_bounds`` and ``failure_reward``
+    together (:class:`iceenvs.ship_env.ShipEnv`), and
+    :func:`iceenvs.checks.check_rewards` holds every registered id to it.
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    #: the reward of a step that ends the episode by a failure (the task's,
+    #: the physics' or a non-finite reward); within :attr:`reward_bounds`
     failure_reward = 0.0
     task_parameters: tuple[TaskParameter, ...] = ()
     #: episode task values passed to the reward function with ``reward_params``
@@ -209,6 +238,12 @@ class ControlEnv(gym.Env):
     drawn: tuple[str, ...] = ()
     _renderer = None
     horizon = None
+
+    @property
+    def reward_bounds(self) -> tuple[float, float]:
+        """(lowest, highest) reward of one step, a failure's included:
+        :data:`REWARD_RANGE` unless the task declares its own."""
+        return REWARD_RANGE
 
     def _set_render_mode(self, render_mode: str | None) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -446,7 +481,9 @@ class FloeEnv(ControlEnv):
 
     Arguments common to every floe environment
     ------------------------------------------
-    n_floes : int — number of floes
+    n_floes : int or None — number of floes; None for an environment that
+        draws its own field (``own_field``), whose count comes with each
+        episode's field (``n_floes`` is 0 until the first reset)
     preset : PaperPreset — parameter table (FSD, material, forcing)
     control_interval : float — model seconds per env step
     reward_fn : callable, optional — ``reward(prev, action, now, **params)``
@@ -467,15 +504,19 @@ class FloeEnv(ControlEnv):
     action_names: tuple[str, ...] = ()
     reward_fn: Callable = None
     colour_label = "speed [m/s]"
+    #: the environment draws each episode's field itself, and with it the number
+    #: of floes (it passes ``n_floes=None``)
+    own_field = False
 
-    def __init__(self, *, n_floes: int, preset: PaperPreset, control_interval: float,
+    def __init__(self, *, n_floes: int | None, preset: PaperPreset, control_interval: float,
                  reward_fn=None, reward_params: dict | None = None,
                  stiffness_scale: float = 1.0, cluster_gap: float = 0.1,
                  horizon: int | None = None, colour_scale: float = 0.5,
                  render_mode: str | None = None, **task):
-        if isinstance(n_floes, bool) or not isinstance(n_floes, (int, np.integer)):
-            raise ValueError(f"n_floes must be an integer >= 2, got {n_floes!r}")
-        check_range("n_floes", n_floes, 2, None)
+        if n_floes is not None or not self.own_field:
+            if isinstance(n_floes, bool) or not isinstance(n_floes, (int, np.integer)):
+                raise ValueError(f"n_floes must be an integer >= 2, got {n_floes!r}")
+            check_range("n_floes", n_floes, 2, None)
         check_range("control_interval", control_interval, 0.0, None, low_open=True)
         check_range("cluster_gap", cluster_gap, 0.0, None)
         check_range("colour_scale", colour_scale, 0.0, None, low_open=True)
@@ -484,7 +525,7 @@ class FloeEnv(ControlEnv):
                             f"got {type(preset).__name__}")
         self._set_render_mode(render_mode)
         self._init_task(task)
-        self.n_floes = int(n_floes)
+        self.n_floes = 0 if n_floes is None else int(n_floes)
         self.preset = preset
         self.control_interval = float(control_interval)
         self.stiffness_scale = float(stiffness_scale)

@@ -14,8 +14,10 @@ the reason when the environment breaks a convention:
   observations and rewards, bit for bit;
 - :func:`check_fuzz`: seeded wild actions (NaN, ±inf, far out of range)
   are sanitised: finite observations inside the space, finite rewards
-  in the environment's ``reward_bounds`` (default
-  :data:`iceenvs.base.REWARD_RANGE`), no physics failure;
+  in the environment's ``reward_bounds``, no physics failure;
+- :func:`check_rewards`: the reward contract of
+  :class:`iceenvs.base.ControlEnv`: finite bounds, the failure's reward
+  within them, and every reward of seeded random episodes too;
 - :func:`check_facts`: the facts agree with the environment: the logged
   metrics exist, the main metric is among them after a step, and every
   controller acts inside the action space.
@@ -41,10 +43,10 @@ import warnings
 import gymnasium as gym
 import numpy as np
 
-from .base import REWARD_RANGE
 from .facts import env_facts
 
-__all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_facts",
+__all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_rewards",
+           "check_facts",
            "check_all", "CHECKS", "fingerprint"]
 
 
@@ -122,14 +124,13 @@ def check_determinism(env_id: str, steps: int = 5, seed: int = 123) -> None:
 def check_fuzz(env_id: str, steps: int = 12, seed: int = 0) -> None:
     """Seeded wild actions (NaN, ±inf, 1e30, in range) are sanitised: the
     observations stay finite and inside the space, the rewards finite and
-    within the environment's ``reward_bounds`` (default
-    :data:`~iceenvs.base.REWARD_RANGE`), and the physics does not fail."""
+    within the environment's ``reward_bounds``, and the physics does not
+    fail."""
     rng = np.random.default_rng(seed)
     env = make_small(env_id)
     try:
         space = env.action_space
-        # the built-in floe tasks reward in [0, 1]; others declare reward_bounds
-        low, high = getattr(env.unwrapped, "reward_bounds", REWARD_RANGE)
+        low, high = env.unwrapped.reward_bounds
         wild = np.array([np.nan, np.inf, -np.inf, 1e30, -1e30], dtype=np.float64)
         obs, _ = env.reset(seed=seed)
         for k in range(steps):
@@ -145,6 +146,32 @@ def check_fuzz(env_id: str, steps: int = 12, seed: int = 0) -> None:
                 f"{env_id}: reward {reward} outside [{low}, {high}]"
             if terminated or truncated:
                 obs, _ = env.reset()
+    finally:
+        env.close()
+
+
+def check_rewards(env_id: str, steps: int = 20, seed: int = 0) -> None:
+    """The reward contract of :class:`iceenvs.base.ControlEnv`: the
+    environment's ``reward_bounds`` are finite and ordered, its
+    ``failure_reward`` lies within them, and so does every reward of
+    ``steps`` seeded random actions (resetting when an episode ends)."""
+    env = make_small(env_id)
+    try:
+        base = env.unwrapped
+        low, high = (float(b) for b in base.reward_bounds)
+        assert math.isfinite(low) and math.isfinite(high) and low < high, \
+            f"{env_id}: reward_bounds {base.reward_bounds} are not finite and ordered"
+        failure = float(base.failure_reward)
+        assert low <= failure <= high, \
+            f"{env_id}: failure_reward {failure} is outside reward_bounds ({low}, {high})"
+        env.action_space.seed(seed)
+        env.reset(seed=seed)
+        for _ in range(steps):
+            _, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+            assert low <= reward <= high, \
+                f"{env_id}: reward {reward} is outside reward_bounds ({low}, {high})"
+            if terminated or truncated:
+                env.reset()
     finally:
         env.close()
 
@@ -179,7 +206,7 @@ def check_facts(env_id: str, steps: int = 3, seed: int = 0) -> None:
 
 #: name → check, in the order :func:`check_all` runs them
 CHECKS = {"api": check_api, "determinism": check_determinism, "fuzz": check_fuzz,
-          "facts": check_facts}
+          "rewards": check_rewards, "facts": check_facts}
 
 
 def check_all(env_id: str) -> None:

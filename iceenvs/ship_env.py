@@ -190,6 +190,8 @@ class ShipEnv(HertzEnv):
 
     controls: tuple[str, ...] = tuple(CONTROLS)
     vector_base = ShipVectorEnv
+    #: each episode's field is drawn in the channel (:meth:`_floe_field`)
+    own_field = True
     #: the goal line lies ahead along +x; the channel is centred on the box
     start_x = 50.0
 
@@ -245,9 +247,8 @@ class ShipEnv(HertzEnv):
         #: the step as a batch of one (made at the first step)
         self._one: ShipBatch | None = None
         self._one_sums = None
-        super().__init__(n_floes=2, preset=preset, control_interval=control_interval,
+        super().__init__(n_floes=None, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
-        self.failure_reward = -float(self.reward_params["failure_penalty"])
         vector_space = self.observation_space
         image_space = gym.spaces.Box(0, 255, (4, self.image_size, self.image_size),
                                      dtype=np.uint8)
@@ -256,7 +257,6 @@ class ShipEnv(HertzEnv):
         elif obs_type == "dict":
             self.observation_space = gym.spaces.Dict({"vector": vector_space,
                                                       "image": image_space})
-        self.n_floes = 0
 
     # -- geometry -------------------------------------------------------------------
     @property
@@ -513,9 +513,19 @@ class ShipEnv(HertzEnv):
         ``reset``)."""
         return self._ship
 
+    # the reward contract of ControlEnv: a failure pays -failure_penalty, and every
+    # step's reward lies in reward_bounds
+    @property
+    def failure_reward(self) -> float:
+        """The reward of a step that fails the task (beset, out of the
+        channel, a physics failure): ``-failure_penalty`` of the reward
+        parameters (:mod:`iceenvs.rewards`)."""
+        return -float(self.reward_params["failure_penalty"])
+
     @property
     def reward_bounds(self) -> tuple[float, float]:
-        """(lowest, highest) reward of one step (:func:`iceenvs.rewards.ship_reward_bounds`)."""
+        """(lowest, highest) reward of one step, a failure's included
+        (:func:`iceenvs.rewards.ship_reward_bounds`)."""
         from .rewards import ship_reward_bounds
 
         return ship_reward_bounds(self.reward_params)

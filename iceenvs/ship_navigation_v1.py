@@ -12,13 +12,13 @@ from physics.checks import check_range
 from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, navigation_field
 from physics.ship import TransitBox
 
-from .base import TaskParameter, choice, interval, number, task_table
+from .base import TaskParameter, choice, interval, number, revised_task, task_table
 from .observations import Feature, feature_table
 from .ship_controllers import SwathPlanner
 from .ship_env import CONTROLS, ship_features
 from .ship_sensors import (channel_room, check_bands, course_with_room, swath_courses,
                             swath_scan)
-from .ship_navigation import _TASK as _TASK_V0, ShipNavigationEnv
+from .ship_navigation import ShipNavigationEnv
 from .vector import vector_class
 
 __all__ = ["ShipNavigationV1Env", "ShipNavigationV1VectorEnv", "MAX_EPISODE_STEPS",
@@ -91,9 +91,8 @@ _CHANGED = {
 }
 _DEFAULTS = {"concentration_range": (0.2, 0.5), "floe_sizes": "auto_icenav"}
 
-_TASK = tuple(
-    TaskParameter(p.name, _DEFAULTS.get(p.name, p.default), *_CHANGED[p.name])
-    if p.name in _CHANGED else p for p in _TASK_V0) + (
+# ShipNavigation-v0's parameters, revised, then v1's own
+_TASK = revised_task(ShipNavigationEnv.task_parameters, _CHANGED, _DEFAULTS, added=(
     TaskParameter("ice_thickness", 1.2, "thickness [m] of the floes (AUTO-IceNav: 1.2 m of "
                   "first-year ice)", number(0.1, 10.0)),
     TaskParameter("thick_fraction", 0.0, "probability that a floe is of the thick class "
@@ -119,7 +118,7 @@ _TASK = tuple(
                   "a commanded course must leave (the autopilot holds the nearest course that "
                   "does: `guarded_course`); None: every course is held",
                   number(1.0, 1.0e4, optional=True)),
-)
+))
 
 
 class ShipNavigationV1Env(ShipNavigationEnv):

@@ -64,8 +64,8 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, Kick, _NON_FINITE, _OK, _SHIP_LOG_FULL, begin_step,
-                            drift_bound, end_run, first_half, floe_drag, floe_rows,
+from .hertz_kernels import (KICK_FASTMATH, STATUS_NON_FINITE, STATUS_OK, STATUS_SHIP_LOG_FULL,
+                            Kick, begin_step, drift_bound, end_run, first_half, floe_drag, floe_rows,
                             force_buffers, from_order_key, kick_drift_floe, list_expired,
                             max_keep_nan, min_image_step, order_key, pass_status, path_slack,
                             rebuild_in_run, rigid_drift_bound, wall_overlap, wide_floe_test,
@@ -572,7 +572,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
     py = box.periodic_y
     walls = not (px and py)
     done = 0
-    status = _OK
+    status = STATUS_OK
     log_full = False
     expired = False
     lx = 0.0
@@ -582,7 +582,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
     centre = verlet.centre
     while step < end:
         status, kick = begin_step(box, time, step, dt, centre, ship)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         lx, ly = kick.lx, kick.ly
         if ship.active:
@@ -596,7 +596,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
         done += 1
         step += 1
         status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         last = step >= end
         if n_free > 0:
@@ -608,7 +608,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
             if last:
                 if not sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt,
                                  dt_kick0, step - window_start, iterate, verlet.ref):
-                    status = _NON_FINITE
+                    status = STATUS_NON_FINITE
                     break
                 n_free = 0
         if walls:
@@ -631,7 +631,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
             if n_free > 0:
                 if not sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt,
                                  dt_kick0, step - window_start, iterate, verlet.ref):
-                    status = _NON_FINITE
+                    status = STATUS_NON_FINITE
                     break
             expired = True
             break
@@ -640,7 +640,7 @@ def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, 
             all_pairs_live(verlet, awake, pairs)
         live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         if log_full:
-            status = _SHIP_LOG_FULL
+            status = STATUS_SHIP_LOG_FULL
             break
         if last:
             # a pair of this step may have woken a floe of the synced ones
@@ -686,7 +686,7 @@ def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, 
     bounds = np.zeros(4)
     n_rebuilds = 0
     done = 0
-    status = _OK
+    status = STATUS_OK
     step = 0
     n_engaged = n
     while step < n_steps:
@@ -708,7 +708,7 @@ def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, 
         tally[3] += d
         if step < end and not expired:
             tally[1] += 1
-        if status != _OK:
+        if status != STATUS_OK:
             break
         if not expired:
             continue
@@ -720,7 +720,7 @@ def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, 
         live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         awake.count[1] = 0
         if log_full:
-            status = _SHIP_LOG_FULL
+            status = STATUS_SHIP_LOG_FULL
             break
     end_run(floes, fbuf, tbuf, done, dt, ship)
     return done, status, n_rebuilds, verlet, n_engaged

@@ -84,11 +84,11 @@ class HertzStatus(IntEnum):
 
 
 # the statuses as plain integers for the compiled code
-_OK = int(HertzStatus.OK)
-_NON_FINITE = int(HertzStatus.NON_FINITE)
-_CONCENTRATION_LIMIT = int(HertzStatus.CONCENTRATION_LIMIT)
-_UNSTABLE = int(HertzStatus.UNSTABLE)
-_SHIP_LOG_FULL = int(HertzStatus.SHIP_LOG_FULL)
+STATUS_OK = int(HertzStatus.OK)
+STATUS_NON_FINITE = int(HertzStatus.NON_FINITE)
+STATUS_CONCENTRATION_LIMIT = int(HertzStatus.CONCENTRATION_LIMIT)
+STATUS_UNSTABLE = int(HertzStatus.UNSTABLE)
+STATUS_SHIP_LOG_FULL = int(HertzStatus.SHIP_LOG_FULL)
 
 
 class Floes(NamedTuple):
@@ -926,10 +926,10 @@ def pass_status(worst, mx, my, vmax2, dt, skin):
     (:func:`first_half`): non-finite state, or a floe that crossed half the
     skin in one step (the dynamics blew up), or OK."""
     if not math.isfinite(worst + mx + my + vmax2):
-        return _NON_FINITE
+        return STATUS_NON_FINITE
     if vmax2 * dt * dt > 0.25 * skin * skin:
-        return _UNSTABLE
-    return _OK
+        return STATUS_UNSTABLE
+    return STATUS_OK
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1092,12 +1092,12 @@ def begin_step(box, time, step, dt, centre, ship):
     kick = Kick(dt_kick, dt, lx, ly, box.periodic_x, box.periodic_y, lx / lx_old, ly / ly_old,
                 centre[0], centre[1])
     if box.deforming and (conc >= box.max_concentration or conc <= 0.0):
-        return _CONCENTRATION_LIMIT, kick
+        return STATUS_CONCENTRATION_LIMIT, kick
     lengths[0] = lx
     lengths[1] = ly
     if ship.active:
         ship_kick_drift(ship, dt_kick, dt)
-    return _OK, kick
+    return STATUS_OK, kick
 
 
 @njit(cache=True, error_model="numpy")
@@ -1158,12 +1158,12 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
     wall_due = np.full(n, -np.inf)
     skip = not (parallel or box.deforming)
     done = 0
-    status = _OK
+    status = STATUS_OK
     log_full = False
     step = 0
     while step < n_steps:
         status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         lx, ly = kick.lx, kick.ly
         if parallel:
@@ -1174,7 +1174,7 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
         done += 1
         step += 1
         status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         if walls:
             if parallel:
@@ -1208,7 +1208,7 @@ def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, paral
             owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
                         buffers.torque)
         if log_full:
-            status = _SHIP_LOG_FULL
+            status = STATUS_SHIP_LOG_FULL
             break
     gather_cut(0, n, chunks, buffers.force, buffers.torque)
     end_run(floes, buffers.force, buffers.torque, done, dt, ship)

@@ -55,8 +55,8 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, _OK, _SHIP_LOG_FULL, apart_until, begin_step,
-                            drift_bound, first_half, floe_drag, floe_rows, floe_walls,
+from .hertz_kernels import (KICK_FASTMATH, STATUS_OK, STATUS_SHIP_LOG_FULL, apart_until,
+                            begin_step, drift_bound, first_half, floe_drag, floe_rows, floe_walls,
                             floe_walls_skipping, force_buffers, from_order_key, end_run,
                             kick_drift_floe, list_expired, listed_pair, max_keep_nan, order_key,
                             pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
@@ -413,21 +413,21 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
     walls = not (px and py)
     n = floes.pos.shape[0]
     done = 0
-    status = _OK
+    status = STATUS_OK
     log_full = False
     expired = False
     lx = 0.0
     ly = 0.0
     while step < n_steps:
         status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         lx, ly = kick.lx, kick.ly
         worst, mx, my, vmax2 = first_half_awake(work, verlet.ref, drive, kick, awake, path)
         done += 1
         step += 1
         status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != _OK:
+        if status != STATUS_OK:
             break
         if walls:
             awake_wall_forces(awake, floes, wall_law, box, dt, path, wall_due, fbuf, tbuf)
@@ -445,7 +445,7 @@ def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, ver
             break
         pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         if log_full:
-            status = _SHIP_LOG_FULL
+            status = STATUS_SHIP_LOG_FULL
             break
     return step, done, status, expired, log_full, lx, ly
 
@@ -473,7 +473,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
     wall_due = np.full(n, -np.inf)
     n_rebuilds = 0
     done = 0
-    status = _OK
+    status = STATUS_OK
     step = 0
     while step < n_steps:
         step, d, status, expired, log_full, lx, ly = resting_steps(
@@ -492,7 +492,7 @@ def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verle
         add_woken(awake, verlet, pairs)
         pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
         if log_full:
-            status = _SHIP_LOG_FULL
+            status = STATUS_SHIP_LOG_FULL
             break
     end_run(floes, fbuf, tbuf, done, dt, ship)
     return done, status, n_rebuilds, verlet, awake.count[0]

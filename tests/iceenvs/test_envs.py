@@ -68,9 +68,25 @@ def test_every_id_is_registered_with_its_facts():
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_shared_checks(env_id, check, headless):
     """Gymnasium's checker without warnings, determinism, sanitised wild
-    actions and facts that agree with the environment
+    actions, the reward contract and facts that agree with the environment
     (:mod:`iceenvs.checks`)."""
     CHECKS[check](env_id)
+
+
+def test_the_reward_contract_is_held(monkeypatch):
+    """check_rewards fails a task whose failure pays outside its bounds, or
+    whose rewards leave them."""
+    from iceenvs.base import ControlEnv
+    from iceenvs.checks import check_rewards
+
+    env_id = "iceenvs/Convergence-v0"
+    monkeypatch.setattr(ControlEnv, "failure_reward", -1.0)
+    with pytest.raises(AssertionError, match="failure_reward -1.0 is outside"):
+        check_rewards(env_id)
+    monkeypatch.setattr(ControlEnv, "failure_reward", 0.0)
+    monkeypatch.setattr(ControlEnv, "reward_bounds", property(lambda self: (0.0, 1e-9)))
+    with pytest.raises(AssertionError, match="is outside reward_bounds"):
+        check_rewards(env_id)
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
