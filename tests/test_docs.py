@@ -130,6 +130,15 @@ def test_readme_is_short():
     assert size <= README_LIMIT, f"README.md is {size} bytes, more than {README_LIMIT}"
 
 
+def test_the_navigation_page_stays_a_stable_page():
+    """The task, its fields, the planners and how to score a policy of one's
+    own, in at most 400 lines; the history of the PPO runs has its own page."""
+    page = (DOCS / "navigation.md").read_text(encoding="utf-8")
+    assert len(page.splitlines()) <= 400
+    assert page.index("## Evaluate your own policy") < page.index("## The task")
+    assert "{doc}`navigation-ppo`" in page
+
+
 def test_readme_links_resolve():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     targets = re.findall(r"\]\(([^)\s]+)\)", text) + re.findall(r'src="([^"]+)"', text)
