@@ -36,10 +36,8 @@ changes by at most one step between primitives: a turning radius of
 about ``stage_length² / lateral_step`` = 600 m. Gentle turns are chosen
 on purpose: a turning hull sweeps its sides through the ice (the stern
 swings out at the yaw rate times half the length, 1.5 m/s at the
-prescribed ship's full 0.04 rad/s), which the swath cost does not count,
-and in a trial on 6 of ShipNavigation-v1's fields without leads at
-A = 0.4 (not among the documented commands), a lattice with a 100 m
-radius and an even cost met 1.03 times the straight line's ice. Every primitive advances
+prescribed ship's full 0.04 rad/s), which the swath cost does not count.
+Every primitive advances
 along x, so the lattice is acyclic and the cheapest route over it is
 found exactly by dynamic programming, stage by stage (the route A* would
 return, with no heuristic to tune).

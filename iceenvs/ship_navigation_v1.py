@@ -158,25 +158,15 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     ## Task analysis
     * *Reachable:* the straight line reaches the goal in 275 steps at
       every concentration (the ship's speed is imposed).
-    * *Does route choice pay?* In AUTO-IceNav's homogeneous field
-      (`leads=0`) little: at A = 0.4 nearly every beam-wide corridor holds
-      floes every few metres, and the lattice planner
-      (:mod:`agents.planners`) meets 0.83 times the straight line's ice
-      impulse per metre. With the default two leads it meets 0.51, 0.65
-      and 0.69 times it at A = 0.2, 0.3 and 0.4 (0.80 at 0.5), sailing
-      1-1.4 % further. The swath planner
-      (:class:`iceenvs.ship_controllers.SwathPlanner`), deciding on the
-      observation alone, meets 0.57, 0.72, 0.78 and 0.78 times it at
-      A = 0.2-0.5 and beats its return by 14-29 at every concentration.
-      The docs' page "Ship navigation: does route choice pay?" gives the
-      measured leaderboard, the variants and PPO (which, started from a
-      clone of the swath planner, anchored to its decisions, with a limit
-      on the size of its updates and trained for an hour commanding
-      courses with `course_guard=150`, never leaves the channel, meets
-      0.79-0.89 times the straight line's ice and returns more, both by
-      more than two standard errors over the leaderboard's 80 fields of
-      A = 0.2-0.5, by less on 40 other fields; it loses to the planners
-      and to its start).
+    * *Does route choice pay?* That is measured, not specified here: the
+      docs' page "Ship navigation: does route choice pay?" ranks the
+      straight line, the swath planner
+      (:class:`iceenvs.ship_controllers.SwathPlanner`, which decides on the
+      observation alone), the lattice planner (:mod:`agents.planners`,
+      which reads the floes) and PPO on the same seeded fields
+      (`python -m agents.leaderboard`), with the default two leads and
+      with AUTO-IceNav's homogeneous field (`leads=0`), in which nearly
+      every beam-wide corridor holds floes every few metres.
     * *What a good policy does:* reads the ice ahead and steers for leads
       and the open water between the large floes, in gentle turns (a
       turning hull sweeps its sides through the ice).
@@ -186,8 +176,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     action[0] × `max_yaw_rate` (0.04 rad/s) at a fixed 2 m/s
     (`control="yaw"`); `control="course"` (the course action[0] ×
     `max_course`, 45°, held by an autopilot), `control="speed_yaw"` and
-    `control="thrust"` as there. The documented PPO run commands courses,
-    with a course guard of 150 m.
+    `control="thrust"` as there.
     With `course_guard=g` [m] the autopilot holds, for each commanded
     course, the nearest that leaves the ship at least g of room in the
     channel (:meth:`guarded_course`): a course guard that keeps the ship
