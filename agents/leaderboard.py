@@ -14,10 +14,14 @@ most 0.7 times the straight line's ice impulse per metre (the ratio of
 the means over the fields), sailing at most 10 % further.
 
 Output in ``--out`` (default ``runs/leaderboard``; the documented board is
-``--out docs/agents/leaderboard``):
-``leaderboard.md`` (the tables, with command, machine and date),
-``leaderboard.json`` (every episode) and ``leaderboard.png`` (impulse per
-metre and return against concentration)::
+``--out docs/agents/leaderboard``): the record, ``leaderboard.json`` (the
+summaries, the paired comparisons, and the recipe of each policy: the
+command that played it; host and date), with ``leaderboard.md`` (its
+tables) and ``leaderboard.png`` (impulse per metre and return against
+concentration), and the episodes behind it, ``episodes.json`` (every
+episode's final metrics: what ``--merge`` pairs new policies with, and
+``--render`` summarises again; large, and not committed with a documented
+record)::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
@@ -47,6 +51,8 @@ __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_mar
 
 DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
 DEFAULT_OUT = Path("runs/leaderboard")
+#: the record and the episodes behind it, in ``--out``
+RECORD, EPISODES = "leaderboard.json", "episodes.json"
 #: the metrics normalised by the straight line's on the same field
 NORMALISED = ("impulse_per_metre", "energy_to_ice", "mean_impulse", "max_impulse", "path_length")
 #: the metrics of the main table, shown as :data:`agents.metrics.METRIC_UNITS`
@@ -203,10 +209,22 @@ def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
     return f"{_num(s['mean'] / scale, digits)} ± {_num(s['sem'] / scale, 2)}"
 
 
+def recipe_lines(report: dict) -> list[str]:
+    """How each policy's rows were made: one command per policy (a record
+    merged from several runs names each policy's own), or, for a record
+    that kept only its commands, each distinct command once, in order."""
+    recipes = report.get("recipes")
+    if recipes:
+        return ["| policy | recipe |", "|---|---|",
+                *(f"| {name} | `{cmd}` |" for name, cmd in recipes.items()), ""]
+    commands = list(dict.fromkeys(c.strip() for c in report["command"].split("` then `")))
+    return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
+
+
 def board_markdown(report: dict) -> str:
     """The Markdown of a leaderboard report (the JSON of :func:`main`)."""
     summary = report["summary"]
-    lines = [f"Command: `{report['command']}`", "",
+    lines = [*recipe_lines(report),
              f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}); "
              f"{report['episodes']} fields per concentration, field k seeded "
              f"{report['seed']} + k, the same fields for every policy; "
@@ -227,7 +245,9 @@ def board_markdown(report: dict) -> str:
     for a, (name, ratio, path, pays) in verdict.items():
         lines.append(f"| {a} | {name} | {ratio:.3f} | {path:.3f} | "
                      f"{'yes' if pays else '**no**'} |")
-    pooled = pooled_comparison(report["episodes_detail"]) if len(summary) > 1 else {}
+    pooled = report.get("pooled")
+    if pooled is None:
+        pooled = pooled_comparison(report["episodes_detail"]) if len(summary) > 1 else {}
     if pooled:
         n = next(iter(pooled.values()))["fields"]
         lines += ["", "### All concentrations together", "",
@@ -358,22 +378,46 @@ def _write(report: dict, out: Path) -> None:
     plot_board(report, out / "leaderboard.png")
 
 
+def read_board(out: Path) -> tuple[dict, dict | None]:
+    """The record of ``out`` and the episodes behind it (``None`` when they
+    are not there, as for a committed record). A record written before the
+    two were split holds its episodes itself (``episodes_detail``)."""
+    report = json.loads((Path(out) / RECORD).read_text())
+    episodes = report.pop("episodes_detail", None)
+    path = Path(out) / EPISODES
+    if path.exists():
+        episodes = json.loads(path.read_text())
+    return report, episodes
+
+
+def summarised(report: dict, board: dict) -> dict:
+    """``report`` with the summaries and the pooled comparison of ``board``."""
+    summary = summarise_board(board)
+    return {**report, "summary": summary,
+            "pooled": pooled_comparison(board) if len(summary) > 1 else {}}
+
+
 def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
     """The report in ``out`` that ``--merge`` adds to, checked to be of the
     same environment, arguments, fields and concentrations, and, unless
     every policy of it runs again (``again``), of the same host
     (:func:`host_signature`)."""
-    path = out / "leaderboard.json"
+    path = out / RECORD
     if not path.exists():
         parser.error(f"--merge: {path} does not exist")
-    old = json.loads(path.read_text())
+    old, episodes = read_board(out)
     same = (old.get("env") == args.env and old.get("env_kwargs") == env_kwargs
             and old.get("episodes") == args.episodes and old.get("seed") == args.seed
-            and list(old.get("episodes_detail", {})) == [f"{a:g}" for a in conc])
+            and list(old.get("summary", {})) == [f"{a:g}" for a in conc])
     if not same:
         parser.error(f"--merge: {path} is of another environment, arguments, fields or "
                      f"concentrations")
-    kept = set(next(iter(old["episodes_detail"].values()))) - set(again)
+    kept = set(next(iter(old["summary"].values()))) - set(again)
+    if kept and episodes is None:
+        parser.error(f"--merge: the episodes behind {path} are not in {out} ({EPISODES}, "
+                     f"which a committed record leaves out); run all of its policies again "
+                     f"(--replace {','.join(sorted(kept))})")
+    old["episodes_detail"] = episodes or {}
     host = host_signature()
     if kept and old.get("host") != host:
         parser.error(f"--merge: {path} was computed on another host "
@@ -390,11 +434,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     args = parser.parse_args(argv)
     out = args.out
     if args.render:
-        path = out / "leaderboard.json"
+        path = out / RECORD
         if not path.exists():
             parser.error(f"--render: {path} does not exist")
-        report = json.loads(path.read_text())
-        report["summary"] = summarise_board(report["episodes_detail"])
+        report, episodes = read_board(out)
+        if episodes is not None:            # summarised again, with this version's statistics
+            report = summarised(report, episodes)
         _write(report, out)
         return report
 
@@ -454,20 +499,23 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     out.mkdir(parents=True, exist_ok=True)
     if old is not None:
         recipes = {name: r for name, r in recipes.items()
-                   if name in again or name not in next(iter(old["episodes_detail"].values()))}
+                   if name in again or name not in next(iter(old["summary"].values()))}
     agent_kwargs = {**(old or {}).get("agent_kwargs", {}), **{
         name: run_agent_kwargs(r[1]) for name, r in recipes.items() if r[0] == "trained"}}
     planner_names = {*PLANNERS, *default_policies(args.env)}
     t0 = time.perf_counter()
     board = run_leaderboard(args.env, conc, recipes, episodes=args.episodes, seed=args.seed,
                             processes=args.processes, env_kwargs=env_kwargs)
+    argv_text = " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
+    command = f"{prog} {argv_text}".strip()
+    played = {name: command for name in recipes}
     if old is not None:
         board = {a: {**old["episodes_detail"][a], **board[a]} for a in board}
+        before = old.get("recipes") or {n: old["command"] for n in old["summary"][f"{conc[0]:g}"]}
+        played = {name: played.get(name) or before[name] for name in board[next(iter(board))]}
         recipes = {name: None for name in board[next(iter(board))]}
-    summary = summarise_board(board)
-    argv_text = " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
     report = dict(
-        command=(f"{old['command']}` then `" if old else "") + f"{prog} {argv_text}".strip(),
+        recipes=played,
         env=args.env, env_kwargs=env_kwargs,
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
@@ -476,16 +524,16 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
         host=host_signature(),
         date=datetime.date.today().isoformat(),
-        wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0),
-        summary=summary,
-        episodes_detail={a: {name: [{k: v for k, v in e.items()
-                                     if k not in ("rewards", "trace")} for e in eps]
-                             for name, eps in policies_.items()}
-                         for a, policies_ in board.items()})
-    (out / "leaderboard.json").write_text(json.dumps(report, indent=1))
+        wall_s=time.perf_counter() - t0 + (old["wall_s"] if old else 0.0))
+    episodes = {a: {name: [{k: v for k, v in e.items() if k not in ("rewards", "trace")}
+                           for e in eps] for name, eps in policies_.items()}
+                for a, policies_ in board.items()}
+    report = summarised(report, episodes)
+    (out / RECORD).write_text(json.dumps(report, indent=1))
+    (out / EPISODES).write_text(json.dumps(episodes))
     _write(report, out)
     print(board_markdown(report))
-    return report
+    return {**report, "episodes_detail": episodes}
 
 
 if __name__ == "__main__":

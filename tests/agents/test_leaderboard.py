@@ -18,7 +18,13 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path, capsys):
             "--out", str(out)] + SHORT
     report = leaderboard.main(base + ["--policies", "straight"])
     assert {p.name for p in out.iterdir()} == {"leaderboard.json", "leaderboard.md",
-                                               "leaderboard.png"}
+                                               "leaderboard.png", "episodes.json"}
+    # the record holds the summaries and the recipe, the episodes lie beside it
+    record = json.loads((out / "leaderboard.json").read_text())
+    assert "episodes_detail" not in record and record["summary"] == json.loads(
+        json.dumps(report["summary"]))
+    assert list(record["recipes"]) == ["straight"]
+    assert record["recipes"]["straight"].startswith("python -m agents.leaderboard")
     s = report["summary"]["0.2"]["straight"]
     # no floe hit on some field: its ratio is undefined (NaN), never another number
     ratio = s["ratio_impulse_per_metre"]["mean"]
@@ -37,9 +43,25 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path, capsys):
         [e["ret"] for e in merged["episodes_detail"]["0.2"]["straight"]]
     text = (out / "leaderboard.md").read_text()
     assert "### Does route choice pay?" in text and "| 0.2 | lattice |" in text
+    # one recipe per policy: the straight line's from the last run, the lattice's from its own
+    recipes = json.loads((out / "leaderboard.json").read_text())["recipes"]
+    assert "--replace straight" in recipes["straight"]
+    assert "--replace" not in recipes["lattice"] and "straight,lattice" in recipes["lattice"]
+    assert text.count("| `python -m agents.leaderboard") == 2
     (out / "leaderboard.md").unlink()
     leaderboard.main(["--render", "--out", str(out)])
     assert (out / "leaderboard.md").read_text() == text
+    # a committed record, without its episodes: rendered from its summaries alike, and
+    # merged onto only by running its policies again
+    committed = tmp_path / "committed"
+    committed.mkdir()
+    (committed / "leaderboard.json").write_bytes((out / "leaderboard.json").read_bytes())
+    leaderboard.main(["--render", "--out", str(committed)])
+    assert (committed / "leaderboard.md").read_text() == text
+    with pytest.raises(SystemExit):
+        leaderboard.main([*base[:-len(SHORT) - 1], str(committed), *SHORT, "--policies",
+                          "straight", "--merge"])
+    assert "are not in" in capsys.readouterr().err
     # episodes of another host start from the same fields but round otherwise, so
     # they would not pair with new ones: merging onto them is refused ...
     assert again["host"] == leaderboard.host_signature()
