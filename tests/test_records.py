@@ -1,0 +1,121 @@
+"""The records the documentation shows (``docs/records.yaml``): each exists,
+is shown by its page, is written by commands of the project that its page
+gives (or that the record names itself), and stays small; nothing generated
+under docs/ is left out of the manifest."""
+import importlib
+import importlib.util
+import json
+import shlex
+import tomllib
+from pathlib import Path
+
+import pytest
+import yaml
+
+from benchmarks import SUITES
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+MANIFEST = yaml.safe_load((DOCS / "records.yaml").read_text(encoding="utf-8"))["records"]
+#: the folders of generated files, every one of which a record covers
+GENERATED = ("agents", "benchmarks", "crosscheck", "figures")
+#: the largest a committed generated file may be [bytes]
+FILE_LIMIT = 1_500_000
+#: the largest the trained agents' records may be together [bytes]
+AGENTS_LIMIT = 8_000_000
+SCRIPTS = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
+
+
+def generated_files() -> list[Path]:
+    return sorted(p for folder in GENERATED for p in (DOCS / folder).rglob("*")
+                  if p.is_file() and not p.name.startswith(".") and p.name != "episodes.json")
+
+
+def page_text(page: str) -> str:
+    """A page with its shell lines joined and its whitespace collapsed."""
+    text = (ROOT / page).read_text(encoding="utf-8").replace("\\\n", " ")
+    return " ".join(text.split())
+
+
+def record_commands(path: Path) -> list[str]:
+    """The commands a record names itself: ``command`` (joined runs
+    separated by "` then `") or ``recipes`` of its JSON files (a table or
+    figure names those of the JSON beside it)."""
+    files = sorted(path.glob("*.json")) if path.is_dir() else [path.with_suffix(".json")]
+    out = []
+    for f in files:
+        record = json.loads(f.read_text(encoding="utf-8"))
+        if isinstance(record.get("recipes"), dict):
+            out += list(record["recipes"].values())
+        elif isinstance(record.get("command"), str):
+            out += [c.strip() for c in record["command"].split("` then `")]
+    return out
+
+
+def is_project_command(command: str) -> bool:
+    """``python -m MODULE`` of a module with a ``main`` or a ``__main__``, a
+    console script of the project (``seaice bench SUITE`` naming a suite)."""
+    words = shlex.split(command)
+    if words[:2] == ["python", "-m"] and len(words) > 2:
+        module = words[2]
+        try:
+            spec = importlib.util.find_spec(module)
+        except ModuleNotFoundError:
+            return False
+        if spec is None:
+            return False
+        if spec.submodule_search_locations and importlib.util.find_spec(f"{module}.__main__"):
+            return True
+        return hasattr(importlib.import_module(module), "main")
+    if words and words[0] in SCRIPTS:
+        return words[:2] != ["seaice", "bench"] or (len(words) > 2 and words[2] in SUITES)
+    return False
+
+
+@pytest.mark.parametrize("entry", MANIFEST, ids=[e["path"] for e in MANIFEST])
+def test_each_record_exists_is_shown_and_has_its_commands(entry):
+    path = ROOT / entry["path"]
+    assert path.exists(), entry["path"]
+    text = page_text(entry["page"])
+    rel = path.relative_to(DOCS).as_posix()
+    shown = (rel, Path(rel).parent.as_posix() if path.is_file() else rel, path.name)
+    assert any(s in text for s in shown), f"{entry['page']} does not show {rel}"
+    if entry["commands"] == "record":
+        commands = record_commands(path)
+        assert commands, f"{rel} names no command"
+    else:
+        commands = entry["commands"]
+        for command in commands:
+            assert " ".join(command.split()) in text, f"{entry['page']} lacks `{command}`"
+    for command in commands:
+        assert is_project_command(command), f"{rel}: `{command}` is not a command of the project"
+
+
+def _entry_of(path: Path) -> str | None:
+    for entry in MANIFEST:
+        root = ROOT / entry["path"]
+        if path == root or root in path.parents:
+            return entry["path"]
+    return None
+
+
+def test_every_generated_file_is_in_a_record_and_small():
+    files = generated_files()
+    assert len(files) > 50
+    left_out = [f.relative_to(ROOT).as_posix() for f in files if _entry_of(f) is None]
+    assert not left_out, f"not in docs/records.yaml: {left_out}"
+    large = {f.relative_to(ROOT).as_posix(): f.stat().st_size for f in files
+             if f.stat().st_size > FILE_LIMIT}
+    assert not large, f"larger than {FILE_LIMIT} bytes: {large}"
+    agents = sum(f.stat().st_size for f in files if (DOCS / "agents") in f.parents)
+    assert agents <= AGENTS_LIMIT, f"docs/agents holds {agents} bytes"
+
+
+def test_the_check_of_commands_can_fail():
+    assert is_project_command("python -m agents.leaderboard --out runs/x")
+    assert is_project_command("python -m physics.crosscheck all")
+    assert is_project_command("seaice bench itd --docs")
+    assert is_project_command("ice-scenarios run herman2013-miz")
+    assert not is_project_command("python -m agents.no_such_module")
+    assert not is_project_command("seaice bench no_such_suite")
+    assert not is_project_command("cp a b")
