@@ -79,7 +79,7 @@ def plot_learning_curve(run_dir: str | Path, path: str | Path | None = None) -> 
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(alpha=0.3)
     path.parent.mkdir(parents=True, exist_ok=True)
-    return plots.savefig(fig, path, dpi=110)
+    return plots.savefig(fig, path, dpi=110, palette=True)
 
 
 def main(argv: list[str] | None = None) -> Path:

@@ -24,7 +24,8 @@ baseline), or else of a search run here with the defaults of
 from the evaluation episodes. Its row in the table names the action.
 
 Output (in ``--out``, default the run directory): ``evaluation.md``
-(printed as well), ``evaluation.json`` and ``evaluation.png``.
+(printed as well), ``evaluation.json``, ``evaluation.png`` and
+``episodes.json``.
 
 ``evaluation.md`` is for people: the mean ± standard error of the mean of
 the return and of the final physics metrics, each with a readable header
@@ -42,9 +43,11 @@ A). Then the paired differences of the return and of the compared
 metric.
 
 ``evaluation.json`` is the record, in SI units: the summaries (mean, std,
-standard error), the comparisons, and every episode's return, final
-metrics, drawn task parameters (``task``), and rewards and main physics
-metric per step. ``evaluation.png`` draws the reward and the task's main
+standard error), the comparisons and the task. ``episodes.json`` holds
+the episodes behind it: every episode's return, final metrics, drawn task
+parameters (``task``), and rewards and main physics metric per step
+(large, and not committed with a documented record).
+``evaluation.png`` draws the reward and the task's main
 physics metric against step, per policy, with each episode's target
 where the task has one. The policy beats a baseline when the mean of the
 paired differences of return exceeds two standard errors of that mean.
@@ -65,6 +68,9 @@ from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, 
                       metric_unit, scaled, significant)
 from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
                        rounded, run_episode, summarise)
+
+#: the episodes behind an evaluation's record, beside it
+EPISODES = "episodes.json"
 
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
            "compare", "markdown_table", "table_columns", "task_report", "task_lines",
@@ -279,7 +285,7 @@ def plot_trajectories(env_id: str, results: dict, path: str | Path) -> None:
     axes[1].set_ylabel(metric_header(metric) if metric else "physics metric")
     axes[1].set_xlabel("step")
     fig.suptitle(env_id)
-    plots.savefig(fig, path, dpi=100)
+    plots.savefig(fig, path, dpi=100, palette=True)
 
 
 def _episode_targets(results: dict) -> dict:
@@ -348,11 +354,15 @@ def render(out: Path) -> str:
     from .constant import format_action
 
     report = json.loads((Path(out) / "evaluation.json").read_text())
-    env_id, detail = report["env"], report["episodes_detail"]
+    detail = report.pop("episodes_detail", None)
+    if (Path(out) / EPISODES).exists():
+        detail = json.loads((Path(out) / EPISODES).read_text())
+    env_id = report["env"]
     comparisons = report.get("comparisons") or {}
     metric_comparisons = report.get("metric_comparisons")
     facts = env_facts(env_id)
-    if metric_comparisons is None and comparisons and facts.compared_metric is not None:
+    if (metric_comparisons is None and comparisons and facts.compared_metric is not None
+            and detail is not None):
         metric, lower = facts.compared_metric
         first = detail[next(iter(report["summaries"]))]
         metric_comparisons = {n: compare(first, detail[n], metric, lower) for n in comparisons}
@@ -362,7 +372,8 @@ def render(out: Path) -> str:
     table = markdown_table(env_id, report["summaries"], comparisons, report["episodes"],
                            report["seed"], labels, metric_comparisons, report.get("task"))
     (Path(out) / "evaluation.md").write_text(table)
-    plot_trajectories(env_id, detail, Path(out) / "evaluation.png")
+    if detail is not None:                 # the figure needs the episodes
+        plot_trajectories(env_id, detail, Path(out) / "evaluation.png")
     return table
 
 
@@ -543,15 +554,15 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
                   metric_comparisons=metric_comparisons,
-                  main_metric=facts.main_metric, task=task,
-                  episodes_detail={n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
-                                            terminated=e["terminated"], final=e["final"],
-                                            task=e.get("task", {}),
-                                            rewards=rounded(e["rewards"]),
-                                            trace=rounded(e["trace"]))
-                                       for e in eps] for n, eps in results.items()})
+                  main_metric=facts.main_metric, task=task)
+    episodes = {n: [dict(seed=e["seed"], ret=e["ret"], length=e["length"],
+                         terminated=e["terminated"], final=e["final"], task=e.get("task", {}),
+                         rewards=rounded(e["rewards"]), trace=rounded(e["trace"]))
+                    for e in eps] for n, eps in results.items()}
     with open(out / "evaluation.json", "w") as fh:
         json.dump(report, fh)
+    with open(out / EPISODES, "w") as fh:
+        json.dump(episodes, fh)
     plot_trajectories(env_id, results, out / "evaluation.png")
     return summaries
 

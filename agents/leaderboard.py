@@ -308,6 +308,8 @@ def plot_board(report: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from physics.scenarios.plots import to_palette
+
     summary = report["summary"]
     conc = [float(a) for a in summary]
     names = list(next(iter(summary.values())))
@@ -329,6 +331,7 @@ def plot_board(report: dict, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    to_palette(path)
 
 
 def default_policies(env_id: str) -> list[str]:
@@ -529,7 +532,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
                            for e in eps] for name, eps in policies_.items()}
                 for a, policies_ in board.items()}
     report = summarised(report, episodes)
-    (out / RECORD).write_text(json.dumps(report, indent=1))
+    (out / RECORD).write_text(json.dumps(report))
     (out / EPISODES).write_text(json.dumps(episodes))
     _write(report, out)
     print(board_markdown(report))

@@ -21,8 +21,8 @@ MANIFEST = yaml.safe_load((DOCS / "records.yaml").read_text(encoding="utf-8"))["
 GENERATED = ("agents", "benchmarks", "crosscheck", "figures")
 #: the largest a committed generated file may be [bytes]
 FILE_LIMIT = 1_500_000
-#: the largest the trained agents' records may be together [bytes]
-AGENTS_LIMIT = 8_000_000
+#: the largest the trained agents' records may be together [bytes]: 3 MiB
+AGENTS_LIMIT = 3 * 2**20
 SCRIPTS = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
 
 

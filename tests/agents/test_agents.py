@@ -136,11 +136,11 @@ def test_ppo_run_saves_reloads_and_evaluates(ppo_runs, env_id, tmp_path):
     summaries = evaluate_main([str(run), "--episodes", "2", "--no-progress",
                                "--out", str(tmp_path), "--seed", "7"])
     assert set(summaries) == {"ppo policy", "random", "zero", "heuristic"}
-    report = json.loads((tmp_path / "evaluation.json").read_text())
-    for episodes in report["episodes_detail"].values():
+    detail = json.loads((tmp_path / "episodes.json").read_text())
+    for episodes in detail.values():
         assert [e["seed"] for e in episodes] == [7, 8]
     # the two seeds are two different episodes
-    zero = report["episodes_detail"]["zero"]
+    zero = detail["zero"]
     assert zero[0]["final"] != zero[1]["final"]
     table = (tmp_path / "evaluation.md").read_text()
     assert "beaten by > 2 standard errors" in table and "| heuristic |" in table
@@ -153,7 +153,7 @@ def test_evaluation_in_worker_processes_gives_the_same_episodes(ppo_runs, tmp_pa
     for processes in ("1", "2"):
         evaluate_main([str(ppo_runs[CONVERGENCE]), "--episodes", "2", "--no-progress",
                        "--processes", processes, "--out", str(tmp_path / processes)])
-    one, two = (json.loads((tmp_path / p / "evaluation.json").read_text())["episodes_detail"]
+    one, two = (json.loads((tmp_path / p / "episodes.json").read_text())
                 for p in ("1", "2"))
     assert set(one) == {"ppo policy", "random", "zero", "heuristic"}
     # the same code on the same seeded episodes, only in other processes: bit for bit

@@ -186,7 +186,8 @@ def test_evaluation_reports_the_drawn_and_fixed_task_and_plots_the_targets(tmp_p
     evaluate_main(["--baseline", "heuristic", "--env", CONVERGENCE, "--episodes", "3",
                    "--no-progress", "--out", str(tmp_path / "a"), "--env-kwargs", *kwargs])
     report = json.loads((tmp_path / "a" / "evaluation.json").read_text())
-    episodes = report["episodes_detail"]["heuristic"]
+    assert "episodes_detail" not in report
+    episodes = json.loads((tmp_path / "a" / "episodes.json").read_text())["heuristic"]
     targets = [e["task"]["target"] for e in episodes]
     assert len(set(targets)) == 3 and [e["final"]["target"] for e in episodes] == targets
     assert report["task"]["drawn"]["target"]["min"] == min(targets)
@@ -233,7 +234,7 @@ def test_a_fixed_concentration_plays_the_leaderboards_fields(tmp_path):
     args = [f"{k}={v}" for k, v in SHORT_SHIP.items()]
     evaluate_main(["--baseline", "straight", "--env", SHIP, "--episodes", "1", "--no-progress",
                    "--out", str(tmp_path), "--env-kwargs", *args, "concentration=0.3"])
-    mine = json.loads((tmp_path / "evaluation.json").read_text())["episodes_detail"]["straight"]
+    mine = json.loads((tmp_path / "episodes.json").read_text())["straight"]
     board = run_leaderboard(SHIP, [0.3], {"straight": ("baseline", "straight", {})},
                             episodes=1, seed=10_000, processes=1, env_kwargs=SHORT_SHIP,
                             progress=False)
