@@ -660,7 +660,7 @@ def draw_view(box: ViewBox, positions, radii, box_size, *, periodic=(False, True
         wrapping round a periodic y, and within ``ice_band``.
     ice_band : (x0, x1), optional
         The band of ice [m] along x that the leads cut (e.g. a
-        :class:`physics.ship.TransitBox`'s ``band``); default the whole box
+        :class:`physics.ice_fields.TransitBox`'s ``band``); default the whole box
         (inside its walls).
     title : str, optional
         A line of text over the plot.

@@ -64,7 +64,7 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics import FloeField, HERMAN2013
+from physics import HERMAN2013, ice_fields
 from physics.checks import check_range
 from physics.hertz import hull_contact_time
 
@@ -79,7 +79,7 @@ from .ship_sensors import occupancy_image
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
            "METRICS", "SLOW_TIME"]
 
-#: floe-size presets: (``sizes`` of :func:`physics.ship.transit_field`,
+#: floe-size presets: (``sizes`` of :func:`physics.ice_fields.transit_field`,
 #: log-normal (median diameter [m], σ of ln d))
 FLOE_SIZES = {
     "pack": ("lognormal", (20.0, 0.5)),
@@ -115,8 +115,8 @@ def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
 
 
 #: below this concentration the floes are placed directly; above it they are
-#: placed at it and compressed (FIRE relaxation)
-PLACEMENT_LIMIT = 0.8
+#: placed at it and compressed (FIRE relaxation; :func:`physics.ice_fields.channel_field`)
+PLACEMENT_LIMIT = ice_fields.PLACEMENT_LIMIT
 #: open water [m] left between the hull's reach and the floes at the start
 START_CLEARANCE = 2.0
 
@@ -280,51 +280,16 @@ class ShipEnv(HertzEnv):
     def _floe_field(self, box, rng, *, concentration: float, floe_sizes: str,
                     band: float | None = None):
         """Floes of the preset's material at rest covering ``concentration``
-        of ``box`` (compressed with FIRE relaxation above
-        :data:`PLACEMENT_LIMIT`), or of its strip 0 ≤ y < ``band`` [m], those
-        within reach of the ship's start removed. Sets the concentration the
-        observation reports (of the box or of the strip)."""
-        from physics.domain import Box
-        from physics.floes import place_floes, spatial_order
-        from physics.ship import covering_diameters
-
+        of ``box``, or of its strip 0 ≤ y < ``band`` [m]
+        (:func:`physics.ice_fields.channel_field`), those within reach of the
+        ship's start removed. Sets the concentration the observation reports
+        (of the box or of the strip)."""
         sizes, lognormal = FLOE_SIZES[floe_sizes]
-        p = self.preset
-        region = box if band is None else Box(box.lx, band, periodic=box.periodic)
-        target = concentration * region.area
-        d = covering_diameters(p, sizes, lognormal, 2.0 * target, rng)
-        # no floe wider than a third of the box's shorter side: drop those and
-        # keep the others until they cover the target
-        d = d[d < min(region.lx, region.ly) / 3.0]
-        area = np.cumsum(0.25 * math.pi * d ** 2)
-        d = d[: int(np.searchsorted(area, target)) + 1]
-        # the last floe overshoots the target: scale the diameters a little
-        # so that the floes cover it exactly
-        d *= math.sqrt(target / (0.25 * math.pi * float(np.sum(d ** 2))))
-        r = 0.5 * d
-        self._field_concentration = math.pi * float(np.sum(r ** 2)) / region.area
-        if concentration <= PLACEMENT_LIMIT or band is not None:
-            pos = place_floes(r, region, rng)
-        else:
-            from physics.domain import PeriodicBox
-            from physics.jamming import compress_floes
-
-            if not all(box.periodic):
-                raise ValueError(f"concentration {concentration:g} is above {PLACEMENT_LIMIT} "
-                                 f"and the box has walls: floes are compressed to it only in "
-                                 f"a periodic box")
-            a = math.pi * float(np.sum(r ** 2)) / box.area
-            k = math.sqrt(a / PLACEMENT_LIMIT)
-            box0 = PeriodicBox(box.lx * k, box.ly * k)
-            loose = FloeField(place_floes(r, box0, rng), r, p.thickness, np.zeros((r.size, 2)),
-                              density=p.forcing.ice_density)
-            packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
-            pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
-        keep = self._clear_of_start(pos, r, box)
-        pos, r = pos[keep], r[keep]
-        field = FloeField(pos, r, p.thickness, np.zeros((r.size, 2)),
-                          density=p.forcing.ice_density)
-        return field.take(spatial_order(field.positions, box))
+        field, self._field_concentration = ice_fields.channel_field(
+            self.preset, box, rng, concentration=concentration, sizes=sizes,
+            lognormal=lognormal, band=band,
+            keep=lambda positions, radii: self._clear_of_start(positions, radii, box))
+        return field
 
     def _clear_of_start(self, positions, radii, box) -> np.ndarray:
         """Mask of the floes (``positions``, ``radii`` in ``box``) that leave

@@ -9,8 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from physics.checks import check_range
-from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, navigation_field
-from physics.ship import TransitBox
+from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, TransitBox, navigation_field
 
 from .base import TaskParameter, choice, interval, number, revised_task, task_table
 from .observations import Feature, feature_table

@@ -39,7 +39,8 @@ from .engine import FloeEngine
 from .floes import PlacementError
 from .hertz import HertzSimulation, hertz_time_step
 from .params import HERMAN2013
-from .ship import TransitBox, psv_ship, transit_field
+from .ice_fields import TransitBox, transit_field
+from .ship import psv_ship
 
 __all__ = ["force_chains", "wall_force", "wind_force", "draw", "chain_width", "chain_samples",
            "ship_transit", "draw_transit", "error_meaning", "main"]

@@ -40,10 +40,13 @@ from statistics import NormalDist
 import numpy as np
 
 from .checks import check_range
+from .domain import Box
+from .floes import FloeField, place_floes, power_law_diameters, spatial_order
 
 __all__ = ["LogMassSizes", "AUTO_ICENAV_SIZES", "floe_area_quantile", "draw_floe_areas",
            "covering_areas", "Lead", "field_keep_probability", "navigation_field",
-           "MAX_PLACED_CONCENTRATION"]
+           "MAX_PLACED_CONCENTRATION", "TransitBox", "FLOE_SIZE_LAWS", "transit_field",
+           "covering_diameters", "channel_field", "PLACEMENT_LIMIT"]
 
 
 @dataclass(frozen=True)
@@ -226,9 +229,6 @@ def navigation_field(sizes: LogMassSizes, *, concentration: float, band: tuple, 
         For options out of range, or when the leads and the gradient need
         the floes placed above :data:`MAX_PLACED_CONCENTRATION`.
     """
-    from .domain import Box
-    from .floes import FloeField, place_floes
-
     check_range("concentration", concentration, 0.0, MAX_PLACED_CONCENTRATION, low_open=True)
     check_range("width", width, 0.0, None, low_open=True)
     check_range("thick_fraction", thick_fraction, 0.0, 1.0)
@@ -280,3 +280,177 @@ def navigation_field(sizes: LogMassSizes, *, concentration: float, band: tuple, 
     pos[:, 0] += x0
     field = FloeField(pos, r, h_floe, np.zeros((r.size, 2)), density=rho)
     return field, covered
+
+
+# ---------------------------------------------------------------------------
+# The transit channel, and fields covering a box or a strip of it
+# ---------------------------------------------------------------------------
+
+class TransitBox(Box):
+    """A transit channel: rigid walls ahead (x = lx) and behind (x = 0),
+    periodic across (y), and a band of ice ``band = (x0, x1)`` with open
+    water before and after it (:func:`transit_field` fills it)."""
+
+    def __init__(self, lx, ly=None, *, band=None):
+        super().__init__(lx, ly, periodic=(False, True))
+        band = (0.0, self.lx) if band is None else tuple(float(b) for b in band)
+        if not (len(band) == 2 and 0.0 <= band[0] < band[1] <= self.lx):
+            raise ValueError(f"band must be (x0, x1) with 0 <= x0 < x1 <= lx = {self.lx:g}, "
+                             f"got {band!r}")
+        self.band = band
+
+    @property
+    def band_area(self) -> float:
+        return (self.band[1] - self.band[0]) * self.ly
+
+    def __repr__(self):
+        return f"TransitBox({self.lx:g}, {self.ly:g}, band={self.band})"
+
+
+#: the floe-size laws of :func:`transit_field` and :func:`covering_diameters`
+FLOE_SIZE_LAWS = ("power", "lognormal", "auto_icenav")
+
+
+def transit_field(preset, *, concentration: float, band: tuple, length: float, width: float,
+                  seed: int | None = 0, sizes: str = "power", lognormal=(1.0, 0.5),
+                  thickness: float | None = None, box_type=TransitBox):
+    """A band of floes at rest in a transit channel.
+
+    Parameters
+    ----------
+    preset : PaperPreset
+        Material (thickness, density) and, with ``sizes="power"``, the
+        power-law floe sizes of the preset (exponent and mean diameter).
+    concentration : float
+        Ice concentration in the band, in (0, 0.9].
+    band : (x0, x1)
+        The ice band along the channel [m].
+    length, width : float
+        The channel [m].
+    sizes : {"power", "lognormal", "auto_icenav"}
+        Power-law diameters of the preset (random draws between its
+        cut-offs), log-normal diameters with ``lognormal = (median
+        diameter [m], σ of ln d)``, clipped to 0.2–5 times the median, or
+        the floe areas of AUTO-IceNav's ice fields
+        (:data:`physics.ice_fields.AUTO_ICENAV_SIZES`), each floe a disc.
+    box_type : class
+        :class:`TransitBox` (default) or any box class taking
+        ``(lx, ly)``, e.g. :class:`~physics.domain.ChannelBox`.
+
+    Returns
+    -------
+    (FloeField, Box)
+    """
+    check_range("concentration", concentration, 0.0, 0.9, low_open=True)
+    check_range("length", length, 0.0, None, low_open=True)
+    check_range("width", width, 0.0, None, low_open=True)
+    if sizes not in FLOE_SIZE_LAWS:
+        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
+    box = box_type(length, width, band=band) if box_type is TransitBox else box_type(length, width)
+    x0, x1 = (box.band if isinstance(box, TransitBox) else tuple(float(b) for b in band))
+    if not 0.0 <= x0 < x1 <= length:
+        raise ValueError(f"band must lie inside the channel (0, {length:g}), got {band!r}")
+    rng = np.random.default_rng(seed)
+    target = concentration * (x1 - x0) * width
+    d = covering_diameters(preset, sizes, lognormal, target, rng)
+    band_box = Box(x1 - x0, width, periodic=(False, box.periodic[1]))
+    pos = place_floes(0.5 * d, band_box, rng)
+    pos[:, 0] += x0
+    h = preset.thickness if thickness is None else thickness
+    field = FloeField(pos, 0.5 * d, h, np.zeros((d.size, 2)), density=preset.forcing.ice_density)
+    return field.take(spatial_order(field.positions, box)), box
+
+
+def covering_diameters(preset, sizes: str, lognormal, target_area: float,
+                       rng: np.random.Generator) -> np.ndarray:
+    """Floe diameters [m] whose discs just cover ``target_area`` [m²]: the
+    floes of :func:`transit_field` (``sizes`` and ``lognormal`` as there,
+    ``preset`` a :class:`~physics.params.PaperPreset`), drawn from ``rng``.
+    The draw is repeated until it covers the area, and cut after the first
+    floe that reaches it."""
+    if sizes not in FLOE_SIZE_LAWS:
+        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
+    if sizes == "auto_icenav":
+        return 2.0 * np.sqrt(covering_areas(AUTO_ICENAV_SIZES, target_area, rng) / math.pi)
+    if sizes == "power":
+        mean_d = preset.mean_diameter
+        alpha = preset.fsd_exponent
+        n = max(int(target_area / (math.pi * 0.25 * mean_d ** 2 * 1.5)), 4)
+        d = power_law_diameters(n, alpha, mean_d, method="random", rng=rng)
+    else:
+        median, sigma = (float(x) for x in lognormal)
+        check_range("lognormal median", median, 0.0, None, low_open=True)
+        check_range("lognormal sigma", sigma, 0.0, None)
+        n = max(int(4 * target_area / (math.pi * median ** 2)), 4)
+        d = np.clip(median * np.exp(sigma * rng.standard_normal(n)), 0.2 * median, 5 * median)
+    # keep floes until they cover the target area
+    area = np.cumsum(0.25 * math.pi * d ** 2)
+    while area[-1] < target_area:
+        d = np.concatenate([d, d])
+        area = np.cumsum(0.25 * math.pi * d ** 2)
+    return d[: int(np.searchsorted(area, target_area)) + 1]
+
+
+#: the largest concentration :func:`channel_field` places floes at directly;
+#: above it they are placed looser and compressed to it (FIRE relaxation)
+PLACEMENT_LIMIT = 0.8
+
+
+def channel_field(preset, box, rng: np.random.Generator, *, concentration: float,
+                  sizes: str = "power", lognormal=(1.0, 0.5), band: float | None = None,
+                  keep=None) -> tuple[FloeField, float]:
+    """Floes of ``preset``'s material at rest covering ``concentration`` of
+    ``box``, or of its strip 0 ≤ y < ``band`` [m] (the fields of
+    ShipNavigation-v0 and ShipBeset-v0).
+
+    The diameters are those of :func:`covering_diameters` (``sizes``,
+    ``lognormal``) for twice the target area, without the floes wider than
+    a third of the region's shorter side, cut after the floe that covers the
+    target and scaled so that they cover it exactly. They are placed at
+    random; above :data:`PLACEMENT_LIMIT` (a whole periodic box only) they
+    are placed looser and compressed to it. ``keep``, a function of
+    (positions, radii) giving a mask, removes floes afterwards (those in
+    the ship's way at its start).
+
+    Returns
+    -------
+    (FloeField, float)
+        The floes in spatial order, and the concentration they cover of the
+        region before ``keep``.
+    """
+    region = box if band is None else Box(box.lx, band, periodic=box.periodic)
+    target = concentration * region.area
+    d = covering_diameters(preset, sizes, lognormal, 2.0 * target, rng)
+    # no floe wider than a third of the box's shorter side: drop those and
+    # keep the others until they cover the target
+    d = d[d < min(region.lx, region.ly) / 3.0]
+    area = np.cumsum(0.25 * math.pi * d ** 2)
+    d = d[: int(np.searchsorted(area, target)) + 1]
+    # the last floe overshoots the target: scale the diameters a little
+    # so that the floes cover it exactly
+    d *= math.sqrt(target / (0.25 * math.pi * float(np.sum(d ** 2))))
+    r = 0.5 * d
+    covered = math.pi * float(np.sum(r ** 2)) / region.area
+    if concentration <= PLACEMENT_LIMIT or band is not None:
+        pos = place_floes(r, region, rng)
+    else:
+        from .domain import PeriodicBox
+        from .jamming import compress_floes
+
+        if not all(box.periodic):
+            raise ValueError(f"concentration {concentration:g} is above {PLACEMENT_LIMIT} "
+                             f"and the box has walls: floes are compressed to it only in "
+                             f"a periodic box")
+        a = math.pi * float(np.sum(r ** 2)) / box.area
+        k = math.sqrt(a / PLACEMENT_LIMIT)
+        box0 = PeriodicBox(box.lx * k, box.ly * k)
+        loose = FloeField(place_floes(r, box0, rng), r, preset.thickness, np.zeros((r.size, 2)),
+                          density=preset.forcing.ice_density)
+        packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
+        pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
+    if keep is not None:
+        mask = keep(pos, r)
+        pos, r = pos[mask], r[mask]
+    field = FloeField(pos, r, preset.thickness, np.zeros((r.size, 2)),
+                      density=preset.forcing.ice_density)
+    return field.take(spatial_order(field.positions, box)), covered

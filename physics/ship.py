@@ -27,7 +27,8 @@ ground. The hull does not touch the walls of a box.
 Example
 -------
 >>> from physics import HERMAN2013, HertzSimulation
->>> from physics.ship import psv_ship, transit_field
+>>> from physics.ice_fields import transit_field
+>>> from physics.ship import psv_ship
 >>> field, box = transit_field(HERMAN2013, concentration=0.3, band=(150.0, 350.0),
 ...                            length=500.0, width=150.0, seed=1)
 >>> ship = psv_ship(position=(50.0, 75.0), speed=2.0)
@@ -46,12 +47,12 @@ import numpy as np
 
 from . import hull_contact as HC
 from .checks import check_range
-from .domain import Box
-from .floes import FloeField, place_floes, power_law_diameters, spatial_order
 from .hull import MODEL_HULL, PSV_HULL, Hull
+# the transit channel and its fields live with the other ice fields; kept importable here
+from .ice_fields import FLOE_SIZE_LAWS, TransitBox, covering_diameters, transit_field  # noqa: F401
 
 __all__ = ["Ship", "ShipHydrodynamics", "ShipState", "ShipLoads", "psv_ship", "model_ship",
-           "TransitBox", "transit_field", "covering_diameters", "FOSSEN_SUPPLY"]
+           "FOSSEN_SUPPLY"]
 
 #: Fossen's supply-vessel model (length 76.2 m, 6000 t), diagonal terms in
 #: the bis system: (M_x, M_y, I_z) = m (1.1274, 1.8902, 0.1278 L²) with
@@ -254,117 +255,6 @@ def _scaled_ship(hull, mass, draft, mode, kwargs):
     kwargs.setdefault("max_thrust", 0.0085 * mass * _GRAVITY)
     kwargs.setdefault("max_yaw_moment", 0.0021 * mass * _GRAVITY * hull.length)
     return Ship(hull, mass, inertia, hydro, mode, **kwargs)
-
-
-# ---------------------------------------------------------------------------
-# The transit channel
-# ---------------------------------------------------------------------------
-
-class TransitBox(Box):
-    """A transit channel: rigid walls ahead (x = lx) and behind (x = 0),
-    periodic across (y), and a band of ice ``band = (x0, x1)`` with open
-    water before and after it (:func:`transit_field` fills it)."""
-
-    def __init__(self, lx, ly=None, *, band=None):
-        super().__init__(lx, ly, periodic=(False, True))
-        band = (0.0, self.lx) if band is None else tuple(float(b) for b in band)
-        if not (len(band) == 2 and 0.0 <= band[0] < band[1] <= self.lx):
-            raise ValueError(f"band must be (x0, x1) with 0 <= x0 < x1 <= lx = {self.lx:g}, "
-                             f"got {band!r}")
-        self.band = band
-
-    @property
-    def band_area(self) -> float:
-        return (self.band[1] - self.band[0]) * self.ly
-
-    def __repr__(self):
-        return f"TransitBox({self.lx:g}, {self.ly:g}, band={self.band})"
-
-
-#: the floe-size laws of :func:`transit_field` and :func:`covering_diameters`
-FLOE_SIZE_LAWS = ("power", "lognormal", "auto_icenav")
-
-
-def transit_field(preset, *, concentration: float, band: tuple, length: float, width: float,
-                  seed: int | None = 0, sizes: str = "power", lognormal=(1.0, 0.5),
-                  thickness: float | None = None, box_type=TransitBox):
-    """A band of floes at rest in a transit channel.
-
-    Parameters
-    ----------
-    preset : PaperPreset
-        Material (thickness, density) and, with ``sizes="power"``, the
-        power-law floe sizes of the preset (exponent and mean diameter).
-    concentration : float
-        Ice concentration in the band, in (0, 0.9].
-    band : (x0, x1)
-        The ice band along the channel [m].
-    length, width : float
-        The channel [m].
-    sizes : {"power", "lognormal", "auto_icenav"}
-        Power-law diameters of the preset (random draws between its
-        cut-offs), log-normal diameters with ``lognormal = (median
-        diameter [m], σ of ln d)``, clipped to 0.2–5 times the median, or
-        the floe areas of AUTO-IceNav's ice fields
-        (:data:`physics.ice_fields.AUTO_ICENAV_SIZES`), each floe a disc.
-    box_type : class
-        :class:`TransitBox` (default) or any box class taking
-        ``(lx, ly)``, e.g. :class:`~physics.domain.ChannelBox`.
-
-    Returns
-    -------
-    (FloeField, Box)
-    """
-    check_range("concentration", concentration, 0.0, 0.9, low_open=True)
-    check_range("length", length, 0.0, None, low_open=True)
-    check_range("width", width, 0.0, None, low_open=True)
-    if sizes not in FLOE_SIZE_LAWS:
-        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
-    box = box_type(length, width, band=band) if box_type is TransitBox else box_type(length, width)
-    x0, x1 = (box.band if isinstance(box, TransitBox) else tuple(float(b) for b in band))
-    if not 0.0 <= x0 < x1 <= length:
-        raise ValueError(f"band must lie inside the channel (0, {length:g}), got {band!r}")
-    rng = np.random.default_rng(seed)
-    target = concentration * (x1 - x0) * width
-    d = covering_diameters(preset, sizes, lognormal, target, rng)
-    band_box = Box(x1 - x0, width, periodic=(False, box.periodic[1]))
-    pos = place_floes(0.5 * d, band_box, rng)
-    pos[:, 0] += x0
-    h = preset.thickness if thickness is None else thickness
-    field = FloeField(pos, 0.5 * d, h, np.zeros((d.size, 2)), density=preset.forcing.ice_density)
-    return field.take(spatial_order(field.positions, box)), box
-
-
-def covering_diameters(preset, sizes: str, lognormal, target_area: float,
-                       rng: np.random.Generator) -> np.ndarray:
-    """Floe diameters [m] whose discs just cover ``target_area`` [m²]: the
-    floes of :func:`transit_field` (``sizes`` and ``lognormal`` as there,
-    ``preset`` a :class:`~physics.params.PaperPreset`), drawn from ``rng``.
-    The draw is repeated until it covers the area, and cut after the first
-    floe that reaches it."""
-    if sizes not in FLOE_SIZE_LAWS:
-        raise ValueError(f"sizes must be one of {FLOE_SIZE_LAWS}, got {sizes!r}")
-    if sizes == "auto_icenav":
-        from .ice_fields import AUTO_ICENAV_SIZES, covering_areas
-
-        return 2.0 * np.sqrt(covering_areas(AUTO_ICENAV_SIZES, target_area, rng) / math.pi)
-    if sizes == "power":
-        mean_d = preset.mean_diameter
-        alpha = preset.fsd_exponent
-        n = max(int(target_area / (math.pi * 0.25 * mean_d ** 2 * 1.5)), 4)
-        d = power_law_diameters(n, alpha, mean_d, method="random", rng=rng)
-    else:
-        median, sigma = (float(x) for x in lognormal)
-        check_range("lognormal median", median, 0.0, None, low_open=True)
-        check_range("lognormal sigma", sigma, 0.0, None)
-        n = max(int(4 * target_area / (math.pi * median ** 2)), 4)
-        d = np.clip(median * np.exp(sigma * rng.standard_normal(n)), 0.2 * median, 5 * median)
-    # keep floes until they cover the target area
-    area = np.cumsum(0.25 * math.pi * d ** 2)
-    while area[-1] < target_area:
-        d = np.concatenate([d, d])
-        area = np.cumsum(0.25 * math.pi * d ** 2)
-    return d[: int(np.searchsorted(area, target_area)) + 1]
 
 
 # ---------------------------------------------------------------------------

@@ -95,7 +95,8 @@ from ..forcing import steady_drift
 from ..hertz import HertzSimulation, hertz_time_step, hull_contact_time
 from ..hull_contact import LOG_COLUMNS
 from ..params import HERMAN2013
-from ..ship import TransitBox, psv_ship
+from ..ice_fields import TransitBox
+from ..ship import psv_ship
 from . import plots
 from .experiment import Experiment, register
 from .herman2013 import advance, contact_law
@@ -190,7 +191,7 @@ def floe_diameters(p: dict, target_area: float, rng: np.random.Generator) -> np.
     (the last one dropped if it would overshoot it): power-law (exponent of
     Herman 2013, mean ``mean_diameter``, d_max/d_min = ``size_ratio``) or
     log-normal (median ``lognormal_median``, σ of ln d ``lognormal_sigma``,
-    clipped to 0.2–5 times the median as in :func:`physics.ship.transit_field`)."""
+    clipped to 0.2–5 times the median as in :func:`physics.ice_fields.transit_field`)."""
     if p["sizes"] == "power":
         mean_area = 0.25 * math.pi * p["mean_diameter"] ** 2
         n = max(int(2.0 * target_area / mean_area), 16)

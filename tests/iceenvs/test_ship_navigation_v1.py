@@ -12,7 +12,7 @@ import iceenvs  # noqa: F401  (registers the ids)
 from physics.floes import FloeField
 from physics.ice_fields import (AUTO_ICENAV_SIZES, Lead, field_keep_probability,
                                 floe_area_quantile, navigation_field)
-from physics.ship import TransitBox
+from physics.ice_fields import TransitBox
 from iceenvs.ship_navigation_v1 import ICE_AHEAD, ShipNavigationV1Env
 
 V1 = "iceenvs/ShipNavigation-v1"

@@ -9,7 +9,7 @@ import pytest
 from physics.ice_fields import (AUTO_ICENAV_SIZES, LogMassSizes, covering_areas,
                                 draw_floe_areas, floe_area_quantile)
 from physics.params import HERMAN2013
-from physics.ship import transit_field
+from physics.ice_fields import transit_field
 
 
 def test_the_median_floe_is_that_of_the_generator():
@@ -77,3 +77,25 @@ def test_bad_input_is_refused():
     with pytest.raises(ValueError, match="sizes must be one of"):
         transit_field(HERMAN2013, concentration=0.3, band=(0.0, 100.0), length=100.0,
                       width=50.0, sizes="polygons")
+
+
+def test_channel_field_covers_its_region_exactly_and_keeps_what_keep_says():
+    """The diameters are scaled to cover the target area: the concentration
+    covered is the one asked (to rounding), of the box or of its strip; the
+    floes that ``keep`` rejects are gone, the others in the region."""
+    from physics import HERMAN2013
+    from physics.domain import Box
+    from physics.ice_fields import channel_field
+
+    box = Box(400.0, 200.0, periodic=(False, True))
+    field, covered = channel_field(HERMAN2013, box, np.random.default_rng(3), concentration=0.3,
+                                   sizes="lognormal", lognormal=(20.0, 0.5))
+    assert covered == pytest.approx(0.3, rel=1e-12)
+    assert np.pi * np.sum(field.radii ** 2) / box.area == pytest.approx(0.3, rel=1e-12)
+    strip, covered = channel_field(HERMAN2013, box, np.random.default_rng(3), concentration=0.3,
+                                   sizes="lognormal", lognormal=(20.0, 0.5), band=100.0,
+                                   keep=lambda pos, r: pos[:, 0] > 100.0)
+    assert covered == pytest.approx(0.3, rel=1e-12)
+    assert strip.n > 0 and np.all(strip.positions[:, 0] > 100.0)
+    assert np.all(strip.positions[:, 1] < 100.0)
+    assert np.pi * np.sum(strip.radii ** 2) < 0.3 * 400.0 * 100.0

@@ -307,7 +307,7 @@ def test_ship_in_every_box_with_wind_and_fast_ice(box_name):
     from physics.domain import Box, WalledBox
     from physics.floes import place_floes
     from physics.forcing import Forcing
-    from physics.ship import TransitBox
+    from physics.ice_fields import TransitBox
 
     rng = np.random.default_rng(5)
     lx, ly = 200.0, 120.0
