@@ -42,8 +42,9 @@ seed: episode k is field k of :mod:`agents.leaderboard` at concentration
 A). Then the paired differences of the return and of the compared
 metric.
 
-``evaluation.json`` is the record, in SI units: the summaries (mean, std,
-standard error), the comparisons and the task. ``episodes.json`` holds
+``evaluation.json`` is the record, in SI units: the command, the source
+commit (:mod:`physics.provenance`), the host and the date, the summaries
+(mean, std, standard error), the comparisons and the task. ``episodes.json`` holds
 the episodes behind it: every episode's return, final metrics, drawn task
 parameters (``task``), and rewards and main physics metric per step
 (large, and not committed with a documented record).
@@ -55,7 +56,9 @@ paired differences of return exceeds two standard errors of that mean.
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
+import shlex
 import re
 import sys
 from pathlib import Path
@@ -63,6 +66,7 @@ from pathlib import Path
 import numpy as np
 
 from iceenvs.facts import env_facts
+from physics.provenance import source_commit
 
 from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, metric_header,
                       metric_unit, scaled, significant)
@@ -160,9 +164,19 @@ def task_lines(task: dict, episodes: int, seed: int) -> list[str]:
     return lines
 
 
+def made_line(report: dict) -> list[str]:
+    """How a record was made: its command, commit, host and date (those of
+    them it has)."""
+    if not report.get("command"):
+        return []
+    about = "; ".join(str(report[k]) for k in ("commit", "host", "date") if report.get(k))
+    return [f"`{report['command']}`" + (f" ({about})" if about else ""), ""]
+
+
 def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: int,
                    seed: int, labels: dict | None = None,
-                   metric_comparisons: dict | None = None, task: dict | None = None) -> str:
+                   metric_comparisons: dict | None = None, task: dict | None = None,
+                   made: dict | None = None) -> str:
     """The comparison as Markdown: one row per policy, one column per
     quantity (mean ± standard error of the mean, in the display units of
     :data:`agents.metrics.METRIC_UNITS`), the quantities that do not fit
@@ -172,7 +186,7 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
     (default: the name)."""
     labels = labels or {}
     first, rest = table_columns(env_id, next(iter(summaries.values())))
-    lines = [f"## Evaluation on `{env_id}`", "",
+    lines = [f"## Evaluation on `{env_id}`", "", *made_line(made or {}),
              f"{episodes} episodes per policy, episode k seeded {seed} + k, the same episodes "
              f"for every policy. Each cell is the mean ± the standard error of the mean over "
              f"the episodes (the standard deviation over the episodes is "
@@ -370,7 +384,8 @@ def render(out: Path) -> str:
     if report.get("constant") and "constant" in report["summaries"]:
         labels["constant"] = f"constant {format_action(report['constant']['action'])}"
     table = markdown_table(env_id, report["summaries"], comparisons, report["episodes"],
-                           report["seed"], labels, metric_comparisons, report.get("task"))
+                           report["seed"], labels, metric_comparisons, report.get("task"),
+                           made=report)
     (Path(out) / "evaluation.md").write_text(table)
     if detail is not None:                 # the figure needs the episodes
         plot_trajectories(env_id, detail, Path(out) / "evaluation.png")
@@ -546,12 +561,19 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
             metric, lower = facts.compared_metric
             metric_comparisons = {n: compare(results[first], results[n], metric, lower)
                                   for n in names}
+    from .leaderboard import host_signature
+
+    made = dict(command=shlex.join([*prog.split(), *map(str, sys.argv[1:] if argv is None
+                                                         else argv)]),
+                commit=source_commit(), host=host_signature(),
+                date=datetime.date.today().isoformat())
     table = markdown_table(env_id, summaries, comparisons, args.episodes, args.seed, labels,
-                           metric_comparisons, task)
+                           metric_comparisons, task, made=made)
     print(table)
     out.mkdir(parents=True, exist_ok=True)
     (out / "evaluation.md").write_text(table)
-    report = dict(env=env_id, env_kwargs=env_kwargs, episodes=args.episodes, seed=args.seed,
+    report = dict(**made, env=env_id, env_kwargs=env_kwargs, episodes=args.episodes,
+                  seed=args.seed,
                   constant=constant, summaries=summaries, comparisons=comparisons,
                   metric_comparisons=metric_comparisons,
                   main_metric=facts.main_metric, task=task)

@@ -16,7 +16,7 @@ the means over the fields), sailing at most 10 % further.
 Output in ``--out`` (default ``runs/leaderboard``; the documented board is
 ``--out docs/agents/leaderboard``): the record, ``leaderboard.json`` (the
 summaries, the paired comparisons, and the recipe of each policy: the
-command that played it; host and date), with ``leaderboard.md`` (its
+command that played it and the source commit it ran; host and date), with ``leaderboard.md`` (its
 tables) and ``leaderboard.png`` (impulse per metre and return against
 concentration), and the episodes behind it, ``episodes.json`` (every
 episode's final metrics: what ``--merge`` pairs new policies with, and
@@ -43,6 +43,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from physics.provenance import source_commit
 
 from .metrics import METRIC_UNITS
 
@@ -215,8 +217,10 @@ def recipe_lines(report: dict) -> list[str]:
     that kept only its commands, each distinct command once, in order."""
     recipes = report.get("recipes")
     if recipes:
-        return ["| policy | recipe |", "|---|---|",
-                *(f"| {name} | `{cmd}` |" for name, cmd in recipes.items()), ""]
+        commits = report.get("commits") or {}
+        return ["| policy | recipe | commit |", "|---|---|---|",
+                *(f"| {name} | `{cmd}` | {commits.get(name) or '–'} |"
+                  for name, cmd in recipes.items()), ""]
     commands = list(dict.fromkeys(c.strip() for c in report["command"].split("` then `")))
     return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
 
@@ -511,14 +515,19 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
                             processes=args.processes, env_kwargs=env_kwargs)
     argv_text = " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
     command = f"{prog} {argv_text}".strip()
+    commit = source_commit()
     played = {name: command for name in recipes}
+    commits = {name: commit for name in recipes}
     if old is not None:
         board = {a: {**old["episodes_detail"][a], **board[a]} for a in board}
+        names = list(board[next(iter(board))])
         before = old.get("recipes") or {n: old["command"] for n in old["summary"][f"{conc[0]:g}"]}
-        played = {name: played.get(name) or before[name] for name in board[next(iter(board))]}
-        recipes = {name: None for name in board[next(iter(board))]}
+        played = {name: played.get(name) or before[name] for name in names}
+        commits = {name: commits[name] if name in commits else
+                   (old.get("commits") or {}).get(name, old.get("commit")) for name in names}
+        recipes = {name: None for name in names}
     report = dict(
-        recipes=played,
+        recipes=played, commits=commits, commit=commit,
         env=args.env, env_kwargs=env_kwargs,
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,

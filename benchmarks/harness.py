@@ -64,8 +64,10 @@ DOCS_DIR = ROOT / "docs" / "benchmarks"
 #: where the prepared floe fields are kept: .bench_cache of the checkout
 CACHE_DIR = ROOT / ".bench_cache"
 #: keys of every record, in the order they are written
-RECORD_KEYS = ("suite", "title", "description", "command", "machine", "date", "wall_seconds",
-               "tables", "data")
+RECORD_KEYS = ("suite", "title", "description", "command", "commit", "machine", "date",
+               "wall_seconds", "tables", "data")
+#: keys that records written before them lack (``commit``: the source commit)
+LATER_KEYS = ("commit",)
 #: keys of every table of a record
 TABLE_KEYS = ("title", "columns", "rows", "notes")
 #: keys of a record's machine description
@@ -540,10 +542,13 @@ def _plain(value):
 def make_record(suite: str, title: str, description: str, command: str, tables: Sequence[dict],
                 data: dict, wall_seconds: float, machine: dict | None = None,
                 date: str | None = None) -> dict:
-    """A record of the documented layout (see the module docstring)."""
+    """A record of the documented layout (see the module docstring), with
+    the source commit it was measured with (:mod:`physics.provenance`)."""
+    from physics.provenance import source_commit
+
     return _plain(dict(suite=suite, title=title, description=description.strip(),
-                       command=command, machine=machine or machine_info(),
-                       date=date or utc_now(),
+                       command=command, commit=source_commit(),
+                       machine=machine or machine_info(), date=date or utc_now(),
                        wall_seconds=None if wall_seconds is None else float(wall_seconds),
                        tables=list(tables), data=data))
 
@@ -560,7 +565,7 @@ def validate_record(record: dict) -> None:
     """
     if not isinstance(record, dict):
         raise TypeError(f"a record is a dict, got {type(record).__name__}")
-    missing = [k for k in RECORD_KEYS if k not in record]
+    missing = [k for k in RECORD_KEYS if k not in record and k not in LATER_KEYS]
     if missing:
         raise ValueError(f"record misses {', '.join(missing)}")
     missing = [k for k in MACHINE_KEYS if k not in record["machine"]]
@@ -635,7 +640,8 @@ def machine_line(record: dict) -> str:
     """How, where and when a record was measured, in one line."""
     m = record["machine"]
     versions = ", ".join(f"{k} {m[k]}" for k in ("python", "numpy", "numba") if m.get(k))
-    return (f"Command: `{record['command']}`; machine: {m.get('cpu') or '?'}, "
+    commit = f"; commit {record['commit']}" if record.get("commit") else ""
+    return (f"Command: `{record['command']}`{commit}; machine: {m.get('cpu') or '?'}, "
             f"{m.get('logical_cpus')} logical CPUs, {m.get('numba_threads')} Numba "
             f"thread{'s' * (m.get('numba_threads') != 1)}, {versions}, {m.get('platform')}; "
             f"date: {record['date']}"
