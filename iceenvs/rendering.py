@@ -343,6 +343,15 @@ def draw_floes(positions, radii, box_size, speeds, *, frozen=None, contact_i=Non
     return _to_array(surf, pygame)
 
 
+def _route_edges(points: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
+    """The two edges of a route's swath: ``points`` (M ≥ 2, 2) moved
+    ``half`` [m] to either side along the route's normal."""
+    d = np.gradient(points, axis=0)
+    normal = np.column_stack([-d[:, 1], d[:, 0]])
+    normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-12)[:, None]
+    return points - half * normal, points + half * normal
+
+
 HULL = (235, 90, 40)            # orange
 TRACK = (250, 250, 250)         # white
 GOAL = (60, 220, 90)            # green
@@ -415,11 +424,8 @@ def draw_ship(picture, box_size, hull_vertices, track=None, *, goal_x=None,
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         half = _check_number("route half-width", half)
         if points.shape[0] >= 2 and np.all(np.isfinite(points)):
-            d = np.gradient(points, axis=0)
-            normal = np.column_stack([-d[:, 1], d[:, 0]])
-            normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-12)[:, None]
-            for side in (-1.0, 1.0):
-                polyline(points + side * half * normal, ROUTE, 1)
+            for edge in _route_edges(points, half):
+                polyline(edge, ROUTE, 1)
             polyline(points, ROUTE, 2)
     if track is not None:
         polyline(track, TRACK, 2)
@@ -858,11 +864,8 @@ def draw_view(box: ViewBox, positions, radii, box_size, *, periodic=(False, True
         half = _check_number("route half-width", half)
         if points.shape[0] >= 2 and np.all(np.isfinite(points)):
             points = _unwrapped(points, periods)
-            g = np.gradient(points, axis=0)
-            normal = np.column_stack([-g[:, 1], g[:, 0]])
-            normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-12)[:, None]
-            for side in (-1.0, 1.0):
-                path(points + side * half * normal, ROUTE, 1)
+            for edge in _route_edges(points, half):
+                path(edge, ROUTE, 1)
             path(points, ROUTE, 3)
     if track is not None:
         path(track, TRACK, 2)
