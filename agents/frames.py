@@ -56,8 +56,6 @@ SHEET_BACKGROUND = "#1c1e24"
 SHEET_TEXT = "#e8e8e8"
 #: width [px] of the contact sheet
 SHEET_WIDTH = 1200
-#: colours of the contact sheet's palette
-SHEET_COLOURS = 256
 
 _FRAME_FILE = re.compile(r"^frame_\d+\.png$")
 
@@ -271,9 +269,11 @@ def contact_sheet(tiles, overview, path: Path, title: str, *, width: int = SHEET
     in order) in a grid of two columns (one for wide pictures), each under
     its label, above ``overview`` (``(label, frame)``, across the whole
     width), under ``title`` (one line or more, the first in bold); a PNG
-    of :data:`SHEET_COLOURS` colours."""
+    of 256 colours."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+
+    from physics.scenarios.plots import save_palette_png
 
     dpi = 100
     pad, label_h = 10, 24
@@ -309,19 +309,9 @@ def contact_sheet(tiles, overview, path: Path, title: str, *, width: int = SHEET
               tile_w, tile_h)
     place(ov, ov_label, pad, title_h + rows * (label_h + tile_h + pad), ov_w, ov_h)
     canvas.draw()
-    _palette_png(np.asarray(canvas.buffer_rgba())[..., :3], path)
+    # a quarter of the bytes of a full-colour PNG, no visible loss: the frames hold few colours
+    save_palette_png(np.asarray(canvas.buffer_rgba())[..., :3], path, fast=True)
     return path
-
-
-def _palette_png(picture: np.ndarray, path: Path) -> None:
-    """``picture`` written as a PNG of :data:`SHEET_COLOURS` colours (the
-    frames' few colours and their edges: a quarter of the bytes of a
-    full-colour PNG, no visible loss)."""
-    from PIL import Image
-
-    image = Image.fromarray(np.ascontiguousarray(picture)).quantize(
-        SHEET_COLOURS, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
-    image.save(path, optimize=True)
 
 
 def _sheet(episode: dict, out: Path, title: str) -> Path:
@@ -384,11 +374,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
 
     from iceenvs.facts import env_spec
 
-    from .baselines import baseline_names, make_baseline
+    from .baselines import baseline_names
     from .envs import make_checked_env, parse_key_values
     from .metrics import env_name
     from .policy import is_reference
-    from .rollouts import TrainedPolicy, policy_recipe, run_agent_kwargs, trained_argument
+    from .rollouts import (TrainedPolicy, policy_from_recipe, policy_recipe, run_agent_kwargs,
+                           trained_argument)
 
     if args.every is not None and args.every < 1:
         parser.error(f"--every must be at least 1, got {args.every}")
@@ -448,10 +439,9 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
     try:
         if hasattr(env.unwrapped, "view_box"):
             env.unwrapped.view = args.view
-        if run is None:
-            _, target, kwargs = recipe             # a baseline, or a policy of one's own
+        if run is None:                        # a baseline, or a policy of one's own
             try:
-                agent = make_baseline(target, env, seed=args.seed, **kwargs)
+                agent = policy_from_recipe(recipe, env, args.seed)
             except ValueError as err:
                 parser.error(str(err))
         else:
