@@ -78,7 +78,7 @@ EPISODES = "episodes.json"
 
 __all__ = ["TrainedPolicy", "run_episode", "evaluate", "evaluate_in_processes", "summarise",
            "compare", "markdown_table", "table_columns", "task_report", "task_lines",
-           "plot_trajectories", "main"]
+           "plot_trajectories", "metric_differences", "render", "main"]
 
 
 #: the most quantity columns of one table; with more, the metrics that are
@@ -360,6 +360,20 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     return p
 
 
+def metric_differences(env_id: str, episodes: dict, names) -> dict:
+    """The compared metric of ``env_id`` (its facts' ``compared_metric``)
+    of the first policy of ``episodes`` (``{policy: [episode dicts]}``)
+    minus that of each of ``names``, paired by seed
+    (:func:`agents.rollouts.compare`); empty when the environment compares
+    none."""
+    compared = env_facts(env_id).compared_metric
+    if compared is None:
+        return {}
+    metric, lower = compared
+    first = episodes[next(iter(episodes))]
+    return {n: compare(first, episodes[n], metric, lower) for n in names}
+
+
 def render(out: Path) -> str:
     """Write ``evaluation.md`` and ``evaluation.png`` of ``out`` again from
     its ``evaluation.json``, with the table and plot of this version;
@@ -374,12 +388,8 @@ def render(out: Path) -> str:
     env_id = report["env"]
     comparisons = report.get("comparisons") or {}
     metric_comparisons = report.get("metric_comparisons")
-    facts = env_facts(env_id)
-    if (metric_comparisons is None and comparisons and facts.compared_metric is not None
-            and detail is not None):
-        metric, lower = facts.compared_metric
-        first = detail[next(iter(report["summaries"]))]
-        metric_comparisons = {n: compare(first, detail[n], metric, lower) for n in comparisons}
+    if metric_comparisons is None and comparisons and detail is not None:
+        metric_comparisons = metric_differences(env_id, detail, comparisons)
     labels = {}
     if report.get("constant") and "constant" in report["summaries"]:
         labels["constant"] = f"constant {format_action(report['constant']['action'])}"
@@ -557,10 +567,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     if args.baseline is None:
         first = next(iter(results))
         comparisons = {n: compare(results[first], results[n]) for n in names}
-        if facts.compared_metric is not None:
-            metric, lower = facts.compared_metric
-            metric_comparisons = {n: compare(results[first], results[n], metric, lower)
-                                  for n in names}
+        metric_comparisons = metric_differences(env_id, results, names)
     from .leaderboard import host_signature
 
     made = dict(command=shlex.join([*prog.split(), *map(str, sys.argv[1:] if argv is None

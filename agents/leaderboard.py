@@ -48,7 +48,8 @@ from physics.provenance import source_commit
 
 from .metrics import METRIC_UNITS
 
-__all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "plot_board", "main",
+__all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "record_commands",
+           "plot_board", "main",
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
 DEFAULT_ENV = "iceenvs/ShipNavigation-v1"
@@ -211,6 +212,16 @@ def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
     return f"{_num(s['mean'] / scale, digits)} ± {_num(s['sem'] / scale, 2)}"
 
 
+def record_commands(report: dict) -> list[str]:
+    """The commands that made a record, in order: one per policy
+    (``recipes``), else those of its ``command`` (runs joined by
+    "` then `", as records kept them before the recipes)."""
+    recipes = report.get("recipes")
+    if isinstance(recipes, dict) and recipes:
+        return list(recipes.values())
+    return [c.strip() for c in str(report.get("command", "")).split("` then `") if c.strip()]
+
+
 def recipe_lines(report: dict) -> list[str]:
     """How each policy's rows were made: one command per policy (a record
     merged from several runs names each policy's own), or, for a record
@@ -221,7 +232,7 @@ def recipe_lines(report: dict) -> list[str]:
         return ["| policy | recipe | commit |", "|---|---|---|",
                 *(f"| {name} | `{cmd}` | {commits.get(name) or '–'} |"
                   for name, cmd in recipes.items()), ""]
-    commands = list(dict.fromkeys(c.strip() for c in report["command"].split("` then `")))
+    commands = list(dict.fromkeys(record_commands(report)))
     return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
 
 

@@ -25,7 +25,7 @@ import yaml
 from iceenvs.facts import env_facts
 
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
-           "evaluate_in_processes", "rounded", "stats", "summarise", "compare",
+           "evaluate_in_processes", "policy_from_recipe", "rounded", "stats", "summarise", "compare",
            "AGENT_KWARGS", "run_agent_kwargs"]
 
 #: environment arguments that set how an agent acts and what it sees rather
@@ -232,9 +232,7 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     once (``reset(seed=env_seed)``, as the evaluation's main process does)
     and each policy once from its recipe, then runs
     :func:`run_episode`."""
-    from .baselines import make_baseline
     from .envs import make_checked_env
-    from .policy import make_policy
 
     if not _WORKER:
         import torch
@@ -248,13 +246,7 @@ def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, rec
     env = envs[key]
     policies = _WORKER["policies"]
     if (key, name) not in policies:
-        kind, target, kwargs = recipe
-        if kind == "trained":
-            policies[key, name] = TrainedPolicy(target, **kwargs)
-        elif kind == "policy":                      # imported here, from its search path
-            policies[key, name] = make_policy(target, env, seed=env_seed, **kwargs)
-        else:
-            policies[key, name] = make_baseline(target, env, seed=env_seed, **kwargs)
+        policies[key, name] = policy_from_recipe(recipe, env, env_seed)
     return run_episode(env, policies[key, name], episode_seed, env_facts(env_id).main_metric)
 
 
@@ -267,6 +259,21 @@ def policy_recipe(name: str) -> tuple:
     if is_reference(name):
         return ("policy", check_reference(name), {"search": search_path(name)})
     return ("baseline", name, {})
+
+
+def policy_from_recipe(recipe: tuple, env, seed: int):
+    """The policy a recipe (:func:`evaluate_in_processes`) makes for
+    ``env``: a trained run, a policy of one's own (imported here, from its
+    search path) or a baseline."""
+    from .baselines import make_baseline
+    from .policy import make_policy
+
+    kind, target, kwargs = recipe
+    if kind == "trained":
+        return TrainedPolicy(target, **kwargs)
+    if kind == "policy":
+        return make_policy(target, env, seed=seed, **kwargs)
+    return make_baseline(target, env, seed=seed, **kwargs)
 
 
 def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,

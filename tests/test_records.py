@@ -38,18 +38,12 @@ def page_text(page: str) -> str:
 
 
 def record_commands(path: Path) -> list[str]:
-    """The commands a record names itself: ``command`` (joined runs
-    separated by "` then `") or ``recipes`` of its JSON files (a table or
-    figure names those of the JSON beside it)."""
+    """The commands a record names itself (:func:`agents.leaderboard.record_commands`
+    of its JSON files; a table or figure names those of the JSON beside it)."""
+    from agents.leaderboard import record_commands as of_record
+
     files = sorted(path.glob("*.json")) if path.is_dir() else [path.with_suffix(".json")]
-    out = []
-    for f in files:
-        record = json.loads(f.read_text(encoding="utf-8"))
-        if isinstance(record.get("recipes"), dict):
-            out += list(record["recipes"].values())
-        elif isinstance(record.get("command"), str):
-            out += [c.strip() for c in record["command"].split("` then `")]
-    return out
+    return [c for f in files for c in of_record(json.loads(f.read_text(encoding="utf-8")))]
 
 
 def is_project_command(command: str) -> bool:
