@@ -124,7 +124,6 @@ class Demonstrations:
     number."""
 
     def __init__(self, obs, actions, rewards, episode_starts):
-        self.episodes = int(np.count_nonzero(episode_starts))
         self.obs = np.asarray(obs, dtype=np.float32)
         self.actions = np.asarray(actions, dtype=np.float32)
         self.rewards = np.asarray(rewards, dtype=np.float64)
@@ -132,6 +131,10 @@ class Demonstrations:
 
     def __len__(self) -> int:
         return len(self.obs)
+
+    @property
+    def episodes(self) -> int:
+        return int(np.count_nonzero(self.episode_starts))
 
     def running_returns(self, gamma: float) -> np.ndarray:
         """The discounted return so far at each step, ``R_t = γ R_{t-1} +
@@ -175,36 +178,32 @@ def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: in
     try:
         policy = make_baseline(teacher, env, seed=seed)
         obs_list, actions, rewards, starts = [], [], [], []
-        began, sailed = time.perf_counter(), 0
-        bar = tqdm(range(episodes), desc=f"{teacher} demonstrations", unit="episode",
-                   disable=not progress)
-        for k in bar:
-            if deadline is not None and sailed:
-                now = time.perf_counter()
-                if now + (now - began) / sailed > deadline:
-                    break
-            obs, _ = env.reset(seed=seed + k)
-            policy.reset(seed + k)
-            done, first = False, True
-            while not done:
-                action = np.asarray(policy.predict(obs)[0], dtype=np.float32)
-                obs_list.append(np.array(obs, dtype=np.float32))
-                actions.append(action.reshape(env.action_space.shape))
-                starts.append(first)
-                obs, reward, terminated, truncated, _ = env.step(action)
-                rewards.append(float(reward))
-                done, first = terminated or truncated, False
-            sailed += 1
-            if deadline is not None and sailed == 1 and time.perf_counter() > deadline:
-                took = time.perf_counter() - began
-                raise BudgetTooShort(f"one {teacher} episode took {took:.0f} s, more than the "
-                                     f"warm start's share of the budget")
-        bar.close()
+        began = time.perf_counter()
+        with tqdm(range(episodes), desc=f"{teacher} demonstrations", unit="episode",
+                  disable=not progress) as bar:
+            for k in bar:                     # k episodes sailed so far
+                if deadline is not None and k:
+                    now = time.perf_counter()
+                    if now + (now - began) / k > deadline:
+                        break
+                obs, _ = env.reset(seed=seed + k)
+                policy.reset(seed + k)
+                done, first = False, True
+                while not done:
+                    action = np.asarray(policy.predict(obs)[0], dtype=np.float32)
+                    obs_list.append(np.array(obs, dtype=np.float32))
+                    actions.append(action.reshape(env.action_space.shape))
+                    starts.append(first)
+                    obs, reward, terminated, truncated, _ = env.step(action)
+                    rewards.append(float(reward))
+                    done, first = terminated or truncated, False
+                if deadline is not None and k == 0 and time.perf_counter() > deadline:
+                    took = time.perf_counter() - began
+                    raise BudgetTooShort(f"one {teacher} episode took {took:.0f} s, more than "
+                                         f"the warm start's share of the budget")
     finally:
         env.close()
-    demos = Demonstrations(obs_list, actions, rewards, starts)
-    demos.episodes = sailed
-    return demos
+    return Demonstrations(obs_list, actions, rewards, starts)
 
 
 def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> None:
