@@ -214,8 +214,8 @@ def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
 
 def record_commands(report: dict) -> list[str]:
     """The commands that made a record, in order: one per policy
-    (``recipes``), else those of its ``command`` (runs joined by
-    "` then `", as records kept them before the recipes)."""
+    (``recipes``), else those of its ``command`` (the runs joined by
+    "then", as records kept them before the recipes)."""
     recipes = report.get("recipes")
     if isinstance(recipes, dict) and recipes:
         return list(recipes.values())
