@@ -23,6 +23,12 @@ GENERATED = ("agents", "benchmarks", "crosscheck", "figures")
 FILE_LIMIT = 1_500_000
 #: the largest the trained agents' records may be together [bytes]: 3 MiB
 AGENTS_LIMIT = 3 * 2**20
+#: the largest the files of one trained agents' record (a leaderboard, an
+#: evaluation: the files of one folder under docs/agents) may be together
+#: [bytes]. Regenerated, the record
+#: adds new versions of these files to the history, each stored compressed,
+#: so a rerun grows the repository's pack by less than this.
+RUN_RECORD_LIMIT = 1_000_000
 SCRIPTS = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
 
 
@@ -103,6 +109,18 @@ def test_every_generated_file_is_in_a_record_and_small():
     assert not large, f"larger than {FILE_LIMIT} bytes: {large}"
     agents = sum(f.stat().st_size for f in files if (DOCS / "agents") in f.parents)
     assert agents <= AGENTS_LIMIT, f"docs/agents holds {agents} bytes"
+
+
+def test_a_regenerated_record_adds_less_than_a_megabyte():
+    folders: dict[Path, int] = {}
+    for f in generated_files():
+        if (DOCS / "agents") not in f.parents:
+            continue
+        folders[f.parent] = folders.get(f.parent, 0) + f.stat().st_size
+    assert (DOCS / "agents" / "leaderboard") in folders
+    large = {d.relative_to(ROOT).as_posix(): n for d, n in folders.items()
+             if n > RUN_RECORD_LIMIT}
+    assert not large, f"records of more than {RUN_RECORD_LIMIT} bytes: {large}"
 
 
 def test_the_check_of_commands_can_fail():
