@@ -198,6 +198,23 @@ def baseline_names(env_id: str | None = None) -> list[str]:
     return names
 
 
+#: how a policy of one's own is named, in the messages that list the valid names
+OWN_POLICY = "a policy of one's own as module:Class or path/to/file.py:Class"
+
+
+def check_policy_names(names, env_id: str, also: str = "") -> None:
+    """Raise ValueError unless every name of ``names`` is a baseline of
+    ``env_id`` or a policy by reference (``module:Class``); the message
+    names the unknown ones and lists the valid ones (then ``also``, another
+    kind of name the caller takes)."""
+    valid = baseline_names(env_id)
+    unknown = [n for n in names if n not in valid and not is_reference(n)]
+    if unknown:
+        what = "policy" if len(unknown) == 1 else "policies"
+        raise ValueError(f"unknown {what} {', '.join(map(repr, unknown))} for {env_id}; valid: "
+                         f"{', '.join(valid)}, or {OWN_POLICY}{also}")
+
+
 def make_baseline(name: str, env: gym.Env, seed: int = 0, **kwargs) -> Baseline:
     """The baseline ``name`` for ``env``: a generic one (:data:`GENERIC`),
     one of the environment's controllers (its facts' ``controllers``) or a

@@ -459,10 +459,9 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     returns the summaries per policy."""
     from iceenvs.facts import registered_ids
 
-    from .baselines import ConstantPolicy, baseline_names, make_baseline
+    from .baselines import ConstantPolicy, check_policy_names, make_baseline
     from .constant import format_action
     from .envs import make_checked_env, parse_key_values
-    from .policy import is_reference
     from .rollouts import policy_recipe
 
     parser = build_parser(prog)
@@ -508,12 +507,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         policies[f"{trained.args['algo']} policy"] = trained
         out = args.out or (args.run_dir if args.checkpoint is None
                            else args.run_dir / f"checkpoint_{args.checkpoint}")
-    valid = baseline_names(env_id)
-    unknown = [n for n in names if n not in valid and not is_reference(n)]
-    if unknown:
-        parser.error(f"unknown baselines {unknown} for {env_id}; valid baselines: "
-                     f"{', '.join(valid)}, or a policy of one's own as module:Class or "
-                     f"path/to/file.py:Class")
+    try:
+        check_policy_names(names, env_id)
+    except ValueError as err:
+        parser.error(str(err))
     try:
         env_kwargs = parse_key_values(args.env_kwargs, into=base_kwargs)
         env = make_checked_env(env_id, env_kwargs, seed=args.seed)

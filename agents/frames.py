@@ -374,7 +374,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
 
     from iceenvs.facts import env_spec
 
-    from .baselines import baseline_names
+    from .baselines import baseline_names, check_policy_names
     from .envs import make_checked_env, parse_key_values
     from .metrics import env_name
     from .policy import is_reference
@@ -415,18 +415,16 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
     env_id = args.env or (run.env_id if run is not None else DEFAULT_ENV)
     try:
         env_spec(env_id)
-        valid = baseline_names(env_id)
+        baseline_names(env_id)      # an id without facts is refused here
     except ValueError as err:
         parser.error(f"--env {env_id}: {err}")
     if "rgb_array" not in _render_modes(env_id):
         parser.error(f"{env_id} draws no frames: its render modes are "
                      f"{_render_modes(env_id) or 'none'}, and agents.frames needs 'rgb_array'")
     if run is None:
-        if not is_reference(policy) and policy not in valid:
-            parser.error(f"unknown policy {policy!r} for {env_id}; valid: {', '.join(valid)}, "
-                         f"or a policy of one's own as module:Class or path/to/file.py:Class, "
-                         f"or a run of agents.train as RUN_DIR or RUN_DIR@STEPS")
         try:
+            check_policy_names([policy], env_id,
+                               also=", or a run of agents.train as RUN_DIR or RUN_DIR@STEPS")
             recipe = policy_recipe(policy)
         except ValueError as err:
             parser.error(str(err))

@@ -463,7 +463,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
 
     import numba
 
-    from .baselines import baseline_names
+    from .baselines import check_policy_names
     from .envs import make_checked_env, parse_key_values
     from .planners import PLANNERS
     from .policy import is_reference
@@ -482,13 +482,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         parser.error("--concentrations is empty")
     if "concentration" in env_kwargs:
         parser.error("--env-kwargs concentration: the concentrations come from --concentrations")
-    valid = baseline_names(args.env)
     policies = ([p.strip() for p in args.policies.split(",") if p.strip()]
                 if args.policies is not None else default_policies(args.env))
-    for name in policies:
-        if name not in valid and not is_reference(name):
-            parser.error(f"unknown policy {name!r} for {args.env}; valid: {', '.join(valid)}, "
-                         f"or a policy of one's own as module:Class or path/to/file.py:Class")
+    try:
+        check_policy_names(policies, args.env)
+    except ValueError as err:
+        parser.error(str(err))
     if "straight" not in policies:
         policies.insert(0, "straight")
     try:

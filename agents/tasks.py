@@ -267,7 +267,7 @@ def _own_policies(parser, text: str, ids) -> list[str]:
     """The names of ``--policies``, each a baseline of every environment of
     ``ids`` or a reference whose class imports; a bad one exits with the
     reason."""
-    from .baselines import baseline_names
+    from .baselines import check_policy_names
     from .policy import check_reference, is_reference
 
     names = [n.strip() for n in text.split(",") if n.strip()]
@@ -279,11 +279,10 @@ def _own_policies(parser, text: str, ids) -> list[str]:
                 parser.error(f"--policies: {err}")
             continue
         for env in ids:
-            valid = baseline_names(f"iceenvs/{env}")
-            if name not in valid:
-                parser.error(f"--policies: unknown policy {name!r} for {env}; valid: "
-                             f"{', '.join(valid)}, or a policy of one's own as module:Class "
-                             f"or path/to/file.py:Class")
+            try:
+                check_policy_names([name], f"iceenvs/{env}")
+            except ValueError as err:
+                parser.error(f"--policies: {err}")
     return names
 
 

@@ -118,3 +118,17 @@ def test_a_class_made_otherwise_is_refused(steer_module):
     with pytest.raises(ValueError, match=r"Steer\(env, seed=seed, \*\*kwargs\)"):
         make_policy("steer_policy:Steer?speed=3", env)
     env.close()
+
+
+def test_one_check_of_policy_names_for_every_command():
+    from agents.baselines import check_policy_names
+
+    check_policy_names(["straight", "lattice", "my_policy.py:Mine", "pkg.mod:Cls"],
+                       "iceenvs/ShipNavigation-v1")
+    with pytest.raises(ValueError, match=r"unknown policies 'swerve', 'zig' for "
+                                         r"iceenvs/ShipNavigation-v1; valid: .*lattice.*"
+                                         r"module:Class or path/to/file.py:Class, or a run"):
+        check_policy_names(["straight", "swerve", "zig"], "iceenvs/ShipNavigation-v1",
+                           also=", or a run")
+    with pytest.raises(ValueError, match="unknown policy 'lattice' for iceenvs/Convergence-v0"):
+        check_policy_names(["lattice"], "iceenvs/Convergence-v0")

@@ -121,7 +121,7 @@ def test_a_policy_of_ones_own_joins_the_row(tmp_path):
 @pytest.mark.parametrize("policies, words", [
     ("no_such_module:Policy", "no_such_module"),
     ("agents.baselines:NoSuchClass", "NoSuchClass"),
-    ("lattice", "unknown policy 'lattice' for ThicknessDistribution-v0"),
+    ("lattice", "unknown policy 'lattice' for iceenvs/ThicknessDistribution-v0"),
 ])
 def test_bad_policies_are_refused_before_anything_runs(tmp_path, capsys, policies, words):
     with pytest.raises(SystemExit) as exit_info:
