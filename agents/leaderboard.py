@@ -46,7 +46,7 @@ import numpy as np
 
 from physics.provenance import source_commit
 
-from .metrics import METRIC_UNITS
+from .metrics import METRIC_UNITS, significant
 
 __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "record_commands",
            "plot_board", "main",
@@ -178,7 +178,7 @@ def pooled_comparison(board: dict, reference: str = "straight") -> dict:
 def _paired_cell(c: dict | None, scale: float) -> str:
     if c is None:
         return "–"
-    return (f"{_num(c['diff'] / scale, 3)} ± {_num(c['sem'] / scale, 2)}"
+    return (_plus_minus(c["diff"] / scale, c["sem"] / scale)
             + (" (beats)" if c["beats"] else ""))
 
 
@@ -198,18 +198,16 @@ def route_choice_pays(summary: dict, planners) -> dict:
     return verdict
 
 
-def _num(x: float, digits: int) -> str:
-    """``x`` to ``digits`` significant digits, without an exponent."""
-    if x == 0 or not math.isfinite(x):
-        return f"{x:g}"
-    decimals = max(digits - 1 - int(math.floor(math.log10(abs(x)))), 0)
-    return f"{x:.{decimals}f}"
-
-
 def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
     if not s or not math.isfinite(s.get("mean", math.nan)):
         return "–"
-    return f"{_num(s['mean'] / scale, digits)} ± {_num(s['sem'] / scale, 2)}"
+    return _plus_minus(s["mean"] / scale, s["sem"] / scale, digits)
+
+
+def _plus_minus(value: float, error: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant figures and ``error`` to two,
+    neither with its integer part rounded."""
+    return f"{significant(value, digits, whole=True)} ± {significant(error, 2, whole=True)}"
 
 
 def record_commands(report: dict) -> list[str]:

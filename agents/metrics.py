@@ -176,14 +176,17 @@ def _fixed(x: float, decimals: int) -> str:
     return f"{x:.{decimals}f}"
 
 
-def significant(x: float, digits: int = 3) -> str:
+def significant(x: float, digits: int = 3, whole: bool = False) -> str:
     """``x`` to ``digits`` significant figures, without an exponent
-    (``218600000.0`` → ``"219000000"``, ``0.0001234`` → ``"0.000123"``)."""
+    (``218600000.0`` → ``"219000000"``, ``0.0001234`` → ``"0.000123"``);
+    with ``whole``, the integer part is never rounded (``1234.5`` →
+    ``"1234"``)."""
     if not math.isfinite(x):
         return "–" if math.isnan(x) else str(x)
     if x == 0:
         return "0"
-    return _fixed(x, _decimals(x, digits))
+    decimals = _decimals(x, digits)
+    return _fixed(x, max(decimals, 0) if whole else decimals)
 
 
 def format_pm(mean: float, error: float, digits: int = 3, error_digits: int = 2) -> str:

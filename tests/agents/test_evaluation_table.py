@@ -248,3 +248,12 @@ def test_a_fixed_concentration_plays_the_leaderboards_fields(tmp_path):
     assert "concentration = 0.3" in table
     assert ("These episodes are its field 0 at A = 0.3 of a leaderboard run with "
             "`--env-kwargs goal_distance=200.0 length=500.0`." in table)
+
+
+def test_significant_keeps_the_integer_part_when_asked_to():
+    from agents.metrics import significant
+
+    assert significant(1234.5, 3) == "1230"
+    assert significant(1234.5, 3, whole=True) == "1234"
+    assert significant(0.012345, 3, whole=True) == "0.0123"
+    assert significant(-98.76, 2, whole=True) == "-99"
