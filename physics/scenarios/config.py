@@ -222,9 +222,14 @@ def bundled_configs() -> dict[str, Path]:
     return {p.stem: p for p in sorted(CONFIG_DIR.glob("*.yaml"))}
 
 
+#: words that YAML 1.1 reads as booleans but that name choices here
+#: (``--set wind=off``): they stay text; ``true`` and ``false`` are booleans
+_WORDS = {"on", "off", "yes", "no", "y", "n"}
+
+
 def parse_set(items) -> dict[str, Any]:
-    """``["key=value", ...]`` (values in YAML syntax: 0.5, true, [0.6, 0.7])
-    → dict."""
+    """``["key=value", ...]`` (values in YAML syntax: 0.5, true, [0.6, 0.7];
+    ``on``, ``off``, ``yes`` and ``no`` stay words) → dict."""
     out = {}
     for item in items or ():
         if "=" not in item:
@@ -233,6 +238,9 @@ def parse_set(items) -> dict[str, Any]:
         key = key.strip()
         if not key:
             raise ValueError(f"--set expects key=value, got {item!r}")
+        if text.strip().lower() in _WORDS:
+            out[key] = text.strip()
+            continue
         yaml = _yaml()
         try:
             out[key] = yaml.safe_load(text)

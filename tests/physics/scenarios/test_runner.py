@@ -163,6 +163,13 @@ def test_set_values_are_yaml():
         parse_set(["novalue"])
 
 
+def test_choice_words_that_yaml_reads_as_booleans_stay_words():
+    """``--set wind=off`` names the choice "off" of ship-transit's wind; YAML
+    1.1 would read it as False, which no choice is."""
+    assert parse_set(["wind=off", "w=On", "c=false"]) == dict(wind="off", w="On", c=False)
+    assert find_config("ship-transit").resolve(parse_set(["wind=off"]))["wind"] == "off"
+
+
 def test_broken_scenario_file_is_reported(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: x\nparameters: {a: {default: [1, }\n")
