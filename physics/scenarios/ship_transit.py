@@ -94,6 +94,7 @@ from ..floes import (FloeField, PlacementError, max_overlap, place_floes, power_
 from ..forcing import steady_drift
 from ..hertz import HertzSimulation, hertz_time_step, hull_contact_time
 from ..hull_contact import LOG_COLUMNS
+from ..ice_resistance import power_law_fit
 from ..params import HERMAN2013
 from ..ice_fields import TransitBox
 from ..ship import psv_ship
@@ -341,19 +342,6 @@ def autopilot(ship_state, heading: float) -> float:
 # ---------------------------------------------------------------------------
 # analysis helpers
 # ---------------------------------------------------------------------------
-
-def power_law_fit(x, y) -> tuple[float, float]:
-    """(a, b) of y = a x^b by least squares of ln y against ln x over the
-    finite, positive points; NaNs with fewer than two distinct x."""
-    x = np.asarray(x, dtype=float).ravel()
-    y = np.asarray(y, dtype=float).ravel()
-    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
-    x, y = x[ok], y[ok]
-    if np.unique(x).size < 2:
-        return math.nan, math.nan
-    b, ln_a = np.polyfit(np.log(x), np.log(y), 1)
-    return float(math.exp(ln_a)), float(b)
-
 
 def beset_concentration(concentration, beset) -> float:
     """The lowest concentration at which the ship was beset (NaN: never)."""
