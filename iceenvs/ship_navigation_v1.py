@@ -219,6 +219,17 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     penalty. The cap of 10 (2.5·10⁶ N s in a step) keeps a step's reward
     bounded and still counts a hit on a large floe.
 
+    ## Ice loads
+    The hull meets the floes through Hertz contacts in the plane, with
+    friction along it: the loads, and the impulse J of the reward, are the
+    momentum the ship gives the floes it pushes aside, the inertial part of
+    a ship's resistance in pack ice. A plane model of rigid floes leaves out
+    their breaking, their turning and submerging under the hull, their
+    added mass and ventilation: the speed-independent term of Zuev's law,
+    which holds most of it at low speed. The `ship-resistance` scenario sets
+    the loads beside the field's laws (the Validation page, "Ship resistance
+    beside the field's laws").
+
     ## Starting State
     A new field every episode (seeded). The ship at (50 m, 100 m),
     heading +x, at `speed`; the ice from 150 m to the goal line at 1150 m.

@@ -283,3 +283,7 @@ def disc_hull_contact(cx, cy, radius, vx, vy):
 PSV_HULL = Hull.pointed(76.2, 18.0, name="platform supply vessel")
 #: 1:45 model-scale hull (1.84 m × 0.38 m), the same plan form.
 MODEL_HULL = Hull.pointed(1.84, 0.38, name="1:45 model")
+
+#: a research icebreaker of Araon's main dimensions (110 m × 19 m), with the
+#: pointed waterline of the other hulls, not Araon's own lines
+RESEARCH_HULL = Hull.pointed(110.0, 19.0, name="research icebreaker")

@@ -47,7 +47,7 @@ import numpy as np
 
 from . import hull_contact as HC
 from .checks import check_range
-from .hull import MODEL_HULL, PSV_HULL, Hull
+from .hull import MODEL_HULL, PSV_HULL, RESEARCH_HULL, Hull
 # the transit channel and its fields live with the other ice fields; kept importable here
 from .ice_fields import FLOE_SIZE_LAWS, TransitBox, covering_diameters, transit_field  # noqa: F401
 
@@ -238,6 +238,15 @@ def psv_ship(mode: str = "prescribed", *, draft: float = 6.0, **kwargs) -> Ship:
     most 500 kN (about 5.5 m/s in open water) and a yaw moment of at most
     9.5 MN m (0.025 rad/s steady turn). Keywords go to :class:`Ship`."""
     return _scaled_ship(PSV_HULL, 6.0e6, draft, mode, kwargs)
+
+
+def research_ship(mode: str = "prescribed", *, draft: float = 6.8, **kwargs) -> Ship:
+    """A research icebreaker of Araon's main dimensions:
+    :data:`~physics.hull.RESEARCH_HULL` (110 m × 19 m, the pointed
+    waterline of :func:`psv_ship` stretched to them, not Araon's lines),
+    7.5·10⁶ kg, draft 6.8 m, the same non-dimensional hydrodynamics and
+    bounds as :func:`psv_ship`. Keywords go to :class:`Ship`."""
+    return _scaled_ship(RESEARCH_HULL, 7.5e6, draft, mode, kwargs)
 
 
 def model_ship(mode: str = "prescribed", *, draft: float = 0.13, **kwargs) -> Ship:

@@ -31,6 +31,8 @@ RUN_SHARE = 0.60
 #: modules run as ``python -m MODULE`` whose ``build_parser()`` reads a command line
 PARSED_MODULES = ("agents.train", "agents.evaluate", "agents.leaderboard", "agents.frames",
                   "agents.constant")
+#: words that end a command on a shell line (a redirection, a pipe, a list)
+SHELL_OPERATORS = {">", ">>", "|", "&&", "||", ";", "2>"}
 PROJECT_PACKAGES = ("agents", "iceenvs", "physics", "benchmarks", "seaice_gym")
 _COMMAND = re.compile(r"^(?:\.venv/bin/)?(ice-scenarios|python -m [\w.]+)\b")
 
@@ -69,6 +71,8 @@ def block_commands(block: Block) -> list[str]:
         if not _COMMAND.match(line) or "$(" in line:
             continue
         words = shlex.split(re.sub(r"\$\w+", "WORD", line), comments=True)
+        cut = [k for k, w in enumerate(words) if w in SHELL_OPERATORS]
+        words = words[:cut[0]] if cut else words           # the command, not what follows it
         if words[0].startswith(".venv/bin/"):
             words[0] = words[0].removeprefix(".venv/bin/")
         out.append(shlex.join(words))

@@ -10,8 +10,8 @@ Command line: ``ice-scenarios`` (or ``python -m physics.scenarios``); see
 Layout: ``configs/*.yaml`` the scenario files (parameters, ranges, the
 ``--quick`` form); ``config.py`` their parsing and checks; ``experiment.py``
 the interface and registry of experiments, and how to add one; ``herman2013.py``,
-``herman2011.py``, ``godlovitch.py``, ``ship_transit.py`` the experiments; ``recorder.py`` time
-series, snapshots and checkpoints; ``checkpoint.py`` the checkpoint file
+``herman2011.py``, ``godlovitch.py``, ``ship_transit.py``, ``ship_resistance.py``
+the experiments; ``recorder.py`` time series, snapshots and checkpoints; ``checkpoint.py`` the checkpoint file
 format (NumPy arrays and YAML, no pickle); ``jobs.py`` one simulation of a
 run; ``runner.py`` ensembles, run directories,
 NetCDF; ``plots.py`` shared figure helpers; ``cli.py`` the command line.

@@ -96,8 +96,8 @@ from ..hertz import HertzSimulation, hertz_time_step, hull_contact_time
 from ..hull_contact import LOG_COLUMNS
 from ..ice_resistance import power_law_fit
 from ..params import HERMAN2013
-from ..ice_fields import TransitBox
-from ..ship import psv_ship
+from ..ice_fields import AUTO_ICENAV_SIZES, TransitBox, covering_areas
+from ..ship import psv_ship, research_ship
 from . import plots
 from .experiment import Experiment, register
 from .herman2013 import advance, contact_law
@@ -187,12 +187,21 @@ RESULT_VARIABLES = {
 # the ice, the ship and the simulation
 # ---------------------------------------------------------------------------
 
+#: the hulls a run can sail (the ``hull`` parameter; ship-transit sails the PSV)
+SHIPS = {"psv": psv_ship, "research": research_ship}
+
+
 def floe_diameters(p: dict, target_area: float, rng: np.random.Generator) -> np.ndarray:
     """Diameters [m] in random order whose discs cover ``target_area``
     (the last one dropped if it would overshoot it): power-law (exponent of
     Herman 2013, mean ``mean_diameter``, d_max/d_min = ``size_ratio``) or
     log-normal (median ``lognormal_median``, σ of ln d ``lognormal_sigma``,
-    clipped to 0.2–5 times the median as in :func:`physics.ice_fields.transit_field`)."""
+    clipped to 0.2–5 times the median as in :func:`physics.ice_fields.transit_field`)
+    or AUTO-IceNav's (``"auto_icenav"``: :data:`physics.ice_fields.AUTO_ICENAV_SIZES`,
+    the draws in order up to the first that covers the area)."""
+    if p["sizes"] == "auto_icenav":
+        # AUTO-IceNav's log-normal masses, radii clipped to 2-50 m
+        return 2.0 * np.sqrt(covering_areas(AUTO_ICENAV_SIZES, target_area, rng) / math.pi)
     if p["sizes"] == "power":
         mean_area = 0.25 * math.pi * p["mean_diameter"] ** 2
         n = max(int(2.0 * target_area / mean_area), 16)
@@ -259,7 +268,7 @@ def pack_ice(p: dict, concentration: float, seed: int, walls: bool = False):
                 f"radius): a band with open water around it cannot hold it; choose a lower "
                 f"concentration (the fields of this scenario jam near 0.87)")
         pos = np.mod(packed.positions, [band, width])
-    bow, stern = hull_extent(psv_ship().hull)
+    bow, stern = hull_extent(SHIPS[p.get("hull", "psv")]().hull)
     x_ship = STERN_CLEARANCE + stern
     x0 = x_ship + bow + LEAD_IN
     x1 = x0 + band
@@ -311,8 +320,9 @@ def build_simulation(p: dict, case: dict, seed: int, *, skip_resting: bool = Tru
              0.1 * hull_contact_time(field.radii, field.thickness, field.density, contact,
                                      impact))
     dynamic = bool(case["dynamic"])
-    ship = psv_ship("dynamic" if dynamic else "prescribed", position=(geo["x_ship"], geo["y_ship"]),
-                    speed=v, friction=p["hull_friction"], max_speed=max(10.0, v))
+    ship = SHIPS[p.get("hull", "psv")]("dynamic" if dynamic else "prescribed",
+                                       position=(geo["x_ship"], geo["y_ship"]), speed=v,
+                                       friction=p["hull_friction"], max_speed=max(10.0, v))
     thrust = open_water_thrust(ship, v) if dynamic else 0.0
     if thrust > ship.max_thrust:
         raise ValueError(f"speed {v:g} m/s needs a thrust of {thrust / 1e3:.0f} kN in open "
