@@ -19,6 +19,7 @@ import numpy as np
 
 from ..ice_resistance import (GRAVITY, huang_resistance, power_law_fit, zuev_coefficient,
                               zuev_resistance, zuev_terms)
+from ..ice_fields import AUTO_ICENAV_SIZES
 from ..params import HERMAN2013
 from . import plots
 from .experiment import register
@@ -69,6 +70,12 @@ class ShipResistance(ShipTransit):
     case_label = "concentration"
 
     def cases(self, p: dict) -> list[dict]:
+        widest = 4.0 * AUTO_ICENAV_SIZES.max_radius
+        if "auto_icenav" in SIZE_LAWS[p["size_laws"]] and p["channel_width"] <= widest:
+            raise ValueError(f"channel_width = {p['channel_width']:g} m cannot hold AUTO-IceNav's "
+                             f"largest floes (radius {AUTO_ICENAV_SIZES.max_radius:g} m) across "
+                             f"a periodic channel: give more than {widest:g} m, or "
+                             f"size_laws = brash")
         hulls = [HULLS["both"].index(h) for h in HULLS[p["hulls"]]]
         laws = [SIZE_LAWS["both"].index(s) for s in SIZE_LAWS[p["size_laws"]]]
         return [{"hull": h, "size_law": s, "concentration": float(c),

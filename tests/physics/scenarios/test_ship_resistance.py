@@ -22,7 +22,7 @@ from physics.scenarios.ship_resistance import (ShipResistance, field_seed, froud
 
 # one hull, one size law, concentrations 0.2 and 0.6, Fr_h 0.25 and 1, two fields
 SMALL = dict(hulls="psv", size_laws="auto_icenav", concentrations=[0.2, 0.6],
-             froude_numbers=[0.25, 1.0], fields=2, band_length=200.0, channel_width=200.0,
+             froude_numbers=[0.25, 1.0], fields=2, band_length=200.0, channel_width=210.0,
              output_interval=2.0)
 
 
@@ -87,3 +87,5 @@ def test_cases_fields_and_parameters():
     assert brash["hull"] == "research" and brash["sizes"] == "lognormal"
     assert brash["lognormal_median"] == p["brash_median"]
     assert transit_parameters(p, {"hull": 0, "size_law": 0})["sizes"] == "auto_icenav"
+    with pytest.raises(ValueError, match="cannot hold AUTO-IceNav's largest floes"):
+        ShipResistance().cases(dict(p, channel_width=200.0))
