@@ -122,8 +122,9 @@ class ShipResistance(ShipTransit):
                          f"ρ g B h² 0.5 Fr_h² (2 − S) S² (median, range)", _ratio(rq),
                          "1 if the model's resistance is the inertial part of Zuev's"))
             rel = g["err"] / g["mean"]
-            rows.append((f"{label}: standard error of a point over its {g['fields']} fields "
-                         f"(median, largest), of its mean", _ratio(rel, percent=True), "—"))
+            rows.append((f"{label}: standard error of a point's mean over its fields "
+                         f"({g['fields']}), as a share of the mean (median, largest)",
+                         _ratio(rel, percent=True), "—"))
         return rows
 
     # -- figures ------------------------------------------------------------
