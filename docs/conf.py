@@ -31,7 +31,7 @@ root_doc = "index"
 # page renders the JSON records, the Cross-checks page includes the report.
 exclude_patterns = [
     "_build", "_generated/cache", "_generated/include", "benchmarks/**", "crosscheck/report.md", "agents/**",
-    "examples/**", "Thumbs.db", ".DS_Store",
+    "figures/**/*.md", "examples/**", "Thumbs.db", ".DS_Store",
 ]
 
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]

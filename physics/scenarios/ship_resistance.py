@@ -164,7 +164,7 @@ class ShipResistance(ShipTransit):
                    title="the same points in the form of Zuev's law")
             ax.legend(fontsize=7)
         fig.tight_layout()
-        return [plots.savefig(fig, Path(out_dir) / "resistance_laws.png")]
+        return [plots.savefig(fig, Path(out_dir) / "resistance_laws.png", palette=True)]
 
 
 def resistance_points(ds) -> list[dict]:
