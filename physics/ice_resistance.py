@@ -18,15 +18,14 @@ concentration is a fraction in [0, 1].
   quoted with S a fraction. The sources at hand give no range of validity
   beyond 0 ≤ S ≤ 1 and speeds of ships in ice (Fr_h up to about 1).
 * :func:`huang_resistance`: Huang et al.'s fit to coupled CFD–DEM
-  simulations of a ship in floating floes (Huang, Tuhkuri, Igrec, Li,
-  Stagonas, Toffoli, Cardiff and Thomas, "Ship resistance when operating in
-  floating ice floes: a combined CFD&DEM approach", Marine Structures 74,
-  102817, 2020; and the empirical equation derived from it, Marine
-  Structures, 2021): R = C_R ρ_i B h v² C^1.5 / Fn, with Fn = v / √(g L) the
-  ship's Froude number on its length and C_R ≈ 0.2 for the hull they
-  simulated. Because R ∝ v² / Fn, it grows linearly with v. Their
-  simulations span concentrations of about 0.4 to 0.9 and low speeds
-  (Fn below about 0.2).
+  simulations of a ship in floating floes (Huang et al., "Ship resistance
+  when operating in floating ice floes: a combined CFD&DEM approach",
+  Marine Structures, 2020, and the empirical equation derived from it):
+  R = C_R ρ_i B h v² C^1.5 / Fn, with Fn = v / √(g L) the ship's Froude
+  number on its length and C_R ≈ 0.2 for the hull they simulated, as
+  AUTO-IceNav's code uses it. Because R ∝ v² / Fn, it grows linearly with
+  v. The form and C_R are taken from that code; the papers' own range of
+  validity could not be read here and is not stated.
 
 What the laws hold and the model does not: Zuev's constant term
 (0.13 B/h, speed-independent) stands for breaking and submerging floes
