@@ -22,6 +22,7 @@ from ..ice_resistance import (GRAVITY, huang_resistance, power_law_fit, zuev_coe
 from ..ice_fields import AUTO_ICENAV_SIZES
 from ..params import HERMAN2013
 from . import plots
+from .config import bundled_configs, load_config
 from .experiment import register
 from .ship_transit import SHIPS, ShipTransit
 
@@ -50,11 +51,12 @@ def field_seed(seed: int, field: int) -> int:
 
 
 def transit_parameters(p: dict, case: dict) -> dict:
-    """The ``ship-transit`` parameters of one case: its hull, its floe-size
-    law, the prescribed mode and no wind."""
+    """The ``ship-transit`` parameters of one case: that scenario's defaults,
+    then this one's parameters, its hull, its floe-size law and no wind."""
     hull = HULLS["both"][int(case["hull"])]
     law = SIZE_LAWS["both"][int(case["size_law"])]
-    q = dict(p, hull=hull, wind_speed=0.0, beset_speed=0.05, beset_time=30.0, snapshot_at=0.6)
+    transit = load_config(bundled_configs()["ship-transit"]).defaults()
+    q = dict(transit, **p, hull=hull, wind_speed=0.0)
     if law == "brash":
         q.update(sizes="lognormal", lognormal_median=p["brash_median"],
                  lognormal_sigma=BRASH_SIGMA)
