@@ -43,9 +43,7 @@ import math
 import numpy as np
 
 from .checks import check_range
-
-#: the gravitational acceleration [m/s²]
-GRAVITY = 9.81
+from .params import GRAVITY
 
 #: Zuev's coefficients of B/h, Fr_h and Fr_h²
 ZUEV_COEFFICIENTS = (0.13, 1.3, 0.5)

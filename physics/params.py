@@ -28,7 +28,11 @@ from .checks import NONNEG, POSITIVE, check_fields, check_range
 from .floes import make_floe_field
 from .forcing import Forcing, ForcingParams
 
+#: the gravitational acceleration [m/s²]
+GRAVITY = 9.81
+
 __all__ = [
+    "GRAVITY",
     "ContactParams",
     "PaperPreset",
     "ItdPreset",

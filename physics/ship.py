@@ -48,6 +48,7 @@ import numpy as np
 from . import hull_contact as HC
 from .checks import check_range
 from .hull import MODEL_HULL, PSV_HULL, RESEARCH_HULL, Hull
+from .params import GRAVITY
 # the transit channel and its fields live with the other ice fields; kept importable here
 from .ice_fields import FLOE_SIZE_LAWS, TransitBox, covering_diameters, transit_field  # noqa: F401
 
@@ -60,7 +61,6 @@ __all__ = ["Ship", "ShipHydrodynamics", "ShipState", "ShipLoads", "psv_ship", "m
 #: 0.0308 L²).
 FOSSEN_SUPPLY = {"mass": (1.1274, 1.8902, 0.1278), "damping": (0.0358, 0.1183, 0.0308)}
 
-_GRAVITY = 9.81
 _WATER_DENSITY = 1025.0
 
 
@@ -113,7 +113,7 @@ class ShipHydrodynamics:
         and ``½ ρ T L⁴/32 r²``.
         """
         m_bis, d_bis = FOSSEN_SUPPLY["mass"], FOSSEN_SUPPLY["damping"]
-        root = math.sqrt(_GRAVITY / length)
+        root = math.sqrt(GRAVITY / length)
         yaw_total = m_bis[2] * mass * length ** 2
         added = ((m_bis[0] - 1.0) * mass, (m_bis[1] - 1.0) * mass,
                  max(yaw_total - yaw_inertia, 0.0))
@@ -261,8 +261,8 @@ def _scaled_ship(hull, mass, draft, mode, kwargs):
     hydro = kwargs.pop("hydrodynamics", None) or ShipHydrodynamics.fossen_supply(
         mass, hull.length, inertia, draft)
     # bounds as fractions of m g and m g L (those of the full-scale ship)
-    kwargs.setdefault("max_thrust", 0.0085 * mass * _GRAVITY)
-    kwargs.setdefault("max_yaw_moment", 0.0021 * mass * _GRAVITY * hull.length)
+    kwargs.setdefault("max_thrust", 0.0085 * mass * GRAVITY)
+    kwargs.setdefault("max_yaw_moment", 0.0021 * mass * GRAVITY * hull.length)
     return Ship(hull, mass, inertia, hydro, mode, **kwargs)
 
 
