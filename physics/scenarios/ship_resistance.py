@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..ice_resistance import (GRAVITY, huang_resistance, power_law_fit, zuev_coefficient,
-                              zuev_resistance, zuev_terms)
+from ..ice_resistance import (HUANG_COEFFICIENT, huang_coefficient, huang_resistance,
+                              power_law_fit, zuev_coefficient, zuev_resistance, zuev_terms)
 from ..ice_fields import AUTO_ICENAV_SIZES
-from ..params import HERMAN2013
+from ..params import GRAVITY, HERMAN2013
 from . import plots
 from .config import bundled_configs, load_config
 from .experiment import register
@@ -32,6 +32,11 @@ SIZE_LAWS = {"both": ("auto_icenav", "brash"), "auto_icenav": ("auto_icenav",),
              "brash": ("brash",)}
 #: σ of ln d of the brash floes
 BRASH_SIGMA = 0.4
+#: the ShipNavigation tasks' Froude numbers on the ice thickness (2 m/s on
+#: 1.2-1.5 m of ice: 0.52-0.58) and drawn concentrations (v0: 0.2-0.6, v1:
+#: 0.2-0.5): the summary's row for the points inside both ranges
+TASK_FROUDE = (0.4, 0.7)
+TASK_CONCENTRATIONS = (0.2, 0.6)
 
 
 def ice_thickness() -> float:
@@ -123,6 +128,14 @@ class ShipResistance(ShipTransit):
             rows.append((f"{label}: R / the inertial term of Zuev's law alone, "
                          f"ρ g B h² 0.5 Fr_h² (2 − S) S² (median, range)", _ratio(rq),
                          "1 if the model's resistance is the inertial part of Zuev's"))
+            task = ((g["concentration"] >= TASK_CONCENTRATIONS[0])
+                    & (g["concentration"] <= TASK_CONCENTRATIONS[1]))[:, None] & (
+                (g["froude"] >= TASK_FROUDE[0]) & (g["froude"] <= TASK_FROUDE[1]))[None, :]
+            rows.append((f"{label}: at the ShipNavigation tasks' speeds and concentrations "
+                         f"(Fr_h {TASK_FROUDE[0]:g}–{TASK_FROUDE[1]:g}, "
+                         f"S {TASK_CONCENTRATIONS[0]:g}–{TASK_CONCENTRATIONS[1]:g}): "
+                         f"R / Zuev's R; R / its inertial term; R / Huang et al.'s R",
+                         "; ".join(_ratio(x[task]) for x in (rz, rq, rh)), "1; 1; 1"))
             rel = g["err"] / g["mean"]
             rows.append((f"{label}: standard error of a point's mean over its fields "
                          f"({g['fields']}), as a share of the mean (median, largest)",
@@ -134,39 +147,69 @@ class ShipResistance(ShipTransit):
         groups = resistance_points(ds)
         if not groups:
             return []
-        plt = plots.pyplot()
-        fig, axes = plt.subplots(len(groups), 2, figsize=(11, 4.0 * len(groups)),
-                                 squeeze=False)
-        for row, g in zip(axes, groups):
-            s, v = g["concentration"], g["speed"]
-            zuev, huang = law_values(g, s, v)
-            ax = row[0]
-            for j, f in enumerate(g["froude"]):
-                line = ax.errorbar(s, g["mean"][:, j] / 1e3, yerr=g["err"][:, j] / 1e3, fmt="o",
-                                   ms=4, capsize=2, label=f"Fr_h = {f:g} ({v[j]:.2g} m/s)")
-                colour = line[0].get_color()
-                ax.plot(s, zuev[:, j] / 1e3, "--", color=colour, lw=1)
-                ax.plot(s, huang[:, j] / 1e3, ":", color=colour, lw=1)
-            ax.set(xscale="log", yscale="log", xlabel="concentration S",
-                   ylabel="ice resistance [kN]",
-                   title=f"{g['hull']}, {g['law']} floes\n"
-                         f"points ± s.e.; Zuev's law dashed, Huang et al.'s dotted")
-            ax.legend(fontsize=7)
-            ax = row[1]
-            h, beam = ice_thickness(), g["beam"]
-            fr = np.linspace(0.0, max(g["froude"]) * 1.1, 50)
-            ax.plot(fr, 0.13 * beam / h + 1.3 * fr + 0.5 * fr ** 2, "k--", lw=1,
-                    label="Zuev: 0.13 B/h + 1.3 Fr_h + 0.5 Fr_h²")
-            ax.plot(fr[1:], 0.5 * fr[1:] ** 2, "k:", lw=1, label="its inertial term, 0.5 Fr_h²")
-            for i, c in enumerate(s):
-                cz = zuev_coefficient(g["mean"][i], c, beam, h, density=g["density"])
-                ax.plot(g["froude"], cz, "o-", ms=4, lw=1, label=f"S = {c:g}")
-            ax.set(yscale="log", xlabel="Fr_h = v / √(g h)",
-                   ylabel="R / (ρ g B h² (2 − S) S²)",
-                   title="the same points in the form of Zuev's law")
-            ax.legend(fontsize=7)
-        fig.tight_layout()
-        return [plots.savefig(fig, Path(out_dir) / "resistance_laws.png", palette=True)]
+        return [law_figure(groups, law, Path(out_dir)) for law in FIGURES]
+
+
+#: the figures of a run: law → (file name, title of the law's curves)
+FIGURES = {"zuev": ("resistance_zuev.png", "Zuev's law dashed, its inertial term dotted"),
+           "huang": ("resistance_huang.png", "Huang et al.'s law dashed")}
+
+
+def law_figure(groups: list[dict], law: str, out_dir: Path) -> Path:
+    """One law's figure (:data:`FIGURES`): a row per hull × size law, the
+    points against the law's resistance (left) and in its nondimensional
+    form (right)."""
+    plt = plots.pyplot()
+    name, curves = FIGURES[law]
+    fig, axes = plt.subplots(len(groups), 2, figsize=(11, 4.0 * len(groups)), squeeze=False)
+    for (left, right), g in zip(axes, groups):
+        s, v = g["concentration"], g["speed"]
+        zuev, huang = law_values(g, s, v)
+        lines = ([(zuev, "--"), (law_values(g, s, v, terms=("quadratic",))[0], ":")]
+                 if law == "zuev" else [(huang, "--")])
+        for j, f in enumerate(g["froude"]):
+            bars = left.errorbar(s, g["mean"][:, j] / 1e3, yerr=g["err"][:, j] / 1e3, fmt="o",
+                                 ms=4, capsize=2, label=f"Fr_h = {f:g} ({v[j]:.2g} m/s)")
+            for values, style in lines:
+                left.plot(s, values[:, j] / 1e3, style, color=bars[0].get_color(), lw=1)
+        left.set(xscale="log", yscale="log", xlabel="concentration S",
+                 ylabel="ice resistance [kN]",
+                 title=f"{g['hull']}, {g['law']} floes\npoints ± s.e.; {curves}")
+        left.legend(fontsize=7)
+        (_zuev_form if law == "zuev" else _huang_form)(right, g)
+    fig.tight_layout()
+    return plots.savefig(fig, out_dir / name, palette=True)
+
+
+def _zuev_form(ax, g: dict) -> None:
+    """The points of ``g`` as Zuev's coefficient against Fr_h, with the law."""
+    h, beam = ice_thickness(), g["beam"]
+    fr = np.linspace(0.0, max(g["froude"]) * 1.1, 50)
+    ax.plot(fr, 0.13 * beam / h + 1.3 * fr + 0.5 * fr ** 2, "k--", lw=1,
+            label="Zuev: 0.13 B/h + 1.3 Fr_h + 0.5 Fr_h²")
+    ax.plot(fr[1:], 0.5 * fr[1:] ** 2, "k:", lw=1, label="its inertial term, 0.5 Fr_h²")
+    for i, c in enumerate(g["concentration"]):
+        cz = zuev_coefficient(g["mean"][i], c, beam, h, density=g["density"])
+        ax.plot(g["froude"], cz, "o-", ms=4, lw=1, label=f"S = {c:g}")
+    ax.set(yscale="log", xlabel="Fr_h = v / √(g h)", ylabel="R / (ρ g B h² (2 − S) S²)",
+           title="the same points in the form of Zuev's law")
+    ax.legend(fontsize=7)
+
+
+def _huang_form(ax, g: dict) -> None:
+    """The points of ``g`` as Huang et al.'s coefficient against the
+    ship's Froude number on its length, with the law's C_R."""
+    h, beam, length = ice_thickness(), g["beam"], g["length"]
+    fn = g["speed"] / math.sqrt(GRAVITY * length)
+    ax.axhline(HUANG_COEFFICIENT, color="k", ls="--", lw=1,
+               label=f"Huang et al.: C_R = {HUANG_COEFFICIENT:g}")
+    for i, c in enumerate(g["concentration"]):
+        cr = huang_coefficient(g["mean"][i], g["speed"], c, beam, h, length,
+                               density=g["density"])
+        ax.plot(fn, cr, "o-", ms=4, lw=1, label=f"S = {c:g}")
+    ax.set(yscale="log", xlabel="Fn = v / √(g L)", ylabel="R Fn / (ρ B h v² S^1.5)",
+           title="the same points in the form of Huang et al.'s law")
+    ax.legend(fontsize=7)
 
 
 def resistance_points(ds) -> list[dict]:

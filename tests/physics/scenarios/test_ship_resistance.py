@@ -43,7 +43,7 @@ def test_the_sweep_writes_every_point(small_run):
     # prescribed: the ship holds the speed of its Froude number on the 1.5 m ice
     assert np.allclose(ds["speed_loss"].values, 0.0, atol=1e-9)
     assert froude_speed(1.0) == pytest.approx(math.sqrt(9.81 * 1.5), rel=1e-12)
-    assert [f.name for f in res.figures] == ["resistance_laws.png"]
+    assert [f.name for f in res.figures] == ["resistance_zuev.png", "resistance_huang.png"]
 
 
 def test_resistance_rises_with_concentration_and_speed(small_run):
@@ -70,6 +70,9 @@ def test_the_summary_sets_the_laws_beside_the_points(small_run):
     assert any("exponent b of R = a S^b" in q for q in quantities)
     assert any("exponent b of R = a v^b" in q for q in quantities)
     assert any("R / Zuev's R" in q for q in quantities)
+    # no point of this sweep is at the tasks' speeds (Fr_h 0.25 and 1 only)
+    (task,) = [r for r in rows if "ShipNavigation tasks'" in r[0]]
+    assert task[1] == "—; —; —"
     (g,) = resistance_points(ds)
     assert law_values(g, [0.5], [2.0])[0][0, 0] == pytest.approx(
         zuev_resistance(2.0, 0.5, 18.0, 1.5), rel=1e-12)
