@@ -77,10 +77,29 @@ from .ship_measures import (METRICS, SUM_COLUMNS, ShipBatch, ShipVectorEnv, as_m
 from .ship_sensors import occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
+           "ICE_LOADS",
            "METRICS", "SLOW_TIME"]
 
 #: floe-size presets: (``sizes`` of :func:`physics.ice_fields.transit_field`,
 #: log-normal (median diameter [m], σ of ln d))
+#: the "Ice loads" section of the ShipNavigation tasks' docs: what the
+#: loads on the hull hold, and where they are set beside the field's laws
+ICE_LOADS = """The hull meets the floes through Hertz contacts in the plane, with
+    friction along it: the loads, and the impulse J of the reward, are the
+    momentum the ship gives the floes it pushes aside, the inertial part of
+    a ship's resistance in pack ice, with the water drag on the floes it
+    sets moving. A plane model of rigid floes leaves out their breaking,
+    their turning and submerging under the hull, their added mass and
+    ventilation: the speed-independent term of Zuev's law, which holds most
+    of the resistance at low speed. The `ship-resistance` scenario sets the
+    loads beside Zuev's law and Huang et al.'s fit (the Validation page,
+    "Ship resistance beside the field's laws"); its table's rows "at the
+    ShipNavigation tasks' speeds and concentrations" give how far they are
+    from each law at the tasks' speed (Froude number on the ice thickness
+    0.5-0.6) and drawn concentrations, for both hulls and floe-size laws.
+    No measured resistance in floating, unbroken floes is compared yet."""
+
+
 FLOE_SIZES = {
     "pack": ("lognormal", (20.0, 0.5)),
     "brash": ("lognormal", (6.0, 0.5)),

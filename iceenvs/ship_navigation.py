@@ -13,7 +13,8 @@ from physics.forcing import steady_drift
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
-from .ship_env import CONTROLS, FLOE_SIZES, SLOW_TIME, ShipEnv, ship_facts, ship_features
+from .ship_env import (CONTROLS, FLOE_SIZES, ICE_LOADS, SLOW_TIME, ShipEnv, ship_facts,
+                       ship_features)
 from .vector import vector_class
 
 __all__ = ["ShipNavigationEnv", "ShipNavigationVectorEnv", "MAX_EPISODE_STEPS"]
@@ -151,6 +152,9 @@ class ShipNavigationEnv(ShipEnv):
     when outside the channel, + `goal_bonus` (10) on the step that reaches
     the goal. A failure gives −`failure_penalty` (−10).
     `env.unwrapped.reward_bounds` gives the bounds of one step.
+
+    ## Ice loads
+    {ICE_LOADS}
 
     ## Starting State
     Floes placed at random (seeded) at the drawn concentration with the

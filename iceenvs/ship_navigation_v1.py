@@ -14,7 +14,7 @@ from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, TransitBox, navigation_f
 from .base import TaskParameter, choice, interval, number, revised_task, task_table
 from .observations import Feature, feature_table
 from .ship_controllers import SwathPlanner
-from .ship_env import CONTROLS, ship_features
+from .ship_env import CONTROLS, ICE_LOADS, ship_features
 from .ship_sensors import (channel_room, check_bands, course_with_room, swath_courses,
                             swath_scan)
 from .ship_navigation import ShipNavigationEnv
@@ -220,15 +220,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
     bounded and still counts a hit on a large floe.
 
     ## Ice loads
-    The hull meets the floes through Hertz contacts in the plane, with
-    friction along it: the loads, and the impulse J of the reward, are the
-    momentum the ship gives the floes it pushes aside, the inertial part of
-    a ship's resistance in pack ice. A plane model of rigid floes leaves out
-    their breaking, their turning and submerging under the hull, their
-    added mass and ventilation: the speed-independent term of Zuev's law,
-    which holds most of it at low speed. The `ship-resistance` scenario sets
-    the loads beside the field's laws (the Validation page, "Ship resistance
-    beside the field's laws").
+    {ICE_LOADS}
 
     ## Starting State
     A new field every episode (seeded). The ship at (50 m, 100 m),

@@ -469,3 +469,25 @@ def test_draw_ship_paints_the_hull_and_rejects_bad_input():
         draw_ship(pic, (200.0, 100.0), hull[:2])
     with pytest.raises(ValueError, match="picture"):
         draw_ship(pic[..., 0], (200.0, 100.0), hull)
+
+
+@pytest.mark.parametrize("env_id", ["iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"])
+def test_the_resistance_records_task_row_covers_the_tasks(env_id):
+    """The ship-resistance summary's row for the ShipNavigation tasks
+    (physics.scenarios.ship_resistance.TASK_FROUDE, TASK_CONCENTRATIONS)
+    holds each task's default speed on its floes' thickness, as a Froude
+    number, and its range of drawn concentrations: the tasks' docs point to
+    that row to say how far their loads are from the laws."""
+    from physics.scenarios.ship_resistance import TASK_CONCENTRATIONS, TASK_FROUDE
+
+    env = gym.make(env_id, concentration=0.3)
+    try:
+        env.reset(seed=0)
+        u = env.unwrapped
+        thickness = float(np.median(u.sim.field.thickness))
+        froude = u.episode["speed"] / math.sqrt(9.81 * thickness)
+        assert TASK_FROUDE[0] <= froude <= TASK_FROUDE[1], froude
+        low, high = u.episode["concentration_range"]
+        assert TASK_CONCENTRATIONS[0] <= low and high <= TASK_CONCENTRATIONS[1]
+    finally:
+        env.close()
