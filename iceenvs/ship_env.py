@@ -77,11 +77,8 @@ from .ship_measures import (METRICS, SUM_COLUMNS, ShipBatch, ShipVectorEnv, as_m
 from .ship_sensors import occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
-           "ICE_LOADS",
-           "METRICS", "SLOW_TIME"]
+           "ICE_LOADS", "METRICS", "SLOW_TIME"]
 
-#: floe-size presets: (``sizes`` of :func:`physics.ice_fields.transit_field`,
-#: log-normal (median diameter [m], σ of ln d))
 #: the "Ice loads" section of the ShipNavigation tasks' docs: what the
 #: loads on the hull hold, and where they are set beside the field's laws
 ICE_LOADS = """The hull meets the floes through Hertz contacts in the plane, with
@@ -100,6 +97,8 @@ ICE_LOADS = """The hull meets the floes through Hertz contacts in the plane, wit
     No measured resistance in floating, unbroken floes is compared yet."""
 
 
+#: floe-size presets: (``sizes`` of :func:`physics.ice_fields.transit_field`,
+#: log-normal (median diameter [m], σ of ln d))
 FLOE_SIZES = {
     "pack": ("lognormal", (20.0, 0.5)),
     "brash": ("lognormal", (6.0, 0.5)),
