@@ -143,14 +143,33 @@ def resistance_exponents(law, speed, concentration, *, step=1e-4, **kwargs):
     return a, b
 
 
-def power_law_fit(x, y) -> tuple[float, float]:
-    """(a, b) of y = a x^b by least squares of ln y against ln x over the
-    finite, positive points; NaNs with fewer than two distinct x."""
+def _log_points(x, y) -> tuple[np.ndarray, np.ndarray]:
+    """(ln x, ln y) of the finite, positive points."""
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
     ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
-    x, y = x[ok], y[ok]
-    if np.unique(x).size < 2:
+    return np.log(x[ok]), np.log(y[ok])
+
+
+def power_law_fit(x, y) -> tuple[float, float]:
+    """(a, b) of y = a x^b by least squares of ln y against ln x over the
+    finite, positive points; NaNs with fewer than two distinct x."""
+    lx, ly = _log_points(x, y)
+    if np.unique(lx).size < 2:
         return math.nan, math.nan
-    b, ln_a = np.polyfit(np.log(x), np.log(y), 1)
+    b, ln_a = np.polyfit(lx, ly, 1)
     return float(math.exp(ln_a)), float(b)
+
+
+def power_law_exponent(x, y) -> tuple[float, float]:
+    """(b, its standard error) of the fit of :func:`power_law_fit`: the
+    residuals' variance over n − 2 divided by the spread Σ (ln x − mean)²,
+    so that it holds both the points' scatter and the curvature of ln y
+    against ln x; NaN error with fewer than three distinct x."""
+    lx, ly = _log_points(x, y)
+    b = power_law_fit(np.exp(lx), np.exp(ly))[1]
+    if np.unique(lx).size < 3:
+        return b, math.nan
+    dx = lx - lx.mean()
+    residuals = ly - ly.mean() - b * dx
+    return b, float(math.sqrt(np.sum(residuals ** 2) / (lx.size - 2) / np.sum(dx ** 2)))

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from ..ice_resistance import (HUANG_COEFFICIENT, huang_coefficient, huang_resistance,
-                              power_law_fit, zuev_coefficient, zuev_resistance, zuev_terms)
+                              power_law_exponent, power_law_fit, zuev_coefficient,
+                              zuev_resistance, zuev_terms)
 from ..ice_fields import AUTO_ICENAV_SIZES
 from ..params import GRAVITY, HERMAN2013
 from . import plots
@@ -104,18 +105,18 @@ class ShipResistance(ShipTransit):
         for g in resistance_points(ds):
             label = f"{g['hull']}, {g['law']}"
             s, v, r = g["concentration"], g["speed"], g["mean"]
-            b_s = [power_law_fit(s, r[:, j])[1] for j in range(v.size)]
-            b_v = [power_law_fit(v, r[i, :])[1] for i in range(s.size)]
+            b_s = [power_law_exponent(s, r[:, j]) for j in range(v.size)]
+            b_v = [power_law_exponent(v, r[i, :]) for i in range(s.size)]
             zuev, huang = law_values(g, s, v)
             zs = [power_law_fit(s, zuev[:, j])[1] for j in range(v.size)]
             zv = [power_law_fit(v, zuev[i, :])[1] for i in range(s.size)]
-            rows.append((f"{label}: exponent b of R = a S^b, at Fr_h = "
+            rows.append((f"{label}: exponent b of R = a S^b (± its standard error), at Fr_h = "
                          + ", ".join(f"{f:g}" for f in g["froude"]),
-                         _numbers(b_s),
+                         _exponents(b_s),
                          f"Zuev {_numbers(zs)}; Huang 1.5"))
-            rows.append((f"{label}: exponent b of R = a v^b, at S = "
+            rows.append((f"{label}: exponent b of R = a v^b (± its standard error), at S = "
                          + ", ".join(f"{x:g}" for x in s),
-                         _numbers(b_v), f"Zuev {_numbers(zv)}; Huang 1; momentum flux 2"))
+                         _exponents(b_v), f"Zuev {_numbers(zv)}; Huang 1; momentum flux 2"))
             with np.errstate(divide="ignore", invalid="ignore"):
                 rz, rh = r / zuev, r / huang
             rows.append((f"{label}: R / Zuev's R over the sweep (median, range)",
@@ -260,6 +261,12 @@ def law_values(g: dict, s, v, terms=None) -> tuple[np.ndarray, np.ndarray]:
 
 def _numbers(values) -> str:
     return ", ".join("—" if not np.isfinite(x) else f"{x:.2f}" for x in values)
+
+
+def _exponents(fits) -> str:
+    """Exponents ± their standard errors (:func:`power_law_exponent`)."""
+    return ", ".join("—" if not np.isfinite(b) else f"{b:.2f}" if not np.isfinite(se)
+                     else f"{b:.2f} ± {se:.2f}" for b, se in fits)
 
 
 def _ratio(values, percent: bool = False) -> str:

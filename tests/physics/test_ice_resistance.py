@@ -4,10 +4,11 @@ their errors. (The sources available here print no worked example of their
 own; the hand calculations are spelled out below.)"""
 import math
 
+import numpy as np
 import pytest
 
 from physics.ice_resistance import (HUANG_COEFFICIENT, huang_coefficient, huang_resistance,
-                                    momentum_flux_resistance, power_law_fit,
+                                    momentum_flux_resistance, power_law_exponent, power_law_fit,
                                     resistance_exponents, zuev_coefficient, zuev_resistance,
                                     zuev_terms)
 
@@ -81,3 +82,18 @@ def test_arrays_and_the_dilute_limit():
 def test_bad_input_is_refused(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_the_exponents_error_by_hand():
+    """ln x = 0, 1, 2 and ln y = 0, 1 + d, 2: the line through them has
+    slope 1 and intercept d/3, residuals (−d, 2d, −d)/3, so
+    s² = (6 d²/9) / (3 − 2) and se(b) = √(s² / 2) = |d|/√3."""
+    d = 0.3
+    x = np.exp([0.0, 1.0, 2.0])
+    b, se = power_law_exponent(x, np.exp([0.0, 1.0 + d, 2.0]))
+    assert b == pytest.approx(1.0, rel=1e-12)
+    assert se == pytest.approx(d / math.sqrt(3.0), rel=1e-12)
+    b, se = power_law_exponent(x, 3.0 * x ** 1.5)             # an exact power law
+    assert b == pytest.approx(1.5, rel=1e-12) and se < 1e-12
+    b, se = power_law_exponent([1.0, 2.0, np.nan], [1.0, 4.0, 9.0])
+    assert b == pytest.approx(2.0, rel=1e-12) and math.isnan(se)
