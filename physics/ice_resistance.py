@@ -167,9 +167,12 @@ def power_law_exponent(x, y) -> tuple[float, float]:
     so that it holds both the points' scatter and the curvature of ln y
     against ln x; NaN error with fewer than three distinct x."""
     lx, ly = _log_points(x, y)
-    b = power_law_fit(np.exp(lx), np.exp(ly))[1]
-    if np.unique(lx).size < 3:
-        return b, math.nan
-    dx = lx - lx.mean()
-    residuals = ly - ly.mean() - b * dx
-    return b, float(math.sqrt(np.sum(residuals ** 2) / (lx.size - 2) / np.sum(dx ** 2)))
+    distinct = np.unique(lx).size
+    if distinct < 2:
+        return math.nan, math.nan
+    b, ln_a = np.polyfit(lx, ly, 1)
+    if distinct < 3:
+        return float(b), math.nan
+    residuals = ly - ln_a - b * lx
+    return float(b), float(math.sqrt(np.sum(residuals ** 2) / (lx.size - 2)
+                                     / np.sum((lx - lx.mean()) ** 2)))
