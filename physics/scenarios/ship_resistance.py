@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..ice_resistance import (HUANG_COEFFICIENT, huang_coefficient, huang_resistance,
-                              power_law_exponent, power_law_fit, zuev_coefficient,
-                              zuev_resistance, zuev_terms)
+from ..ice_resistance import (HUANG_COEFFICIENT, ZUEV_COEFFICIENTS, huang_coefficient,
+                              huang_resistance, power_law_exponent, power_law_fit,
+                              zuev_coefficient, zuev_resistance, zuev_terms)
 from ..ice_fields import AUTO_ICENAV_SIZES
 from ..params import GRAVITY, HERMAN2013
 from . import plots
@@ -185,10 +185,11 @@ def law_figure(groups: list[dict], law: str, out_dir: Path) -> Path:
 def _zuev_form(ax, g: dict) -> None:
     """The points of ``g`` as Zuev's coefficient against Fr_h, with the law."""
     h, beam = ice_thickness(), g["beam"]
+    k1, k2, k3 = ZUEV_COEFFICIENTS
     fr = np.linspace(0.0, max(g["froude"]) * 1.1, 50)
-    ax.plot(fr, 0.13 * beam / h + 1.3 * fr + 0.5 * fr ** 2, "k--", lw=1,
-            label="Zuev: 0.13 B/h + 1.3 Fr_h + 0.5 Fr_h²")
-    ax.plot(fr[1:], 0.5 * fr[1:] ** 2, "k:", lw=1, label="its inertial term, 0.5 Fr_h²")
+    ax.plot(fr, k1 * beam / h + k2 * fr + k3 * fr ** 2, "k--", lw=1,
+            label=f"Zuev: {k1:g} B/h + {k2:g} Fr_h + {k3:g} Fr_h²")
+    ax.plot(fr[1:], k3 * fr[1:] ** 2, "k:", lw=1, label=f"its inertial term, {k3:g} Fr_h²")
     for i, c in enumerate(g["concentration"]):
         cz = zuev_coefficient(g["mean"][i], c, beam, h, density=g["density"])
         ax.plot(g["froude"], cz, "o-", ms=4, lw=1, label=f"S = {c:g}")
