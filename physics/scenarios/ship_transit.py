@@ -191,6 +191,11 @@ RESULT_VARIABLES = {
 SHIPS = {"psv": psv_ship, "research": research_ship}
 
 
+def transit_ship(p: dict):
+    """The ship builder of a run's ``hull`` (:data:`SHIPS`; the PSV without one)."""
+    return SHIPS[p.get("hull", "psv")]
+
+
 def floe_diameters(p: dict, target_area: float, rng: np.random.Generator) -> np.ndarray:
     """Diameters [m] in random order whose discs cover ``target_area``
     (the last one dropped if it would overshoot it): power-law (exponent of
@@ -268,7 +273,7 @@ def pack_ice(p: dict, concentration: float, seed: int, walls: bool = False):
                 f"radius): a band with open water around it cannot hold it; choose a lower "
                 f"concentration (the fields of this scenario jam near 0.87)")
         pos = np.mod(packed.positions, [band, width])
-    bow, stern = hull_extent(SHIPS[p.get("hull", "psv")]().hull)
+    bow, stern = hull_extent(transit_ship(p)().hull)
     x_ship = STERN_CLEARANCE + stern
     x0 = x_ship + bow + LEAD_IN
     x1 = x0 + band
@@ -320,9 +325,9 @@ def build_simulation(p: dict, case: dict, seed: int, *, skip_resting: bool = Tru
              0.1 * hull_contact_time(field.radii, field.thickness, field.density, contact,
                                      impact))
     dynamic = bool(case["dynamic"])
-    ship = SHIPS[p.get("hull", "psv")]("dynamic" if dynamic else "prescribed",
-                                       position=(geo["x_ship"], geo["y_ship"]), speed=v,
-                                       friction=p["hull_friction"], max_speed=max(10.0, v))
+    ship = transit_ship(p)("dynamic" if dynamic else "prescribed",
+                           position=(geo["x_ship"], geo["y_ship"]), speed=v,
+                           friction=p["hull_friction"], max_speed=max(10.0, v))
     thrust = open_water_thrust(ship, v) if dynamic else 0.0
     if thrust > ship.max_thrust:
         raise ValueError(f"speed {v:g} m/s needs a thrust of {thrust / 1e3:.0f} kN in open "
