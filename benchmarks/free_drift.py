@@ -1,11 +1,12 @@
-"""The free-drift step against the exact one: ``python -m benchmarks.free_drift``
-(``seaice bench free_drift``).
+"""The ship's steps against the exact one, an equivalence test:
+``python -m benchmarks.free_drift`` (``seaice bench free_drift``).
 
-    python -m benchmarks.free_drift [--parts statistics,speed] [--seeds 10]
+    python -m benchmarks.free_drift [--parts statistics,speed] [--seeds 40]
                                     [--concentrations 0.2,0.3,0.4,0.5]
-                                    [--policies straight,lattice] [--seed 10000]
+                                    [--policies straight,swath,lattice]
+                                    [--variants fast,soft-0.1,soft-0.01] [--seed 10000]
                                     [--workers 2] [--speed-seed 10001] [--rounds 3]
-                                    [--late-after 100]
+                                    [--late-after 100] [--fields PATH]
                                     [--quiet] [--quick] [--json PATH | --no-json]
 
 The episodes of the statistics are shared among ``--workers`` processes, each
@@ -15,6 +16,7 @@ one thread, before them.
 from __future__ import annotations
 
 import concurrent.futures
+import json
 import math
 import multiprocessing
 import os
@@ -27,61 +29,67 @@ import numpy as np
 from . import harness
 
 SUITE = "free_drift"
-TITLE = "Free drift: the fast serial step against the exact one"
+TITLE = "The ship's fast step and soft ice against the exact step: an equivalence test"
 DESCRIPTION = """
-What the free-drift step (`HertzSimulation(free_drift=True)`, the ship
-environments' `free_drift=True`) changes in the ship's episodes and what it
-saves. The floes that provably cannot touch anything during a window of
-steps drift in closed form, the others take the full contact step: the same
-physics up to rounding. Granular contact dynamics are chaotic, so an episode
-run with each step from the same seed follows the same trajectory for a
-while and then another one; only the statistics over many fields can agree,
-and they are what is compared here, against the exact step
-(`free_drift=False`, the default, which skips the floes at rest).
+Whether the cheaper steps of the ship environments give the exact step's
+episodes in distribution, and what they save. The **fast step**
+(`free_drift=True`) lets the floes that provably touch nothing during a
+window of steps drift in closed form: the same physics up to rounding.
+**Soft ice** (`stiffness_scale` 0.1 or 0.01, with the fast step) lowers
+Young's modulus, so that the Hertz time step grows as its −2/5 power: the
+impulse a binary collision exchanges does not depend on it, its peak force
+and duration do. Granular contact dynamics are chaotic, so an episode run
+with each step from the same field follows the exact one for a while and
+then another trajectory: only statistics over many fields can agree.
 
-* **Statistics.** `iceenvs/ShipNavigation-v1` at ice concentrations
+* **The episodes.** `iceenvs/ShipNavigation-v1` at ice concentrations
   A = 0.2, 0.3, 0.4 and 0.5 (the environment's `concentration`, set as the
-  leaderboard sets it), 10 fields each, field k seeded 10000 + k as the
-  leaderboard seeds them, with two of the leaderboard's policies: the
-  straight line (`straight`, whose action on this prescribed ship is zero
-  throughout) and the lattice planner (`lattice`, `agents.planners`). Every
-  field is sailed twice, with the exact and with the fast step, one after the
-  other in the same worker process. From each episode's final info: the ice
-  impulse per metre, the collisions, the energy given to the ice and the path
-  length, and the episode's wall time (reset and policy included). For each
-  concentration, policy and metric: the mean under each step, the
-  difference of the means relative to the exact mean, and the standard error
-  of the mean of the per-field (paired) differences. A row passes when the
-  difference of the means is within 2 % of the exact mean *and* within two
-  standard errors of the paired differences; the tables say which rows do
-  not. Whether route choice pays is given for each step side by side: the
-  lattice planner's mean impulse per metre over the straight line's.
-* **The control.** The same fields sailed a third time with the exact step,
+  leaderboard sets it), 40 fields each, field k seeded 10000 + k as the
+  leaderboard seeds them, with three of the leaderboard's policies: the
+  straight line (`straight`), the swath planner (`swath`) and the lattice
+  planner (`lattice`, `agents.planners`). Every field is sailed by every
+  policy under the exact step (`free_drift=False`), the fast step and the
+  two soft ices, and a last time under the **control**: the exact step with
   every mobile floe's velocity nudged at reset by a normal variate of
-  standard deviation 1e-12 m/s (seeded by the field): two exact runs a
-  rounding error apart, compared by the same criteria. The fast step adds
-  nothing but rounding (its check mode, which steps the free floes one
-  step at a time, gives the exact step's episodes bit for bit; the tests
-  check it), and the contacts amplify rounding until episodes from the same
-  field part; the control shows how far apart that alone takes the means
-  over this many fields.
-* **Speed.** One straight-line episode (zero action) of ShipNavigation-v1,
-  seed 10001, its concentration as the environment draws it, in a fresh
-  process on one Numba thread: env steps/s over the whole episode (the
-  steps' own wall time, the reset left out) and the mean wall time of an env
-  step after env step 100, under each step. The two steps take turns, round
-  after round (three rounds; each figure is the best round, with the slowest
-  beside it), after one untimed episode of each that compiles and loads
-  every kernel. Beside them the floes the step integrates: those awake (exact
-  step) or engaged (fast step) at the end of each env step, on average, and
-  for the fast step the engaged floe-steps over the steps of its tally
-  (`sim.free_tally`), against the number of floes.
+  standard deviation 1e-12 m/s (seeded by the field), two exact runs a
+  rounding error apart. From each episode's final info: the ice impulse per
+  metre, the collisions, the energy given to the ice and the path length.
+* **The equivalence test** (stated before the episodes were run). For each
+  candidate (the fast step, each soft ice, and the control), concentration,
+  policy and metric: the per-field differences candidate − exact, and a 90 %
+  confidence interval of their centre. The candidate is equivalent on that
+  row when the whole interval lies within ±5 % of the exact mean (two
+  one-sided tests at the 5 % level). The centre is the mean (Student's t
+  interval) where the control resolves the margin with it, that is where
+  the control's own interval of the mean lies within ±5 %; elsewhere the
+  per-field differences are dominated by a few fields (a large floe struck
+  in one run and missed in the other), and the centre is the 20 %-trimmed
+  mean of the differences (Yuen's interval), which a few such fields
+  cannot move. The control alone decides which statistic a row uses, so the
+  choice owes nothing to a candidate's result. A row that neither statistic
+  resolves for the control is reported as unresolved with these fields.
+* **The leaderboard's conclusions under each step.** Whether route choice
+  pays (the best planner meets at most 0.7 times the straight line's
+  impulse per metre, ratio of means, sailing at most 10 % further), and the
+  order of the three policies by their impulse per metre over all
+  concentrations together, with the paired difference of the two planners.
+* **Sustained rates.** The env steps of the straight-line episodes over
+  their wall time (reset included), per concentration and over all four
+  together: whole transits, in worker processes on one Numba thread each,
+  the workers side by side on the machine.
+* **Speed on one thread.** One straight-line episode (zero action) of
+  ShipNavigation-v1, seed 10001, its concentration as the environment draws
+  it, in a fresh process on one Numba thread: env steps/s over the whole
+  episode and the mean wall time of an env step after env step 100, under
+  each step, the steps taking turns round after round (three rounds; each
+  figure is the best round, with the slowest beside it), after one untimed
+  episode of each. Beside them the floes each step integrates.
 
-The episodes of the statistics run in two worker processes, each on one
-Numba thread, each warmed up before its first episode by one untimed episode
-of every policy under each step on the environment's small instance, so that
-no compilation falls into an episode's wall time. Every random number is
-seeded: the fields by their seeds, the policies by the first field's.
+The episodes of the statistics run in worker processes, each warmed up
+before its first episode by one untimed episode of every policy under each
+step on the environment's small instance, so that no compilation falls into
+an episode's wall time. Every random number is seeded: the fields by their
+seeds, the policies by the first field's.
 """
 
 #: the environment whose episodes are compared
@@ -89,34 +97,49 @@ ENV_ID = "iceenvs/ShipNavigation-v1"
 #: the parts of the suite
 PARTS = ("statistics", "speed")
 #: the policies compared by default, as the leaderboard names them
-POLICIES = ("straight", "lattice")
+POLICIES = ("straight", "swath", "lattice")
 #: the metrics of each episode's final info: (key, label, scale, unit)
 METRICS = (("impulse_per_metre", "impulse per metre", 1e3, "kN s/m"),
            ("collisions", "collisions", 1.0, ""),
            ("energy_to_ice", "energy to the ice", 1e6, "MJ"),
            ("path_length", "path length", 1.0, "m"))
-#: a row passes when the difference of the means is within this fraction of
-#: the exact mean ...
-RELATIVE_TOLERANCE = 0.02
-#: ... and within this many standard errors of the paired differences
-STANDARD_ERRORS = 2.0
-#: the two steps, by their ``free_drift`` flag
-STEPS = {False: "exact", True: "fast"}
-#: the control: the exact step on the same field with every mobile floe's
+#: what a run keeps of its episode's final info: the metrics, and what the
+#: leaderboard's summary reads besides them
+KEPT = tuple(dict.fromkeys([key for key, *_ in METRICS] + ["success", "mean_impulse",
+                                                           "max_impulse"]))
+#: the steps, by name: the environment's keywords of each (besides the
+#: concentration); the first is the reference
+VARIANTS = {"exact": dict(free_drift=False),
+            "fast": dict(free_drift=True),
+            "soft-0.1": dict(free_drift=True, stiffness_scale=0.1),
+            "soft-0.01": dict(free_drift=True, stiffness_scale=0.01)}
+REFERENCE = "exact"
+#: the candidates compared with the reference by default
+CANDIDATES = ("fast", "soft-0.1", "soft-0.01")
+#: the control: the reference step on the same field with every mobile floe's
 #: velocity nudged at reset by a normal variate of this standard deviation
 #: [m/s] (seeded by the field): two exact runs a rounding error apart
 NUDGE = 1e-12
 CONTROL = "nudged"
+#: the equivalence margin, as a fraction of the reference's mean
+MARGIN = 0.05
+#: the confidence of the interval (two one-sided tests at (1 − it)/2 each)
+CONFIDENCE = 0.90
+#: the fraction trimmed from each end by the robust statistic
+TRIM = 0.2
+#: the verdicts of a row
+PASS, FAIL, UNRESOLVED = "pass", "**fail**", "unresolved"
 
 #: seed and concentration of the untimed warm-up episodes of a worker
 WARMUP_SEED = 0
 WARMUP_CONCENTRATION = 0.3
 #: the full run's sizes
-DEFAULTS = dict(seeds=10, concentrations=(0.2, 0.3, 0.4, 0.5), policies=POLICIES,
-                seed=10_000, workers=2, speed_seed=10_001, rounds=3, late_after=100,
-                small=False)
+DEFAULTS = dict(seeds=40, concentrations=(0.2, 0.3, 0.4, 0.5), policies=POLICIES,
+                variants=CANDIDATES, seed=10_000, workers=2, speed_seed=10_001, rounds=3,
+                late_after=100, small=False)
 #: sizes of ``--quick`` (the small instance, iceenvs.facts.EnvFacts.small)
-QUICK = dict(seeds=2, concentrations=(0.3,), rounds=1, late_after=20, small=True)
+QUICK = dict(seeds=5, concentrations=(0.3,), policies=("straight", "lattice"),
+             variants=("fast", "soft-0.01"), rounds=1, late_after=20, small=True)
 
 
 def _small_kwargs(small: bool) -> dict:
@@ -128,10 +151,11 @@ def _small_kwargs(small: bool) -> dict:
     return dict(env_facts(ENV_ID).small)
 
 
-def env_kwargs(concentration: float | None, free_drift: bool, small: bool) -> dict:
-    """The keywords of an episode: the instance (small or not), the step and,
-    unless ``None``, the concentration, which the leaderboard sets the same way."""
-    kwargs = {**_small_kwargs(small), "free_drift": bool(free_drift)}
+def env_kwargs(concentration: float | None, variant: str, small: bool) -> dict:
+    """The keywords of an episode: the instance (small or not), the step of
+    ``variant`` (a key of :data:`VARIANTS`) and, unless ``None``, the
+    concentration, which the leaderboard sets the same way."""
+    kwargs = {**_small_kwargs(small), **VARIANTS[variant]}
     if concentration is not None:
         kwargs["concentration"] = float(concentration)
     return kwargs
@@ -157,14 +181,14 @@ class _PoolThreads:
 
 
 # ---------------------------------------------------------------------------
-# the statistics, in worker processes
+# the episodes, in worker processes
 # ---------------------------------------------------------------------------
 
 #: a worker's environments and policies, built once each
 _WORKER: dict = {}
 
 
-def _worker_policy(concentration: float, free_drift: bool, name: str, small: bool, seed: int):
+def _worker_policy(concentration: float, variant: str, name: str, small: bool, seed: int):
     """The environment of a concentration and step, and the policy ``name``
     made for it, built on first use in this worker and kept, as
     :func:`agents.rollouts.evaluate_in_processes` keeps them: every episode
@@ -172,10 +196,10 @@ def _worker_policy(concentration: float, free_drift: bool, name: str, small: boo
     from agents.baselines import make_baseline
     from agents.envs import make_checked_env
 
-    key = (float(concentration), bool(free_drift), bool(small))
+    key = (float(concentration), variant, bool(small))
     envs = _WORKER.setdefault("envs", {})
     if key not in envs:
-        envs[key] = make_checked_env(ENV_ID, env_kwargs(concentration, free_drift, small),
+        envs[key] = make_checked_env(ENV_ID, env_kwargs(concentration, variant, small),
                                      seed=seed)
     policies = _WORKER.setdefault("policies", {})
     if (key, name) not in policies:
@@ -183,16 +207,16 @@ def _worker_policy(concentration: float, free_drift: bool, name: str, small: boo
     return envs[key], policies[key, name]
 
 
-def init_worker(policies, small: bool, seed: int) -> None:
+def init_worker(policies, variants, small: bool, seed: int) -> None:
     """Start a worker: one Numba thread, then one untimed episode of every
     policy under each step on the small instance, so that every kernel is
     compiled or loaded before the first timed episode."""
     from agents.rollouts import run_episode
 
     numba.set_num_threads(1)
-    for free_drift in STEPS:
+    for variant in variants:
         for name in policies:
-            env, policy = _worker_policy(WARMUP_CONCENTRATION, free_drift, name, True, seed)
+            env, policy = _worker_policy(WARMUP_CONCENTRATION, variant, name, True, seed)
             run_episode(env, policy, WARMUP_SEED, None)
 
 
@@ -219,148 +243,230 @@ class Nudged:
         return obs, info
 
 
-def field_pair(concentration: float, name: str, field_seed: int, small: bool,
-               seed: int) -> dict:
-    """One field sailed by policy ``name`` with the exact step, the fast step
-    and the control (:class:`Nudged`), one after the other in this worker
-    (the order of the first two alternating with the seed, so that neither
-    step always runs first): per run the episode of
-    :func:`agents.rollouts.run_episode` without its per-step series, its wall
-    time [s], the floes and, for the fast step, the engine's tally."""
+def run_order(variants, field_seed: int) -> list[str]:
+    """The runs of a field, the reference's and the candidates', then the
+    control's: the steps rotated by the field's seed, so that none always
+    runs first (the order changes nothing but the machine's state)."""
+    steps = [REFERENCE, *[v for v in variants if v != REFERENCE]]
+    k = field_seed % len(steps)
+    return steps[k:] + steps[:k] + [CONTROL]
+
+
+def field_runs(concentration: float, name: str, field_seed: int, small: bool, seed: int,
+               variants) -> dict:
+    """One field sailed by policy ``name`` under the reference step, each of
+    ``variants`` and the control (:class:`Nudged`), one after the other in
+    this worker: per run the metrics of :data:`METRICS`, the return, the
+    env steps, the wall time [s] of the episode (reset and decisions
+    included), the floes and, for a fast step, the engine's tally."""
     from agents.rollouts import run_episode
 
     out = {}
-    order = list(STEPS) if field_seed % 2 == 0 else list(STEPS)[::-1]
-    for free_drift, label in [(f, STEPS[f]) for f in order] + [(False, CONTROL)]:
-        env, policy = _worker_policy(concentration, free_drift, name, small, seed)
+    for label in run_order(variants, field_seed):
+        variant = REFERENCE if label == CONTROL else label
+        env, policy = _worker_policy(concentration, variant, name, small, seed)
         t0 = time.perf_counter()
         e = run_episode(Nudged(env) if label == CONTROL else env, policy, field_seed, None)
         wall = time.perf_counter() - t0
         sim = env.unwrapped.sim
-        e = {k: v for k, v in e.items() if k not in ("rewards", "trace")}
-        e.update(wall=wall, floes=int(sim.n_floes),
-                 tally=[int(x) for x in sim.free_tally] if free_drift else None)
-        out[label] = e
+        out[label] = dict({key: float(e["final"][key]) for key in KEPT},
+                          ret=float(e["ret"]), length=int(e["length"]), wall=wall,
+                          floes=int(sim.n_floes),
+                          tally=[int(x) for x in sim.free_tally] if sim.free_drift else None)
     return out
 
 
 def run_statistics(st: dict, quiet: bool = False) -> list[dict]:
-    """Every field of every concentration with every policy, both steps, over
-    ``st["workers"]`` worker processes on one Numba thread each; one entry
-    per field and policy: ``dict(concentration, policy, seed, exact, fast)``
-    in the order of the concentrations, the policies and the seeds."""
+    """Every field of every concentration with every policy under every step,
+    over ``st["workers"]`` worker processes on one Numba thread each; one
+    entry per field and policy, ``dict(concentration, policy, seed, <step>:
+    run, ...)``, in the order of the concentrations, the policies and the
+    seeds."""
     jobs = [(a, name, st["seed"] + k) for a in st["concentrations"] for name in st["policies"]
             for k in range(st["seeds"])]
+    runs = 2 + len(st["variants"])
     done = {}
     context = multiprocessing.get_context("spawn")
     with _PoolThreads(1), concurrent.futures.ProcessPoolExecutor(
             st["workers"], mp_context=context, initializer=init_worker,
-            initargs=(tuple(st["policies"]), st["small"], st["seed"])) as pool, \
-            harness.Progress(3 * len(jobs), SUITE, quiet, unit="episode") as bar:
-        futures = {pool.submit(field_pair, a, name, s, st["small"], st["seed"]): (a, name, s)
+            initargs=(tuple(st["policies"]), (REFERENCE, *st["variants"]), st["small"],
+                      st["seed"])) as pool, \
+            harness.Progress(runs * len(jobs), SUITE, quiet, unit="episode") as bar:
+        futures = {pool.submit(field_runs, a, name, s, st["small"], st["seed"],
+                               tuple(st["variants"])): (a, name, s)
                    for a, name, s in jobs}
         for future in concurrent.futures.as_completed(futures):
             done[futures[future]] = future.result()
-            bar.advance(3)
+            bar.advance(runs)
     return [dict(concentration=a, policy=name, seed=s, **done[a, name, s])
             for a, name, s in jobs]
 
 
-def _passes(relative: float, diff: float, sem: float) -> tuple[bool, bool]:
-    """(within the relative tolerance of the mean, within the standard errors)."""
-    return (bool(abs(relative) <= RELATIVE_TOLERANCE),
-            bool(abs(diff) <= STANDARD_ERRORS * sem))
+# ---------------------------------------------------------------------------
+# the equivalence test
+# ---------------------------------------------------------------------------
+
+def mean_interval(d, confidence: float = CONFIDENCE) -> tuple[float, float, float]:
+    """(mean, lower, upper): the mean of the differences ``d`` and its
+    two-sided ``confidence`` interval (Student's t, n − 1 degrees of
+    freedom)."""
+    from scipy import stats
+
+    d = np.asarray(d, dtype=float)
+    n = d.size
+    centre = float(np.mean(d))
+    half = float(stats.t.ppf(0.5 + 0.5 * confidence, n - 1) * np.std(d, ddof=1) / math.sqrt(n))
+    return centre, centre - half, centre + half
 
 
-def _episodes(fields: list[dict], concentration: float, policy: str, step: str) -> list[dict]:
+def trimmed_interval(d, trim: float = TRIM,
+                     confidence: float = CONFIDENCE) -> tuple[float, float, float]:
+    """(trimmed mean, lower, upper): the mean of the differences ``d`` with
+    g = ⌊trim n⌋ taken off each end, and Yuen's two-sided ``confidence``
+    interval: standard error s_w / ((1 − 2 g/n) √n), s_w the standard
+    deviation of the winsorized differences, n − 2g − 1 degrees of
+    freedom."""
+    from scipy import stats
+
+    x = np.sort(np.asarray(d, dtype=float))
+    n = x.size
+    g = int(math.floor(trim * n))
+    h = n - 2 * g
+    centre = float(np.mean(x[g:n - g]))
+    w = x.copy()
+    if g > 0:
+        w[:g] = x[g]
+        w[n - g:] = x[n - g - 1]
+    se = float(np.std(w, ddof=1)) / ((h / n) * math.sqrt(n))
+    half = float(stats.t.ppf(0.5 + 0.5 * confidence, h - 1) * se)
+    return centre, centre - half, centre + half
+
+
+def within(interval, scale: float, margin: float = MARGIN) -> bool:
+    """Whether the interval (centre, lower, upper) lies within ±``margin``
+    of ``scale`` (the reference's mean)."""
+    return bool(abs(interval[1]) < margin * scale and abs(interval[2]) < margin * scale)
+
+
+def relative(interval, scale: float) -> list[float]:
+    """An interval (centre, lower, upper) over ``scale`` (a reference's
+    mean; a zero scale gives 0 for zeros and ±∞ otherwise)."""
+    if scale > 0:
+        return [v / scale for v in interval]
+    return [0.0 if v == 0 else math.copysign(math.inf, v) for v in interval]
+
+
+def _runs(fields: list[dict], concentration: float, policy: str, step: str) -> list[dict]:
     return [f[step] for f in fields if f["concentration"] == concentration
             and f["policy"] == policy]
 
 
-def metric_rows(fields: list[dict], st: dict, other: str = "fast") -> list[dict]:
-    """Per concentration, policy and metric of :data:`METRICS`: the mean
-    under the exact step and under ``other`` (the fast step, or the
-    control), the difference of the means (other − exact, also relative to
-    the exact mean), the standard error of the paired differences
-    (:func:`agents.rollouts.compare`) and the two criteria. The keys say
-    ``fast`` for the other either way."""
-    from agents.rollouts import compare, stats
-
+def equivalence_rows(fields: list[dict], st: dict) -> list[dict]:
+    """Per concentration, policy and metric of :data:`METRICS`: the
+    reference's mean, the statistic the control decides (``"mean"``,
+    ``"trimmed"``, or None where neither resolves the margin for it), and
+    for the control and each candidate the per-field differences'
+    intervals of the mean and of the trimmed mean, relative to the
+    reference's mean, and the verdict (:data:`PASS`, :data:`FAIL` or
+    :data:`UNRESOLVED`)."""
     rows = []
     for a in st["concentrations"]:
         for name in st["policies"]:
-            exact = _episodes(fields, a, name, "exact")
-            fast = _episodes(fields, a, name, other)
+            ref = _runs(fields, a, name, REFERENCE)
             for key, *_ in METRICS:
-                mean_exact = stats([e["final"][key] for e in exact])["mean"]
-                mean_fast = stats([e["final"][key] for e in fast])["mean"]
-                paired = compare(fast, exact, key)
-                diff, sem = paired["diff"], paired["sem"]
-                relative = diff / abs(mean_exact) if mean_exact != 0 else (
-                    0.0 if diff == 0 else math.inf)
-                within_mean, within_se = _passes(relative, diff, sem)
+                x = np.array([r[key] for r in ref])
+                scale = abs(float(np.mean(x)))
+                out = {}
+                for label in (CONTROL, *st["variants"]):
+                    d = np.array([r[key] for r in _runs(fields, a, name, label)]) - x
+                    m, t = mean_interval(d), trimmed_interval(d)
+                    out[label] = dict(mean=relative(m, scale), trimmed=relative(t, scale),
+                                      mean_mean=float(np.mean(x + d)),
+                                      within_mean=within(m, scale),
+                                      within_trimmed=within(t, scale))
+                c = out[CONTROL]
+                statistic = ("mean" if c["within_mean"] else
+                             "trimmed" if c["within_trimmed"] else None)
+                for o in out.values():
+                    o["verdict"] = (UNRESOLVED if statistic is None else
+                                    PASS if o[f"within_{statistic}"] else FAIL)
                 rows.append(dict(concentration=a, policy=name, metric=key,
-                                 exact=mean_exact, fast=mean_fast, difference=diff,
-                                 relative=relative, sem=sem, n=len(exact),
-                                 within_mean=within_mean, within_se=within_se,
-                                 passed=within_mean and within_se))
+                                 reference=float(np.mean(x)), n=int(x.size),
+                                 statistic=statistic, runs=out))
     return rows
 
 
-def wall_rows(fields: list[dict], st: dict) -> list[dict]:
-    """Per concentration and policy: the mean wall time and env steps of an
-    episode under each step, and the exact mean over the fast one."""
-    from agents.rollouts import stats
-
-    rows = []
-    for a in st["concentrations"]:
-        for name in st["policies"]:
-            w = {step: stats([e["wall"] for e in _episodes(fields, a, name, step)])
-                 for step in STEPS.values()}
-            n = {step: stats([e["length"] for e in _episodes(fields, a, name, step)])["mean"]
-                 for step in STEPS.values()}
-            rows.append(dict(concentration=a, policy=name, exact=w["exact"], fast=w["fast"],
-                             steps_exact=n["exact"], steps_fast=n["fast"],
-                             speedup=w["exact"]["mean"] / w["fast"]["mean"]))
-    return rows
-
-
-def route_choice(fields: list[dict], st: dict) -> list[dict]:
-    """Per concentration and step: the lattice planner's mean impulse per
-    metre over the straight line's (the leaderboard's ratio of means,
-    :func:`agents.leaderboard.summarise_board`), and the mean of the
-    per-field ratios with its standard error. Empty unless both ran."""
-    from agents.leaderboard import summarise_board
-
-    if not {"straight", "lattice"} <= set(st["policies"]):
-        return []
-    rows = []
-    for a in st["concentrations"]:
-        row = dict(concentration=a)
-        for step in STEPS.values():
-            board = {f"{a:g}": {name: _episodes(fields, a, name, step)
-                                for name in ("straight", "lattice")}}
-            s = summarise_board(board)[f"{a:g}"]["lattice"]
-            row[step] = dict(ratio_of_means=s["ipm_ratio_of_means"],
-                             per_field=s["ratio_impulse_per_metre"],
-                             path_ratio=s["path_ratio_of_means"])
-        rows.append(row)
-    return rows
-
-
-def field_records(fields: list[dict]) -> list[dict]:
-    """The fields as the record keeps them: per step the metrics of
-    :data:`METRICS`, the wall time, the env steps, the floes and the tally."""
-    keep = [key for key, *_ in METRICS]
-    out = []
-    for f in fields:
-        entry = dict(concentration=f["concentration"], policy=f["policy"], seed=f["seed"])
-        for step in (*STEPS.values(), CONTROL):
-            e = f[step]
-            entry[step] = dict({k: e["final"][k] for k in keep}, wall=e["wall"],
-                               length=e["length"], floes=e["floes"], tally=e["tally"])
-        out.append(entry)
+def verdicts(rows: list[dict], labels) -> dict:
+    """Per label: the rows that pass, fail and are unresolved."""
+    out = {}
+    for label in labels:
+        v = [r["runs"][label]["verdict"] for r in rows]
+        out[label] = dict(passed=v.count(PASS), failed=v.count(FAIL),
+                          unresolved=v.count(UNRESOLVED), total=len(v),
+                          failures=[dict(concentration=r["concentration"], policy=r["policy"],
+                                         metric=r["metric"],
+                                         interval=r["runs"][label][r["statistic"]])
+                                    for r in rows if r["runs"][label]["verdict"] == FAIL])
     return out
+
+
+def conclusions(fields: list[dict], st: dict) -> dict:
+    """The leaderboard's conclusions under each step: per step, whether route
+    choice pays at each concentration (:func:`agents.leaderboard.route_choice_pays`,
+    the best planner and its ratios), and, over all concentrations together,
+    each policy's impulse per metre over the straight line's (ratio of
+    means), the order of the policies by it, and the paired difference of
+    the planners' impulse per metre (the second of
+    :data:`POLICIES` present minus the third) with its standard error.
+    Empty unless the straight line and a planner ran."""
+    from agents.leaderboard import pooled_comparison, route_choice_pays, summarise_board
+    from agents.rollouts import compare
+
+    planners = [p for p in st["policies"] if p != "straight"]
+    if "straight" not in st["policies"] or not planners:
+        return {}
+    out = {}
+    for label in (REFERENCE, *st["variants"], CONTROL):
+        board = {f"{a:g}": {name: [dict(final={k: r[k] for k in KEPT}, ret=r["ret"],
+                                        length=r["length"])
+                                   for r in _runs(fields, a, name, label)]
+                            for name in st["policies"]}
+                 for a in st["concentrations"]}
+        summary = summarise_board(board)
+        pays = route_choice_pays(summary, planners)
+        pooled = pooled_comparison(board)
+        ratios = {"straight": 1.0, **{p: pooled[p]["ipm_ratio_of_means"] for p in planners}}
+        entry = dict(route_choice={a: dict(best=b, ratio=r, path=pth, pays=ok)
+                                   for a, (b, r, pth, ok) in pays.items()},
+                     pooled_ratio=ratios, order=sorted(ratios, key=ratios.get))
+        if len(planners) >= 2:
+            first, second = planners[0], planners[1]
+            mine = [e for pol in board.values() for e in pol[second]]
+            theirs = [e for pol in board.values() for e in pol[first]]
+            entry["planners"] = dict(compare(mine, theirs, "impulse_per_metre"),
+                                     pair=[second, first])
+        out[label] = entry
+    return out
+
+
+def rate_rows(fields: list[dict], st: dict) -> list[dict]:
+    """Per step and concentration, over the straight-line episodes (or the
+    first policy's): env steps over wall time, whole transits (reset
+    included); and over all concentrations together."""
+    name = "straight" if "straight" in st["policies"] else st["policies"][0]
+    rows = []
+    for label in (REFERENCE, *st["variants"]):
+        per = {}
+        for a in st["concentrations"]:
+            runs = _runs(fields, a, name, label)
+            per[f"{a:g}"] = sum(r["length"] for r in runs) / sum(r["wall"] for r in runs)
+        runs = [r for a in st["concentrations"] for r in _runs(fields, a, name, label)]
+        engaged = [r["tally"][2] / r["tally"][3] for r in runs if r["tally"] and r["tally"][3]]
+        rows.append(dict(step=label, policy=name, per_concentration=per,
+                         pooled=sum(r["length"] for r in runs) / sum(r["wall"] for r in runs),
+                         engaged_per_substep=float(np.mean(engaged)) if engaged else None,
+                         floes=float(np.mean([r["floes"] for r in runs]))))
+    return rows
 
 
 # ---------------------------------------------------------------------------
@@ -399,27 +505,28 @@ def speed_child(st: dict) -> dict:
 
     numba.set_num_threads(1)
     seed, late_after = st["speed_seed"], st["late_after"]
-    envs = {step: make_checked_env(ENV_ID, env_kwargs(None, free_drift, st["small"]),
-                                   seed=seed) for free_drift, step in STEPS.items()}
+    envs = {v: make_checked_env(ENV_ID, env_kwargs(None, v, st["small"]), seed=seed)
+            for v in (REFERENCE, *st["variants"])}
     try:
         for env in envs.values():
             _timed_episode(env, seed, late_after)                        # untimed
         runs = [lambda env=env: _timed_episode(env, seed, late_after) for env in envs.values()]
         rounds = harness.interleaved_rounds(runs, st["rounds"])
-        u = envs["exact"].unwrapped
+        u = envs[REFERENCE].unwrapped
         concentration = float(u.episode["concentration"])
         floes = int(u.sim.n_floes)
     finally:
         for env in envs.values():
             env.close()
     return dict(seed=seed, late_after=late_after, concentration=concentration,
-                drawn="concentration" not in env_kwargs(None, False, st["small"]), floes=floes,
-                rounds=dict(zip(envs, rounds)))
+                drawn="concentration" not in env_kwargs(None, REFERENCE, st["small"]),
+                floes=floes, rounds=dict(zip(envs, rounds)))
 
 
 def summarise_speed(speed: dict) -> dict:
     """Per step the best round and the slowest of the rate and of the late
-    ms per env step, and the fast step's gain on each (best over best)."""
+    ms per env step, and each step's gain over the reference (best over
+    best)."""
     out = {}
     for step, rounds in speed["rounds"].items():
         rates = [r["rate"] for r in rounds]
@@ -432,24 +539,18 @@ def summarise_speed(speed: dict) -> dict:
                          awake_mean=float(np.mean([r["awake_mean"] for r in rounds])),
                          engaged_per_step=tally[2] / tally[3] if tally and tally[3] else None,
                          windows=tally[0] if tally else None,
-                         ended_by_guard=tally[1] if tally else None,
                          substeps=tally[3] if tally else None)
-    e, f = out["exact"], out["fast"]
-    out["gain"] = dict(rate=f["rate"] / e["rate"],
-                       late=(e["late_ms"] / f["late_ms"]
-                             if e["late_ms"] and f["late_ms"] else None))
+    e = out[REFERENCE]
+    out["gain"] = {step: dict(rate=s["rate"] / e["rate"],
+                              late=(e["late_ms"] / s["late_ms"]
+                                    if e["late_ms"] and s["late_ms"] else None))
+                   for step, s in list(out.items()) if step != REFERENCE}
     return out
 
 
 # ---------------------------------------------------------------------------
 # the record
 # ---------------------------------------------------------------------------
-
-def _percent(x: float, signed: bool = True) -> str:
-    if x is None or not math.isfinite(x):
-        return "–"
-    return f"{100 * x:+.2f} %" if signed else f"{100 * x:.2f} %"
-
 
 def _spread(best: float, slowest: float, higher_is_better: bool) -> str:
     if best is None or slowest is None:
@@ -458,111 +559,138 @@ def _spread(best: float, slowest: float, higher_is_better: bool) -> str:
     return f"{'−' if higher_is_better else '+'}{100 * worse:.0f} %"
 
 
+def _interval(iv) -> str:
+    """A relative interval (centre, lower, upper) as percentages."""
+    if iv is None or not all(math.isfinite(v) for v in iv):
+        return "–"
+    return f"{100 * iv[0]:+.1f} % [{100 * iv[1]:+.1f}, {100 * iv[2]:+.1f}]"
+
+
 def speed_table(speed: dict, summary: dict, rounds: int) -> dict:
     """Env steps/s and late ms per env step under each step, and the floes
     each step integrates."""
     rows = []
-    for step in STEPS.values():
+    for step in speed["rounds"]:
         s = summary[step]
+        g = summary["gain"].get(step)
         rows.append([step, s["rate"], _spread(s["rate"], s["slowest_rate"], True),
+                     "–" if g is None else f"{g['rate']:.2f}×",
                      s["late_ms"], _spread(s["late_ms"], s["slowest_late_ms"], False),
-                     s["awake_mean"], s["engaged_per_step"], speed["floes"]])
-    g = summary["gain"]
-    rows.append(["fast over exact", f"{g['rate']:.2f}× the rate", "",
-                 "–" if g["late"] is None else f"{1 / g['late']:.2f}× the time",
-                 "", "", "", ""])
-    f = summary["fast"]
-    guard = ("" if not f["windows"] else
-             f" The fast step's tally: {f['windows']} windows over {f['substeps']} substeps, "
-             f"{100 * f['ended_by_guard'] / f['windows']:.0f} % of them ended by a guard.")
+                     s["awake_mean"], s["engaged_per_step"]])
+    first = summary[REFERENCE]
     return harness.table(
-        f"Speed: one straight-line episode, seed {speed['seed']}, A = "
+        f"Speed on one thread: one straight-line episode, seed {speed['seed']}, A = "
         f"{speed['concentration']:.3f} "
         f"({'as the environment draws it' if speed['drawn'] else 'set by the instance'}), "
-        f"{speed['floes']} floes, "
-        f"one thread (best of {rounds} round{'s' * (rounds != 1)})",
-        ["step", "env steps/s (whole episode)", "slowest round",
+        f"{speed['floes']} floes (best of {rounds} round{'s' * (rounds != 1)})",
+        ["step", "env steps/s (whole episode)", "slowest round", f"over {REFERENCE}",
          f"ms per env step after step {speed['late_after']}", "slowest round",
          "floes awake or engaged at the end of an env step (mean)",
-         "engaged floe-steps per substep (tally)", "floes"], rows,
-        f"Env steps/s: the {f['steps']} env steps of the episode over their own wall time, "
-        f"the reset left out; the late figure is the mean over its last {f['late_steps']} "
+         "engaged floe-steps per substep"], rows,
+        f"Env steps/s: the {first['steps']} env steps of the episode over their own wall time, "
+        f"the reset left out; the late figure is the mean over its last {first['late_steps']} "
         f"steps. Slowest round: how much worse than the best the slowest round was. Floes "
-        f"awake (exact step: those not at rest, `sim.n_awake`) or engaged (fast step: those "
+        f"awake (exact step: those not at rest, `sim.n_awake`) or engaged (fast steps: those "
         f"of the last window that take the contact step) at the end of each env step, "
-        f"averaged over the episode; engaged floe-steps per substep from the fast step's "
-        f"`sim.free_tally`, over the whole episode.{guard}")
+        f"averaged over the episode; engaged floe-steps per substep from the fast steps' "
+        f"`sim.free_tally`, over the whole episode.")
 
 
-def statistics_table(rows: list[dict], st: dict, other: str = "fast") -> dict:
-    """The means under the exact step and ``other`` (the fast step or the
-    control) and the two criteria, per concentration, policy and metric."""
+def summary_table(rows: list[dict], st: dict, tally: dict) -> dict:
+    """Per candidate and the control: the rows that pass, fail and are
+    unresolved, and the failures."""
+    body = []
+    for label in (*st["variants"], CONTROL):
+        v = tally[label]
+        failures = "; ".join(
+            f"A = {f['concentration']:g}, {f['policy']}, {_label(f['metric'])}: "
+            f"{_interval(f['interval'])}" for f in v["failures"]) or "–"
+        body.append([label, f"{v['passed']} of {v['total']}", v["failed"], v["unresolved"],
+                     failures])
+    statistics = [r["statistic"] for r in rows]
+    return harness.table(
+        f"The equivalence test: {st['seeds']} fields per concentration and policy, margin "
+        f"±{100 * MARGIN:g} % of the exact mean, {100 * CONFIDENCE:g} % intervals",
+        ["step", "rows equivalent", "rows not shown equivalent", "rows unresolved",
+         "not shown equivalent: interval of (step − exact) / exact mean"], body,
+        f"A row (concentration, policy, metric) is equivalent when the {100 * CONFIDENCE:g} % "
+        f"interval of the centre of the per-field differences lies within ±{100 * MARGIN:g} % "
+        f"of the exact step's mean. The centre is the mean on "
+        f"{statistics.count('mean')} rows and the {100 * TRIM:g} %-trimmed mean on "
+        f"{statistics.count('trimmed')}, as the control decides (the mean where the "
+        f"control's interval of the mean lies within the margin); "
+        f"{statistics.count(None)} rows are resolved by neither for the control. The "
+        f"control is the exact step with every floe's velocity nudged by {NUDGE:g} m/s at "
+        f"reset: what chaos alone does to the same fields.")
+
+
+def _label(key: str) -> str:
+    return next(label for k, label, *_ in METRICS if k == key)
+
+
+def equivalence_table(rows: list[dict], st: dict) -> dict:
+    """Every row: the exact mean, the statistic, and the interval and
+    verdict of the control and of each candidate."""
     labels = {key: (f"{label} [{unit}]" if unit else label, scale)
               for key, label, scale, unit in METRICS}
     body = []
     for r in rows:
         label, scale = labels[r["metric"]]
-        body.append([r["concentration"], r["policy"], label, r["exact"] / scale,
-                     r["fast"] / scale, r["difference"] / scale, _percent(r["relative"]),
-                     r["sem"] / scale, "yes" if r["within_mean"] else "**no**",
-                     "yes" if r["within_se"] else "**no**",
-                     "pass" if r["passed"] else "**fail**"])
-    failed = [r for r in rows if not r["passed"]]
-    verdict = (f"All {len(rows)} rows pass." if not failed else
-               f"{len(rows) - len(failed)} of {len(rows)} rows pass; {len(failed)} fail: "
-               + "; ".join(f"A = {r['concentration']:g}, {r['policy']}, {r['metric']}"
-                           for r in failed) + ".")
-    if other == CONTROL:
-        title = (f"The control: the exact step against itself, the velocity of every floe "
-                 f"nudged by {NUDGE:g} m/s at reset, means over {st['seeds']} fields")
-    else:
-        title = f"Exact and fast step: means over {st['seeds']} fields"
+        stat = r["statistic"]
+        cells = [r["concentration"], r["policy"], label, r["reference"] / scale,
+                 {"mean": "mean", "trimmed": "trimmed mean", None: "–"}[stat]]
+        for step in (CONTROL, *st["variants"]):
+            o = r["runs"][step]
+            shown = o[stat] if stat else o["mean"]
+            cells.append(f"{_interval(shown)} {o['verdict'] if o['verdict'] != PASS else ''}"
+                         .strip())
+        body.append(cells)
     return harness.table(
-        title,
-        ["A", "policy", "metric", "mean, exact", f"mean, {other}", f"{other} − exact",
-         "relative to exact", "SE of paired differences",
-         f"within {100 * RELATIVE_TOLERANCE:g} % of the mean",
-         f"within {STANDARD_ERRORS:g} SE", "both"], body,
-        f"{other} − exact: the difference of the means, which is the mean of the per-field "
-        f"differences; SE: the standard error of that mean over the {st['seeds']} fields "
-        f"(paired: the same field under both). A row passes when the difference is "
-        f"within {100 * RELATIVE_TOLERANCE:g} % of the exact mean and within "
-        f"{STANDARD_ERRORS:g} standard errors. {verdict}")
+        "Every row: (step − exact) / exact mean, the centre and its interval",
+        ["A", "policy", "metric", "mean, exact", "statistic", CONTROL, *st["variants"]], body,
+        f"Each cell: the centre of the per-field differences relative to the exact mean and "
+        f"its {100 * CONFIDENCE:g} % interval; a cell is marked when the interval is not "
+        f"within ±{100 * MARGIN:g} % (fail) or when the control's is within it for neither "
+        f"statistic (unresolved; the cell then shows the mean).")
 
 
-def wall_table(rows: list[dict], st: dict) -> dict:
-    """The mean wall time of an episode under each step."""
-    body = [[r["concentration"], r["policy"], r["steps_exact"], r["exact"]["mean"],
-             r["fast"]["mean"], f"{r['speedup']:.2f}×"] for r in rows]
-    return harness.table(
-        "Wall time of an episode",
-        ["A", "policy", "env steps (mean)", "exact [s]", "fast [s]", "exact over fast"], body,
-        f"Means over the {st['seeds']} fields of the statistics, each episode in a worker "
-        f"process on one Numba thread, {st['workers']} workers side by side on the machine; "
-        f"the reset and the policy's decisions (the lattice planner's plans) are included.")
-
-
-def route_table(rows: list[dict], st: dict) -> dict:
-    """The lattice planner's impulse per metre over the straight line's,
-    under each step."""
-    def below(x):
-        return "yes" if x < 1.0 else "**no**"
-
+def conclusions_table(concl: dict, st: dict) -> dict:
+    """Route choice and the policies' order under each step."""
     body = []
-    for r in rows:
-        e, f = r["exact"], r["fast"]
-        body.append([r["concentration"], e["ratio_of_means"], f["ratio_of_means"],
-                     f"{e['per_field']['mean']:.3f} ± {e['per_field']['sem']:.3f}",
-                     f"{f['per_field']['mean']:.3f} ± {f['per_field']['sem']:.3f}",
-                     f"{below(e['ratio_of_means'])} / {below(f['ratio_of_means'])}"])
+    for label, c in concl.items():
+        pays = ", ".join(f"{a}: {'yes' if v['pays'] else 'no'} ({v['best']} {v['ratio']:.3f})"
+                         for a, v in c["route_choice"].items())
+        order = " < ".join(f"{p} ({c['pooled_ratio'][p]:.3f})" for p in c["order"])
+        pl = c.get("planners")
+        planners = "–" if pl is None else (
+            f"{pl['pair'][0]} − {pl['pair'][1]}: {pl['diff'] / 1e3:+.2f} ± {pl['sem'] / 1e3:.2f}")
+        body.append([label, pays, order, planners])
     return harness.table(
-        "Does route choice pay under each step?",
-        ["A", "lattice / straight, exact", "lattice / straight, fast",
-         "per field, exact (mean ± SE)", "per field, fast (mean ± SE)",
-         "below 1: exact / fast"], body,
-        f"The lattice planner's mean ice impulse per metre over the straight line's on the "
-        f"same {st['seeds']} fields (the leaderboard's ratio of means), and the mean of the "
-        f"per-field ratios. The leaderboard finds it below 1 at A = 0.2–0.4.")
+        "The leaderboard's conclusions under each step",
+        ["step", "route choice pays (best planner, impulse per metre / straight)",
+         "order by impulse per metre, all A (ratio of means to straight)",
+         "planners' paired difference in impulse per metre [kN s/m] (mean ± SE)"], body,
+        "Route choice pays at a concentration when the best planner meets at most 0.7 "
+        "times the straight line's impulse per metre (ratio of means) sailing at most 10 % "
+        f"further, as on the leaderboard. The order pools the {len(st['concentrations'])} "
+        f"concentrations' {st['seeds']} fields each.")
+
+
+def rate_table(rates: list[dict], st: dict) -> dict:
+    """Sustained env steps/s of each step per concentration."""
+    concentrations = [f"{a:g}" for a in st["concentrations"]]
+    ref = next(r for r in rates if r["step"] == REFERENCE)
+    body = [[r["step"], *[r["per_concentration"][a] for a in concentrations], r["pooled"],
+             f"{r['pooled'] / ref['pooled']:.2f}×", r["engaged_per_substep"]] for r in rates]
+    return harness.table(
+        f"Sustained rates: env steps/s over whole transits ({rates[0]['policy']} line)",
+        ["step", *[f"A = {a}" for a in concentrations], "all A", f"over {REFERENCE}",
+         "engaged floe-steps per substep"], body,
+        f"The env steps of the {st['seeds']} {rates[0]['policy']}-line episodes per "
+        f"concentration over their wall time, reset included, each in a worker process on "
+        f"one Numba thread, {st['workers']} workers side by side on the machine; all A: the "
+        f"episodes of every concentration together (the environment draws A uniformly in "
+        f"0.2–0.5).")
 
 
 def parse_parts(text: str | None) -> list[str]:
@@ -624,7 +752,10 @@ def main(argv=None, prog: str | None = None) -> int:
     p.add_argument("--concentrations", default=None,
                    help="ice concentrations, comma-separated (default 0.2,0.3,0.4,0.5)")
     p.add_argument("--policies", default=None,
-                   help="baselines, comma-separated (default straight,lattice)")
+                   help="baselines, comma-separated (default " + ",".join(POLICIES) + ")")
+    p.add_argument("--variants", default=None,
+                   help="steps compared with the exact one, comma-separated: "
+                        + ", ".join(CANDIDATES) + " (default: all)")
     p.add_argument("--seed", type=int, default=None,
                    help=f"seed of the first field, and of the policies "
                         f"(default {DEFAULTS['seed']})")
@@ -637,11 +768,14 @@ def main(argv=None, prog: str | None = None) -> int:
     p.add_argument("--late-after", type=int, default=None,
                    help=f"env steps before the late part of the timed episode "
                         f"(default {DEFAULTS['late_after']})")
+    p.add_argument("--fields", default=None, metavar="PATH",
+                   help="also write every field's runs to this JSON file (the record keeps "
+                        "the summaries)")
     args, argv = harness.parse(p, argv)
     st = harness.settings(args, DEFAULTS, QUICK, ("seeds", "seed", "workers", "speed_seed",
                                                   "rounds", "late_after"))
-    if st["seeds"] < 2:
-        p.error(f"--seeds must be at least 2 (standard errors), got {st['seeds']}")
+    if st["seeds"] < 5:
+        p.error(f"--seeds must be at least 5 (the trimmed mean's interval), got {st['seeds']}")
     if min(st["workers"], st["rounds"]) < 1 or st["late_after"] < 0:
         p.error("--workers and --rounds must be at least 1, --late-after at least 0")
     try:
@@ -650,11 +784,14 @@ def main(argv=None, prog: str | None = None) -> int:
             st["concentrations"] = parse_concentrations(args.concentrations)
         if args.policies is not None:
             st["policies"] = parse_policies(args.policies)
+        if args.variants is not None:
+            st["variants"] = tuple(harness.pick_names(args.variants, CANDIDATES, "variant"))
     except ValueError as exc:
         p.error(str(exc))
 
     t0 = time.perf_counter()
-    tables, data = [], dict(parts=parts, settings=st, quick=args.quick)
+    tables, data = [], dict(parts=parts, settings=st, quick=args.quick, margin=MARGIN,
+                            confidence=CONFIDENCE, trim=TRIM, nudge=NUDGE)
     if "speed" in parts:
         if not args.quiet:
             print("speed: one episode per step and round, in a fresh process ...", flush=True)
@@ -663,24 +800,23 @@ def main(argv=None, prog: str | None = None) -> int:
         data["speed"] = dict(speed, summary=summary)
         tables.append(speed_table(speed, summary, st["rounds"]))
         if not args.quiet:
-            print(f"  env steps/s: exact {summary['exact']['rate']:.3g}, fast "
-                  f"{summary['fast']['rate']:.3g} ({summary['gain']['rate']:.2f}×)", flush=True)
+            print("  env steps/s: " + ", ".join(f"{k} {v['rate']:.3g}" for k, v in summary.items()
+                                                if k != "gain"), flush=True)
     if "statistics" in parts:
         fields = run_statistics(st, args.quiet)
-        rows = metric_rows(fields, st)
-        control = metric_rows(fields, st, CONTROL)
-        walls = wall_rows(fields, st)
-        routes = route_choice(fields, st)
-        data["statistics"] = dict(rows=rows, wall=walls, route_choice=routes,
-                                  passed=sum(r["passed"] for r in rows), total=len(rows),
-                                  control=control,
-                                  control_passed=sum(r["passed"] for r in control),
-                                  fields=field_records(fields))
-        tables.append(statistics_table(rows, st))
-        tables.append(statistics_table(control, st, CONTROL))
-        if routes:
-            tables.append(route_table(routes, st))
-        tables.append(wall_table(walls, st))
+        if args.fields:
+            with open(args.fields, "w", encoding="utf-8") as fh:
+                json.dump(fields, fh)
+        rows = equivalence_rows(fields, st)
+        tally = verdicts(rows, (*st["variants"], CONTROL))
+        concl = conclusions(fields, st)
+        rates = rate_rows(fields, st)
+        data["statistics"] = dict(rows=rows, verdicts=tally, conclusions=concl, rates=rates)
+        tables.append(summary_table(rows, st, tally))
+        tables.append(rate_table(rates, st))
+        if concl:
+            tables.append(conclusions_table(concl, st))
+        tables.append(equivalence_table(rows, st))
     record = harness.make_record(
         SUITE, TITLE, DESCRIPTION, harness.command_line(SUITE, argv), tables, data,
         time.perf_counter() - t0, machine=harness.machine_info(1))
