@@ -44,10 +44,14 @@ then another trajectory: only statistics over many fields can agree.
 
 * **The episodes.** `iceenvs/ShipNavigation-v1` at ice concentrations
   A = 0.2, 0.3, 0.4 and 0.5 (the environment's `concentration`, set as the
-  leaderboard sets it), 40 fields each, field k seeded 10000 + k as the
-  leaderboard seeds them, with three of the leaderboard's policies: the
-  straight line (`straight`), the swath planner (`swath`) and the lattice
-  planner (`lattice`, `agents.planners`). Every field is sailed by every
+  leaderboard sets it), 80 fields each, field k seeded 20000 + k (fields of
+  their own, apart from the leaderboard's, seeded 10000 + k), with three of
+  the leaderboard's policies: the straight line (`straight`), the swath
+  planner (`swath`) and the lattice planner (`lattice`, `agents.planners`).
+  (`--env` runs the same test on ShipNavigation-v0 at A = 0.2, 0.4, 0.6
+  with the straight line and the lattice planner, or on ShipBeset-v0 at
+  A = 0.6, 0.675, 0.75 with the straight line and the reactive controller,
+  and writes its record beside this one.) Every field is sailed by every
   policy under the exact step (`free_drift=False`), the fast step and the
   two soft ices, and a last time under the **control**: the exact step with
   every mobile floe's velocity nudged at reset by a normal variate of
@@ -57,17 +61,24 @@ then another trajectory: only statistics over many fields can agree.
 * **The equivalence test** (stated before the episodes were run). For each
   candidate (the fast step, each soft ice, and the control), concentration,
   policy and metric: the per-field differences candidate − exact, and a 90 %
-  confidence interval of their centre. The candidate is equivalent on that
-  row when the whole interval lies within ±5 % of the exact mean (two
-  one-sided tests at the 5 % level). The centre is the mean (Student's t
-  interval) where the control resolves the margin with it, that is where
-  the control's own interval of the mean lies within ±5 %; elsewhere the
-  per-field differences are dominated by a few fields (a large floe struck
-  in one run and missed in the other), and the centre is the 20 %-trimmed
-  mean of the differences (Yuen's interval), which a few such fields
-  cannot move. The control alone decides which statistic a row uses, so the
-  choice owes nothing to a candidate's result. A row that neither statistic
-  resolves for the control is reported as unresolved with these fields.
+  confidence interval of their 20 %-trimmed mean (Yuen's interval: the
+  mean of the middle 60 % of the differences, its standard error from the
+  winsorized ones). The candidate is equivalent on that row when the whole
+  interval lies within ±5 % of the exact mean (two one-sided tests at the
+  5 % level). A row is unresolved where the control's own interval does not
+  lie within the margin: there these fields cannot tell a rounding error
+  from a difference of 5 %. The trimmed mean and the 80 fields come from a
+  pilot (the record `free_drift-pilot` below, `--statistic control`: 40 of
+  the leaderboard's fields, the mean where the control resolved the margin
+  with it). There one or two fields held most of the spread of the
+  differences in some rows, a large floe struck in one run and missed in
+  the other or a planner's route flipped: chaos, not a difference of the
+  steps, and on whichever step it fell it widened the interval of the
+  mean past the margin. Two steps equal in distribution give differences
+  symmetric about zero, whose trimmed mean estimates the same centre as the
+  mean while a few such fields cannot move it; its intervals reached about
+  the margin with 40 fields, and 80 halve their variance. The intervals of
+  the mean are given beside.
 * **The leaderboard's conclusions under each step.** Whether route choice
   pays (the best planner meets at most 0.7 times the straight line's
   impulse per metre, ratio of means, sailing at most 10 % further), and the
@@ -92,8 +103,17 @@ an episode's wall time. Every random number is seeded: the fields by their
 seeds, the policies by the first field's.
 """
 
-#: the environment whose episodes are compared
+#: the environment whose episodes are compared by default
 ENV_ID = "iceenvs/ShipNavigation-v1"
+#: the ship environments the suite can compare (``--env``), each with its
+#: concentrations and policies by default (the first is the one the others
+#: are compared with in the leaderboard's conclusions)
+ENVS = {"iceenvs/ShipNavigation-v1": dict(concentrations=(0.2, 0.3, 0.4, 0.5),
+                                          policies=("straight", "swath", "lattice")),
+        "iceenvs/ShipNavigation-v0": dict(concentrations=(0.2, 0.4, 0.6),
+                                          policies=("straight", "lattice")),
+        "iceenvs/ShipBeset-v0": dict(concentrations=(0.6, 0.675, 0.75),
+                                     policies=("straight", "reactive"))}
 #: the parts of the suite
 PARTS = ("statistics", "speed")
 #: the policies compared by default, as the leaderboard names them
@@ -129,33 +149,36 @@ CONFIDENCE = 0.90
 TRIM = 0.2
 #: the verdicts of a row
 PASS, FAIL, UNRESOLVED = "pass", "**fail**", "unresolved"
+#: the choices of the statistic (``--statistic``): the trimmed mean on every
+#: row, or the one the control decides row by row
+STATISTICS = ("trimmed", "control")
 
-#: seed and concentration of the untimed warm-up episodes of a worker
+#: seed of the untimed warm-up episodes of a worker (at the environment's
+#: first concentration)
 WARMUP_SEED = 0
-WARMUP_CONCENTRATION = 0.3
 #: the full run's sizes
-DEFAULTS = dict(seeds=40, concentrations=(0.2, 0.3, 0.4, 0.5), policies=POLICIES,
-                variants=CANDIDATES, seed=10_000, workers=2, speed_seed=10_001, rounds=3,
-                late_after=100, small=False)
+DEFAULTS = dict(env=ENV_ID, seeds=80, concentrations=ENVS[ENV_ID]["concentrations"],
+                policies=POLICIES, variants=CANDIDATES, seed=20_000, workers=2,
+                speed_seed=10_001, rounds=3, late_after=100, small=False)
 #: sizes of ``--quick`` (the small instance, iceenvs.facts.EnvFacts.small)
-QUICK = dict(seeds=5, concentrations=(0.3,), policies=("straight", "lattice"),
-             variants=("fast", "soft-0.01"), rounds=1, late_after=20, small=True)
+QUICK = dict(seeds=5, variants=("fast", "soft-0.01"), rounds=1, late_after=20, small=True)
 
 
-def _small_kwargs(small: bool) -> dict:
+def _small_kwargs(small: bool, env_id: str = ENV_ID) -> dict:
     """``gymnasium.make`` keywords of the environment's small instance, or none."""
     if not small:
         return {}
     from iceenvs.facts import env_facts
 
-    return dict(env_facts(ENV_ID).small)
+    return dict(env_facts(env_id).small)
 
 
-def env_kwargs(concentration: float | None, variant: str, small: bool) -> dict:
+def env_kwargs(concentration: float | None, variant: str, small: bool,
+               env_id: str = ENV_ID) -> dict:
     """The keywords of an episode: the instance (small or not), the step of
     ``variant`` (a key of :data:`VARIANTS`) and, unless ``None``, the
     concentration, which the leaderboard sets the same way."""
-    kwargs = {**_small_kwargs(small), **VARIANTS[variant]}
+    kwargs = {**_small_kwargs(small, env_id), **VARIANTS[variant]}
     if concentration is not None:
         kwargs["concentration"] = float(concentration)
     return kwargs
@@ -188,7 +211,8 @@ class _PoolThreads:
 _WORKER: dict = {}
 
 
-def _worker_policy(concentration: float, variant: str, name: str, small: bool, seed: int):
+def _worker_policy(env_id: str, concentration: float, variant: str, name: str, small: bool,
+                   seed: int):
     """The environment of a concentration and step, and the policy ``name``
     made for it, built on first use in this worker and kept, as
     :func:`agents.rollouts.evaluate_in_processes` keeps them: every episode
@@ -196,10 +220,10 @@ def _worker_policy(concentration: float, variant: str, name: str, small: bool, s
     from agents.baselines import make_baseline
     from agents.envs import make_checked_env
 
-    key = (float(concentration), variant, bool(small))
+    key = (env_id, float(concentration), variant, bool(small))
     envs = _WORKER.setdefault("envs", {})
     if key not in envs:
-        envs[key] = make_checked_env(ENV_ID, env_kwargs(concentration, variant, small),
+        envs[key] = make_checked_env(env_id, env_kwargs(concentration, variant, small, env_id),
                                      seed=seed)
     policies = _WORKER.setdefault("policies", {})
     if (key, name) not in policies:
@@ -207,7 +231,7 @@ def _worker_policy(concentration: float, variant: str, name: str, small: bool, s
     return envs[key], policies[key, name]
 
 
-def init_worker(policies, variants, small: bool, seed: int) -> None:
+def init_worker(env_id: str, policies, variants, small: bool, seed: int) -> None:
     """Start a worker: one Numba thread, then one untimed episode of every
     policy under each step on the small instance, so that every kernel is
     compiled or loaded before the first timed episode."""
@@ -216,7 +240,8 @@ def init_worker(policies, variants, small: bool, seed: int) -> None:
     numba.set_num_threads(1)
     for variant in variants:
         for name in policies:
-            env, policy = _worker_policy(WARMUP_CONCENTRATION, variant, name, True, seed)
+            concentration = ENVS[env_id]["concentrations"][0]
+            env, policy = _worker_policy(env_id, concentration, variant, name, True, seed)
             run_episode(env, policy, WARMUP_SEED, None)
 
 
@@ -252,8 +277,8 @@ def run_order(variants, field_seed: int) -> list[str]:
     return steps[k:] + steps[:k] + [CONTROL]
 
 
-def field_runs(concentration: float, name: str, field_seed: int, small: bool, seed: int,
-               variants) -> dict:
+def field_runs(env_id: str, concentration: float, name: str, field_seed: int, small: bool,
+               seed: int, variants) -> dict:
     """One field sailed by policy ``name`` under the reference step, each of
     ``variants`` and the control (:class:`Nudged`), one after the other in
     this worker: per run the metrics of :data:`METRICS`, the return, the
@@ -264,7 +289,7 @@ def field_runs(concentration: float, name: str, field_seed: int, small: bool, se
     out = {}
     for label in run_order(variants, field_seed):
         variant = REFERENCE if label == CONTROL else label
-        env, policy = _worker_policy(concentration, variant, name, small, seed)
+        env, policy = _worker_policy(env_id, concentration, variant, name, small, seed)
         t0 = time.perf_counter()
         e = run_episode(Nudged(env) if label == CONTROL else env, policy, field_seed, None)
         wall = time.perf_counter() - t0
@@ -274,6 +299,29 @@ def field_runs(concentration: float, name: str, field_seed: int, small: bool, se
                           floes=int(sim.n_floes),
                           tally=[int(x) for x in sim.free_tally] if sim.free_drift else None)
     return out
+
+
+def read_runs(path, st: dict) -> list[dict]:
+    """The fields' runs of a JSON file written by ``--fields``, checked to
+    hold every field, policy and step of the settings ``st``.
+
+    Raises
+    ------
+    ValueError
+        If one is missing.
+    """
+    with open(path, encoding="utf-8") as fh:
+        fields = json.load(fh)
+    have = {(f["concentration"], f["policy"], f["seed"]) for f in fields}
+    want = [(a, name, st["seed"] + k) for a in st["concentrations"] for name in st["policies"]
+            for k in range(st["seeds"])]
+    missing = [w for w in want if w not in have]
+    steps = [REFERENCE, *st["variants"], CONTROL]
+    if missing or any(step not in f for f in fields for step in steps):
+        raise ValueError(f"--runs {path}: not the runs of these settings (missing "
+                         f"{missing[:3] or 'a step'})")
+    return [f for w in want for f in fields
+            if (f["concentration"], f["policy"], f["seed"]) == w]
 
 
 def run_statistics(st: dict, quiet: bool = False) -> list[dict]:
@@ -289,10 +337,10 @@ def run_statistics(st: dict, quiet: bool = False) -> list[dict]:
     context = multiprocessing.get_context("spawn")
     with _PoolThreads(1), concurrent.futures.ProcessPoolExecutor(
             st["workers"], mp_context=context, initializer=init_worker,
-            initargs=(tuple(st["policies"]), (REFERENCE, *st["variants"]), st["small"],
-                      st["seed"])) as pool, \
+            initargs=(st["env"], tuple(st["policies"]), (REFERENCE, *st["variants"]),
+                      st["small"], st["seed"])) as pool, \
             harness.Progress(runs * len(jobs), SUITE, quiet, unit="episode") as bar:
-        futures = {pool.submit(field_runs, a, name, s, st["small"], st["seed"],
+        futures = {pool.submit(field_runs, st["env"], a, name, s, st["small"], st["seed"],
                                tuple(st["variants"])): (a, name, s)
                    for a, name, s in jobs}
         for future in concurrent.futures.as_completed(futures):
@@ -363,12 +411,14 @@ def _runs(fields: list[dict], concentration: float, policy: str, step: str) -> l
 
 def equivalence_rows(fields: list[dict], st: dict) -> list[dict]:
     """Per concentration, policy and metric of :data:`METRICS`: the
-    reference's mean, the statistic the control decides (``"mean"``,
-    ``"trimmed"``, or None where neither resolves the margin for it), and
-    for the control and each candidate the per-field differences'
-    intervals of the mean and of the trimmed mean, relative to the
-    reference's mean, and the verdict (:data:`PASS`, :data:`FAIL` or
-    :data:`UNRESOLVED`)."""
+    reference's mean, the statistic of the row (``st["statistic"]``:
+    ``"trimmed"``, the trimmed mean on every row, or ``"control"``, the one
+    the control decides: ``"mean"`` where it resolves the margin, else
+    ``"trimmed"``), None where the control's interval of that statistic does
+    not lie within the margin (the row is unresolved), and for the control
+    and each candidate the per-field differences' intervals of the mean and
+    of the trimmed mean, relative to the reference's mean, and the verdict
+    (:data:`PASS`, :data:`FAIL` or :data:`UNRESOLVED`)."""
     rows = []
     for a in st["concentrations"]:
         for name in st["policies"]:
@@ -385,8 +435,11 @@ def equivalence_rows(fields: list[dict], st: dict) -> list[dict]:
                                       within_mean=within(m, scale),
                                       within_trimmed=within(t, scale))
                 c = out[CONTROL]
-                statistic = ("mean" if c["within_mean"] else
-                             "trimmed" if c["within_trimmed"] else None)
+                if st.get("statistic", "trimmed") == "trimmed":
+                    statistic = "trimmed" if c["within_trimmed"] else None
+                else:
+                    statistic = ("mean" if c["within_mean"] else
+                                 "trimmed" if c["within_trimmed"] else None)
                 for o in out.values():
                     o["verdict"] = (UNRESOLVED if statistic is None else
                                     PASS if o[f"within_{statistic}"] else FAIL)
@@ -505,7 +558,8 @@ def speed_child(st: dict) -> dict:
 
     numba.set_num_threads(1)
     seed, late_after = st["speed_seed"], st["late_after"]
-    envs = {v: make_checked_env(ENV_ID, env_kwargs(None, v, st["small"]), seed=seed)
+    envs = {v: make_checked_env(st["env"], env_kwargs(None, v, st["small"], st["env"]),
+                                seed=seed)
             for v in (REFERENCE, *st["variants"])}
     try:
         for env in envs.values():
@@ -518,8 +572,8 @@ def speed_child(st: dict) -> dict:
     finally:
         for env in envs.values():
             env.close()
-    return dict(seed=seed, late_after=late_after, concentration=concentration,
-                drawn="concentration" not in env_kwargs(None, REFERENCE, st["small"]),
+    return dict(env=st["env"], seed=seed, late_after=late_after, concentration=concentration,
+                drawn="concentration" not in env_kwargs(None, REFERENCE, st["small"], st["env"]),
                 floes=floes, rounds=dict(zip(envs, rounds)))
 
 
@@ -579,7 +633,8 @@ def speed_table(speed: dict, summary: dict, rounds: int) -> dict:
                      s["awake_mean"], s["engaged_per_step"]])
     first = summary[REFERENCE]
     return harness.table(
-        f"Speed on one thread: one straight-line episode, seed {speed['seed']}, A = "
+        f"Speed on one thread: one zero-action episode of `{speed['env']}`, seed "
+        f"{speed['seed']}, A = "
         f"{speed['concentration']:.3f} "
         f"({'as the environment draws it' if speed['drawn'] else 'set by the instance'}), "
         f"{speed['floes']} floes (best of {rounds} round{'s' * (rounds != 1)})",
@@ -609,19 +664,23 @@ def summary_table(rows: list[dict], st: dict, tally: dict) -> dict:
                      failures])
     statistics = [r["statistic"] for r in rows]
     return harness.table(
-        f"The equivalence test: {st['seeds']} fields per concentration and policy, margin "
-        f"±{100 * MARGIN:g} % of the exact mean, {100 * CONFIDENCE:g} % intervals",
+        f"The equivalence test on `{st['env']}`: {st['seeds']} fields per concentration and "
+        f"policy, margin ±{100 * MARGIN:g} % of the exact mean, {100 * CONFIDENCE:g} % "
+        f"intervals",
         ["step", "rows equivalent", "rows not shown equivalent", "rows unresolved",
          "not shown equivalent: interval of (step − exact) / exact mean"], body,
         f"A row (concentration, policy, metric) is equivalent when the {100 * CONFIDENCE:g} % "
         f"interval of the centre of the per-field differences lies within ±{100 * MARGIN:g} % "
-        f"of the exact step's mean. The centre is the mean on "
-        f"{statistics.count('mean')} rows and the {100 * TRIM:g} %-trimmed mean on "
-        f"{statistics.count('trimmed')}, as the control decides (the mean where the "
-        f"control's interval of the mean lies within the margin); "
-        f"{statistics.count(None)} rows are resolved by neither for the control. The "
-        f"control is the exact step with every floe's velocity nudged by {NUDGE:g} m/s at "
-        f"reset: what chaos alone does to the same fields.")
+        f"of the exact step's mean. "
+        + (f"The centre is the {100 * TRIM:g} %-trimmed mean on every row; "
+           if st.get("statistic", "trimmed") == "trimmed" else
+           f"The centre is the mean on {statistics.count('mean')} rows and the "
+           f"{100 * TRIM:g} %-trimmed mean on {statistics.count('trimmed')}, as the control "
+           f"decides (the mean where the control's interval of the mean lies within the "
+           f"margin); ")
+        + f"{statistics.count(None)} rows are not resolved for the control. The control is "
+          f"the exact step with every floe's velocity nudged by {NUDGE:g} m/s at reset: what "
+          f"chaos alone does to the same fields.")
 
 
 def _label(key: str) -> str:
@@ -633,6 +692,7 @@ def equivalence_table(rows: list[dict], st: dict) -> dict:
     verdict of the control and of each candidate."""
     labels = {key: (f"{label} [{unit}]" if unit else label, scale)
               for key, label, scale, unit in METRICS}
+    fallback = "trimmed" if st.get("statistic", "trimmed") == "trimmed" else "mean"
     body = []
     for r in rows:
         label, scale = labels[r["metric"]]
@@ -641,17 +701,21 @@ def equivalence_table(rows: list[dict], st: dict) -> dict:
                  {"mean": "mean", "trimmed": "trimmed mean", None: "–"}[stat]]
         for step in (CONTROL, *st["variants"]):
             o = r["runs"][step]
-            shown = o[stat] if stat else o["mean"]
-            cells.append(f"{_interval(shown)} {o['verdict'] if o['verdict'] != PASS else ''}"
-                         .strip())
+            shown = o[stat] if stat else o[fallback]
+            verdict = o["verdict"] if o["verdict"] != PASS else ""
+            beside = ("" if (stat or fallback) == "mean" or not math.isfinite(o["mean"][0]) else
+                      f"; mean {100 * o['mean'][0]:+.1f} % [{100 * o['mean'][1]:+.1f}, "
+                      f"{100 * o['mean'][2]:+.1f}]")
+            cells.append(f"{_interval(shown)} {verdict}".strip() + beside)
         body.append(cells)
     return harness.table(
         "Every row: (step − exact) / exact mean, the centre and its interval",
         ["A", "policy", "metric", "mean, exact", "statistic", CONTROL, *st["variants"]], body,
         f"Each cell: the centre of the per-field differences relative to the exact mean and "
-        f"its {100 * CONFIDENCE:g} % interval; a cell is marked when the interval is not "
-        f"within ±{100 * MARGIN:g} % (fail) or when the control's is within it for neither "
-        f"statistic (unresolved; the cell then shows the mean).")
+        f"its {100 * CONFIDENCE:g} % interval (the row's statistic), then, where that is the "
+        f"trimmed mean, the mean and its interval; a cell is marked when its interval is not "
+        f"within ±{100 * MARGIN:g} % (fail), or when the control's is not (unresolved; the "
+        f"cell then shows the {fallback}).")
 
 
 def conclusions_table(concl: dict, st: dict) -> dict:
@@ -722,7 +786,7 @@ def parse_concentrations(text: str) -> tuple[float, ...]:
     return values
 
 
-def parse_policies(text: str) -> tuple[str, ...]:
+def parse_policies(text: str, env_id: str = ENV_ID) -> tuple[str, ...]:
     """The policies of ``--policies``: baselines of the environment
     (:func:`agents.baselines.baseline_names`), in the order given.
 
@@ -733,7 +797,7 @@ def parse_policies(text: str) -> tuple[str, ...]:
     """
     from agents.baselines import baseline_names
 
-    valid = baseline_names(ENV_ID)
+    valid = baseline_names(env_id)
     names = tuple(dict.fromkeys(n.strip() for n in str(text).split(",") if n.strip()))
     unknown = [n for n in names if n not in valid]
     if unknown or not names:
@@ -742,17 +806,37 @@ def parse_policies(text: str) -> tuple[str, ...]:
     return names
 
 
+def record_path(path, env_id: str):
+    """Where the record of ``env_id`` goes: ``path`` as given, unless it is
+    the suite's own file of a directory (``--docs`` or the default) and the
+    environment is not :data:`ENV_ID`, whose record keeps that name; then
+    ``<suite>-<name>.json`` beside it."""
+    from pathlib import Path
+
+    path = Path(path)
+    if env_id == ENV_ID or path.name != f"{SUITE}.json":
+        return path
+    return path.with_name(f"{SUITE}-{env_id.split('/')[1]}.json")
+
+
 def main(argv=None, prog: str | None = None) -> int:
     p = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     p.add_argument("--parts", default=None,
                    help="what to measure, comma-separated: " + ", ".join(PARTS)
                         + " (default: both)")
+    p.add_argument("--env", default=ENV_ID, choices=list(ENVS),
+                   help=f"the ship environment (default {ENV_ID}); the record of another one "
+                        f"is written beside this one's, as {SUITE}-<name>.json")
     p.add_argument("--seeds", type=int, default=None,
                    help=f"fields per concentration and policy (default {DEFAULTS['seeds']})")
     p.add_argument("--concentrations", default=None,
-                   help="ice concentrations, comma-separated (default 0.2,0.3,0.4,0.5)")
+                   help="ice concentrations, comma-separated (default: the environment's, "
+                        + "; ".join(f"{e.split('/')[1]}: {','.join(f'{a:g}' for a in v['concentrations'])}"
+                                    for e, v in ENVS.items()) + "; --quick: the first)")
     p.add_argument("--policies", default=None,
-                   help="baselines, comma-separated (default " + ",".join(POLICIES) + ")")
+                   help="baselines, comma-separated (default: the environment's, "
+                        + "; ".join(f"{e.split('/')[1]}: {','.join(v['policies'])}"
+                                    for e, v in ENVS.items()) + "; --quick: the first two)")
     p.add_argument("--variants", default=None,
                    help="steps compared with the exact one, comma-separated: "
                         + ", ".join(CANDIDATES) + " (default: all)")
@@ -771,6 +855,13 @@ def main(argv=None, prog: str | None = None) -> int:
     p.add_argument("--fields", default=None, metavar="PATH",
                    help="also write every field's runs to this JSON file (the record keeps "
                         "the summaries)")
+    p.add_argument("--runs", default=None, metavar="PATH",
+                   help="take the fields' runs from this JSON file (written by --fields) "
+                        "instead of sailing them, and compute the statistics of them")
+    p.add_argument("--statistic", default="trimmed", choices=STATISTICS,
+                   help="the centre of the differences: the 20 %%-trimmed mean on every row "
+                        "(trimmed, the default), or the mean where the control resolves the "
+                        "margin with it and the trimmed mean elsewhere (control)")
     args, argv = harness.parse(p, argv)
     st = harness.settings(args, DEFAULTS, QUICK, ("seeds", "seed", "workers", "speed_seed",
                                                   "rounds", "late_after"))
@@ -778,12 +869,17 @@ def main(argv=None, prog: str | None = None) -> int:
         p.error(f"--seeds must be at least 5 (the trimmed mean's interval), got {st['seeds']}")
     if min(st["workers"], st["rounds"]) < 1 or st["late_after"] < 0:
         p.error("--workers and --rounds must be at least 1, --late-after at least 0")
+    st["env"] = args.env
+    own = ENVS[args.env]
+    st["concentrations"] = own["concentrations"][:1] if args.quick else own["concentrations"]
+    st["policies"] = own["policies"][:2] if args.quick else own["policies"]
+    args.json = record_path(args.json, args.env)
     try:
         parts = parse_parts(args.parts)
         if args.concentrations is not None:
             st["concentrations"] = parse_concentrations(args.concentrations)
         if args.policies is not None:
-            st["policies"] = parse_policies(args.policies)
+            st["policies"] = parse_policies(args.policies, args.env)
         if args.variants is not None:
             st["variants"] = tuple(harness.pick_names(args.variants, CANDIDATES, "variant"))
     except ValueError as exc:
@@ -802,8 +898,12 @@ def main(argv=None, prog: str | None = None) -> int:
         if not args.quiet:
             print("  env steps/s: " + ", ".join(f"{k} {v['rate']:.3g}" for k, v in summary.items()
                                                 if k != "gain"), flush=True)
+    st["statistic"] = args.statistic
     if "statistics" in parts:
-        fields = run_statistics(st, args.quiet)
+        try:
+            fields = read_runs(args.runs, st) if args.runs else run_statistics(st, args.quiet)
+        except (OSError, ValueError) as exc:
+            p.error(str(exc))
         if args.fields:
             with open(args.fields, "w", encoding="utf-8") as fh:
                 json.dump(fields, fh)
@@ -817,8 +917,9 @@ def main(argv=None, prog: str | None = None) -> int:
         if concl:
             tables.append(conclusions_table(concl, st))
         tables.append(equivalence_table(rows, st))
+    title = TITLE if st["env"] == ENV_ID else f"{TITLE}: {st['env'].split('/')[1]}"
     record = harness.make_record(
-        SUITE, TITLE, DESCRIPTION, harness.command_line(SUITE, argv), tables, data,
+        SUITE, title, DESCRIPTION, harness.command_line(SUITE, argv), tables, data,
         time.perf_counter() - t0, machine=harness.machine_info(1))
     harness.finish(args, record)
     return 0

@@ -589,14 +589,17 @@ def write_record(record: dict, path: str | os.PathLike) -> Path:
 
 
 def load_records(directory: str | os.PathLike = DOCS_DIR) -> list[dict]:
-    """The records of ``directory`` (files ``<suite>.json``), in the order
-    of :data:`benchmarks.SUITES`; suites without a file are left out."""
+    """The records of ``directory`` (files ``<suite>.json``, then a suite's
+    further records ``<suite>-<name>.json`` in the order of their names), in
+    the order of :data:`benchmarks.SUITES`; suites without a file are left
+    out."""
     directory = Path(directory)
     out = []
     for suite in SUITES:
-        path = directory / f"{suite}.json"
-        if path.is_file():
-            out.append(json.loads(path.read_text(encoding="utf-8")))
+        paths = [directory / f"{suite}.json", *sorted(directory.glob(f"{suite}-*.json"))]
+        for path in paths:
+            if path.is_file():
+                out.append(json.loads(path.read_text(encoding="utf-8")))
     return out
 
 

@@ -11,9 +11,9 @@ repository) when the builder starts:
   workload of the scaling benchmark's record, shown with its tables;
 * ``figures/where_time_goes.png`` — the shares of a ShipNavigation-v1
   substep and of PPO training on it, from the where_time_goes record;
-* ``figures/free_drift.png`` — the ice impulse per metre of every field
-  under the fast step against the exact step, and the relative differences
-  of the means, from the free_drift record;
+* ``figures/free_drift.png`` — the equivalence test of the ship's steps, per
+  step, concentration, policy and metric beside the control, from the
+  free_drift record;
 * ``api/<module>.md`` — one autodoc page per public module;
 * ``include/`` — parts of hand-written pages: the lists of those pages in
   registry order (``environments_toc.md``, ``api_toc.md``), the tables of the
@@ -29,6 +29,7 @@ incremental.
 from __future__ import annotations
 
 import importlib
+import math
 import os
 import pkgutil
 import re
@@ -69,12 +70,14 @@ def save_png_if_changed(fig, path: Path) -> None:
         path.write_bytes(data)
 
 
-def with_record_figure(text: str, record: dict, out: Path, draw, alt: str, caption: str) -> str:
+def with_record_figure(text: str, record: dict, out: Path, draw, alt: str, caption: str,
+                       name: str | None = None) -> str:
     """The rendered record ``text`` with the figure that ``draw(record,
-    path)`` writes to ``figures/<suite>.png`` of ``out`` between its tables
-    and its last line (command, machine, date); ``text`` as it is when
-    ``draw`` returns False (nothing to draw)."""
-    name = f"{record['suite']}.png"
+    path)`` writes to ``figures/<name>.png`` of ``out`` (``name``: the
+    record's suite unless given) between its tables and its last line
+    (command, machine, date); ``text`` as it is when ``draw`` returns False
+    (nothing to draw)."""
+    name = f"{name or record['suite']}.png"
     if not draw(record, out / "figures" / name):
         return text
     body, _, last = text.strip().rpartition("\n\n")
@@ -288,8 +291,10 @@ _SHARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"
 
 def where_time_goes_figure(record: dict, path: Path) -> bool:
     """Horizontal stacked bars of the shares of a where_time_goes record
-    (``benchmarks.where_time_goes``): a late engine substep (its kick–drift
-    pass, live-pair loop and the rest) and PPO training (engine,
+    (``benchmarks.where_time_goes``): a late engine substep under the exact
+    step (its kick–drift pass, live-pair loop and the rest) and under the
+    fast step (classification, closed form, list rebuilds, the engaged
+    floes' steps), and PPO training in each configuration (engine,
     environments' Python, adapter, VecNormalize, policy, buffer, update,
     rest), as a PNG at ``path`` (rewritten only when it changes). Returns
     ``False``, writing nothing, when the record has neither."""
@@ -302,13 +307,22 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
     data = record["data"]
     bars = []
     if data.get("substep"):
-        s = data["substep"]["summary"]["shares"]
-        bars.append(("engine substep", [("kick–drift pass", s["kick_drift"]),
-                                        ("live-pair loop", s["live_pairs"]),
-                                        ("rest of the substep", s["rest"])]))
-    if data.get("ppo"):
-        s = data["ppo"]["shares"]
-        bars.append(("PPO training", [(SHARE_LABELS[k].split(" (")[0], s[k]) for k in SHARES]))
+        summary = data["substep"]["summary"]
+        s = summary["shares"]
+        bars.append(("engine substep, exact step", [("kick–drift pass", s["kick_drift"]),
+                                                    ("live-pair loop", s["live_pairs"]),
+                                                    ("rest of the substep", s["rest"])]))
+        if summary.get("fast"):
+            f = summary["fast"]["shares"]
+            bars.append(("engine substep, fast step (the default)",
+                         [("classification of the windows", f["classify"]),
+                          ("closed form of the free floes", f["sync"]),
+                          ("Verlet list rebuilds", f["rebuild"]),
+                          ("steps of the engaged floes", f["steps"])]))
+    for configuration, r in (data.get("ppo") or {}).items():
+        s = r["one"]["shares"]
+        bars.append((f"PPO training, {configuration} configuration, one thread",
+                     [(SHARE_LABELS[k].split(" (")[0], s[k]) for k in SHARES]))
     if not bars:
         return False
     fig = Figure(figsize=(7.5, 1.0 + 1.6 * len(bars)), layout="constrained")
@@ -334,99 +348,69 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
     return True
 
 
-#: markers of the free_drift figure's policies (others get a square) and of its
-#: metrics (coloured apart from the concentrations of the other panel)
-_POLICY_MARKERS = {"straight": "o", "lattice": "^"}
+#: markers of the free_drift figure's metrics
 _METRIC_MARKERS = ("o", "s", "D", "v")
 
 
 def free_drift_figure(record: dict, path: Path) -> bool:
-    """Two panels of a free_drift record (``benchmarks.free_drift``): the
-    ice impulse per metre of every field under the fast step against the
-    exact step, beside the identity line; and per concentration, policy and
-    metric the difference of the means relative to the exact mean, with bars
-    of two standard errors of the paired differences and the band of the
-    relative tolerance, so that both criteria of the table show. A PNG at
-    ``path`` (rewritten only when it changes). Returns ``False``, writing
-    nothing, when the record has no statistics."""
+    """The equivalence test of a free_drift record (``benchmarks.free_drift``),
+    one panel per step compared with the exact one: for each concentration,
+    policy and metric, the centre of the per-field differences relative to
+    the exact mean with its interval (the statistic the control chose),
+    beside the control's (grey), and the band of the margin. A row is
+    equivalent when its bar lies inside the band. A PNG at ``path``
+    (rewritten only when it changes). Returns ``False``, writing nothing,
+    when the record has no statistics."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from benchmarks.free_drift import METRICS, RELATIVE_TOLERANCE, STANDARD_ERRORS
+    from benchmarks.free_drift import CONTROL, METRICS
 
     stats = record["data"].get("statistics")
-    if not stats or not stats.get("fields"):
+    if not stats or not stats.get("rows"):
         return False
-    fields, rows = stats["fields"], stats["rows"]
-    concentrations = sorted({f["concentration"] for f in fields})
-    policies = list(dict.fromkeys(f["policy"] for f in fields))
-    colours = {a: f"C{k}" for k, a in enumerate(concentrations)}
-    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
-    FigureCanvasAgg(fig)
-    left, right = fig.subplots(1, 2, gridspec_kw=dict(width_ratios=(1.0, 1.35)))
-
-    scale = 1e3
-    values = []
-    for name in policies:
-        for a in concentrations:
-            mine = [f for f in fields if f["policy"] == name and f["concentration"] == a]
-            x = [f["exact"]["impulse_per_metre"] / scale for f in mine]
-            y = [f["fast"]["impulse_per_metre"] / scale for f in mine]
-            values += x + y
-            left.scatter(x, y, s=18, color=colours[a], marker=_POLICY_MARKERS.get(name, "s"),
-                         alpha=0.8, label=f"{name}, A = {a:g}")
-    top = 1.05 * max(values)
-    left.plot([0, top], [0, top], ":", color="0.3", lw=1, label="fast = exact")
-    left.set_xlim(0, top)
-    left.set_ylim(0, top)
-    left.set_aspect("equal")
-    left.set_xlabel("exact step [kN s/m]", fontsize=8)
-    left.set_ylabel("fast step [kN s/m]", fontsize=8)
-    left.set_title("ice impulse per metre, each field", fontsize=9)
-    left.tick_params(labelsize=7)
-    left.legend(fontsize=6, loc="upper left", ncol=2)
-
+    rows = stats["rows"]
+    margin = 100 * record["data"]["margin"]
+    steps = list(record["data"]["settings"]["variants"])
+    groups = list(dict.fromkeys((r["concentration"], r["policy"]) for r in rows))
     keys = [key for key, *_ in METRICS]
     labels = {key: label for key, label, *_ in METRICS}
-    groups = [(a, name) for a in concentrations for name in policies]
+    fig = Figure(figsize=(10.0, 2.6 * len(steps) + 0.6), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(steps), 1, sharex=True, squeeze=False)[:, 0]
     width = 0.8 / len(keys)
-    band = 100 * RELATIVE_TOLERANCE
-    right.axhspan(-band, band, color="0.9", zorder=0,
-                  label=f"±{band:g} % of the exact mean")
-    right.axhline(0.0, color="0.4", lw=0.8)
-    for k, key in enumerate(keys):
-        xs, ys, errs = [], [], []
-        for g, (a, name) in enumerate(groups):
-            r = next((r for r in rows if r["concentration"] == a and r["policy"] == name
-                      and r["metric"] == key), None)
-            if r is None or not r["exact"]:
-                continue
-            xs.append(g - 0.4 + width * (k + 0.5))
-            ys.append(100 * r["relative"])
-            errs.append(100 * STANDARD_ERRORS * r["sem"] / abs(r["exact"]))
-        right.errorbar(xs, ys, yerr=errs, fmt=_METRIC_MARKERS[k % len(_METRIC_MARKERS)],
-                       ms=4, capsize=2, color=f"C{4 + k}", label=labels[key])
-        # the control beside it: the exact step against itself, nudged
-        cx, cy = [], []
-        for g, (a, name) in enumerate(groups):
-            r = next((r for r in stats.get("control", []) if r["concentration"] == a
-                      and r["policy"] == name and r["metric"] == key), None)
-            if r is None or not r["exact"]:
-                continue
-            cx.append(g - 0.4 + width * (k + 0.5))
-            cy.append(100 * r["relative"])
-        if cx:
-            right.scatter(cx, cy, s=16, marker=_METRIC_MARKERS[k % len(_METRIC_MARKERS)],
-                          facecolors="none", edgecolors=f"C{4 + k}", linewidths=0.8,
-                          label=f"{labels[key]}, control" if k == 0 else None)
-    right.set_xticks(range(len(groups)), [f"{a:g}\n{name}" for a, name in groups], fontsize=7)
-    right.set_xlim(-0.6, len(groups) - 0.4)
-    right.set_ylabel("(fast − exact) / exact [%]", fontsize=8)
-    right.set_title(f"difference of the means, ± {STANDARD_ERRORS:g} SE of the paired "
-                    f"differences", fontsize=9)
-    right.tick_params(axis="y", labelsize=7)
-    right.grid(True, axis="y", alpha=0.3)
-    right.legend(fontsize=7, loc="best")
+    limit = 4.0 * margin
+    for ax, step in zip(axes, steps):
+        ax.axhspan(-margin, margin, color="0.9", zorder=0, label=f"±{margin:g} % margin")
+        ax.axhline(0.0, color="0.4", lw=0.8)
+        for k, key in enumerate(keys):
+            for who, colour, shift in ((CONTROL, "0.55", -0.25), (step, f"C{k}", 0.25)):
+                xs, ys, lo, hi = [], [], [], []
+                for g, group in enumerate(groups):
+                    r = next(r for r in rows if (r["concentration"], r["policy"]) == group
+                             and r["metric"] == key)
+                    iv = r["runs"][who][r["statistic"] or "mean"]
+                    if not all(v is not None and math.isfinite(v) for v in iv):
+                        continue
+                    c, a, b = (100 * v for v in iv)
+                    xs.append(g - 0.4 + width * (k + 0.5 + shift))
+                    ys.append(max(-limit, min(limit, c)))
+                    lo.append(max(0.0, min(limit, c) - max(-limit, a)))
+                    hi.append(max(0.0, min(limit, b) - max(-limit, c)))
+                ax.errorbar(xs, ys, yerr=[lo, hi], fmt=_METRIC_MARKERS[k % 4], ms=3.5,
+                            capsize=1.5, lw=0.9, color=colour,
+                            mfc="none" if who == CONTROL else colour,
+                            label=(labels[key] if who != CONTROL else
+                                   ("control (nudged), each metric" if k == 0 else None)))
+        ax.set_ylim(-limit, limit)
+        ax.set_ylabel(f"({step} − exact) / exact [%]", fontsize=8)
+        ax.tick_params(axis="y", labelsize=7)
+        ax.grid(True, axis="y", alpha=0.3)
+        ax.set_title(f"{step} against the exact step, beside the control", fontsize=9)
+    axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    axes[-1].set_xticks(range(len(groups)), [f"{a:g}\n{name}" for a, name in groups],
+                        fontsize=7)
+    axes[-1].set_xlim(-0.6, len(groups) - 0.4)
     save_png_if_changed(fig, path)
     return True
 
@@ -449,22 +433,28 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
         elif r["suite"] == "where_time_goes":
             text = with_record_figure(
                 text, r, out, where_time_goes_figure,
-                "shares of the wall time of a ShipNavigation-v1 engine substep and of PPO "
-                "training on it",
-                "Shares of the wall time: a late ShipNavigation-v1 engine substep (top) and PPO "
-                "training on its native vector environment (bottom), from the tables above.")
+                "shares of the wall time of a ShipNavigation-v1 engine substep under each step "
+                "and of PPO training on it",
+                "Shares of the wall time: a late ShipNavigation-v1 engine substep under the "
+                "exact and under the fast step, and PPO training on its native vector "
+                "environment in each configuration, from the tables above.")
         elif r["suite"] == "free_drift":
+            from benchmarks.free_drift import ENV_ID
+
+            env = r["data"]["settings"].get("env", ENV_ID)
             text = with_record_figure(
                 text, r, out, free_drift_figure,
-                "ice impulse per metre of every field under the fast step against the exact "
-                "step, and the relative differences of the means with their standard errors",
-                "Left: the ice impulse per metre of every field and policy under the fast step "
-                "against the exact step; the identity line is where they agree. Right: the "
-                "difference of the means of each metric relative to the exact mean, with bars "
-                "of two standard errors of the paired differences, beside the band of the "
-                "relative tolerance: a row of the table passes when its point lies in the band "
-                "and its bar crosses zero. Hollow markers: the same for the control, the exact "
-                "step against itself with the floes nudged by a rounding error.")
+                "the equivalence test: each step's relative difference from the exact step "
+                "with its interval, beside the control's, and the margin",
+                "The equivalence test, one panel per step: for each concentration and policy "
+                "(below the axis) and each metric (colour), the centre of the per-field "
+                "differences from the exact step relative to the exact mean, with its 90 % "
+                "interval; grey hollow markers beside each: the control, the exact step "
+                "with every floe nudged by a rounding error, which shows what chaos alone "
+                "does to the same fields. A row is equivalent when its bar lies in the grey "
+                "band of the margin; values beyond four times the margin are drawn at the "
+                "edge.",
+                name="free_drift" if env == ENV_ID else f"free_drift-{env.split('/')[1]}")
         parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make records` writes them to `docs/benchmarks/`.\n"]
