@@ -164,6 +164,31 @@ def test_the_control_chooses_the_statistic_and_the_verdicts_follow():
     assert tally["unresolved"] == tally["total"] == len(fd.METRICS)
 
 
+def _record(verdicts, confidence=fd.CONFIDENCE, statistic="trimmed", resolved=True):
+    """A record of rows (A = 0.5, swath, one metric each) with the fast
+    step's verdicts."""
+    rows = [dict(concentration=0.5, policy="swath", metric=key,
+                 statistic="trimmed" if resolved else None,
+                 runs={"fast": dict(verdict=v), fd.CONTROL: dict(verdict=fd.PASS)})
+            for key, v in zip(("impulse_per_metre", "energy_to_ice"), verdicts)]
+    return dict(data=dict(settings=dict(env=fd.ENV_ID, statistic=statistic),
+                          confidence=confidence, statistics=dict(rows=rows)))
+
+
+def test_a_record_supports_a_step_when_every_row_passes_there_or_in_an_extension():
+    assert fd.supports(_record([fd.PASS, fd.PASS]), "fast")
+    assert not fd.supports(_record([fd.PASS, fd.PASS]), "soft-0.1")
+    assert not fd.supports(_record([fd.PASS, fd.PASS], resolved=False), "fast")
+    short = _record([fd.PASS, fd.FAIL])
+    assert not fd.supports(short, "fast")
+    # the row sailed again on more fields, with a stricter interval, settles it ...
+    again = _record([fd.FAIL, fd.PASS], confidence=0.95)
+    assert fd.supports(short, "fast", [again])
+    # ... but not a record at the same confidence (the pilot), nor one where it fails
+    assert not fd.supports(short, "fast", [_record([fd.PASS, fd.PASS], statistic="control")])
+    assert not fd.supports(short, "fast", [_record([fd.PASS, fd.FAIL], confidence=0.95)])
+
+
 def _check_record(record, st):
     harness.validate_record(record)
     assert record["suite"] == fd.SUITE and record["title"] == fd.TITLE
