@@ -23,9 +23,13 @@ Sustained steps per second of every registered environment in its default
 configuration, each in a fresh process with Numba limited to one thread,
 random actions from a seeded action space. After a warm-up (an episode start
 and 5 steps, which compile or load the kernels, then 2 seconds of untimed
-steps), three consecutive runs of at least 20 wall seconds each are timed; an
-episode that ends (terminated or truncated) is reset inside the run and the
-reset is timed too, as in training: these are the rates training sees. The
+steps), three consecutive runs of whole episodes, at least 20 wall seconds
+each, are timed: each run starts with a fresh episode and ends with the
+first episode end after its 20 seconds, and every episode's reset is timed
+too, as in training. So a run weighs every part of an episode as an
+episode does (a ship's transit costs little before the ship reaches the ice
+and most where it has set the pack moving): these are the rates training
+sees. The
 table gives the mean steps/s over the runs, their range and standard
 deviation, the resets and the physics errors (steps with `info["error"]`).
 
@@ -56,8 +60,8 @@ PEER_LIKE = dict(floe_sizes="brash", concentration=0.09)
 def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0,
                 warmup: float = 2.0, kwargs: dict | None = None) -> dict:
     """Sustained steps/s of ``env_id`` (made with ``kwargs``) in this
-    process: ``runs`` consecutive timed runs of at least ``seconds`` each,
-    after the warm-up, with resets at episode ends."""
+    process: ``runs`` consecutive timed runs of whole episodes, at least
+    ``seconds`` each, after the warm-up, each episode with its reset."""
     import gymnasium as gym
 
     import iceenvs  # noqa: F401
@@ -82,9 +86,9 @@ def measure_env(env_id: str, seconds: float = 20.0, runs: int = 3, seed: int = 0
             if term or trunc:
                 env.reset()
                 resets += 1
-            wall = time.perf_counter() - t0
-            if wall >= seconds:
-                break
+                wall = time.perf_counter() - t0
+                if wall >= seconds:
+                    break
         rates.append(n / wall)
         steps.append(n)
         walls.append(wall)
@@ -131,7 +135,7 @@ def environments_table(result: dict) -> dict:
     st = result["settings"]
     return harness.table(
         f"Sustained environment steps per second, one core (Numba: 1 thread), {st['runs']} "
-        f"runs of ≥ {st['seconds']:g} s each after a warm-up",
+        f"runs of whole episodes, ≥ {st['seconds']:g} s each, after a warm-up",
         COLUMNS, [env_row(r) for r in result["environments"]],
         "The spread within one run is a few per cent; the load of a shared host moves the "
         "rates of two runs of the command further apart than that.")

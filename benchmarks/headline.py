@@ -6,8 +6,8 @@ Rewrites the block between ``<!-- headline:start -->`` and
 floe-steps/s at Ā = 0.7 and jammed, each with its contacts per floe and a
 line on what the two regimes cost, the hard-disc engine's collisions/s and
 each environment's sustained steps/s, the native vector environments'
-steps/s and PPO's training steps/s on them, ShipNavigation-v1 under the
-free-drift step, as far as records of full runs
+steps/s and PPO's training steps/s on them, ShipNavigation-v1 under each
+engine step over whole transits, as far as records of full runs
 (not ``--quick``) exist, each with its date.
 """
 from __future__ import annotations
@@ -125,17 +125,26 @@ def _vector_rows(record: dict) -> list[list[str]]:
 
 
 def _free_drift_rows(record: dict) -> list[list[str]]:
-    """ShipNavigation-v1 under the free-drift step against the exact step,
-    one straight-line episode on one core."""
-    speed = record["data"].get("speed")
-    if not speed:
+    """ShipNavigation-v1 under each engine step, sustained over whole
+    transits at A = 0.2–0.5 (the equivalence test's straight-line episodes,
+    one core each, two side by side), from the main record of the suite
+    (not the pilot's, not another environment's)."""
+    from .free_drift import ENV_ID, REFERENCE
+
+    settings = record["data"].get("settings", {})
+    stats = record["data"].get("statistics")
+    if (settings.get("env", ENV_ID) != ENV_ID or settings.get("statistic") == "control"
+            or not stats or not stats.get("rates")):
         return []
-    s = speed["summary"]
-    e, f = s["exact"], s["fast"]
-    return [["`iceenvs/ShipNavigation-v1`, `free_drift=True`",
-             f"{f['rate']:.0f} steps/s, one core, over an episode ({e['rate']:.0f} with the exact "
-             f"step); {f['late_ms']:.1f} ms a step after step {speed['late_after']} "
-             f"({e['late_ms']:.1f})"]]
+    rates = {r["step"]: r["pooled"] for r in stats["rates"]}
+    others = ", ".join(f"{rates[s]:.0f} {s}" for s in rates if s not in (REFERENCE, "fast"))
+    a = "–".join(f"{float(x):g}" for x in (settings["concentrations"][0],
+                                           settings["concentrations"][-1]))
+    return [[f"`{ENV_ID}`, sustained over whole transits, A = {a}",
+             f"{rates['fast']:.0f} steps/s with the default (fast) step, "
+             f"{rates[REFERENCE]:.0f} with the exact step" + (f"; soft ice: {others}"
+                                                              if others else "")
+             + "; one core each, two runs side by side"]]
 
 
 _ROWS = {"hertz": _hertz_rows, "harddisk": _harddisk_rows, "environments": _environment_rows,

@@ -47,7 +47,10 @@ cores, each beside a loop that shows what the machine itself gives:
 * **native vector environments** of ShipNavigation-v0 and ShipNavigation-v1
   with 64 sub-environments (`gymnasium.make_vec(...,
   vectorization_mode="vector_entry_point")`), stepped with seeded random
-  actions, episodes reset as they end: env steps/s = 64 × vector steps / s;
+  actions from a reset until every sub-environment has ended an episode
+  (whole transits: early steps, before the ship reaches the ice, cost far
+  less than late ones among the floes it has set moving), episodes reset as
+  they end: env steps/s = 64 × vector steps / s, at most three rounds;
   after the rounds, one more segment on one thread times the share of the
   step that runs outside the compiled calls that are parallel over the
   sub-environments, and so bounds their speed-up (Amdahl);
@@ -96,6 +99,9 @@ QUICK = dict(rounds=2, floes=400, large_floes=800, steps=20, ceiling_floes=4000,
 CEILING_DT = 1e-3
 #: untimed vector steps of every copy of a vector environment before the timing
 VECTOR_WARMUP = 3
+#: the most rounds of a vector workload (each round is a whole transit of
+#: every sub-environment on every thread count)
+VECTOR_ROUNDS = 3
 
 
 def group(key: str) -> str:
@@ -214,9 +220,13 @@ def _hertz_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
 
 def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
     """A native vector environment of ``n`` sub-environments per thread
-    count, each reset with the same seed and stepped with its own generator
-    of the same seed, and a few untimed steps; the timed segments:
-    ``steps`` vector steps."""
+    count, warmed up by a few steps; the timed segments: whole transits,
+    each from a reset with the same seed and actions from a generator of the
+    same seed, until every sub-environment has ended an episode (so that the
+    steps weigh every part of an episode as training does: a ship costs
+    little before it reaches the ice and most among the floes it has set
+    moving). Its rate: env steps (n per vector step) over the segment's
+    wall time."""
     import gymnasium as gym
 
     import iceenvs  # noqa: F401  (registers the ids)
@@ -235,14 +245,20 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
             env.step(random_actions(env.single_action_space, rng, n))
         copies.append((env, rng))
 
-    def segment(k, env, rng):
+    def segment(k, env):
         def go():
             numba.set_num_threads(k)
             space = env.single_action_space
+            rng = np.random.default_rng(spec["seed"])
+            env.reset(seed=spec["seed"])
+            ended = np.zeros(n, dtype=bool)
+            count = 0
             t0 = time.perf_counter()
-            for _ in range(steps):
-                env.step(random_actions(space, rng, n))
-            return n * steps / (time.perf_counter() - t0)
+            while not ended.all():
+                _, _, term, trunc, _ = env.step(random_actions(space, rng, n))
+                ended |= np.asarray(term) | np.asarray(trunc)
+                count += 1
+            return n * count / (time.perf_counter() - t0)
         return go
 
     def after(rounds):
@@ -252,7 +268,7 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
             env.close()
         return share
 
-    return [segment(k, *c) for k, c in zip(threads, copies)], dict(steps=steps), after
+    return [segment(k, c[0]) for k, c in zip(threads, copies)], dict(steps=steps), after
 
 
 #: the compiled calls of a native vector environment's step that run in
@@ -371,6 +387,7 @@ def time_workload(key: str, spec: dict, threads: list[int], rounds: int) -> dict
             runs, info, after = _ppo_runs(spec, threads)
         else:
             raise ValueError(f"unknown workload {key!r}")
+        rounds = min(rounds, spec.get("most_rounds", rounds))
         try:
             rates = harness.interleaved_rounds(runs, rounds)
         finally:
@@ -418,6 +435,8 @@ def workload_specs(keys, st: dict, seed: int, cache_dir: Path, quiet: bool) -> d
             env_id = ENV_IDS[key]
             steps = st["vector_steps"] if kind == "vector" else st["ppo_steps"]
             what = "PPO on " if kind == "ppo" else ""
+            if kind == "vector":
+                spec.update(most_rounds=VECTOR_ROUNDS)
             spec.update(n=st["envs"], steps=steps, env_id=env_id, rollout=st["ppo_rollout"],
                         kwargs=dict(env_facts(env_id).small) if st["small"] else {},
                         label=f"{what}{env_id.split('/')[1]}, native vector env, "
@@ -499,12 +518,13 @@ def rates_table(results: list[dict], threads: list[int], rounds: int) -> dict:
         body.append([res["label"], res["unit"]] + cells)
     notes = ["Each cell: the best segment, and in brackets how much slower the slowest round "
              "of the same thread count was."]
-    if any(group(res["workload"]) in ("vector", "ppo") for res in results):
-        notes.append("An environment's steps cost more as its episodes go on: the ship wakes "
-                     "the floes it pushes, and a floe at rest costs nothing (skip_resting). "
-                     "The copies of a workload are at the same step of the same episodes in a "
-                     "round, so the thread counts of one round compare like with like; the "
-                     "best segment of a vector environment is mostly that of its first timed steps.")
+    if any(group(res["workload"]) == "vector" for res in results):
+        notes.append(f"An environment's steps cost more as its episodes go on: the ship sets "
+                     f"moving the floes it pushes, and a floe that drifts free costs little. "
+                     f"A vector environment's segment is therefore a whole transit of every "
+                     f"sub-environment from the same reset (at most {VECTOR_ROUNDS} rounds), "
+                     f"so that the thread counts of one round compare like with like and the "
+                     f"rate is the one training sustains.")
     return harness.table(
         f"Rate against Numba threads (best of {rounds} rounds)",
         ["workload", "unit"] + _thread_columns(threads), body, "\n\n".join(notes))

@@ -27,8 +27,11 @@ per sub-environment) and the environment's native vector environment
 process, the engines of all sub-environments advanced in one compiled call,
 Numba on all the machine's threads). Each measurement runs in a fresh
 process: seeded random actions, a warm-up (the kernels loaded and a second of
-untimed steps), then at least the stated wall seconds of timed steps, with
-episodes reset as they end. The configurations take turns, round after
+untimed steps), then, from a reset, timed steps until every sub-environment
+has ended an episode and at least the stated wall seconds have passed, the
+episodes reset as they end: whole episodes, so that every part of one
+weighs as it does in training (a ship's transit costs little before the
+ship reaches the ice and most where it has set the pack moving). The configurations take turns, round after
 round, so that the load of a shared machine falls on all of them alike; the
 tables give the mean over the rounds and their range.
 
@@ -39,7 +42,8 @@ vectorization, after one untimed rollout and update: the training steps
 per second that a run sees.
 """
 #: the environments timed by default (default configurations)
-DEFAULT_IDS = ("iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0", "iceenvs/WindDrift-v0")
+DEFAULT_IDS = ("iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1", "iceenvs/ShipBeset-v0",
+               "iceenvs/WindDrift-v0")
 DEFAULT_SIZES = (1, 8, 16, 32)
 #: settings of ``--quick``
 #: (each environment in its small instance, iceenvs.facts.EnvFacts.small, in
@@ -68,7 +72,10 @@ def _warm_up(step, seconds: float):
 def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
                      kwargs: dict | None = None) -> dict:
     """Env steps/s of ``env_id`` stepped ``mode``-wise with ``n``
-    sub-environments ("single" ignores ``n``), in this process."""
+    sub-environments ("single" ignores ``n``), in this process: after a
+    warm-up, from a reset until every sub-environment has ended an episode
+    and at least ``seconds`` have passed (whole episodes, each as
+    training sees it)."""
     import gymnasium as gym
     import numpy as np
 
@@ -78,46 +85,62 @@ def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
     rng = np.random.default_rng(seed)
     if mode == "single":
         env = gym.make(env_id, **kwargs)
-        env.reset(seed=seed)
         space = env.action_space
+        n = 1
+
+        def reset():
+            env.reset(seed=seed)
 
         def step():
             _, _, term, trunc, _ = env.step(random_actions(space, rng, 1)[0])
             if term or trunc:
                 env.reset()
-            return 1
-    else:
-        if mode == "subproc":
-            from stable_baselines3.common.vec_env import SubprocVecEnv
+            return np.array([term or trunc])
+    elif mode == "subproc":
+        from stable_baselines3.common.vec_env import SubprocVecEnv
 
-            from agents.envs import EnvFactory
+        from agents.envs import EnvFactory
 
-            env = SubprocVecEnv([EnvFactory(env_id, kwargs, seed + k) for k in range(n)])
+        env = SubprocVecEnv([EnvFactory(env_id, kwargs, seed + k) for k in range(n)])
+        space = env.action_space
+
+        def reset():
             env.seed(seed)
             env.reset()
-            space = env.action_space
-        else:
-            if mode == "native":
-                env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point",
-                                   **kwargs)
-            else:
-                env = gym.vector.SyncVectorEnv([lambda: gym.make(env_id, **kwargs)] * n)
-            env.reset(seed=seed)
-            space = env.single_action_space
 
         def step():
-            env.step(random_actions(space, rng, n))
-            return n
+            return np.asarray(env.step(random_actions(space, rng, n))[2], dtype=bool)
+    else:
+        if mode == "native":
+            env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point",
+                               **kwargs)
+        else:
+            env = gym.vector.SyncVectorEnv([lambda: gym.make(env_id, **kwargs)] * n)
+        space = env.single_action_space
+
+        def reset():
+            env.reset(seed=seed)
+
+        def step():
+            _, _, term, trunc, _ = env.step(random_actions(space, rng, n))
+            return np.asarray(term) | np.asarray(trunc)
+    reset()
     _warm_up(step, seconds)
-    steps = 0
+    reset()
+    ended = np.zeros(n, dtype=bool)
+    steps = episodes = 0
     t0 = time.perf_counter()
     while True:
-        steps += step()
+        done = step()
+        steps += n
+        episodes += int(done.sum())
+        ended |= done
         wall = time.perf_counter() - t0
-        if wall >= seconds:
+        if wall >= seconds and ended.all():
             break
     env.close()
-    return dict(mode=mode, id=env_id, n=n, steps=steps, seconds=wall, rate=steps / wall)
+    return dict(mode=mode, id=env_id, n=n, steps=steps, seconds=wall, rate=steps / wall,
+                episodes=episodes)
 
 
 def measure_training(mode: str, env_id: str, n: int, steps: int, seed: int,
@@ -277,7 +300,10 @@ def _summary(runs: list[dict]) -> dict:
     if failed:
         return dict(failed=failed[0])
     rates = [r["rate"] for r in runs]
-    return dict(rates=rates, mean=statistics.fmean(rates), min=min(rates), max=max(rates))
+    out = dict(rates=rates, mean=statistics.fmean(rates), min=min(rates), max=max(rates))
+    if all("episodes" in r for r in runs):
+        out["episodes"] = [r["episodes"] for r in runs]
+    return out
 
 
 def run_benchmark(ids, sizes, seconds: float, rounds: int, seed: int, ppo_envs: int | None,

@@ -24,6 +24,9 @@ def test_quick_run_writes_every_configuration(tmp_path, capsys):
     assert modes == {("single", 1), ("sync", 2), ("subproc", 2), ("native", 2)}
     for r in data["stepping"] + data["training"]:
         assert r["min"] <= r["mean"] <= r["max"] and r["min"] > 0
+    # stepping is timed over whole episodes: every sub-environment ended one
+    for r in data["stepping"]:
+        assert all(e >= r["n"] for e in r["episodes"]), r
     # the quick run trains without worker processes
     assert {r["mode"] for r in data["training"]} == {"sync", "native"}
     phases = data["phases"]
