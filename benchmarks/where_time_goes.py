@@ -25,50 +25,66 @@ SUITE = "where_time_goes"
 TITLE = "Where the time of a ShipNavigation-v1 step goes"
 DESCRIPTION = """
 Where the time of a step of `iceenvs/ShipNavigation-v1` goes, and that of
-PPO training on it, so that it shows what a faster step must cut. Everything
-runs on one thread (`numba.set_num_threads(1)`, `torch.set_num_threads(1)`),
-in a fresh process per measurement, compilation excluded, every random
-number seeded.
+PPO training on it, so that it shows what a faster step must cut. The
+substep's parts run on one thread (`numba.set_num_threads(1)`,
+`torch.set_num_threads(1)`), in a fresh process, compilation excluded,
+every random number seeded.
 
-* **A late engine substep.** The episode of seed 10001, the ship sailing
-  straight ahead (a zero action) for 200 environment steps; then, on that
-  state, the engine's own step over one control interval
-  (`sim.step(n_sub)`, divided by its n_sub substeps), beside two of its
-  parts, each in a compiled loop of n_sub calls on copies of the same
-  state, with the floes awake and the live pairs that the engine's next run
-  finds at its start (`find_awake`, `live_pairs` of
-  `physics.hertz_resting`): the kick–drift pass (`first_half_awake`, which
-  with half the floes or more awake is `first_half` of
-  `physics.hertz_kernels` over all floes, the table says which; Δt = 0 so
-  that the state stays put) and the loop over the live pairs (`live_pair_forces`; the pairs
-  found apart are skipped as the run skips them). The rest, the whole
-  less the two parts, is the ship's hull contacts and motion and the
-  bookkeeping of the lists. The three take turns, round after round (five
-  by default); each figure is the best round, with the slowest beside it.
-  The engine's step moves on by one control interval each round, so that
-  its rounds are consecutive intervals of the episode; the two parts are
-  timed on the state where the rounds begin.
-* **Through the episode.** The same episode from its start, every 20
-  environment steps: the mean wall time of an environment step over the last
-  20, the floes awake, the floes moving faster than 1 cm/s and the floes in
-  contact, with the floes' water-drag time constant m/b (b the engine's
-  linear water-drag coefficient): a floe the ship pushes keeps moving, and
-  awake, for several times m/b.
-* **PPO.** Stable-Baselines3 PPO (MLP policy, rollouts of 2048 steps over
-  16 sub-environments, minibatches of 256, 10 epochs, seed 0) on the native
-  vector environment of ShipNavigation-v1 (N = 16, observations and rewards
-  normalised by `VecNormalize`, as `seaice train` runs it), after one
-  untimed `learn(2048)`: training steps/s over a plain `learn(4096)`, then a
-  second `learn(4096)` under cProfile, whose cumulative times split the wall
-  time into the engine (`physics.hertz.advance_together`), the
-  environments' own Python around it (the vector environment's step less
-  the engine), the Stable-Baselines3 adapter (`agents.vec`'s `step_wait`
-  less the vector step, its `unbatch_info` included), `VecNormalize` (its
-  `step_wait` less the adapter's), the policy's forward passes in the
-  rollouts, the rollout buffer (adding steps, returns and advantages) and
-  PPO's update (`train`); the remainder is the rest of the rollout loop.
-  cProfile's own overhead falls on every Python call, so it inflates the
-  Python parts somewhat against the compiled engine and PyTorch.
+* **A late engine substep, under each step.** The episode of seed 10001 (its
+  default step), the ship sailing straight ahead (a zero action) for 200
+  environment steps; then two copies of that state, one under the exact
+  step (`free_drift=False`, the floes at rest skipped) and one under the
+  fast step (the default, `free_drift=True`), each stepping over one control
+  interval per round (`sim.step(n_sub)`, divided by its n_sub substeps).
+  Beside the exact step, two of its parts, each in a compiled loop of n_sub
+  calls on copies of the same state, with the floes awake and the live
+  pairs that the engine's next run finds at its start (`find_awake`,
+  `live_pairs` of `physics.hertz_resting`): the kick–drift pass
+  (`first_half_awake`, which with half the floes or more awake is
+  `first_half` of `physics.hertz_kernels` over all floes, the table says
+  which; Δt = 0 so that the state stays put) and the loop over the live
+  pairs (`live_pair_forces`; the pairs found apart are skipped as the run
+  skips them); the rest is the ship's hull contacts and motion and the
+  bookkeeping of the lists. Beside the fast step, the parts it pays once a
+  window or once a list, each timed per call in a compiled loop on a copy of
+  the state: the classification of the floes into free and engaged
+  (`classify`), the closed form that brings the free floes up to date at a
+  window's end (`sync_free`, over a whole window) and a rebuild of the
+  Verlet list (`rebuild_in_run`), each counted per substep by how often the
+  timed rounds called it (the fast step's tally); the rest is the steps of
+  the engaged floes themselves (their kick–drift, their live pairs, the
+  hull and the guards). Everything takes turns, round after round (five by
+  default); each figure is the best round, with the slowest beside it. The
+  engines' steps move on by one control interval each round, so that their
+  rounds are consecutive intervals of the episode; the parts are timed on
+  the state where the rounds begin.
+* **Through the episode.** The same episode from its start (its default
+  step), every 20 environment steps: the mean wall time of an environment
+  step over the last 20, the floes awake, the floes moving faster than
+  1 cm/s and the floes in contact, with the floes' water-drag time constant
+  m/b (b the engine's linear water-drag coefficient): a floe the ship
+  pushes keeps moving for several times m/b.
+* **PPO**, in two configurations: the environment's defaults, and its
+  documented training configuration (the `env_kwargs` of its entry in
+  `agents/hyperparams/ppo.yaml`). Stable-Baselines3 PPO (MLP policy,
+  rollouts of 2048 steps over 16 sub-environments, minibatches of 256, 10
+  epochs, seed 0) on the native vector environment of ShipNavigation-v1
+  (N = 16, observations and rewards normalised by `VecNormalize`, as
+  `seaice train` runs it), after one untimed `learn(2048)`: training steps/s
+  over a plain `learn(4096)`, then a second `learn(4096)` under cProfile,
+  whose cumulative times split the wall time into the engine
+  (`physics.hertz.advance_together`), the environments' own Python around
+  it (the vector environment's step less the engine), the
+  Stable-Baselines3 adapter (`agents.vec`'s `step_wait` less the vector
+  step, its `unbatch_info` included), `VecNormalize` (its `step_wait` less
+  the adapter's), the policy's forward passes in the rollouts, the rollout
+  buffer (adding steps, returns and advantages) and PPO's update
+  (`train`); the remainder is the rest of the rollout loop. cProfile's own
+  overhead falls on every Python call, so it inflates the Python parts
+  somewhat against the compiled engine and PyTorch. Each configuration is
+  also trained, unprofiled, with the engine on all the machine's cores
+  (PyTorch on one thread, as `seaice train` runs it): the rate a training
+  run on this machine sees.
 """
 
 #: the environment whose step is broken down
@@ -126,10 +142,12 @@ class _OneThread:
 # ---------------------------------------------------------------------------
 
 def _loops():
-    """The two compiled loops, made on first use (importing ``physics``)."""
-    global _KICKS, _PAIRS
-    if "_KICKS" in globals():
-        return _KICKS, _PAIRS
+    """The compiled loops, made on first use (importing ``physics``)."""
+    global _LOOPS
+    if "_LOOPS" in globals():
+        return _LOOPS
+    from physics import hertz_free_drift as F
+    from physics import hertz_kernels as K
     from physics import hertz_resting as R
 
     @numba.njit
@@ -144,8 +162,34 @@ def _loops():
         for _ in range(m):
             R.live_pair_forces(live, awake, floes, law, box, verlet, dt, path, force, torque)
 
-    _KICKS, _PAIRS = kicks, pairs
-    return kicks, pairs
+    @numba.njit
+    def classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, window, awake, wp, mark,
+                 lines, bounds, m):
+        for _ in range(m):
+            F.classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt, window, awake, wp,
+                       mark, lines, bounds)
+        return awake.count[1]
+
+    @numba.njit
+    def sync(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, window, ref,
+             n_free, m):
+        ok = True
+        for _ in range(m):
+            awake.count[1] = n_free
+            ok = F.sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, dt,
+                             window, False, ref) and ok
+        return ok
+
+    @numba.njit
+    def rebuilds(floes, verlet, lx, ly, px, py, ship, dt, m):
+        n = 0
+        for _ in range(m):
+            n += K.rebuild_in_run(floes, verlet, lx, ly, px, py, False, ship, False,
+                                  dt).nbr.shape[0]
+        return n
+
+    _LOOPS = dict(kicks=kicks, pairs=pairs, classify=classify, sync=sync, rebuilds=rebuilds)
+    return _LOOPS
 
 
 def _make_env(small: bool):
@@ -163,13 +207,70 @@ def _state(sim) -> dict:
                 time=float(sim.time))
 
 
+def _fast_parts(sim, loops, n_sub: int):
+    """The window-level parts of the fast step on ``sim``'s state (a copy of
+    its floes, made here): timed calls of the classification, of the closed
+    form of the free floes over a whole window and of a list rebuild, each
+    per call [s], and the floes free in the window that begins now."""
+    import copy
+
+    from physics import hertz_free_drift as F
+
+    mine = copy.deepcopy(sim)
+    n, floes, law, wall_law, drive, box, ship = mine._kernel_arguments(n_sub)
+    verlet = mine._verlet
+    nf = floes.pos.shape[0]
+    fbuf, tbuf = floes.force.copy(), floes.torque.copy()
+    awake = F.Awake(np.ones(nf, dtype=np.uint8), np.empty(nf, dtype=np.int64),
+                    np.empty(nf, dtype=np.int64), np.zeros(3, dtype=np.int64))
+    wp = F.new_pairs(verlet)
+    mark = np.zeros(nf, dtype=np.uint8)
+    lines = np.empty((nf, 6))
+    bounds = np.zeros(6)
+    table = F.drift_table(floes, drive, mine.dt)
+    window = int(mine.free_window)
+    path = np.zeros(nf)
+    n_free = loops["classify"](floes, fbuf, tbuf, table, box, verlet, ship, mine.dt, window,
+                               awake, wp, mark, lines, bounds, 1)
+    loops["sync"](floes, fbuf, tbuf, drive, table, box, awake, lines, path, mine.dt, window,
+                  verlet.ref, n_free, 1)
+    loops["rebuilds"](floes, verlet, box.lengths[0], box.lengths[1], box.periodic_x,
+                      box.periodic_y, ship, mine.dt, 1)
+    m = 20
+
+    def classify():
+        t0 = time.perf_counter()
+        loops["classify"](floes, fbuf, tbuf, table, box, verlet, ship, mine.dt, window, awake,
+                          wp, mark, lines, bounds, m)
+        return (time.perf_counter() - t0) / m
+
+    def sync():
+        t0 = time.perf_counter()
+        loops["sync"](floes, fbuf, tbuf, drive, table, box, awake, lines, path, mine.dt,
+                      window, verlet.ref, n_free, m)
+        return (time.perf_counter() - t0) / m
+
+    def rebuild():
+        t0 = time.perf_counter()
+        loops["rebuilds"](floes, verlet, box.lengths[0], box.lengths[1], box.periodic_x,
+                          box.periodic_y, ship, mine.dt, m)
+        return (time.perf_counter() - t0) / m
+
+    return [classify, sync, rebuild], int(n_free)
+
+
 def substep_breakdown(steps: int = 200, rounds: int = REPEATS, seed: int = EPISODE_SEED,
                       small: bool = False) -> dict:
-    """Time a late engine substep of ShipNavigation-v1 and two of its parts
-    (see :data:`DESCRIPTION`) in this process, on one thread: the state
-    after ``steps`` straight-line env steps of episode ``seed``, then
-    ``rounds`` rounds of the whole engine step, the kick–drift pass and the
-    live-pair loop taking turns. Times are per substep [s]."""
+    """Time a late engine substep of ShipNavigation-v1 under each step (see
+    :data:`DESCRIPTION`) in this process, on one thread: the state after
+    ``steps`` straight-line env steps of episode ``seed`` (the default
+    step), then ``rounds`` rounds of the exact step's whole engine step, its
+    kick–drift pass and its live-pair loop, and of the fast step's whole
+    engine step, its classification, closed form and list rebuild, taking
+    turns. Times are per substep, or per call of the window-level parts
+    [s]."""
+    import copy
+
     from physics import hertz_kernels as K
     from physics import hertz_resting as R
 
@@ -187,33 +288,45 @@ def substep_breakdown(steps: int = 200, rounds: int = REPEATS, seed: int = EPISO
             u = env.unwrapped
             sim = u.sim
             n_sub = int(round(u.control_interval / sim.dt))
-            state = _state(sim)
+            exact = copy.deepcopy(sim)
+            exact.free_drift, exact.skip_resting = False, True
+            fast = copy.deepcopy(sim)
+            fast.free_drift, fast.skip_resting = True, False
+            state = _state(exact)
 
-            kicks, pairs_loop = _loops()
-            floes = sim._floes._replace(pos=sim._pos.copy(), vel=sim._vel.copy(),
-                                        omega=sim._omega.copy(), force=sim._force.copy(),
-                                        torque=sim._torque.copy())
-            verlet = sim._verlet._replace(ref=sim._verlet.ref.copy(),
-                                          hist=sim._verlet.hist.copy())
-            box = sim.box.kernel_box(sim.time)
+            loops = _loops()
+            kicks, pairs_loop = loops["kicks"], loops["pairs"]
+            floes = exact._floes._replace(pos=exact._pos.copy(), vel=exact._vel.copy(),
+                                          omega=exact._omega.copy(),
+                                          force=exact._force.copy(),
+                                          torque=exact._torque.copy())
+            verlet = exact._verlet._replace(ref=exact._verlet.ref.copy(),
+                                            hist=exact._verlet.hist.copy())
+            box = exact.box.kernel_box(exact.time)
             # Δt = 0: the same pass over the same, unchanging state
             kick = K.Kick(0.0, 0.0, box.lengths[0], box.lengths[1], box.periodic_x,
                           box.periodic_y, 1.0, 1.0, 0.0, 0.0)
-            path = np.zeros(sim.n_floes)
-            drive = sim._drive()
+            path = np.zeros(exact.n_floes)
+            drive = exact._drive()
             # the floes awake and the live pairs as the engine's next run
             # finds them at its start
             awake = R.find_awake(floes, drive, box, verlet)
             n_awake = int(awake.count[0])
             live = R.live_pairs(verlet, awake)
             kicks(floes, verlet.ref, drive, kick, awake, path, 2)     # compile
-            pairs_loop(live, awake, floes, sim._law, box, verlet, sim.dt, path, floes.force,
-                       floes.torque, 1)
+            pairs_loop(live, awake, floes, exact._law, box, verlet, exact.dt, path,
+                       floes.force, floes.torque, 1)
+            fast_parts, n_free = _fast_parts(fast, loops, n_sub)
+            fast.step(n_sub)                                        # untimed: loaded
+            tally0 = fast.free_tally.copy()
+            rebuilds0 = fast.n_rebuilds
 
-            def whole():
-                t0 = time.perf_counter()
-                sim.step(n_sub)
-                return (time.perf_counter() - t0) / n_sub
+            def whole(which):
+                def go():
+                    t0 = time.perf_counter()
+                    which.step(n_sub)
+                    return (time.perf_counter() - t0) / n_sub
+                return go
 
             def kick_pass():
                 t0 = time.perf_counter()
@@ -222,17 +335,24 @@ def substep_breakdown(steps: int = 200, rounds: int = REPEATS, seed: int = EPISO
 
             def pair_loop():
                 t0 = time.perf_counter()
-                pairs_loop(live, awake, floes, sim._law, box, verlet, sim.dt, path,
+                pairs_loop(live, awake, floes, exact._law, box, verlet, exact.dt, path,
                            floes.force, floes.torque, n_sub)
                 return (time.perf_counter() - t0) / n_sub
 
-            times = harness.interleaved_rounds([whole, kick_pass, pair_loop], rounds)
+            times = harness.interleaved_rounds(
+                [whole(exact), kick_pass, pair_loop, whole(fast), *fast_parts], rounds)
+            tally = fast.free_tally - tally0
         finally:
             env.close()
+    keys = ("whole", "kick_drift", "live_pairs", "fast_whole", "classify", "sync", "rebuild")
     return dict(seed=seed, env_steps=done, n_sub=n_sub, dt=float(sim.dt),
                 control_interval=float(u.control_interval), live_pairs=int(awake.count[2]),
                 awake_at_start=n_awake, full_pass=bool(2 * n_awake >= sim.n_floes),
-                **state, times=dict(zip(("whole", "kick_drift", "live_pairs"), times)))
+                free_at_window=n_free, window=int(fast.free_window),
+                fast_tally=dict(windows=int(tally[0]), substeps=int(tally[3]),
+                                engaged_steps=int(tally[2]),
+                                rebuilds=int(fast.n_rebuilds - rebuilds0)),
+                **state, times=dict(zip(keys, times)))
 
 
 def episode_trajectory(every: int = 20, max_steps: int | None = None,
@@ -346,10 +466,26 @@ def shares(cum: dict, wall: float) -> dict:
     return s
 
 
-def ppo_profile(st: dict, seed: int = 0) -> dict:
+def training_kwargs(small: bool = False) -> dict:
+    """The environment keywords of ShipNavigation-v1's documented PPO run
+    (``env_kwargs`` of its entry in ``agents/hyperparams/ppo.yaml``), over
+    the small instance's with ``small``."""
+    from agents.train import read_hyperparams
+
+    return {**_kwargs(small), **read_hyperparams("ppo", ENV_ID)["env_kwargs"]}
+
+
+#: the PPO configurations: the environment's defaults, and its documented
+#: training configuration
+CONFIGURATIONS = ("default", "training")
+
+
+def ppo_profile(st: dict, seed: int = 0, configuration: str = "default",
+                profile: bool = True) -> dict:
     """PPO on the native vector environment of ShipNavigation-v1 in this
-    process, on one thread (see :data:`DESCRIPTION`): training steps/s of a
-    plain and of a profiled ``learn``, and the shares of the profiled one."""
+    process (see :data:`DESCRIPTION`), the environment in ``configuration``
+    (:data:`CONFIGURATIONS`): training steps/s of a plain ``learn`` and,
+    with ``profile`` (on one thread), of a profiled one and its shares."""
     import cProfile
     import pstats
 
@@ -359,8 +495,10 @@ def ppo_profile(st: dict, seed: int = 0) -> dict:
 
     n = st["envs"]
     n_steps = max(st["rollout"] // n, 2)
-    with _OneThread():
-        venv = make_vec_env(ENV_ID, n_envs=n, seed=seed, env_kwargs=_kwargs(st["small"]),
+    kwargs = training_kwargs(st["small"]) if configuration == "training" else _kwargs(st["small"])
+    threads = numba.get_num_threads()
+    with _OneThread() if profile else _Threads(threads):
+        venv = make_vec_env(ENV_ID, n_envs=n, seed=seed, env_kwargs=kwargs,
                             normalize=dict(norm_obs=True, norm_reward=True),
                             vectorization="native")
         try:
@@ -372,20 +510,44 @@ def ppo_profile(st: dict, seed: int = 0) -> dict:
             t0 = time.perf_counter()
             model.learn(st["ppo_steps"], reset_num_timesteps=False)
             plain = (model.num_timesteps - before) / (time.perf_counter() - t0)
-            profiler = cProfile.Profile()
-            before = model.num_timesteps
-            t0 = time.perf_counter()
-            profiler.enable()
-            model.learn(st["ppo_steps"], reset_num_timesteps=False)
-            profiler.disable()
-            wall = time.perf_counter() - t0
-            steps = model.num_timesteps - before
+            out = dict(configuration=configuration, env_kwargs=kwargs, envs=n,
+                       rollout=n_steps * n, batch_size=min(st["batch_size"], n_steps * n),
+                       epochs=st["epochs"], rate=plain, threads=numba.get_num_threads())
+            if profile:
+                profiler = cProfile.Profile()
+                before = model.num_timesteps
+                t0 = time.perf_counter()
+                profiler.enable()
+                model.learn(st["ppo_steps"], reset_num_timesteps=False)
+                profiler.disable()
+                wall = time.perf_counter() - t0
+                steps = model.num_timesteps - before
+                cum = cumulative_times(pstats.Stats(profiler))
+                out.update(steps=steps, wall=wall, profiled_rate=steps / wall, cumulative=cum,
+                           shares=shares(cum, wall))
         finally:
             venv.close()
-    cum = cumulative_times(pstats.Stats(profiler))
-    return dict(envs=n, rollout=n_steps * n, batch_size=min(st["batch_size"], n_steps * n),
-                epochs=st["epochs"], steps=steps, wall=wall, rate=plain,
-                profiled_rate=steps / wall, cumulative=cum, shares=shares(cum, wall))
+    return out
+
+
+class _Threads:
+    """PyTorch on one thread and Numba on ``threads`` inside the block."""
+
+    def __init__(self, threads: int):
+        self.threads = threads
+
+    def __enter__(self):
+        import torch
+
+        self.saved = torch.get_num_threads()
+        torch.set_num_threads(1)
+        numba.set_num_threads(self.threads)
+        return self
+
+    def __exit__(self, *exc):
+        import torch
+
+        torch.set_num_threads(self.saved)
 
 
 # ---------------------------------------------------------------------------
@@ -393,18 +555,33 @@ def ppo_profile(st: dict, seed: int = 0) -> dict:
 # ---------------------------------------------------------------------------
 
 def summarise_breakdown(b: dict) -> dict:
-    """Best and slowest round of each part, the rest (whole less the two
-    parts, best over best) and the shares of the whole."""
+    """Best and slowest round of each part; for the exact step the rest
+    (whole less the two parts, best over best) and the shares of the whole;
+    for the fast step each window-level part per substep (its time per call
+    times the calls per substep of the timed rounds: windows, or list
+    rebuilds), the rest (the steps themselves) and the shares."""
     t = b["times"]
     best = {k: min(v) for k, v in t.items()}
     best["rest"] = best["whole"] - best["kick_drift"] - best["live_pairs"]
     slowest = {k: max(v) for k, v in t.items()}
     share = {k: best[k] / best["whole"] for k in ("kick_drift", "live_pairs", "rest")}
-    return dict(best=best, slowest=slowest, shares=share)
+    out = dict(best=best, slowest=slowest, shares=share)
+    tally = b.get("fast_tally")
+    if tally and tally["substeps"]:
+        per = dict(classify=best["classify"] * tally["windows"] / tally["substeps"],
+                   sync=best["sync"] * tally["windows"] / tally["substeps"],
+                   rebuild=best["rebuild"] * tally["rebuilds"] / tally["substeps"])
+        per["steps"] = best["fast_whole"] - sum(per.values())
+        out["fast"] = dict(per_substep=per,
+                           shares={k: v / best["fast_whole"] for k, v in per.items()},
+                           gain=best["whole"] / best["fast_whole"],
+                           engaged=tally["engaged_steps"] / tally["substeps"],
+                           steps_per_window=tally["substeps"] / max(tally["windows"], 1))
+    return out
 
 
 def breakdown_tables(b: dict, summary: dict) -> list[dict]:
-    """The state and the time per substep of its parts."""
+    """The state and the time per substep of its parts, under each step."""
     rounds = len(b["times"]["whole"])
     state = harness.table(
         f"A late substep: the state after {b['env_steps']} env steps of episode "
@@ -427,11 +604,42 @@ def breakdown_tables(b: dict, summary: dict) -> list[dict]:
         rows.append([label, 1e6 * best[key], spread,
                      "1" if key == "whole" else f"{100 * share[key]:.1f} %"])
     parts = harness.table(
-        f"Time per substep, one thread (best of {rounds} rounds)",
+        f"The exact step (`free_drift=False`): time per substep, one thread (best of "
+        f"{rounds} rounds)",
         ["part", "µs per substep", "slowest round", "share of the step"], rows,
         "The rest is the whole less the two parts, best over best, so the three add up to "
         "the whole.")
-    return [state, parts]
+    tables = [state, parts]
+    f = summary.get("fast")
+    if f:
+        tally = b["fast_tally"]
+        per, sh = f["per_substep"], f["shares"]
+        rows = [["whole engine step (sim.step(n_sub) / n_sub)", 1e6 * best["fast_whole"],
+                 f"+{100 * (slowest['fast_whole'] / best['fast_whole'] - 1):.0f} %", "–", "1"],
+                ["classification of a window (classify)", 1e6 * per["classify"],
+                 f"+{100 * (slowest['classify'] / best['classify'] - 1):.0f} %",
+                 1e6 * best["classify"], f"{100 * sh['classify']:.1f} %"],
+                [f"closed form of the free floes ({b['free_at_window']} of {b['floes']}, "
+                 f"sync_free)", 1e6 * per["sync"],
+                 f"+{100 * (slowest['sync'] / best['sync'] - 1):.0f} %", 1e6 * best["sync"],
+                 f"{100 * sh['sync']:.1f} %"],
+                ["Verlet list rebuild (rebuild_in_run)", 1e6 * per["rebuild"],
+                 f"+{100 * (slowest['rebuild'] / best['rebuild'] - 1):.0f} %",
+                 1e6 * best["rebuild"], f"{100 * sh['rebuild']:.1f} %"],
+                ["rest: the steps of the engaged floes (kick–drift, live pairs, hull, guards)",
+                 1e6 * per["steps"], "–", "–", f"{100 * sh['steps']:.1f} %"]]
+        tables.append(harness.table(
+            f"The fast step (the default): time per substep, one thread (best of {rounds} "
+            f"rounds), {f['gain']:.2f}× faster than the exact step here",
+            ["part", "µs per substep", "slowest round", "µs per call", "share of the step"],
+            rows,
+            f"Over the timed rounds the fast step ran {tally['substeps']} substeps in "
+            f"{tally['windows']} windows ({f['steps_per_window']:.1f} substeps each, "
+            f"{b['window']} at most) with {tally['rebuilds']} list rebuilds and "
+            f"{f['engaged']:.1f} engaged floes per substep. A window-level part per substep is "
+            f"its time per call (timed on copies of the state where the rounds begin) times "
+            f"its calls per substep; the rest is the whole less them."))
+    return tables
 
 
 def trajectory_table(tr: dict) -> dict:
@@ -449,17 +657,24 @@ def trajectory_table(tr: dict) -> dict:
         f"time constant m/b: median {tau}.")
 
 
-def ppo_table(p: dict) -> dict:
-    """Training steps/s and the shares of the profiled run."""
+def ppo_table(p: dict, cores: dict | None = None) -> dict:
+    """Training steps/s and the shares of the profiled run of one
+    configuration, and its plain rate on every core."""
     rows = [[SHARE_LABELS[k], f"{100 * p['shares'][k]:.1f} %"] for k in SHARES]
+    what = ("the environment's defaults" if p["configuration"] == "default" else
+            "its documented training configuration (" + ", ".join(
+                f"{k}={v}" for k, v in p["env_kwargs"].items()) + ")")
+    on_cores = ("" if cores is None else
+                f"; {harness.format_number(cores['rate'])} training steps/s with the engine on "
+                f"{cores['threads']} threads (PyTorch on one)")
     return harness.table(
-        f"PPO on the native vector environment, N = {p['envs']}: "
-        f"{harness.format_number(p['rate'])} training steps/s",
+        f"PPO on the native vector environment, N = {p['envs']}, {what}: "
+        f"{harness.format_number(p['rate'])} training steps/s on one thread",
         ["part", "share of the wall time"], rows,
         f"Rollouts of {p['rollout']} steps, minibatches of {p['batch_size']}, {p['epochs']} "
-        f"epochs. Training steps/s of a plain learn of {p['steps']} steps; under cProfile "
-        f"{harness.format_number(p['profiled_rate'])}/s, whose cumulative times give the "
-        f"shares.")
+        f"epochs. Training steps/s of a plain learn of {p['steps']} steps on one thread"
+        f"{on_cores}; under cProfile {harness.format_number(p['profiled_rate'])}/s on one "
+        f"thread, whose cumulative times give the shares.")
 
 
 def parse_parts(text: str | None) -> list[str]:
@@ -492,13 +707,18 @@ def run_benchmark(parts, st: dict, episode_seed: int, seed: int, quiet: bool = F
                     f"{100 * s['shares']['rest']:.0f} %")
             bar.advance()
         if "ppo" in parts:
-            if st["fresh"]:
-                out["ppo"] = harness.spawn_call(ppo_profile, st, seed, threads=1)
-            else:
-                out["ppo"] = ppo_profile(st, seed)
-            p = out["ppo"]
-            bar.log(f"  PPO: {p['rate']:.3g} training steps/s, engine "
-                    f"{100 * p['shares']['engine']:.0f} %, update {100 * p['shares']['train']:.0f} %")
+            out["ppo"] = {}
+            for configuration in CONFIGURATIONS:
+                if st["fresh"]:
+                    one = harness.spawn_call(ppo_profile, st, seed, configuration, threads=1)
+                    cores = harness.spawn_call(ppo_profile, st, seed, configuration, False)
+                else:
+                    one = ppo_profile(st, seed, configuration)
+                    cores = ppo_profile(st, seed, configuration, False)
+                out["ppo"][configuration] = dict(one=one, cores=cores)
+                bar.log(f"  PPO, {configuration}: {one['rate']:.3g} training steps/s on one "
+                        f"thread (engine {100 * one['shares']['engine']:.0f} %), "
+                        f"{cores['rate']:.3g} on {cores['threads']} threads")
             bar.advance()
     return out
 
@@ -542,7 +762,8 @@ def main(argv=None, prog: str | None = None) -> int:
         tables += breakdown_tables(out["substep"]["breakdown"], out["substep"]["summary"])
         tables.append(trajectory_table(out["substep"]["trajectory"]))
     if "ppo" in out:
-        tables.append(ppo_table(out["ppo"]))
+        for r in out["ppo"].values():
+            tables.append(ppo_table(r["one"], r["cores"]))
     record = harness.make_record(
         SUITE, TITLE, DESCRIPTION, harness.command_line(SUITE, argv), tables,
         dict(parts=parts, settings=st, episode_seed=args.episode_seed, seed=args.seed,

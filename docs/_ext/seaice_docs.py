@@ -441,7 +441,11 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
         elif r["suite"] == "free_drift":
             from benchmarks.free_drift import ENV_ID
 
-            env = r["data"]["settings"].get("env", ENV_ID)
+            settings = r["data"]["settings"]
+            env = settings.get("env", ENV_ID)
+            name = "free_drift" if env == ENV_ID else f"free_drift-{env.split('/')[1]}"
+            if settings.get("statistic") == "control":
+                name += "-pilot"
             text = with_record_figure(
                 text, r, out, free_drift_figure,
                 "the equivalence test: each step's relative difference from the exact step "
@@ -454,7 +458,7 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
                 "does to the same fields. A row is equivalent when its bar lies in the grey "
                 "band of the margin; values beyond four times the margin are drawn at the "
                 "edge.",
-                name="free_drift" if env == ENV_ID else f"free_drift-{env.split('/')[1]}")
+                name=name)
         parts.append(text)
     if not parts:
         parts = ["No benchmark records yet: `make records` writes them to `docs/benchmarks/`.\n"]
@@ -583,6 +587,17 @@ def generate_api(out: Path) -> None:
 # Sphinx hooks
 
 
+def exact_step_records(manifest: Path) -> str:
+    """A Markdown list of the records of ``docs/records.yaml`` made with the
+    exact engine step (``step: exact``), each with its page and what it holds."""
+    import yaml
+
+    entries = yaml.safe_load(manifest.read_text(encoding="utf-8"))["records"]
+    lines = [f"* `{e['path'].removeprefix('docs/')}` ({{doc}}`/{Path(e['page']).stem}`): "
+             f"{e.get('what', '')}" for e in entries if e.get("step") == "exact"]
+    return "\n".join(lines) if lines else "None."
+
+
 def on_builder_inited(app) -> None:
     os.environ.setdefault("SEAICE_QUIET", "1")
     src = Path(app.srcdir)
@@ -594,6 +609,8 @@ def on_builder_inited(app) -> None:
     generate_scenario_parameters(out)
     generate_api(out)
     write_if_changed(out / "include" / "observations.md", observation_table() + "\n")
+    write_if_changed(out / "include" / "exact_step_records.md",
+                     exact_step_records(src / "records.yaml") + "\n")
     app.env_pages = {environment_class(spec): env_id
                      for env_id, spec in registered_environments()}
 

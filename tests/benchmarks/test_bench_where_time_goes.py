@@ -50,7 +50,8 @@ def _check_record(record):
     assert b["floes"] > 0 and 0 <= b["awake"] <= b["floes"] and b["listed_pairs"] >= 0
     assert b["contacts"] >= 0 and b["n_sub"] >= 1 and b["dt"] > 0.0
     assert b["n_sub"] == round(b["control_interval"] / b["dt"])
-    for key in ("whole", "kick_drift", "live_pairs"):
+    for key in ("whole", "kick_drift", "live_pairs", "fast_whole", "classify", "sync",
+                "rebuild"):
         times = b["times"][key]
         assert len(times) == wtg.QUICK["rounds"]
         assert all(t > 0.0 and math.isfinite(t) for t in times)
@@ -60,20 +61,37 @@ def _check_record(record):
     assert best["kick_drift"] + best["live_pairs"] + best["rest"] == pytest.approx(best["whole"])
     assert sum(s["shares"].values()) == pytest.approx(1.0)
     assert all(0.0 <= v <= 1.0 for v in s["shares"].values())
+    # the fast step's parts: per substep, each window-level part its time per
+    # call times its calls per substep, and the four add up to the whole
+    tally, fast = b["fast_tally"], s["fast"]
+    assert tally["substeps"] == wtg.QUICK["rounds"] * b["n_sub"]
+    assert 1 <= tally["windows"] <= tally["substeps"] and tally["rebuilds"] >= 0
+    per = fast["per_substep"]
+    assert per["classify"] == pytest.approx(best["classify"] * tally["windows"]
+                                            / tally["substeps"])
+    assert sum(per.values()) == pytest.approx(best["fast_whole"])
+    assert fast["gain"] == pytest.approx(best["whole"] / best["fast_whole"])
+    assert 0 <= b["free_at_window"] <= b["floes"]
     tr = data["substep"]["trajectory"]
     assert tr["rows"] and tr["tau_median"] > 0.0 and tr["tau_min"] <= tr["tau_median"]
     assert [r["step"] for r in tr["rows"]] == sorted(r["step"] for r in tr["rows"])
     for r in tr["rows"]:
         assert r["step_ms"] > 0.0 and 0 <= r["moving"] <= tr["floes"]
         assert 0 <= r["awake"] <= tr["floes"] and 0 <= r["in_contact"] <= tr["floes"]
-    p = data["ppo"]
-    assert p["envs"] == wtg.QUICK["envs"] and p["rate"] > 0.0 and p["profiled_rate"] > 0.0
-    assert p["steps"] >= wtg.QUICK["ppo_steps"]
-    assert list(p["shares"]) == list(wtg.SHARES)
-    assert all(0.0 <= v <= 1.0 for v in p["shares"].values())
-    assert sum(p["shares"].values()) == pytest.approx(1.0)
-    assert p["shares"]["engine"] > 0.0 and p["shares"]["train"] > 0.0
-    assert [t["columns"][0] for t in record["tables"]] == ["floes", "part", "env step", "part"]
+    assert list(data["ppo"]) == list(wtg.CONFIGURATIONS)
+    for configuration, both in data["ppo"].items():
+        p, cores = both["one"], both["cores"]
+        assert p["configuration"] == cores["configuration"] == configuration
+        assert p["envs"] == wtg.QUICK["envs"] and p["rate"] > 0.0 and p["profiled_rate"] > 0.0
+        assert p["steps"] >= wtg.QUICK["ppo_steps"] and cores["rate"] > 0.0
+        assert list(p["shares"]) == list(wtg.SHARES)
+        assert all(0.0 <= v <= 1.0 for v in p["shares"].values())
+        assert sum(p["shares"].values()) == pytest.approx(1.0)
+        assert p["shares"]["engine"] > 0.0 and p["shares"]["train"] > 0.0
+    # the training configuration is the documented run's
+    assert data["ppo"]["training"]["one"]["env_kwargs"] == wtg.training_kwargs(True)
+    assert [t["columns"][0] for t in record["tables"]] == ["floes", "part", "part", "env step",
+                                                           "part", "part"]
 
 
 def test_quick_run_writes_the_record(tmp_path):
@@ -87,7 +105,7 @@ def test_quick_run_writes_the_record(tmp_path):
     record = json.loads(path.read_text(encoding="utf-8"))
     _check_record(record)
     text = harness.render_markdown(record)
-    assert text.startswith(f"## {wtg.TITLE}\n") and "### Time per substep" in text
+    assert text.startswith(f"## {wtg.TITLE}\n") and "### The fast step (the default)" in text
 
     out = tmp_path / "_generated"
     _, page = benchmarks_page(tmp_path, out)
