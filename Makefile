@@ -64,10 +64,13 @@ bench: setup
 	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite || exit 1; done
 
 # the records the documentation shows: every suite written with --docs to
-# docs/benchmarks/, the README's headline figures from them, the cross-check
-# report and the generated observation page
+# docs/benchmarks/ (and the fast step's equivalence test on the other ship
+# environments beside ShipNavigation-v1's), the README's headline figures
+# from them, the cross-check report and the generated observation page
 records: setup
 	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite --docs || exit 1; done
+	for env in ShipNavigation-v0 ShipBeset-v0; do \
+	  $(PY) -m benchmarks.free_drift --docs --env iceenvs/$$env --variants fast || exit 1; done
 	$(PY) -m benchmarks.headline
 	$(PY) -m physics.crosscheck all --out docs/crosscheck --force
 	$(PY) -m iceenvs.observation_page

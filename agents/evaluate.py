@@ -11,10 +11,12 @@
 Episode k of every policy starts from ``reset(seed=S + k)``. The trained
 policy sees observations normalised with the run's saved statistics
 (``vecnormalize.pkl``, frozen); the baselines see raw observations. The
-environment is built with the run's ``env_kwargs``, with ``--env-kwargs``
-set over them (the observation and action spaces must stay those of the
-run); the arguments are tried on one environment first, and a bad keyword
-exits with status 2 and the environment's message.
+environment is built with the run's ``env_kwargs`` but those of its
+training configuration alone (:data:`TRAINING_ONLY_KWARGS`: soft ice, which
+a run may train on and is evaluated without), with ``--env-kwargs`` set
+over them (the observation and action spaces must stay those of the run);
+the arguments are tried on one environment first, and a bad keyword exits
+with status 2 and the environment's message.
 
 The baseline ``constant`` plays the best constant action of a grid search
 (:mod:`agents.constant`): the first result of ``--constant FILE.json``
@@ -454,6 +456,22 @@ def constant_action(parser: argparse.ArgumentParser, args: argparse.Namespace, e
     return action, source
 
 
+#: environment arguments of a training configuration that a trained run is
+#: not evaluated with unless asked (``--env-kwargs``): soft ice trains faster,
+#: and the task is the default ice's
+TRAINING_ONLY_KWARGS = ("stiffness_scale",)
+
+
+def evaluation_kwargs(env_kwargs: dict) -> dict:
+    """A run's ``env_kwargs`` without :data:`TRAINING_ONLY_KWARGS`: those it
+    is evaluated with by default."""
+    return {k: v for k, v in env_kwargs.items() if k not in TRAINING_ONLY_KWARGS}
+
+
+def _kwargs_words(kwargs: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in kwargs.items())
+
+
 def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate") -> dict:
     """Command-line entry point (``prog``: the command's name in the help);
     returns the summaries per policy."""
@@ -503,7 +521,13 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         except FileNotFoundError as err:
             parser.error(str(err))
         trained = TrainedPolicy(args.run_dir, args.checkpoint)
-        env_id, base_kwargs = trained.env_id, trained.env_kwargs
+        env_id, base_kwargs = trained.env_id, evaluation_kwargs(trained.env_kwargs)
+        dropped = {k: v for k, v in trained.env_kwargs.items() if k not in base_kwargs}
+        if dropped:
+            print(f"the run trained with {_kwargs_words(dropped)}; it is evaluated on the "
+                  f"environment's default (--env-kwargs "
+                  f"{' '.join(f'{k}=...' for k in dropped)} to evaluate it there)",
+                  file=sys.stderr)
         policies[f"{trained.args['algo']} policy"] = trained
         out = args.out or (args.run_dir if args.checkpoint is None
                            else args.run_dir / f"checkpoint_{args.checkpoint}")

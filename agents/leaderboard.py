@@ -234,11 +234,39 @@ def recipe_lines(report: dict) -> list[str]:
     return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
 
 
+def engine_step(env_id: str, env_kwargs: dict) -> str | None:
+    """The engine step an environment made with ``env_kwargs`` runs:
+    ``"fast"`` (``free_drift=True``), ``"exact"``, or None for an
+    environment without that choice."""
+    from .envs import make_checked_env
+
+    env = make_checked_env(env_id, env_kwargs)
+    try:
+        free = getattr(env.unwrapped, "free_drift", None)
+    finally:
+        env.close()
+    return None if free is None else ("fast" if free else "exact")
+
+
+def step_text(report: dict) -> str:
+    """What a report says of its engine step (a report without the entry
+    was made before the fast step became the ship environments' default,
+    with the exact step)."""
+    step = report.get("step", "exact")
+    if step == "fast":
+        return "the fast step (`free_drift=True`, the default)"
+    if "step" in report:
+        return "the exact step (`free_drift=False`)"
+    return ("the exact step (`free_drift=False`; made before the fast step became the "
+            "ship environments' default)")
+
+
 def board_markdown(report: dict) -> str:
     """The Markdown of a leaderboard report (the JSON of :func:`main`)."""
     summary = report["summary"]
     lines = [*recipe_lines(report),
-             f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}); "
+             f"Environment `{report['env']}` ({_kwargs_text(report['env_kwargs'])}), "
+             f"engine step: {step_text(report)}; "
              f"{report['episodes']} fields per concentration, field k seeded "
              f"{report['seed']} + k, the same fields for every policy; "
              f"{report.get('host', report['machine'])}; {report['date']}; "
@@ -428,6 +456,11 @@ def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
     if not same:
         parser.error(f"--merge: {path} is of another environment, arguments, fields or "
                      f"concentrations")
+    step = engine_step(args.env, env_kwargs)
+    if step is not None and old.get("step", "exact") != step:
+        parser.error(f"--merge: {path} was made with {step_text(old)}, this run would use "
+                     f"the {step} step, and their episodes would not pair: make a new board "
+                     f"(without --merge)")
     kept = set(next(iter(old["summary"].values()))) - set(again)
     if kept and episodes is None:
         parser.error(f"--merge: the episodes behind {path} are not in {out} ({EPISODES}, "
@@ -536,7 +569,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         recipes = {name: None for name in names}
     report = dict(
         recipes=played, commits=commits, commit=commit,
-        env=args.env, env_kwargs=env_kwargs,
+        env=args.env, env_kwargs=env_kwargs, step=engine_step(args.env, env_kwargs),
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p != "straight" and p in planner_names],

@@ -1,7 +1,7 @@
 """The checks every environment of the package passes, for a new one too.
 
     python -m iceenvs.checks [ID ...]                 (default: every registered id)
-    python -m iceenvs.checks --fingerprint [ID ...]   (hashes of the behaviour)
+    python -m iceenvs.checks --fingerprint [--exact-step] [ID ...]   (hashes of the behaviour)
 
 Each check builds the environment at its small size (its facts'
 :attr:`~iceenvs.facts.EnvFacts.small`) and raises ``AssertionError`` with
@@ -47,7 +47,7 @@ from .facts import env_facts
 
 __all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_rewards",
            "check_facts",
-           "check_all", "CHECKS", "fingerprint"]
+           "check_all", "CHECKS", "fingerprint", "exact_step_kwargs"]
 
 
 def make_small(env_id: str, **kwargs) -> gym.Env:
@@ -215,16 +215,27 @@ def check_all(env_id: str) -> None:
         check(env_id)
 
 
-def fingerprint(env_id: str, seeds: int = 3, steps: int = 20) -> str:
+def exact_step_kwargs(env_id: str) -> dict:
+    """The keywords that give ``env_id`` the exact engine step: ``free_drift=False``
+    for an environment with that choice (the ship environments, whose default
+    is the fast step), none for the others."""
+    env = gym.make(env_id)
+    try:
+        return {"free_drift": False} if hasattr(env.unwrapped, "free_drift") else {}
+    finally:
+        env.close()
+
+
+def fingerprint(env_id: str, seeds: int = 3, steps: int = 20, kwargs: dict | None = None) -> str:
     """SHA-256 of the observations, rewards and episode ends of ``env_id``
-    (default size) over ``seeds`` episodes seeded 0, 1, … with ``steps``
-    random actions each (the action space seeded like the episode; an
-    episode that ends is reset)."""
+    (default size, made with ``kwargs``) over ``seeds`` episodes seeded 0,
+    1, … with ``steps`` random actions each (the action space seeded like
+    the episode; an episode that ends is reset)."""
     import hashlib
 
     h = hashlib.sha256()
     for seed in range(seeds):
-        env = gym.make(env_id)
+        env = gym.make(env_id, **(kwargs or {}))
         try:
             obs, _ = env.reset(seed=seed)
             env.action_space.seed(seed)
@@ -250,10 +261,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("ids", nargs="*", help="environment ids (default: every registered id)")
     p.add_argument("--fingerprint", action="store_true",
                    help="print each id's behaviour hash (fingerprint) instead of checking it")
+    p.add_argument("--exact-step", action="store_true",
+                   help="with --fingerprint: the ship environments with the exact engine step "
+                        "(free_drift=False) instead of their default, the fast step")
     args = p.parse_args(argv)
+    if args.exact_step and not args.fingerprint:
+        p.error("--exact-step goes with --fingerprint")
     if args.fingerprint:
         for env_id in args.ids or registered_ids():
-            print(env_id, fingerprint(env_id), flush=True)
+            kwargs = exact_step_kwargs(env_id) if args.exact_step else {}
+            print(env_id, fingerprint(env_id, kwargs=kwargs), flush=True)
         return 0
     failed = 0
     for env_id in args.ids or registered_ids():

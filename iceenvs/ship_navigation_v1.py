@@ -255,7 +255,11 @@ class ShipNavigationV1Env(ShipNavigationEnv):
 
     ## Version History
     * v1: a field comparable to AUTO-IceNav's (v0 stays registered,
-      unchanged).
+      unchanged). Its default engine step became the fast step
+      (`free_drift=True`) once the equivalence test of the Benchmarks page
+      (`seaice bench free_drift`) held every metric to the exact step's
+      within its margin; `free_drift=False` gives the exact step of the
+      records made before.
     """
 
     task_parameters = _TASK

@@ -123,6 +123,25 @@ def test_a_regenerated_record_adds_less_than_a_megabyte():
     assert not large, f"records of more than {RUN_RECORD_LIMIT} bytes: {large}"
 
 
+#: what marks a record of agents on a ship environment: its path or its
+#: commands name one, or it is a leaderboard, its frames or the task table
+SHIP_RECORD = ("Ship", "leaderboard", "frames", "docs/agents/tasks")
+
+
+def test_each_ship_record_names_its_engine_step():
+    """The ship environments' default step changed from the exact to the
+    fast one: every record of agents on them says which it ran, and no
+    other record does."""
+    for entry in MANIFEST:
+        commands = entry["commands"] if isinstance(entry["commands"], list) else []
+        ship = entry["path"].startswith("docs/agents") and any(
+            mark in entry["path"] or any(mark in c for c in commands) for mark in SHIP_RECORD)
+        if ship:
+            assert entry.get("step") in ("exact", "fast"), entry["path"]
+        else:
+            assert "step" not in entry, entry["path"]
+
+
 def test_the_check_of_commands_can_fail():
     assert is_project_command("python -m agents.leaderboard --out runs/x")
     assert is_project_command("python -m physics.crosscheck all")

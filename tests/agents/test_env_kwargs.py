@@ -128,3 +128,18 @@ def test_failed_forced_start_removes_only_its_artefacts(tmp_path, monkeypatch):
                     "--out", str(out), "--force", "--eval-freq", "0", "--save-freq", "0",
                     "--no-progress", "--hyperparams", *TINY_PPO, *ITD_SMALL])
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_a_run_on_soft_ice_is_evaluated_on_the_default_ice():
+    """Soft ice is a training configuration: ``agents.evaluate`` leaves the
+    run's ``stiffness_scale`` out unless ``--env-kwargs`` sets it again,
+    and keeps everything else of the run's (how it acts and sees)."""
+    from agents.evaluate import TRAINING_ONLY_KWARGS, evaluation_kwargs
+
+    run = {"control": "course", "swath_edge": True, "stiffness_scale": 0.01}
+    assert evaluation_kwargs(run) == {"control": "course", "swath_edge": True}
+    assert TRAINING_ONLY_KWARGS == ("stiffness_scale",)
+    # the leaderboard plays a trained run with how it acts and sees alone
+    from agents.rollouts import AGENT_KWARGS
+
+    assert not set(TRAINING_ONLY_KWARGS) & set(AGENT_KWARGS)

@@ -73,6 +73,17 @@ def test_leaderboard_writes_its_table_and_merges_a_policy(tmp_path, capsys):
     fresh = leaderboard.main(base + ["--policies", "straight,lattice", "--merge", "--replace",
                                      "straight,lattice"])
     assert fresh["host"] == leaderboard.host_signature()
+    # the board says its engine step (the ship environments' default: the fast
+    # one); a board made before the default changed ran the exact step, and
+    # the two are not merged
+    assert fresh["step"] == "fast"
+    assert "engine step: the fast step (`free_drift=True`" in (out / "leaderboard.md").read_text()
+    assert "made before the fast step became" in leaderboard.step_text({})
+    older = {k: v for k, v in fresh.items() if k not in ("step", "episodes_detail")}
+    (out / "leaderboard.json").write_text(json.dumps(older))
+    with pytest.raises(SystemExit):
+        leaderboard.main(base + ["--policies", "straight", "--merge"])
+    assert "would not pair" in capsys.readouterr().err
 
 
 def _episode(ret, ipm, path):

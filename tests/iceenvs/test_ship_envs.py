@@ -491,3 +491,29 @@ def test_the_resistance_records_task_row_covers_the_tasks(env_id):
         assert TASK_CONCENTRATIONS[0] <= low and high <= TASK_CONCENTRATIONS[1]
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("env_id", [NAV, BESET, "iceenvs/ShipNavigation-v1"])
+def test_the_default_engine_step_is_the_one_the_equivalence_test_supports(env_id):
+    """A ship environment's default engine step is the fast one exactly when
+    its equivalence record (``seaice bench free_drift``, docs/benchmarks)
+    supports it: no row fails the margin and the control resolves nearly
+    every row. Without a record the exact step stays the default. The exact
+    step is one keyword away."""
+    import json
+    from pathlib import Path
+
+    from benchmarks import free_drift as fd
+
+    docs = Path(__file__).resolve().parents[2] / "docs" / "benchmarks"
+    path = fd.record_path(docs / f"{fd.SUITE}.json", env_id)
+    record = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else None
+    others = [json.loads(p.read_text(encoding="utf-8")) for p in docs.glob(f"{fd.SUITE}-*.json")]
+    supported = (record is not None and not record["data"]["quick"]
+                 and fd.supports(record, "fast", [r for r in others if not r["data"]["quick"]]))
+    for kwargs, fast in (({}, supported), ({"free_drift": False}, False)):
+        env = gym.make(env_id, **kwargs)
+        try:
+            assert env.unwrapped.free_drift is fast, (env_id, kwargs)
+        finally:
+            env.close()
