@@ -804,6 +804,11 @@ def conclusions_table(concl: dict, st: dict) -> dict:
         f"concentrations' {st['seeds']} fields each.")
 
 
+def policy_words(name: str) -> str:
+    """How the tables name a policy's episodes."""
+    return "the straight line" if name == "straight" else f"the {name} policy"
+
+
 def rate_table(rates: list[dict], st: dict) -> dict:
     """Sustained env steps/s of each step per concentration."""
     concentrations = [f"{a:g}" for a in st["concentrations"]]
@@ -811,11 +816,11 @@ def rate_table(rates: list[dict], st: dict) -> dict:
     body = [[r["step"], *[r["per_concentration"][a] for a in concentrations], r["pooled"],
              f"{r['pooled'] / ref['pooled']:.2f}×", r["engaged_per_substep"]] for r in rates]
     return harness.table(
-        f"Sustained rates: env steps/s over whole transits ({rates[0]['policy']} line)",
+        f"Sustained rates: env steps/s over whole transits ({policy_words(rates[0]['policy'])})",
         ["step", *[f"A = {a}" for a in concentrations], "all A", f"over {REFERENCE}",
          "engaged floe-steps per substep"], body,
-        f"The env steps of the {st['seeds']} {rates[0]['policy']}-line episodes per "
-        f"concentration over their wall time, reset included, each in a worker process on "
+        f"The env steps of the {st['seeds']} episodes of {policy_words(rates[0]['policy'])} "
+        f"per concentration over their wall time, reset included, each in a worker process on "
         f"one Numba thread, {st['workers']} workers side by side on the machine; all A: the "
         f"episodes of every concentration together (the environment draws A uniformly in "
         f"0.2–0.5).")
