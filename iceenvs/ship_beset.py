@@ -141,7 +141,10 @@ class ShipBesetEnv(ShipEnv):
     `colour_scale=1.0` [m/s], `render_mode`, and the task parameters.
 
     ## Version History
-    * v0: initial version.
+    * v0: initial version. Its default engine step became the fast step
+      (`free_drift=True`) once the equivalence test of the Benchmarks page
+      (`seaice bench free_drift --env ...`) supported it; `free_drift=False`
+      gives the exact step of the records made before.
     """
 
     controls = ("thrust",)
