@@ -447,7 +447,7 @@ class ShipEnv(HertzEnv):
             raise RuntimeError("call reset() before step()")
         a, replaced = sanitise_action(action, self.action_space)
         if self._one is None or self._one_sums is not self._sums:
-            self._one, self._one_sums = ShipBatch([self], self._sums[None, :]), self._sums
+            self._one, self._one_sums = ShipBatch([self], self._sums[None, :], single=True), self._sums
         if not self._begun:
             self._one.begin()
             self._begun = True

@@ -488,11 +488,19 @@ class ShipBatch:
     lists : KernelLists, optional
         The typed lists of the engines' compiled calls, kept from step to
         step (:class:`physics.hertz.KernelLists`).
+    single : bool
+        The batch of a single environment (not a vector environment of
+        one): its step returns the environment's own info dict.
     """
 
-    def __init__(self, envs, table: np.ndarray, lists: KernelLists | None = None):
+    def __init__(self, envs, table: np.ndarray, lists: KernelLists | None = None,
+                 single: bool = False):
         self.envs = list(envs)
         self.num_envs = len(self.envs)
+        if single and self.num_envs != 1:
+            raise ValueError(f"a single environment's batch holds one environment, "
+                             f"not {self.num_envs}")
+        self._single = single
         self.table = table
         self.lists = KernelLists() if lists is None else lists
         e0 = self.envs[0]
@@ -510,9 +518,10 @@ class ShipBatch:
 
     @property
     def one(self) -> bool:
-        """A batch of one: a single environment, whose info is its own dict
-        (the row a vector info would hold for it)."""
-        return self.num_envs == 1
+        """The batch of a single environment, whose info is its own dict
+        (the row a vector info would hold for it); a vector environment of
+        N = 1 gets a vector info, as at any N."""
+        return self._single
 
     #: Gymnasium's builder of a vector info, which needs only ``num_envs``
     _add_info = VectorEnv._add_info

@@ -76,6 +76,29 @@ def test_sub_environment_k_runs_the_single_environment_seeded_the_same(env_id):
     envs.close()
 
 
+@pytest.mark.parametrize("env_id", VECTOR_IDS)
+def test_a_vector_environment_of_one_gives_a_vector_info(env_id):
+    """N = 1 is a vector environment like any other: its step's info is a
+    vector info (columns with their masks), an ended episode included, as
+    the single environment's info is its own dict."""
+    envs = make_vec(env_id, 1, max_episode_steps=2)
+    single = gym.make(env_id, **SMALL[env_id], max_episode_steps=2)
+    envs.reset(seed=4)
+    single.reset(seed=4)
+    action = np.zeros((1,) + envs.single_action_space.shape, dtype=envs.single_action_space.dtype)
+    for _ in range(2):
+        _, _, terminated, truncated, info = envs.step(action)
+        _, _, _, _, inf = single.step(action[0])
+    assert truncated.all() and not terminated.any()
+    final = info["final_info"]
+    assert info["_final_info"][0] and final["_physics"][0]
+    assert final["nonfinite_action"].shape == (1,) and final["_nonfinite_action"][0]
+    for key, value in inf["physics"].items():
+        np.testing.assert_allclose(final["physics"][key][0], value, rtol=RTOL, atol=ATOL,
+                                   err_msg=key)
+    envs.close()
+
+
 def test_an_episode_that_reaches_its_goal_ends_and_resets_in_the_same_step():
     envs = make_vec(SHIP, 2, goal_distance=5.0)
     envs.reset(seed=0)
