@@ -25,17 +25,18 @@ SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: wind-driven one; the long ship channel of the resting-floe benchmark; the
 #: ship tasks whose vector environments and training the scaling suite times;
 #: the ship task whose step and training the where_time_goes suite breaks down; the ship
-#: task whose episodes the free_drift suite runs with both engine steps
+#: tasks whose episodes the free_drift suite runs under each engine step
 EXPERIMENTS = {"benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
                                              "iceenvs/ShipNavigation-v1",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
-               "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipBeset-v0",
-                                        "iceenvs/WindDrift-v0"},
+               "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
+                                        "iceenvs/ShipBeset-v0", "iceenvs/WindDrift-v0"},
                "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"},
                "benchmarks/sensors.py": {"iceenvs/ShipNavigation-v1"},
                "benchmarks/scaling.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"},
                "benchmarks/where_time_goes.py": {"iceenvs/ShipNavigation-v1"},
-               "benchmarks/free_drift.py": {"iceenvs/ShipNavigation-v1"},
+               "benchmarks/free_drift.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
+                                            "iceenvs/ShipBeset-v0"},
                "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 
 
