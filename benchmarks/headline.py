@@ -128,12 +128,14 @@ def _free_drift_rows(record: dict) -> list[list[str]]:
     """ShipNavigation-v1 under each engine step, sustained over whole
     transits at A = 0.2–0.5 (the equivalence test's straight-line episodes,
     one core each, two side by side), from the main record of the suite
-    (not the pilot's, not another environment's)."""
-    from .free_drift import ENV_ID, REFERENCE
+    (not the pilot's, not an extension's over fewer concentrations, not
+    another environment's)."""
+    from .free_drift import ENV_ID, ENVS, REFERENCE
 
     settings = record["data"].get("settings", {})
     stats = record["data"].get("statistics")
     if (settings.get("env", ENV_ID) != ENV_ID or settings.get("statistic") == "control"
+            or list(settings.get("concentrations", ())) != list(ENVS[ENV_ID]["concentrations"])
             or not stats or not stats.get("rates")):
         return []
     rates = {r["step"]: r["pooled"] for r in stats["rates"]}

@@ -170,6 +170,24 @@ def test_headline_block_is_rewritten_from_the_records(tmp_path):
     assert readme.read_text() == once
 
 
+def test_headline_takes_the_sustained_ship_rates_from_the_main_equivalence_record():
+    """The pilot (its own rule), an extension over fewer concentrations and
+    another environment's record give no headline row; the main record of
+    ShipNavigation-v1 gives one, at its concentrations."""
+    def record(rate, statistic="trimmed", concentrations=(0.2, 0.3, 0.4, 0.5),
+               env="iceenvs/ShipNavigation-v1"):
+        rates = [dict(step="exact", pooled=rate / 2), dict(step="fast", pooled=rate)]
+        return _record("free_drift", data=dict(
+            settings=dict(env=env, statistic=statistic, concentrations=list(concentrations)),
+            statistics=dict(rates=rates)))
+    main, pilot = record(240.0), record(111.0, statistic="control")
+    extension, other = record(122.0, concentrations=(0.5,)), record(133.0, env="iceenvs/ShipBeset-v0")
+    text = headline.headline_table([main, pilot, extension, other])
+    assert ("| `iceenvs/ShipNavigation-v1`, sustained over whole transits, A = 0.2–0.5 | 240 "
+            "steps/s with the default (fast) step, 120 with the exact step;") in text
+    assert text.count("sustained over whole transits") == 1
+
+
 def test_headline_says_free_flight_only_of_a_field_whose_floes_barely_touch():
     record = _record("hertz", data=dict(n=20000, rows=_hertz_rows((0.5, 3.89))))
     text = headline.headline_table([record])
