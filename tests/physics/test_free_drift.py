@@ -160,13 +160,14 @@ def test_mid_episode_control_interval():
     """One control interval (2 s) from the state after 60 of seed 10001
     (the ship among floes it set moving): the fast step's floes are the
     exact step's to 1e-6 m, with fewer than half of them engaged."""
-    env = gym.make("iceenvs/ShipNavigation-v1").unwrapped
+    env = gym.make("iceenvs/ShipNavigation-v1", free_drift=False).unwrapped   # the exact step
     env.reset(seed=10001)
     for _ in range(60):
         env.step(np.zeros(1, dtype=np.float32))
     sim = env.sim
     full = copy.deepcopy(sim)
     full.skip_resting = False
+    assert not full.free_drift
     fast = copy.deepcopy(sim)
     fast.skip_resting, fast.free_drift = False, True
     n = int(round(2.0 / sim.dt))
@@ -234,12 +235,14 @@ def test_windows_carried_past_their_guards_bit_for_bit():
     ten control intervals in the check mode are the full step's bit for
     bit after each, while engaged floes left their lines and free floes
     were engaged in the middle of windows (:func:`~physics.hertz_free_drift.repair`)."""
-    env = gym.make("iceenvs/ShipNavigation-v1", concentration=0.5).unwrapped
+    env = gym.make("iceenvs/ShipNavigation-v1", concentration=0.5,
+                   free_drift=False).unwrapped                              # the exact step
     env.reset(seed=10001)
     for _ in range(60):
         env.step(np.zeros(1, dtype=np.float32))
     full = copy.deepcopy(env.sim)
     full.skip_resting = False
+    assert not full.free_drift
     check = copy.deepcopy(env.sim)
     check.skip_resting, check.free_drift, check.free_iterate = False, True, True
     n = int(round(2.0 / full.dt))
