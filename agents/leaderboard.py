@@ -234,20 +234,6 @@ def recipe_lines(report: dict) -> list[str]:
     return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
 
 
-def engine_step(env_id: str, env_kwargs: dict) -> str | None:
-    """The engine step an environment made with ``env_kwargs`` runs:
-    ``"fast"`` (``free_drift=True``), ``"exact"``, or None for an
-    environment without that choice."""
-    from .envs import make_checked_env
-
-    env = make_checked_env(env_id, env_kwargs)
-    try:
-        free = getattr(env.unwrapped, "free_drift", None)
-    finally:
-        env.close()
-    return None if free is None else ("fast" if free else "exact")
-
-
 def step_text(report: dict) -> str:
     """What a report says of its engine step (a report without the entry
     was made before the fast step became the ship environments' default,
@@ -456,6 +442,8 @@ def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
     if not same:
         parser.error(f"--merge: {path} is of another environment, arguments, fields or "
                      f"concentrations")
+    from iceenvs.checks import engine_step
+
     step = engine_step(args.env, env_kwargs)
     if step is not None and old.get("step", "exact") != step:
         parser.error(f"--merge: {path} was made with {step_text(old)}, this run would use "
@@ -493,6 +481,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         return report
 
     import numba
+
+    from iceenvs.checks import engine_step
 
     from .baselines import check_policy_names
     from .envs import make_checked_env, parse_key_values

@@ -47,7 +47,7 @@ from .facts import env_facts
 
 __all__ = ["make_small", "check_api", "check_determinism", "check_fuzz", "check_rewards",
            "check_facts",
-           "check_all", "CHECKS", "fingerprint", "exact_step_kwargs"]
+           "check_all", "CHECKS", "fingerprint", "engine_step", "exact_step_kwargs"]
 
 
 def make_small(env_id: str, **kwargs) -> gym.Env:
@@ -215,15 +215,23 @@ def check_all(env_id: str) -> None:
         check(env_id)
 
 
+def engine_step(env_id: str, kwargs: dict | None = None) -> str | None:
+    """The engine step of ``env_id`` made with ``kwargs``: ``"fast"``
+    (``free_drift=True``, the ship environments' default), ``"exact"``, or
+    None for an environment without that choice."""
+    env = gym.make(env_id, **(kwargs or {}))
+    try:
+        free = getattr(env.unwrapped, "free_drift", None)
+    finally:
+        env.close()
+    return None if free is None else ("fast" if free else "exact")
+
+
 def exact_step_kwargs(env_id: str) -> dict:
     """The keywords that give ``env_id`` the exact engine step: ``free_drift=False``
     for an environment with that choice (the ship environments, whose default
     is the fast step), none for the others."""
-    env = gym.make(env_id)
-    try:
-        return {"free_drift": False} if hasattr(env.unwrapped, "free_drift") else {}
-    finally:
-        env.close()
+    return {} if engine_step(env_id) is None else {"free_drift": False}
 
 
 def fingerprint(env_id: str, seeds: int = 3, steps: int = 20, kwargs: dict | None = None) -> str:
