@@ -14,7 +14,8 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from iceenvs.facts import env_facts
 
-__all__ = ["PhysicsMetricsCallback", "TqdmCallback", "TimeBudgetCallback"]
+__all__ = ["PhysicsMetricsCallback", "TqdmCallback", "TimeBudgetCallback",
+           "SaveNormalizationOnBest"]
 
 
 class PhysicsMetricsCallback(BaseCallback):
@@ -164,9 +165,33 @@ class TimeBudgetCallback(BaseCallback):
     def _on_training_start(self) -> None:
         self._start = time.perf_counter() if self._started is None else self._started
 
+    #: why the callback stopped training (``None`` while it has not)
+    reason: str | None = None
+
     def _on_step(self) -> bool:
         if time.perf_counter() - self._start < self.seconds:
             return True
-        print(f"training stopped by its budget of {self.seconds / 60:g} minutes at "
-              f"{self.num_timesteps} steps")
+        # said by the trainer once the progress bar is closed: a line printed
+        # under a live bar is drawn over by it
+        self.reason = f"its budget of {self.seconds / 60:g} minutes"
         return False
+
+
+class SaveNormalizationOnBest(BaseCallback):
+    """Called by :class:`EvalCallback` on a new best mean return: save the
+    training stack's normalisation statistics beside the best model, so
+    that ``RUN_DIR@best`` observes as it was evaluated (nothing without
+    normalisation)."""
+
+    def __init__(self, path: str | Path):
+        super().__init__(0)
+        self.path = Path(path)
+
+    def _on_step(self) -> bool:
+        from stable_baselines3.common.vec_env import VecNormalize
+
+        env = self.model.get_vec_normalize_env()
+        if isinstance(env, VecNormalize):
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            env.save(str(self.path))
+        return True

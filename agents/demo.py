@@ -34,6 +34,7 @@ from pathlib import Path
 import yaml
 
 from .evaluate import main as evaluate_main
+from .rollouts import verdict
 from .train import HYPERPARAMS_DIR, main as train_main
 
 __all__ = ["CONFIG_FILE", "BASELINES", "LABELS", "load_config", "overrides", "run_seed",
@@ -106,12 +107,12 @@ def returns_table(report: dict) -> str:
     """The returns of one evaluation and the paired differences, as Markdown."""
     s, c = report["summaries"], report["comparisons"]
     lines = ["| policy | return (mean ± standard error) | PPO − policy, paired by seed "
-             "[standard error] | PPO better by > 2 standard errors |",
+             "[standard error] | PPO (by > 2 standard errors) |",
              "|---|---|---|---|",
              f"| PPO | {_pm(s[POLICY]['return'])} | | |"]
     for name in BASELINES:
         lines.append(f"| {name} | {_pm(s[name]['return'])} | {_diff(c[name])} | "
-                     f"{'yes' if c[name]['beats'] else 'no'} |")
+                     f"{verdict(c[name])} |")
     return "\n".join(lines)
 
 

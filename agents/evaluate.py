@@ -73,7 +73,7 @@ from physics.provenance import source_commit
 from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, metric_header,
                       metric_unit, scaled, significant)
 from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
-                       rounded, run_episode, summarise)
+                       rounded, run_episode, summarise, verdict)
 
 #: the episodes behind an evaluation's record, beside it
 EPISODES = "episodes.json"
@@ -212,11 +212,11 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
     if comparisons:
         lines += ["Return of the policy minus the baseline's, paired by seed "
                   "(mean ± standard error of the difference):", "",
-                  "| baseline | return difference | beaten by > 2 standard errors |",
+                  "| baseline | return difference | the policy (by > 2 standard errors) |",
                   "|---|---|---|"]
         for name, c in comparisons.items():
             lines.append(f"| {labels.get(name, name)} | {format_pm(c['diff'], c['sem'])} | "
-                         f"{'yes' if c['beats'] else 'no'} |")
+                         f"{verdict(c)} |")
         lines.append("")
     if metric_comparisons:
         metric, lower = env_facts(env_id).compared_metric
@@ -224,11 +224,11 @@ def markdown_table(env_id: str, summaries: dict, comparisons: dict, episodes: in
                   f"paired by seed ({'lower' if lower else 'higher'} is better; mean ± "
                   f"standard error of the difference):", "",
                   f"| baseline | difference of the {metric_header(metric)} | "
-                  f"better by > 2 standard errors |", "|---|---|---|"]
+                  f"the policy (by > 2 standard errors) |", "|---|---|---|"]
         for name, c in metric_comparisons.items():
             lines.append(f"| {labels.get(name, name)} | "
                          f"{format_pm(scaled(metric, c['diff']), scaled(metric, c['sem']))} | "
-                         f"{'yes' if c['beats'] else 'no'} |")
+                         f"{verdict(c)} |")
         lines.append("")
     return "\n".join(lines).rstrip("\n") + "\n"
 
@@ -319,6 +319,21 @@ def _episode_targets(results: dict) -> dict:
     return out
 
 
+def _checkpoint(value: str) -> int | str:
+    """A ``--checkpoint``: a number of steps or ``best``."""
+    from .runs import BEST
+
+    if value == BEST:
+        return BEST
+    try:
+        steps = int(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number of steps or {BEST!r}, got {value!r}") from None
+    if steps < 0:
+        raise argparse.ArgumentTypeError(f"a number of steps >= 0, got {steps}")
+    return steps
+
+
 def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentParser:
     from .baselines import GENERIC
     from .envs import registered_env_id
@@ -326,9 +341,10 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p = argparse.ArgumentParser(prog=prog,
                                 description="Compare a trained policy with baselines.")
     p.add_argument("run_dir", nargs="?", type=Path, help="run directory of agents.train")
-    p.add_argument("--checkpoint", type=int, metavar="STEPS",
-                   help="evaluate the run's checkpoint saved at STEPS steps instead of its "
-                        "final model (its results go to RUN_DIR/checkpoint_STEPS)")
+    p.add_argument("--checkpoint", type=_checkpoint, metavar="STEPS|best",
+                   help="evaluate the run's checkpoint saved at STEPS steps, or its evaluation "
+                        "callback's best model (best), instead of its final model (its results "
+                        "go to RUN_DIR/checkpoint_STEPS or RUN_DIR/checkpoint_best)")
     p.add_argument("--episodes", type=int, default=20, help="episodes per policy (default 20)")
     p.add_argument("--seed", type=int, default=10_000,
                    help="episode k is seeded SEED + k (default 10000, away from training)")

@@ -24,8 +24,11 @@ import yaml
 
 from iceenvs.facts import env_facts
 
+from .runs import checkpoint_paths_checked, trained_argument  # noqa: F401  (re-exported)
+
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
            "evaluate_in_processes", "policy_from_recipe", "rounded", "stats", "summarise", "compare",
+           "verdict",
            "AGENT_KWARGS", "run_agent_kwargs"]
 
 #: environment arguments that set how an agent acts and what it sees rather
@@ -48,27 +51,10 @@ def _agent_part(env_kwargs: dict) -> dict:
     return {k: v for k, v in env_kwargs.items() if k in AGENT_KWARGS}
 
 
-def checkpoint_files(run_dir: Path, checkpoint: int | None = None) -> tuple[Path, Path]:
-    """(model, normalisation statistics) of a run of :mod:`agents.train`: the
-    final ones, or those its checkpoint callback saved at ``checkpoint``
-    steps (``checkpoints/model_<N>_steps.zip``).
-
-    Raises
-    ------
-    FileNotFoundError
-        When there is no such model; the message lists the run's checkpoints.
-    """
-    from .train import checkpoint_paths
-
-    run_dir = Path(run_dir)
-    model, stats = checkpoint_paths(run_dir, checkpoint)
-    if not model.is_file():
-        saved = sorted(int(p.stem.split("_")[1]) for p in (run_dir / "checkpoints").glob(
-            "model_*_steps.zip"))
-        what = "no model.zip" if checkpoint is None else f"no checkpoint at {checkpoint} steps"
-        raise FileNotFoundError(f"{run_dir} holds {what}; its checkpoints: "
-                                f"{', '.join(map(str, saved)) or 'none'}")
-    return model, stats
+def checkpoint_files(run_dir: Path, checkpoint: int | str | None = None) -> tuple[Path, Path]:
+    """(model, normalisation statistics) of a run of :mod:`agents.train`
+    (:func:`agents.runs.checkpoint_paths_checked`)."""
+    return checkpoint_paths_checked(run_dir, checkpoint)
 
 
 class TrainedPolicy:
@@ -81,7 +67,7 @@ class TrainedPolicy:
         A run directory of :mod:`agents.train`.
     """
 
-    def __init__(self, run_dir: str | Path, checkpoint: int | None = None):
+    def __init__(self, run_dir: str | Path, checkpoint: int | str | None = None):
         from .envs import load_normalization
         from .train import algo_class
 
@@ -106,33 +92,6 @@ class TrainedPolicy:
         if self.normalization is not None:
             obs = self.normalization.normalize_obs(obs).astype(np.float32)
         return self.model.predict(obs, deterministic=deterministic)
-
-
-def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, int | None]:
-    """``(name, run_dir, checkpoint or None)`` of a ``--trained`` argument
-    ``NAME=RUN_DIR`` or ``NAME=RUN_DIR@STEPS``: the run directory of
-    :mod:`agents.train` (it must hold ``args.yaml``) and, with ``@STEPS``,
-    its checkpoint at STEPS steps.
-
-    Raises
-    ------
-    ValueError
-        Another form, a directory that is not a run directory, or a run
-        trained on another environment than ``env_id`` (when given)."""
-    name, sep, target = item.partition("=")
-    run_dir, at, steps = target.partition("@")
-    if not sep or not name or (at and not steps.isdigit()):
-        raise ValueError(f"--trained takes NAME=RUN_DIR or NAME=RUN_DIR@STEPS, got {item!r}")
-    if not (Path(run_dir) / "args.yaml").is_file():
-        raise ValueError(f"--trained {item}: {run_dir} is not an existing run directory of "
-                         f"agents.train (no args.yaml)")
-    if env_id is not None:
-        with open(Path(run_dir) / "args.yaml") as fh:
-            trained_on = yaml.safe_load(fh).get("env")
-        if trained_on != env_id:
-            raise ValueError(f"--trained {item}: the run was trained on {trained_on}, "
-                             f"not {env_id}")
-    return name, run_dir, int(steps) if at else None
 
 
 def episode_task(env, info: dict) -> dict[str, float]:
@@ -340,12 +299,24 @@ def compare(policy: list[dict], baseline: list[dict], metric: str | None = None,
             lower_is_better: bool = False) -> dict:
     """Paired comparison on the same seeds of the returns (or of the final
     physics ``metric``): mean difference (policy − baseline), its standard
-    error and whether the policy is better by more than two standard
-    errors (higher, or lower with ``lower_is_better``)."""
+    error, whether the policy is better by more than two standard errors
+    (``beats``: higher, or lower with ``lower_is_better``), whether it is
+    worse by more than two (``loses``) and the :func:`verdict`."""
     def value(e):
         return e["ret"] if metric is None else e["final"].get(metric, math.nan)
 
     d = np.array([value(p) - value(b) for p, b in zip(policy, baseline)])
     s = stats(d)
     gain = -s["mean"] if lower_is_better else s["mean"]
-    return dict(diff=s["mean"], sem=s["sem"], beats=bool(gain > 2.0 * s["sem"] and gain > 0))
+    out = dict(diff=s["mean"], sem=s["sem"], beats=bool(gain > 2.0 * s["sem"] and gain > 0),
+               loses=bool(-gain > 2.0 * s["sem"] and gain < 0))
+    out["verdict"] = verdict(out)
+    return out
+
+
+def verdict(comparison: dict) -> str:
+    """``"beats"`` or ``"loses"`` where the paired difference of a
+    :func:`compare` is more than two standard errors from zero, else
+    ``"neither"``."""
+    return ("beats" if comparison.get("beats") else "loses" if comparison.get("loses")
+            else "neither")

@@ -50,7 +50,10 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import yaml
+
+from .runs import BEST_STATS, checkpoint_paths, checkpoint_paths_checked
 
 __all__ = ["ALGOS", "HYPERPARAMS_DIR", "SPECIAL_KEYS", "build_parser", "main",
            "read_hyperparams", "valid_keys", "default_run_dir", "checkpoint_paths", "RUN_FILES"]
@@ -65,8 +68,8 @@ _RESERVED = {"self", "policy", "env", "seed", "verbose", "device", "tensorboard_
              "_init_setup_model"}
 #: model artefacts that --force removes from an existing run directory
 RUN_FILES = ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml", "command.txt",
-             "pretrain.yaml", "metrics.csv", "checkpoints", "eval", "logs", "evaluation.md",
-             "evaluation.json", "evaluation.png")
+             "training.yaml", "pretrain.yaml", "metrics.csv", "checkpoints", "eval", "logs",
+             "evaluation.md", "evaluation.json", "evaluation.png")
 #: the evaluation environment is seeded this far from the training seed
 EVAL_SEED_OFFSET = 1000
 
@@ -138,6 +141,12 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                         "end (default: no limit); a warm start takes at most its share "
                         "(pretrain share, default 0.5) and a budget too short for it is "
                         "refused")
+    p.add_argument("--init-from", default=None, metavar="RUN_DIR[@STEPS|@best]",
+                   help="start from the network (and optimiser) and normalisation statistics of "
+                        "a run directory or a reference agent (docs/agents/reference/NAME): its "
+                        "final model, its checkpoint at STEPS steps, or its evaluation's best "
+                        "model; trains --timesteps more under this run's hyperparameters "
+                        "(fine-tuning; resuming is the same with the run's own). No warm start")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--verbose", type=int, default=0, help="SB3 verbosity (0, 1, 2)")
     return p
@@ -163,6 +172,19 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
         if not has_native_vector_env(args.env):
             parser.error(f"--vectorization native: {args.env} has no native vector environment "
                          f"(its registration has no vector_entry_point); use subproc or dummy")
+    if args.init_from is not None:
+        from .runs import trained_argument
+
+        try:
+            _, run_dir, steps = trained_argument(f"init={args.init_from}", args.env)
+            checkpoint_paths_checked(run_dir, steps)
+        except (ValueError, FileNotFoundError) as err:
+            parser.error(f"--init-from: {err}")
+        with open(Path(run_dir) / "args.yaml") as fh:
+            trained_with = yaml.safe_load(fh).get("algo")
+        if trained_with != args.algo:
+            parser.error(f"--init-from {args.init_from}: the run was trained with "
+                         f"{trained_with}, not {args.algo}")
     if args.out is None:
         args.out = default_run_dir(args.env, args.algo, args.seed)
     return args
@@ -419,7 +441,8 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path,
     value; default: the start of learning)."""
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
-    from .callbacks import PhysicsMetricsCallback, TimeBudgetCallback, TqdmCallback
+    from .callbacks import (PhysicsMetricsCallback, SaveNormalizationOnBest, TimeBudgetCallback,
+                            TqdmCallback)
 
     n_envs = hp["n_envs"]
     callbacks = []
@@ -432,6 +455,8 @@ def make_callbacks(args: argparse.Namespace, hp: dict, eval_env, run_dir: Path,
                                       eval_freq=max(args.eval_freq // n_envs, 1),
                                       log_path=str(run_dir / "eval"),
                                       best_model_save_path=str(run_dir / "eval"),
+                                      callback_on_new_best=SaveNormalizationOnBest(
+                                          run_dir / "eval" / BEST_STATS),
                                       deterministic=True, verbose=args.verbose))
     callbacks.append(PhysicsMetricsCallback(args.env, run_dir / "metrics.csv"))
     callbacks.append(TqdmCallback(hp["n_timesteps"], disable=args.no_progress))
@@ -452,6 +477,9 @@ def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path,
     a budget too short for one demonstration is refused with the shortest
     that holds one (:class:`agents.pretrain.BudgetTooShort`)."""
     if not hp.get("pretrain"):
+        return None
+    if args.init_from is not None:
+        print("no warm start: the run starts from --init-from", flush=True)
         return None
     from .pretrain import COLLECT_PART, BudgetTooShort, pretrain
 
@@ -490,6 +518,57 @@ def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path,
     return report
 
 
+# -- step 7c: start from a trained network ------------------------------------------------------
+class InitMismatch(ValueError):
+    """``--init-from`` names a model whose network or observations do not fit the run."""
+
+
+def init_from(args: argparse.Namespace, model, env) -> dict | None:
+    """With ``--init-from RUN_DIR[@STEPS|@best]``: load that model's network
+    and optimiser into ``model`` and its normalisation statistics into the
+    training stack (the run then trains its own timesteps from there).
+
+    Raises
+    ------
+    InitMismatch
+        When the saved network or statistics do not have this run's shapes
+        (another observation, action or architecture)."""
+    if args.init_from is None:
+        return None
+    import pickle
+
+    from .runs import trained_argument
+
+    _, source, steps = trained_argument(f"init={args.init_from}", args.env)
+    model_path, stats_path = checkpoint_paths_checked(source, steps)
+    try:
+        model.set_parameters(str(model_path), exact_match=True, device="cpu")
+    except (ValueError, RuntimeError, KeyError) as err:
+        lines = [line.strip() for line in str(err).splitlines() if line.strip()]
+        first = next((line for line in lines if "mismatch" in line), lines[0] if lines else "")
+        more = sum("mismatch" in line for line in lines) - 1
+        raise InitMismatch(f"--init-from {args.init_from}: its network does not fit this run's "
+                           f"(another observation, action or net_arch?): {first}"
+                           + (f" (and {more} more)" if more > 0 else "")) from None
+    vec_normalize = model.get_vec_normalize_env()
+    stats = "none"
+    if vec_normalize is not None and stats_path.is_file():
+        with open(stats_path, "rb") as fh:
+            saved = pickle.load(fh)
+        mine, theirs = vec_normalize.obs_rms, saved.obs_rms
+        if getattr(mine, "mean", None) is not None and \
+                np.shape(mine.mean) != np.shape(getattr(theirs, "mean", None)):
+            raise InitMismatch(f"--init-from {args.init_from}: its observation statistics have "
+                               f"shape {np.shape(theirs.mean)}, this run observes "
+                               f"{np.shape(mine.mean)}")
+        vec_normalize.obs_rms, vec_normalize.ret_rms = theirs, saved.ret_rms
+        stats = str(stats_path.name)
+    elif vec_normalize is not None:
+        stats = "fresh (the source has none)"
+    print(f"starting from {model_path} (normalisation statistics: {stats})", flush=True)
+    return dict(source=str(args.init_from), model=str(model_path), statistics=stats)
+
+
 # -- step 8: learn and save --------------------------------------------------------------------
 def learn(model, hp: dict, callbacks: list) -> None:
     """Run ``model.learn`` for ``n_timesteps``."""
@@ -499,17 +578,49 @@ def learn(model, hp: dict, callbacks: list) -> None:
                 progress_bar=False)
 
 
-def checkpoint_paths(run_dir: Path, steps: int | None = None) -> tuple[Path, Path]:
-    """(model, normalisation statistics) paths of a run: the final ones
-    (``model.zip``, ``vecnormalize.pkl``) or, with ``steps``, those of the
-    checkpoint at that many steps, as the checkpoint callback names them
-    (``checkpoints/model_<steps>_steps.zip``,
-    ``checkpoints/model_vecnormalize_<steps>_steps.pkl``)."""
-    run_dir = Path(run_dir)
-    if steps is None:
-        return run_dir / "model.zip", run_dir / "vecnormalize.pkl"
-    folder = run_dir / "checkpoints"
-    return folder / f"model_{steps}_steps.zip", folder / f"model_vecnormalize_{steps}_steps.pkl"
+def stop_reason(callbacks: list, model, hp: dict) -> str:
+    """Why learning ended: ``"steps"`` (all ``n_timesteps``) or the reason
+    a callback stopped it (the time budget's)."""
+    for callback in callbacks:
+        if getattr(callback, "reason", None):
+            return callback.reason
+    return "steps" if model.num_timesteps >= hp["n_timesteps"] else "a callback"
+
+
+def host_info() -> dict:
+    """The machine a run trained on: CPU, logical CPUs, torch threads,
+    Python and the platform."""
+    import os
+    import platform
+
+    import torch
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as fh:
+            cpu = next((line.split(":", 1)[1].strip() for line in fh
+                        if line.startswith("model name")), cpu)
+    except OSError:
+        pass
+    return dict(cpu=cpu, logical_cpus=os.cpu_count(), torch_threads=torch.get_num_threads(),
+                python=platform.python_version(), platform=platform.platform())
+
+
+def save_summary(run_dir: Path, hp: dict, model, *, started: float, learn_started: float,
+                 reason: str, init: dict | None, start_utc: str) -> dict:
+    """Write ``training.yaml``: the steps trained and planned, why learning
+    ended, the wall time (from the making of the environments; learning
+    alone), the host, the source commit and the model started from."""
+    from physics.provenance import source_commit
+
+    now = time.perf_counter()
+    summary = dict(steps=int(model.num_timesteps), planned_steps=int(hp["n_timesteps"]),
+                   stopped_by=reason, wall_seconds=round(now - started, 1),
+                   learn_seconds=round(now - learn_started, 1), started_utc=start_utc,
+                   host=host_info(), commit=source_commit(), init_from=init)
+    with open(run_dir / "training.yaml", "w") as fh:
+        yaml.safe_dump(summary, fh, sort_keys=False)
+    return summary
 
 
 def save(model, env, run_dir: Path, steps: int | None = None) -> None:
@@ -561,17 +672,22 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
 
         torch.set_num_threads(1)
         started = time.perf_counter()
+        start_utc = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         env, eval_env = make_envs(args, hp)
         model = make_model(args, hp, env, run_dir)
+        init = init_from(args, model, env)
         callbacks = make_callbacks(args, hp, eval_env, run_dir,
                                    started=started)
         warm_start(args, hp, model, env, run_dir, started)
     except BaseException as exc:
         _close(env, eval_env, model.logger if model is not None else None)
         discard_run_dir(run_dir, created)
-        if isinstance(exc, BudgetTooShort):
+        if isinstance(exc, (BudgetTooShort, InitMismatch)):
             parser.error(str(exc))
         raise
+    learn_started = time.perf_counter()
+    summary = dict(started=started, learn_started=learn_started, init=init,
+                   start_utc=start_utc)
     try:
         try:
             learn(model, hp, callbacks)
@@ -579,12 +695,20 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
             # nothing learnt is lost: the model so far becomes a checkpoint
             steps = model.num_timesteps
             save(model, env, run_dir, steps)
+            save_summary(run_dir, hp, model, reason="an error", **summary)
             print(f"training stopped by an error at {steps} steps; the model so far is saved "
                   f"as its checkpoint (evaluate it as {run_dir}@{steps})", file=sys.stderr)
             raise
         save(model, env, run_dir)
     finally:
         _close(env, eval_env)
+    done = save_summary(run_dir, hp, model, reason=stop_reason(callbacks, model, hp), **summary)
+    if done["stopped_by"] != "steps":
+        print(f"training stopped by {done['stopped_by']} at {done['steps']} of "
+              f"{done['planned_steps']} steps ({done['steps'] / done['planned_steps']:.0%}), "
+              f"after {done['wall_seconds']:.0f} s", flush=True)
+    else:
+        print(f"trained {done['steps']} steps in {done['wall_seconds']:.0f} s", flush=True)
     print(f"saved {run_dir / 'model.zip'}")
     return run_dir
 

@@ -4,8 +4,10 @@ Numba compiles the kernels on their first use and keeps them in an on-disk
 cache (see :mod:`physics._jit_cache`); the first run of an environment or
 of ``make demo`` otherwise spends a minute or two compiling. This module
 builds every registered environment on a small instance, resets it and
-steps it with a few random actions, then runs ``python -m physics.demo`` on
-a few floes and a short Hertz run on the multi-threaded kernels, so that
+steps it with a few random actions, does the same with the native vector
+environment of each that has one (training's, for several environments),
+then runs ``python -m physics.demo`` on a few floes and a short Hertz run
+on the multi-threaded kernels, so that
 later runs load everything from the cache. It prints one line per item and
 the total time; an item that fails is reported and the others still run
 (the exit status is then 1).
@@ -94,6 +96,28 @@ def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
     return note
 
 
+def warm_vector_env(env_id: str, steps: int = 5, seed: int = 0, num_envs: int = 2) -> str:
+    """Make the native vector environment of ``env_id`` (its registration's
+    ``vector_entry_point``, which training uses for several environments)
+    with ``num_envs`` sub-environments at the small size of its facts,
+    reset it and take ``steps`` random actions: its batched kernels are
+    others than the single environment's."""
+    import gymnasium as gym
+
+    from .facts import env_facts
+
+    env = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point",
+                       **dict(env_facts(env_id).small))
+    try:
+        env.action_space.seed(seed)
+        env.reset(seed=seed)
+        for _ in range(steps):      # the vector environment resets its sub-environments itself
+            env.step(env.action_space.sample())
+    finally:
+        env.close()
+    return ""
+
+
 def warm_demo() -> str:
     """``python -m physics.demo`` with 30 floes pressed on the wall for 2
     model seconds and a ship transit of 2 model seconds, its output
@@ -126,7 +150,12 @@ def items(steps: int = 5) -> list[tuple[str, Callable[[], str | None]]]:
     """The warm-up items, as (label, function) pairs."""
     from . import ENV_IDS
 
+    from .facts import env_spec
+
     out = [(env_id, lambda env_id=env_id: warm_env(env_id, steps)) for env_id in ENV_IDS]
+    out += [(f"{env_id}, native vector environment",
+             lambda env_id=env_id: warm_vector_env(env_id, steps))
+            for env_id in ENV_IDS if env_spec(env_id).vector_entry_point is not None]
     out.append(("physics.demo", warm_demo))
     out.append(("Hertz engine, parallel kernels", lambda: warm_parallel(steps)))
     return out

@@ -143,7 +143,11 @@ def test_ppo_run_saves_reloads_and_evaluates(ppo_runs, env_id, tmp_path):
     zero = detail["zero"]
     assert zero[0]["final"] != zero[1]["final"]
     table = (tmp_path / "evaluation.md").read_text()
-    assert "beaten by > 2 standard errors" in table and "| heuristic |" in table
+    assert "the policy (by > 2 standard errors)" in table and "| heuristic |" in table
+    # each baseline's row says beats, loses or neither, as its paired difference does
+    verdicts = [line.rsplit("|", 2)[-2].strip() for line in table.splitlines()
+                if line.startswith("| heuristic |")]
+    assert verdicts[-1] in ("beats", "loses", "neither")
     assert (tmp_path / "evaluation.png").stat().st_size > 1000
 
 
@@ -190,11 +194,18 @@ def test_time_budget_stops_training_and_saves_the_model(tmp_path, capsys):
     train.main(["--env", ITD, "--algo", "ppo", "--timesteps", "100000", "--n-envs", "2",
                 "--out", str(out), "--eval-freq", "0", "--save-freq", "0", "--no-progress",
                 "--minutes", "1e-9", "--hyperparams", *TINY_PPO, *env_kwargs_args(ITD)])
-    assert "training stopped by its budget" in capsys.readouterr().out
+    said = capsys.readouterr().out
     from stable_baselines3 import PPO
 
     # the budget is checked every step: the run stops within its first rollout
-    assert PPO.load(out / "model.zip", device="cpu").num_timesteps < 100000
+    steps = PPO.load(out / "model.zip", device="cpu").num_timesteps
+    assert steps < 100000
+    # said after the progress bar has closed, with how far the run got
+    assert f"training stopped by its budget of 1e-09 minutes at {steps} of 100000 steps" in said
+    summary = yaml.safe_load((out / "training.yaml").read_text())
+    assert summary["stopped_by"] == "its budget of 1e-09 minutes"
+    assert summary["steps"] == steps and summary["planned_steps"] == 100000
+    assert summary["host"]["torch_threads"] == 1 and summary["wall_seconds"] > 0
     with pytest.raises(ValueError, match="minutes"):
         TimeBudgetCallback(0.0)
 
@@ -390,4 +401,4 @@ def test_a_checkpoint_is_evaluated_on_its_own(ppo_runs, tmp_path, capsys):
     assert (run / "checkpoint_128" / "evaluation.json").is_file()
     with pytest.raises(SystemExit):
         evaluate_main([str(run), "--checkpoint", "100", "--no-progress"])
-    assert "no checkpoint at 100 steps; its checkpoints: 128, 256" in capsys.readouterr().err
+    assert "no checkpoint at 100 steps; its checkpoints: 128, 256, best" in capsys.readouterr().err

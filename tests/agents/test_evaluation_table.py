@@ -128,7 +128,7 @@ def test_ship_table_shows_units_and_splits_the_metrics():
     summary["effort"] = _summary(2.186e8, 1.2e7)
     summary["success"] = _summary(0.5, 0.5)
     summary["unlisted_metric"] = _summary(2.5e8, 1e7)
-    comparisons = {"straight": dict(diff=-12.34, sem=4.1, beats=False)}
+    comparisons = {"straight": dict(diff=-12.34, sem=4.1, beats=False, loses=True)}
     metric = {"straight": dict(diff=-3210.0, sem=830.0, beats=True)}
     task = dict(drawn={"concentration": dict(min=0.213, max=0.478, range=[0.2, 0.5])},
                 fixed={"wind_speed": 5.0}, leaderboard=True)
@@ -147,10 +147,10 @@ def test_ship_table_shows_units_and_splits_the_metrics():
             and "seeded 10000 + k" in text)
     assert "fixed for every episode by the environment arguments: wind_speed = 5" in text.lower()
     assert "`--env-kwargs concentration=A`" in text
-    assert "| straight | -12.3 ± 4.1 | no |" in text
+    assert "| straight | -12.3 ± 4.1 | loses |" in text
     assert (f"| baseline | difference of the {metric_header(facts.compared_metric[0])} |"
             in text)
-    assert "| straight | -3.21 ± 0.83 | yes |" in text
+    assert "| straight | -3.21 ± 0.83 | beats |" in text
 
 
 def test_run_episode_records_the_drawn_task():
