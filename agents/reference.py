@@ -1,0 +1,52 @@
+"""The reference agents: one trained agent per environment id, kept in the
+repository, and the seeds that keep their evaluation apart from their
+training and tuning.
+
+A reference agent is a run directory of :mod:`agents.train` (the best of
+its training seeds) under ``docs/agents/reference/<env-name>/``, with only
+what playing it needs: ``model.zip``, ``vecnormalize.pkl``,
+``hyperparams.yaml``, ``args.yaml``, ``command.txt`` and ``training.yaml``,
+each directory under :data:`MAX_BYTES`. Every command that takes a run
+directory takes one (``agents.evaluate``, ``agents.leaderboard --trained
+NAME=DIR``, ``agents.frames``, ``agents.tasks``, ``agents.train
+--init-from``).
+
+Seeds, fixed before any agent was trained or tuned:
+
+- the benchmark plays :data:`EVAL_EPISODES` episodes seeded
+  :data:`EVAL_SEED` + k; nothing is trained or tuned on them;
+- tuning trains trial n from seed :data:`TUNE_TRAIN_SEED` + n and scores it
+  on episodes seeded :data:`TUNE_EVAL_SEED` + k;
+- the reference agents train from seeds :data:`TRAIN_SEEDS` (their
+  evaluation callback plays episodes seeded 1000 + seed,
+  :data:`agents.train.EVAL_SEED_OFFSET`).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = ["EVAL_SEED", "EVAL_EPISODES", "TUNE_TRAIN_SEED", "TUNE_EVAL_SEED", "TRAIN_SEEDS",
+           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir"]
+
+#: the benchmark's episodes are seeded EVAL_SEED + k, k < EVAL_EPISODES
+EVAL_SEED = 40_000
+EVAL_EPISODES = 40
+#: tuning trial n trains from TUNE_TRAIN_SEED + n ...
+TUNE_TRAIN_SEED = 60_000
+#: ... and is scored on episodes seeded TUNE_EVAL_SEED + k
+TUNE_EVAL_SEED = 50_000
+#: the training seeds of a reference agent
+TRAIN_SEEDS = (1, 2, 3)
+#: where the reference agents are kept
+REFERENCE_DIR = Path(__file__).resolve().parent.parent / "docs" / "agents" / "reference"
+#: the largest reference directory kept in the repository [bytes]
+MAX_BYTES = 2 * 1024 * 1024
+#: the files of a run directory that a reference agent keeps
+KEPT_FILES = ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml", "command.txt",
+              "training.yaml", "pretrain.yaml")
+
+
+def reference_dir(env_id: str, root: str | Path | None = None) -> Path:
+    """``docs/agents/reference/<env-name>`` of an environment id (under
+    ``root`` instead of :data:`REFERENCE_DIR` when given)."""
+    return Path(REFERENCE_DIR if root is None else root) / env_id.split("/")[-1]

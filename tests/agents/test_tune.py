@@ -1,0 +1,62 @@
+"""The hyperparameter search (agents.tune): a two-trial study on a short
+budget writes its record, draws inside its search space, keeps its seeds
+apart from the benchmark's, and refuses bad input before it starts."""
+import json
+
+import pytest
+import yaml
+
+pytest.importorskip("optuna")
+pytest.importorskip("stable_baselines3")
+
+from agents import reference, tune
+from cli_checks import assert_refused
+from test_agents import ITD, SMALL
+
+
+def _study(out, *extra):
+    small = [f"{k}={v}" for k, v in SMALL[ITD].items()]
+    return tune.main(["--env", ITD, "--algo", "ppo", "--trials", "2", "--trial-timesteps",
+                      "256", "--evaluations", "2", "--eval-episodes", "1", "--out", str(out),
+                      "--no-progress", "--hyperparams", "n_envs=1", "--env-kwargs", *small,
+                      *extra])
+
+
+def test_a_two_trial_study_writes_its_record(tmp_path):
+    record = _study(tmp_path / "study")
+    saved = json.loads((tmp_path / "study" / "study.json").read_text())
+    assert saved == json.loads(json.dumps(record))
+    assert len(saved["trials"]) == 2 and saved["counts"]["COMPLETE"] == 2
+    for trial in saved["trials"]:
+        # scored twice on the way (the rollouts may pass the budget), on its own seed
+        assert len(trial["scores"]) >= 2 and trial["value"] == trial["scores"][-1][1]
+        assert trial["train_seed"] == reference.TUNE_TRAIN_SEED + trial["number"]
+        assert trial["params"]["n_steps"] in (256, 512, 1024, 2048)
+        assert 1e-5 <= trial["params"]["learning_rate"] <= 3e-3
+    best = max(saved["trials"], key=lambda t: t["value"])
+    assert saved["best"]["number"] == best["number"]
+    # best.yaml is an entry of the hyperparameter file, the drawn values in it
+    entry = yaml.safe_load((tmp_path / "study" / "best.yaml").read_text())[ITD]
+    assert entry["learning_rate"] == pytest.approx(best["params"]["learning_rate"])
+    assert entry["env_kwargs"] == {k: v for k, v in SMALL[ITD].items()}
+    for name in ("study.md", "study.png"):
+        assert (tmp_path / "study" / name).stat().st_size > 0
+    assert "Best trial" in (tmp_path / "study" / "study.md").read_text()
+
+
+def test_tuning_episodes_are_not_the_benchmarks():
+    tuned = range(reference.TUNE_EVAL_SEED, reference.TUNE_EVAL_SEED + 1000)
+    benchmark = range(reference.EVAL_SEED, reference.EVAL_SEED + reference.EVAL_EPISODES)
+    assert not set(tuned) & set(benchmark)
+    assert not set(range(reference.TUNE_TRAIN_SEED, reference.TUNE_TRAIN_SEED + 1000)) \
+        & set(benchmark)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--env", ITD, "--algo", "ppo", "--trials", "0"], "--trials must be >= 1"),
+    (["--env", ITD, "--algo", "ppo", "--minutes", "-1"], "--minutes must be a positive"),
+    (["--env", ITD, "--algo", "ppo", "--hyperparams", "n_stepz=3"], "unknown hyperparameters"),
+    (["--env", ITD, "--algo", "a2c"], "invalid choice"),
+])
+def test_bad_input_is_refused_before_a_trial(argv, words, capsys, tmp_path):
+    assert_refused(tune.main, argv, [words], tmp_path / "x", capsys)
