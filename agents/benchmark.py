@@ -1,0 +1,430 @@
+"""The reference agents and their benchmark: ``python -m agents.benchmark``.
+
+Two steps, each a command:
+
+``ship`` picks the best of an id's trained seeds and keeps it as the id's
+reference agent (:mod:`agents.reference`)::
+
+    python -m agents.benchmark ship runs/reference/WindDrift-v0/seed_* [--episodes 20]
+
+Every seed's final model plays the same selection episodes (seeded
+:data:`agents.reference.TUNE_EVAL_SEED` + k: not the benchmark's) and the
+benchmark's episodes (:data:`agents.reference.EVAL_SEED` + k), on the
+environment's default configuration but for the run's own way of acting
+and observing (:data:`agents.rollouts.AGENT_KWARGS`); the seed of the best
+selection score is copied to ``docs/agents/reference/<env-name>/``
+(:data:`agents.reference.KEPT_FILES`) with ``seeds.json``: each seed's
+scores, returns on the benchmark's episodes, training summary and learning
+curve. Choosing on other episodes than those reported keeps the choice
+from flattering the benchmark.
+
+``run`` (the default) plays every reference agent beside the baselines on
+the benchmark's episodes and writes the record and the page::
+
+    python -m agents.benchmark [run] [--ids WindDrift-v0 ...] [--episodes 40]
+        [--processes 2] [--out docs/agents/benchmark] [--keep]
+    python -m agents.benchmark --render          # the page again from the record
+
+Per id: the agent's return (mean ± standard error over the episodes), the
+spread of its training seeds (from ``seeds.json``), and the paired
+differences with zero, random, the best constant action
+(``docs/agents/tasks/constant_<env-name>.json``), the hand-written
+controller and, for the ship tasks, the other controllers and the planners.
+An id without a reference agent keeps its row, with its baselines. Output:
+``benchmark.json``, ``benchmark.md`` (included in the docs' training page)
+and ``learning_curves.png`` (every seed of every agent).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+__all__ = ["ship", "benchmark_id", "markdown", "main", "DEFAULT_OUT", "AGENT"]
+
+DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
+#: the name of the reference agent among the policies of a row
+AGENT = "agent"
+#: where the best constant action of each id is kept (agents.tasks)
+TASKS_DIR = Path("docs") / "agents" / "tasks"
+
+
+# -- ship ------------------------------------------------------------------------------------
+def _learning_curve(run_dir: Path) -> dict:
+    """The evaluation callback's scores (steps, mean, std) and the training
+    episodes' mean return against steps, thinned to at most 200 points."""
+    out = {"eval": [], "train": []}
+    npz = run_dir / "eval" / "evaluations.npz"
+    if npz.is_file():
+        data = np.load(npz)
+        out["eval"] = [[int(s), float(np.mean(r)), float(np.std(r))]
+                       for s, r in zip(data["timesteps"], data["results"])]
+    try:
+        from .curves import read_progress
+
+        train = read_progress(run_dir)["train"]
+    except (FileNotFoundError, ValueError):
+        train = []
+    if len(train) > 200:
+        train = [train[i] for i in np.linspace(0, len(train) - 1, 200).astype(int)]
+    out["train"] = [[int(s), float(r)] for s, r in train]
+    return out
+
+
+def play(env_id: str, recipes: dict, *, episodes: int, seed: int, processes: int,
+         progress: bool) -> dict:
+    """``{name: [episode dicts]}`` of every recipe
+    (:func:`agents.rollouts.evaluate_in_processes`) on episodes seeded
+    ``seed`` + k of the default environment (a trained run's with its
+    :data:`AGENT_KWARGS`); in this process for one."""
+    import gymnasium as gym
+
+    from .rollouts import evaluate, evaluate_in_processes, policy_from_recipe
+
+    if processes > 1:
+        return evaluate_in_processes(env_id, {}, recipes, episodes=episodes, seed=seed,
+                                     processes=processes, progress=progress)
+    env = gym.make(env_id)
+    try:
+        policies = {name: policy_from_recipe(recipe, env, seed)
+                    for name, recipe in recipes.items()}
+        return evaluate(env, policies, episodes=episodes, seed=seed, progress=progress)
+    finally:
+        env.close()
+
+
+def _play(run_dir: Path, episodes: int, seed: int, processes: int, progress: bool) -> list[float]:
+    """The returns of a run's final model on episodes seeded ``seed`` + k."""
+    with open(run_dir / "args.yaml") as fh:
+        env_id = yaml.safe_load(fh)["env"]
+    runs = play(env_id, {"run": ("trained", str(run_dir), {})}, episodes=episodes, seed=seed,
+                processes=processes, progress=progress)
+    return [e["ret"] for e in runs["run"]]
+
+
+def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
+         progress: bool = True, out: Path | None = None,
+         evaluation_episodes: int | None = None) -> Path:
+    """Score each seed's run on ``episodes`` selection episodes and
+    ``evaluation_episodes`` (default :data:`agents.reference.EVAL_EPISODES`)
+    of the benchmark's, keep the best as the id's reference agent (in
+    ``out``, default ``docs/agents/reference/<env-name>``) and write
+    ``seeds.json`` beside it; returns the reference directory."""
+    from .reference import (EVAL_EPISODES, EVAL_SEED, KEPT_FILES, MAX_BYTES, TUNE_EVAL_SEED,
+                            reference_dir)
+    from .rollouts import stats
+
+    evaluation_episodes = evaluation_episodes or EVAL_EPISODES
+    runs = [Path(r) for r in run_dirs]
+    envs = set()
+    for run in runs:
+        if not (run / "model.zip").is_file() or not (run / "args.yaml").is_file():
+            raise ValueError(f"{run} is not a finished run of agents.train (no model.zip or "
+                             f"args.yaml)")
+        envs.add(yaml.safe_load((run / "args.yaml").read_text())["env"])
+    if len(envs) != 1:
+        raise ValueError(f"the runs are of several environments: {sorted(envs)}")
+    env_id = envs.pop()
+    seeds = []
+    for run in runs:
+        args = yaml.safe_load((run / "args.yaml").read_text())
+        print(f"{run}: {episodes} selection episodes, then {evaluation_episodes} benchmark "
+              f"episodes", flush=True)
+        selection = _play(run, episodes, TUNE_EVAL_SEED, processes, progress)
+        evaluation = _play(run, evaluation_episodes, EVAL_SEED, processes, progress)
+        training = yaml.safe_load((run / "training.yaml").read_text()) \
+            if (run / "training.yaml").is_file() else {}
+        seeds.append(dict(seed=int(args["seed"]), run=run.name,
+                          selection=stats(np.array(selection)),
+                          evaluation=stats(np.array(evaluation)), returns=evaluation,
+                          training=training, curve=_learning_curve(run)))
+    best = max(seeds, key=lambda s: s["selection"]["mean"])
+    target = Path(out) if out is not None else reference_dir(env_id)
+    if target.exists():
+        shutil.rmtree(target)
+    target.mkdir(parents=True)
+    source = runs[seeds.index(best)]
+    for name in KEPT_FILES:
+        if (source / name).is_file():
+            shutil.copy2(source / name, target / name)
+    means = [s["evaluation"]["mean"] for s in seeds]
+    record = dict(env=env_id, chosen_seed=best["seed"],
+                  chosen_by=f"the best mean return on {episodes} selection episodes seeded "
+                            f"{TUNE_EVAL_SEED} + k",
+                  evaluation_episodes=f"{evaluation_episodes} seeded {EVAL_SEED} + k",
+                  across_seeds=dict(mean=float(np.mean(means)), std=float(np.std(means, ddof=1))
+                                    if len(means) > 1 else 0.0, min=float(np.min(means)),
+                                    max=float(np.max(means))),
+                  seeds=seeds, command=shlex.join(["python", "-m", "agents.benchmark", "ship",
+                                                   *map(str, run_dirs)]))
+    (target / "seeds.json").write_text(json.dumps(record, indent=1) + "\n")
+    size = sum(p.stat().st_size for p in target.rglob("*") if p.is_file())
+    print(f"kept seed {best['seed']} of {len(seeds)} in {target} ({size / 1024:.0f} kB); "
+          f"benchmark returns across seeds {', '.join(f'{m:.4g}' for m in means)}", flush=True)
+    if size > MAX_BYTES:
+        raise ValueError(f"{target} holds {size} bytes, more than the {MAX_BYTES} a reference "
+                         f"agent may keep: a smaller network, or fewer files")
+    return target
+
+
+# -- run -------------------------------------------------------------------------------------
+def _baseline_recipes(env_id: str) -> dict:
+    """The baselines of a row: random, zero, the best constant action (when
+    searched), the hand-written controller and the environment's other
+    controllers and planners."""
+    from iceenvs.facts import env_facts
+
+    from .baselines import baseline_names, load_results
+    from .metrics import env_name
+    from .planners import PLANNERS
+
+    recipes = {name: ("baseline", name, {}) for name in ("zero", "random")}
+    search = TASKS_DIR / f"constant_{env_name(env_id)}.json"
+    if search.is_file():
+        action = load_results(search)["results"][0]["action"]
+        recipes["constant"] = ("baseline", "constant", {"action": list(action)})
+    recipes["heuristic"] = ("baseline", "heuristic", {})
+    own = env_facts(env_id).controllers
+    for name in baseline_names(env_id):
+        if name in PLANNERS or (name in own and own[name] is not own.get("heuristic")):
+            recipes[name] = ("baseline", name, {})
+    return recipes
+
+
+def benchmark_id(env_id: str, *, episodes: int, processes: int, progress: bool = True,
+                 root: Path | None = None) -> dict:
+    """One row: every policy's returns on the benchmark's episodes, and the
+    reference agent's paired differences with each baseline (the agents
+    under ``root``, default ``docs/agents/reference``)."""
+    from .reference import EVAL_SEED, reference_dir
+    from .rollouts import compare, stats
+
+    recipes = _baseline_recipes(env_id)
+    agent_dir = reference_dir(env_id, root)
+    has_agent = (agent_dir / "model.zip").is_file()
+    if has_agent:
+        recipes = {AGENT: ("trained", str(agent_dir), {}), **recipes}
+    t0 = time.perf_counter()
+    runs = play(env_id, recipes, episodes=episodes, seed=EVAL_SEED, processes=processes,
+                progress=progress)
+    row = dict(id=env_id, episodes=episodes, seed=EVAL_SEED,
+               returns={name: stats(np.array([e["ret"] for e in eps]))
+                        for name, eps in runs.items()},
+               first_returns={name: [e["ret"] for e in eps[:2]] for name, eps in runs.items()},
+               seconds=round(time.perf_counter() - t0, 1), agent=None)
+    if has_agent:
+        seeds = json.loads((agent_dir / "seeds.json").read_text()) \
+            if (agent_dir / "seeds.json").is_file() else {}
+        hp = yaml.safe_load((agent_dir / "hyperparams.yaml").read_text())
+        args = yaml.safe_load((agent_dir / "args.yaml").read_text())
+        training = yaml.safe_load((agent_dir / "training.yaml").read_text()) \
+            if (agent_dir / "training.yaml").is_file() else {}
+        row["agent"] = dict(
+            algo=args["algo"], seed=args["seed"], steps=training.get("steps"),
+            wall_seconds=training.get("wall_seconds"), host=training.get("host"),
+            env_kwargs=hp.get("env_kwargs") or {}, across_seeds=seeds.get("across_seeds"),
+            seeds=[dict(seed=s["seed"], mean=s["evaluation"]["mean"],
+                        sem=s["evaluation"]["sem"], steps=s["training"].get("steps"),
+                        wall_seconds=s["training"].get("wall_seconds"))
+                   for s in seeds.get("seeds", [])],
+            command=(agent_dir / "command.txt").read_text().strip())
+        row["differences"] = {name: compare(runs[AGENT], eps) for name, eps in runs.items()
+                              if name != AGENT}
+    return row
+
+
+def _pm(s: dict) -> str:
+    from .metrics import format_pm
+
+    return format_pm(s["mean"], s["sem"])
+
+
+#: the ids whose task the straight line solves (no policy can do better)
+SOLVED_BY_STRAIGHT = ("iceenvs/ShipNavigation-v0",)
+
+
+def markdown(record: dict) -> str:
+    """``benchmark.md``: one row per id, then one table of paired differences per id."""
+    from .rollouts import verdict
+
+    lines = [f"Made by `{record['command']}` at commit `{record['commit']}`, {record['date']}. "
+             f"Every policy plays the same {record['episodes']} episodes per id (episode k "
+             f"seeded {record['seed']} + k, fixed before any agent was trained or tuned), on the "
+             f"environment's default configuration. Returns are mean ± standard error over the "
+             f"episodes; \"across seeds\" is the mean (min–max) of the training seeds' "
+             f"returns on the same episodes; differences are the agent's return minus the "
+             f"baseline's, paired by episode.", "",
+             "| id | agent | training | return | across seeds | best baseline | agent − best "
+             "baseline | verdict |", "|---|---|---|---|---|---|---|---|"]
+    for row in record["rows"]:
+        returns = row["returns"]
+        baselines = {n: s for n, s in returns.items() if n != AGENT}
+        best = max(baselines, key=lambda n: baselines[n]["mean"])
+        name = row["id"].split("/")[-1]
+        if row["agent"] is None:
+            lines.append(f"| `{row['id']}` | none yet | — | — | — | {best} "
+                         f"{_pm(baselines[best])} | — | no reference agent |")
+            continue
+        a = row["agent"]
+        spread = a.get("across_seeds") or {}
+        across = (f"{spread['mean']:.4g} ({spread['min']:.4g}–{spread['max']:.4g}), "
+                  f"{len(a['seeds'])} seeds" if spread else "—")
+        hours = f"{a['wall_seconds'] / 60:.0f} min" if a.get("wall_seconds") else "?"
+        soft = " (soft ice)" if a["env_kwargs"].get("stiffness_scale", 1.0) != 1.0 else ""
+        d = row["differences"][best]
+        solved = " (the straight line solves this task)" if row["id"] in SOLVED_BY_STRAIGHT \
+            else ""
+        lines.append(f"| [`{row['id']}`](#{name.lower()}) | {a['algo'].upper()}, seed "
+                     f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "
+                     f"{_pm(returns[AGENT])} | {across} | {best} {_pm(baselines[best])} | "
+                     f"{d['diff']:+.3g} ± {d['sem']:.2g} | {verdict(d)}{solved} |")
+    for row in record["rows"]:
+        if row["agent"] is None:
+            continue
+        name = row["id"].split("/")[-1]
+        a = row["agent"]
+        lines += ["", f"### {name}", "",
+                  f"`{a['command']}`; trained on {a['host']['cpu'] if a.get('host') else '?'} "
+                  f"({a['host']['logical_cpus'] if a.get('host') else '?'} logical CPUs). "
+                  f"Seeds: " + ", ".join(
+                      f"{s['seed']}: {s['mean']:.4g} ± {s['sem']:.2g} ({s['steps']} steps, "
+                      f"{(s['wall_seconds'] or 0) / 60:.0f} min)" for s in a["seeds"]) + ".", "",
+                  "| baseline | its return | agent − baseline (paired) | the agent (by > 2 SE) |",
+                  "|---|---|---|---|"]
+        for base, d in row["differences"].items():
+            lines.append(f"| {base} | {_pm(row['returns'][base])} | {d['diff']:+.3g} ± "
+                         f"{d['sem']:.2g} | {verdict(d)} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_curves(record: dict, path: Path, root: Path | None = None) -> None:
+    """``learning_curves.png``: the evaluation callback's score of every
+    training seed of every reference agent against steps."""
+    from physics.scenarios import plots
+
+    from .reference import reference_dir
+
+    rows = [r for r in record["rows"] if r["agent"] is not None]
+    plt = plots.pyplot()
+    n = max(len(rows), 1)
+    cols = min(n, 4)
+    fig, axes = plt.subplots((n + cols - 1) // cols, cols, figsize=(3.6 * cols,
+                                                                    3.0 * ((n + cols - 1) // cols)),
+                             squeeze=False)
+    for ax, row in zip(axes.flat, rows):
+        seeds_file = reference_dir(row["id"], root) / "seeds.json"
+        seeds = json.loads(seeds_file.read_text())["seeds"] if seeds_file.is_file() else []
+        for k, s in enumerate(seeds):
+            curve = s["curve"]["eval"]
+            if curve:
+                x, y, sd = map(np.array, zip(*curve))
+                ax.plot(x, y, color=f"C{k}", lw=1.2, label=f"seed {s['seed']}")
+                ax.fill_between(x, y - sd, y + sd, color=f"C{k}", alpha=0.15)
+        best = max((n for n in row["returns"] if n != AGENT),
+                   key=lambda n: row["returns"][n]["mean"])
+        ax.axhline(row["returns"][best]["mean"], color="k", ls="--", lw=0.9,
+                   label=f"{best} (benchmark)")
+        ax.set(title=row["id"].split("/")[-1], xlabel="steps", ylabel="evaluation return")
+        ax.legend(fontsize=7)
+    for ax in list(axes.flat)[len(rows):]:
+        ax.set_axis_off()
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from iceenvs import ENV_IDS
+
+    names = [e.split("/")[1] for e in ENV_IDS]
+    p = argparse.ArgumentParser(prog="python -m agents.benchmark",
+                                description="Ship the reference agents and benchmark them.")
+    p.add_argument("action", nargs="?", choices=("run", "ship"), default="run")
+    p.add_argument("runs", nargs="*", type=Path, help="ship: the run directories of one id's "
+                                                      "training seeds")
+    p.add_argument("--ids", nargs="+", choices=names, default=names, metavar="NAME",
+                   help="run: the ids (default all): " + ", ".join(names))
+    p.add_argument("--episodes", type=int, default=None,
+                   help="run: episodes per policy (default 40); ship: selection episodes "
+                        "(default 20)")
+    p.add_argument("--processes", type=int, default=2, help="worker processes (default 2)")
+    p.add_argument("--out", type=Path, default=None,
+                   help=f"run: the record's directory (default {DEFAULT_OUT}); ship: the "
+                        f"reference directory (default docs/agents/reference/<env-name>)")
+    p.add_argument("--reference", type=Path, default=None, metavar="DIR",
+                   help="run: the folder of the reference agents (default docs/agents/reference)")
+    p.add_argument("--keep", action="store_true",
+                   help="run: keep the rows of the ids not run from --out's benchmark.json")
+    p.add_argument("--render", action="store_true",
+                   help="only write benchmark.md and the figure again from benchmark.json")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    return p
+
+
+def main(argv: list[str] | None = None) -> dict | Path:
+    from iceenvs import ENV_IDS
+    from physics.provenance import source_commit
+
+    from .reference import EVAL_EPISODES, EVAL_SEED
+
+    raw = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args = parser.parse_args(raw)
+    if args.episodes is not None and args.episodes < 2:
+        parser.error("--episodes must be >= 2 (a standard error needs two)")
+    if args.processes < 1:
+        parser.error("--processes must be >= 1")
+    if args.action == "ship":
+        if not args.runs:
+            parser.error("ship takes the run directories of one id's training seeds")
+        try:
+            return ship(args.runs, episodes=args.episodes or 20, processes=args.processes,
+                        progress=not args.no_progress, out=args.out)
+        except ValueError as err:
+            parser.error(str(err))
+    if args.runs:
+        parser.error("run takes no run directories (did you mean ship?)")
+    out = args.out or DEFAULT_OUT
+    path = out / "benchmark.json"
+    if args.render:
+        if not path.is_file():
+            parser.error(f"--render: {path} does not exist")
+        record = json.loads(path.read_text())
+    else:
+        episodes = args.episodes or EVAL_EPISODES
+        old = json.loads(path.read_text()) if args.keep and path.is_file() else None
+        if old is not None and old["episodes"] != episodes:
+            parser.error(f"--keep: {path} has {old['episodes']} episodes, this run {episodes}")
+        rows = []
+        for name in args.ids:
+            print(f"{name}: {episodes} episodes per policy ...", flush=True)
+            rows.append(benchmark_id(f"iceenvs/{name}", episodes=episodes,
+                                     processes=args.processes, progress=not args.no_progress,
+                                     root=args.reference))
+        command = shlex.join(["python", "-m", "agents.benchmark", *raw])
+        if old is not None:
+            done = {r["id"] for r in rows}
+            rows = [r for r in old["rows"] if r["id"] not in done] + rows
+            command = f"{old['command']}` then `{command}"
+        rows.sort(key=lambda r: ENV_IDS.index(r["id"]) if r["id"] in ENV_IDS else len(ENV_IDS))
+        from .leaderboard import host_signature
+
+        record = dict(command=command, commit=source_commit(), date=time.strftime("%Y-%m-%d"),
+                      host=host_signature(), episodes=episodes, seed=EVAL_SEED, rows=rows)
+        out.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(record, indent=1) + "\n")
+    (out / "benchmark.md").write_text(markdown(record))
+    plot_curves(record, out / "learning_curves.png", args.reference)
+    print(f"wrote {out / 'benchmark.md'}")
+    return record
+
+
+if __name__ == "__main__":
+    main()
