@@ -31,8 +31,9 @@ differences with zero, random, the best constant action
 (``docs/agents/tasks/constant_<env-name>.json``), the hand-written
 controller and, for the ship tasks, the other controllers and the planners.
 An id without a reference agent keeps its row, with its baselines. Output:
-``benchmark.json``, ``benchmark.md`` (included in the docs' training page)
-and ``learning_curves.png`` (every seed of every agent).
+``benchmark.json``, ``benchmark.md`` (the table, included in the docs'
+training page), ``details.md`` (per id, the paired differences with every
+baseline) and ``learning_curves.png`` (every seed of every agent).
 """
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-__all__ = ["ship", "benchmark_id", "markdown", "main", "DEFAULT_OUT", "AGENT"]
+__all__ = ["ship", "benchmark_id", "markdown", "details_markdown", "main", "DEFAULT_OUT", "AGENT"]
 
 DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
 #: the name of the reference agent among the policies of a row
@@ -251,7 +252,8 @@ SOLVED_BY_STRAIGHT = ("iceenvs/ShipNavigation-v0",)
 
 
 def markdown(record: dict) -> str:
-    """``benchmark.md``: one row per id, then one table of paired differences per id."""
+    """``benchmark.md``: one row per id (:func:`details_markdown` has the
+    paired differences of each)."""
     from .rollouts import verdict
 
     lines = [f"Made by `{record['command']}` at commit `{record['commit']}`, {record['date']}. "
@@ -281,10 +283,20 @@ def markdown(record: dict) -> str:
         d = row["differences"][best]
         solved = " (the straight line solves this task)" if row["id"] in SOLVED_BY_STRAIGHT \
             else ""
-        lines.append(f"| [`{row['id']}`](#{name.lower()}) | {a['algo'].upper()}, seed "
+        lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
+                     f"{a['algo'].upper()}, seed "
                      f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "
                      f"{_pm(returns[AGENT])} | {across} | {best} {_pm(baselines[best])} | "
                      f"{d['diff']:+.3g} ± {d['sem']:.2g} | {verdict(d)}{solved} |")
+    return "\n".join(lines) + "\n"
+
+
+def details_markdown(record: dict) -> str:
+    """``details.md``: per id with a reference agent, its command, host,
+    training seeds and the paired differences with every baseline."""
+    from .rollouts import verdict
+
+    lines = []
     for row in record["rows"]:
         if row["agent"] is None:
             continue
@@ -421,6 +433,7 @@ def main(argv: list[str] | None = None) -> dict | Path:
         out.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(record, indent=1) + "\n")
     (out / "benchmark.md").write_text(markdown(record))
+    (out / "details.md").write_text(details_markdown(record).lstrip("\n"))
     plot_curves(record, out / "learning_curves.png", args.reference)
     print(f"wrote {out / 'benchmark.md'}")
     return record

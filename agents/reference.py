@@ -26,7 +26,7 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = ["EVAL_SEED", "EVAL_EPISODES", "TUNE_TRAIN_SEED", "TUNE_EVAL_SEED", "TRAIN_SEEDS",
-           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir"]
+           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir", "load_reference"]
 
 #: the benchmark's episodes are seeded EVAL_SEED + k, k < EVAL_EPISODES
 EVAL_SEED = 40_000
@@ -50,3 +50,26 @@ def reference_dir(env_id: str, root: str | Path | None = None) -> Path:
     """``docs/agents/reference/<env-name>`` of an environment id (under
     ``root`` instead of :data:`REFERENCE_DIR` when given)."""
     return Path(REFERENCE_DIR if root is None else root) / env_id.split("/")[-1]
+
+
+def load_reference(env: str, root: str | Path | None = None):
+    """The reference agent of an environment (``"iceenvs/WindDrift-v0"`` or
+    ``"WindDrift-v0"``) as a :class:`agents.rollouts.TrainedPolicy`: its
+    ``predict(obs)`` acts on raw observations, ``env_id`` and
+    ``agent_kwargs`` say which environment it plays and how it acts and
+    observes there.
+
+    Raises
+    ------
+    FileNotFoundError
+        When the id has no reference agent; the message lists those that do.
+    """
+    from .rollouts import TrainedPolicy
+
+    folder = reference_dir(env, root)
+    if not (folder / "model.zip").is_file():
+        base = Path(REFERENCE_DIR if root is None else root)
+        have = sorted(p.name for p in base.glob("*") if (p / "model.zip").is_file())
+        raise FileNotFoundError(f"no reference agent for {env}; the reference agents: "
+                                f"{', '.join(have) or 'none'}")
+    return TrainedPolicy(folder)

@@ -32,6 +32,7 @@ from . import __version__
 COMMANDS = {
     "train": ("agents.train:main", "train a stable-baselines3 agent on an environment"),
     "evaluate": ("agents.evaluate:main", "compare a trained policy with the baselines"),
+    "tune": ("agents.tune:main", "search an algorithm's hyperparameters with Optuna"),
     "scenarios": ("physics.scenarios.cli:main", "run the papers' experiments (ice-scenarios)"),
     "crosscheck": ("physics.crosscheck.report:main",
                    "cross-check the engines against pymunk and LAMMPS"),

@@ -12,7 +12,7 @@ import pytest
 from seaice_gym import __version__
 from seaice_gym import cli
 
-SUBCOMMANDS = ["train", "evaluate", "scenarios", "crosscheck", "bench", "validate", "demo"]
+SUBCOMMANDS = ["train", "evaluate", "tune", "scenarios", "crosscheck", "bench", "validate", "demo"]
 
 
 def _exit(argv, capsys) -> tuple[int, str, str]:

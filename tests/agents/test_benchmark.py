@@ -90,6 +90,8 @@ def test_the_page_says_beats_or_loses_and_names_ids_without_an_agent(shipped, ro
                                    seed=reference.EVAL_SEED, rows=rows))
     assert "no reference agent" in text
     assert any(word in text for word in ("| beats", "| loses", "| neither"))
+    details = benchmark.details_markdown(dict(rows=rows))
+    assert details.count("### ThicknessDistribution-v0") == 1 and "| heuristic |" in details
     benchmark.plot_curves(dict(rows=rows), tmp_path / "curves.png", root)
     assert (tmp_path / "curves.png").stat().st_size > 0
 

@@ -60,3 +60,24 @@ def test_tuning_episodes_are_not_the_benchmarks():
 ])
 def test_bad_input_is_refused_before_a_trial(argv, words, capsys, tmp_path):
     assert_refused(tune.main, argv, [words], tmp_path / "x", capsys)
+
+
+def test_sac_draws_are_valid_constructor_arguments():
+    """Every SAC draw builds a model: the space's corners, through FixedTrial."""
+    import gymnasium as gym
+    import optuna
+
+    from agents.train import algo_class, algo_kwargs
+
+    env = gym.make(ITD, **SMALL[ITD])
+    for params in (dict(train_freq=1, net_arch="small", learning_rate=1e-5, batch_size=64,
+                        buffer_size=10_000, gamma=0.95, tau=0.005, learning_starts=100,
+                        log_std_init=-3.0),
+                   dict(train_freq=8, net_arch="large", learning_rate=3e-3, batch_size=512,
+                        buffer_size=10_000, gamma=0.999, tau=0.05, learning_starts=5000,
+                        log_std_init=0.0)):
+        drawn = tune.sample_sac(optuna.trial.FixedTrial(params))
+        assert drawn["gradient_steps"] == drawn["train_freq"]
+        model = algo_class("sac")("MlpPolicy", env, device="cpu", **algo_kwargs(drawn))
+        assert model.batch_size == params["batch_size"]
+    env.close()
