@@ -23,6 +23,7 @@ the benchmark's episodes and writes the record and the page::
 
     python -m agents.benchmark [run] [--ids WindDrift-v0 ...] [--episodes 40]
         [--processes 2] [--out docs/agents/benchmark] [--keep]
+    python -m agents.benchmark --merge A/benchmark.json B/benchmark.json  # runs of other ids
     python -m agents.benchmark --render          # the page again from the record
 
 Per id: the agent's return (mean ± standard error over the episodes), the
@@ -110,6 +111,15 @@ def _play(run_dir: Path, episodes: int, seed: int, processes: int, progress: boo
     return [e["ret"] for e in runs["run"]]
 
 
+def portable_command(text: str) -> str:
+    """A run's ``command.txt`` as anyone runs it: ``python -m ...`` in place
+    of the interpreter's path on the machine that trained it."""
+    words = shlex.split(text)
+    if words and Path(words[0]).name.startswith("python"):
+        words[0] = "python"
+    return shlex.join(words) + "\n"
+
+
 def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
          progress: bool = True, out: Path | None = None,
          evaluation_episodes: int | None = None) -> Path:
@@ -155,6 +165,7 @@ def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
     for name in KEPT_FILES:
         if (source / name).is_file():
             shutil.copy2(source / name, target / name)
+    (target / "command.txt").write_text(portable_command((target / "command.txt").read_text()))
     means = [s["evaluation"]["mean"] for s in seeds]
     record = dict(env=env_id, chosen_seed=best["seed"],
                   chosen_by=f"the best mean return on {episodes} selection episodes seeded "
@@ -352,6 +363,31 @@ def plot_curves(record: dict, path: Path, root: Path | None = None) -> None:
     plt.close(fig)
 
 
+def merge(records: list[dict]) -> dict:
+    """One record of several runs' rows (a later record's row of an id
+    replaces an earlier one's), their commands joined in order.
+
+    Raises
+    ------
+    ValueError
+        When the records played other episodes (count or first seed)."""
+    from iceenvs import ENV_IDS
+
+    first = records[0]
+    for other in records[1:]:
+        for key in ("episodes", "seed"):
+            if other[key] != first[key]:
+                raise ValueError(f"the records differ in {key}: {first[key]} and {other[key]}")
+    rows = {}
+    for record in records:
+        rows.update({row["id"]: row for row in record["rows"]})
+    order = sorted(rows, key=lambda i: ENV_IDS.index(i) if i in ENV_IDS else len(ENV_IDS))
+    return dict(command="` then `".join(r["command"] for r in records),
+                commit=records[-1]["commit"], date=records[-1]["date"],
+                host=records[-1].get("host"), episodes=first["episodes"], seed=first["seed"],
+                rows=[rows[i] for i in order])
+
+
 def build_parser() -> argparse.ArgumentParser:
     from iceenvs import ENV_IDS
 
@@ -374,6 +410,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run: the folder of the reference agents (default docs/agents/reference)")
     p.add_argument("--keep", action="store_true",
                    help="run: keep the rows of the ids not run from --out's benchmark.json")
+    p.add_argument("--merge", nargs="+", type=Path, default=None, metavar="JSON",
+                   help="run: join the rows of these benchmark.json files (of runs over "
+                        "different ids, e.g. in parallel) into --out, without playing")
     p.add_argument("--render", action="store_true",
                    help="only write benchmark.md and the figure again from benchmark.json")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
@@ -409,6 +448,13 @@ def main(argv: list[str] | None = None) -> dict | Path:
         if not path.is_file():
             parser.error(f"--render: {path} does not exist")
         record = json.loads(path.read_text())
+    elif args.merge:
+        try:
+            record = merge([json.loads(Path(f).read_text()) for f in args.merge])
+        except (OSError, ValueError, KeyError) as err:
+            parser.error(f"--merge: {err}")
+        out.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(record, indent=1) + "\n")
     else:
         episodes = args.episodes or EVAL_EPISODES
         old = json.loads(path.read_text()) if args.keep and path.is_file() else None

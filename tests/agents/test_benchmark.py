@@ -47,6 +47,8 @@ def test_the_best_seed_by_its_selection_episodes_is_kept(seeds, shipped):
     assert kept["seed"] == record["chosen_seed"]
     assert {p.name for p in target.iterdir()} <= set(reference.KEPT_FILES) | {"seeds.json"}
     assert (target / "model.zip").is_file() and (target / "training.yaml").is_file()
+    # the command as anyone runs it, not with the training machine's interpreter path
+    assert (target / "command.txt").read_text().startswith("python -m agents.train --env")
     # each seed's learning curve and its returns on the benchmark's episodes
     for s in record["seeds"]:
         assert s["curve"]["eval"] and len(s["returns"]) == 2
@@ -101,3 +103,15 @@ def test_a_reference_over_the_size_limit_is_refused(seeds, tmp_path, monkeypatch
     with pytest.raises(ValueError, match="more than the 1000"):
         benchmark.ship(seeds[:1], episodes=2, evaluation_episodes=2, progress=False,
                        out=tmp_path / "big")
+
+
+def test_records_of_other_ids_merge_in_the_order_of_the_ids(row):
+    other = {**row, "id": "iceenvs/WindDrift-v0"}
+    a = dict(command="a", commit="x", date="d", episodes=2, seed=reference.EVAL_SEED, rows=[row])
+    b = dict(command="b", commit="y", date="e", episodes=2, seed=reference.EVAL_SEED,
+             rows=[other])
+    merged = benchmark.merge([a, b])
+    assert [r["id"] for r in merged["rows"]] == ["iceenvs/WindDrift-v0", ITD]
+    assert merged["command"] == "a` then `b" and merged["commit"] == "y"
+    with pytest.raises(ValueError, match="episodes"):
+        benchmark.merge([a, {**b, "episodes": 3}])
