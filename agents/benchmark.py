@@ -282,8 +282,10 @@ def markdown(record: dict) -> str:
         best = max(baselines, key=lambda n: baselines[n]["mean"])
         name = row["id"].split("/")[-1]
         if row["agent"] is None:
+            solved = ("; in the task table nothing beats the straight line"
+                      if row["id"] in SOLVED_BY_STRAIGHT else "")
             lines.append(f"| `{row['id']}` | none yet | — | — | — | {best} "
-                         f"{_pm(baselines[best])} | — | no reference agent |")
+                         f"{_pm(baselines[best])} | — | no reference agent{solved} |")
             continue
         a = row["agent"]
         spread = a.get("across_seeds") or {}
@@ -292,7 +294,8 @@ def markdown(record: dict) -> str:
         hours = f"{a['wall_seconds'] / 60:.0f} min" if a.get("wall_seconds") else "?"
         soft = " (soft ice)" if a["env_kwargs"].get("stiffness_scale", 1.0) != 1.0 else ""
         d = row["differences"][best]
-        solved = " (the straight line solves this task)" if row["id"] in SOLVED_BY_STRAIGHT \
+        solved = " (in the task table nothing beats the straight line)" \
+            if row["id"] in SOLVED_BY_STRAIGHT \
             else ""
         lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
                      f"{a['algo'].upper()}, seed "
@@ -359,7 +362,7 @@ def plot_curves(record: dict, path: Path, root: Path | None = None) -> None:
     for ax in list(axes.flat)[len(rows):]:
         ax.set_axis_off()
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    fig.savefig(path, dpi=80)
     plt.close(fig)
 
 
@@ -460,24 +463,27 @@ def main(argv: list[str] | None = None) -> dict | Path:
         old = json.loads(path.read_text()) if args.keep and path.is_file() else None
         if old is not None and old["episodes"] != episodes:
             parser.error(f"--keep: {path} has {old['episodes']} episodes, this run {episodes}")
+        from .leaderboard import host_signature
+
+        command = shlex.join(["python", "-m", "agents.benchmark", *raw])
+        if old is not None:
+            command = f"{old['command']}` then `{command}"
         rows = []
+        out.mkdir(parents=True, exist_ok=True)
         for name in args.ids:
             print(f"{name}: {episodes} episodes per policy ...", flush=True)
             rows.append(benchmark_id(f"iceenvs/{name}", episodes=episodes,
                                      processes=args.processes, progress=not args.no_progress,
                                      root=args.reference))
-        command = shlex.join(["python", "-m", "agents.benchmark", *raw])
-        if old is not None:
             done = {r["id"] for r in rows}
-            rows = [r for r in old["rows"] if r["id"] not in done] + rows
-            command = f"{old['command']}` then `{command}"
-        rows.sort(key=lambda r: ENV_IDS.index(r["id"]) if r["id"] in ENV_IDS else len(ENV_IDS))
-        from .leaderboard import host_signature
-
-        record = dict(command=command, commit=source_commit(), date=time.strftime("%Y-%m-%d"),
-                      host=host_signature(), episodes=episodes, seed=EVAL_SEED, rows=rows)
-        out.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(record, indent=1) + "\n")
+            kept = [r for r in (old or {}).get("rows", []) if r["id"] not in done] + rows
+            kept.sort(key=lambda r: ENV_IDS.index(r["id"]) if r["id"] in ENV_IDS
+                      else len(ENV_IDS))
+            # written after every id, so that an interrupted run keeps the rows it made
+            record = dict(command=command, commit=source_commit(),
+                          date=time.strftime("%Y-%m-%d"), host=host_signature(),
+                          episodes=episodes, seed=EVAL_SEED, rows=kept)
+            path.write_text(json.dumps(record, indent=1) + "\n")
     (out / "benchmark.md").write_text(markdown(record))
     (out / "details.md").write_text(details_markdown(record).lstrip("\n"))
     plot_curves(record, out / "learning_curves.png", args.reference)

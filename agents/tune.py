@@ -411,7 +411,7 @@ def plot(record: dict, path: Path) -> None:
         b.set_axis_off()
     fig.suptitle(f"{record['algo'].upper()} on {record['env']}")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=80)
     plt.close(fig)
 
 
