@@ -163,13 +163,26 @@ def environment_page(env_id: str, spec, frame: str) -> str:
     facts = cls.facts
     lines += [f"| main metric | `{facts.main_metric}` |",
               f"| baselines | {_baselines(facts)} |",
-              f"| small instance (tests, warm-up) | {_kwargs(facts.small)} |"]
+              f"| small instance (tests, warm-up) | {_kwargs(facts.small)} |",
+              f"| reference agent | {_reference_agent(env_id)} |"]
     lines += ["", "```python", "import gymnasium as gym",
               "import iceenvs  # noqa: F401  (registers the ids)", "",
               f'env = gym.make("{env_id}", render_mode="rgb_array")',
               "obs, info = env.reset(seed=0)", "```", "",
               myst_roles(body), ""]
     return "\n".join(lines)
+
+
+def _reference_agent(env_id: str) -> str:
+    """A link to the id's row of the reference agents' benchmark, or the
+    page when the id has no reference agent yet."""
+    from agents.reference import reference_dir
+
+    name = env_id.split("/")[-1]
+    if (reference_dir(env_id) / "model.zip").is_file():
+        return (f"`docs/agents/reference/{name}` ([its benchmark row and baselines]"
+                f"(/reference-agents.md#{name.lower()}))")
+    return "none yet ({doc}`/reference-agents`)"
 
 
 def _baselines(facts) -> str:
