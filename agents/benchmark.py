@@ -258,8 +258,22 @@ def _pm(s: dict) -> str:
     return format_pm(s["mean"], s["sem"])
 
 
-#: the ids whose task the straight line solves (no policy can do better)
-SOLVED_BY_STRAIGHT = ("iceenvs/ShipNavigation-v0",)
+def task_table_note(env_id: str) -> str:
+    """``"; no controller beat the best constant action in the task table"``
+    when the task table (``docs/agents/tasks/tasks.json``, :mod:`agents.tasks`)
+    found no controller, planner or trained policy beating the id's best
+    constant action by two standard errors (a task a constant action may
+    solve), else empty."""
+    path = TASKS_DIR / "tasks.json"
+    if not path.is_file():
+        return ""
+    row = next((r for r in json.loads(path.read_text())["rows"] if r["id"] == env_id), None)
+    if row is None:
+        return ""
+    over = row.get("over_constant") or {"heuristic": row["heuristic_minus_constant"]}
+    if any(d.get("beats") for d in over.values()):
+        return ""
+    return "; no controller beat the best constant action in the task table"
 
 
 def markdown(record: dict) -> str:
@@ -282,10 +296,9 @@ def markdown(record: dict) -> str:
         best = max(baselines, key=lambda n: baselines[n]["mean"])
         name = row["id"].split("/")[-1]
         if row["agent"] is None:
-            solved = ("; in the task table nothing beats the straight line"
-                      if row["id"] in SOLVED_BY_STRAIGHT else "")
             lines.append(f"| `{row['id']}` | none yet | — | — | — | {best} "
-                         f"{_pm(baselines[best])} | — | no reference agent{solved} |")
+                         f"{_pm(baselines[best])} | — | no reference agent"
+                         f"{task_table_note(row['id'])} |")
             continue
         a = row["agent"]
         spread = a.get("across_seeds") or {}
@@ -294,9 +307,7 @@ def markdown(record: dict) -> str:
         hours = f"{a['wall_seconds'] / 60:.0f} min" if a.get("wall_seconds") else "?"
         soft = " (soft ice)" if a["env_kwargs"].get("stiffness_scale", 1.0) != 1.0 else ""
         d = row["differences"][best]
-        solved = " (in the task table nothing beats the straight line)" \
-            if row["id"] in SOLVED_BY_STRAIGHT \
-            else ""
+        solved = task_table_note(row["id"])
         lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
                      f"{a['algo'].upper()}, seed "
                      f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "
