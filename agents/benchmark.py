@@ -268,10 +268,9 @@ def task_table_note(env_id: str) -> str:
     if not path.is_file():
         return ""
     row = next((r for r in json.loads(path.read_text())["rows"] if r["id"] == env_id), None)
-    if row is None:
-        return ""
-    over = row.get("over_constant") or {"heuristic": row["heuristic_minus_constant"]}
-    if any(d.get("beats") for d in over.values()):
+    from .tasks import beating_constant
+
+    if row is None or beating_constant(row):
         return ""
     return "; no controller beat the best constant action in the task table"
 

@@ -43,7 +43,7 @@ import sys
 import time
 from pathlib import Path
 
-__all__ = ["analyse", "task_table", "main"]
+__all__ = ["analyse", "beating_constant", "task_table", "main"]
 
 EVAL_SEED = 10_000
 DEFAULT_OUT = Path("runs/agents/tasks")
@@ -113,6 +113,14 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
                 seconds=time.perf_counter() - t0, search_seconds=t_search)
 
 
+def beating_constant(row: dict) -> list[str]:
+    """The policies of a row of :func:`analyse` (the controller, planners,
+    trained and own policies) that beat the best constant action by more
+    than two standard errors of the paired difference."""
+    over = row.get("over_constant", {"heuristic": row["heuristic_minus_constant"]})
+    return [name for name, d in over.items() if d["beats"]]
+
+
 def task_table(rows: list[dict]) -> str:
     """Markdown: one row per environment."""
     from .constant import format_action
@@ -133,7 +141,7 @@ def task_table(rows: list[dict]) -> str:
             return "<br>".join(f"{n}: {over[n]['diff']:+.1f} [{over[n]['sem']:.2g}]"
                                for n in names) or "—"
 
-        winners = [n for n, d in over.items() if d["beats"]]
+        winners = beating_constant(r)
         verdict = "yes (" + ", ".join(winners) + ")" if winners else "not shown"
         lines.append(f"| `{r['id']}` | {r['steps']} | {format_action(r['best_action'])} "
                      f"({r['n_actions']}) | {cell('constant')} | {cell('zero')} | "
