@@ -56,6 +56,8 @@ DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
 AGENT = "agent"
 #: where the best constant action of each id is kept (agents.tasks)
 TASKS_DIR = Path("docs") / "agents" / "tasks"
+#: diagnostics of why an agent loses (:mod:`agents.ceiling` writes ``<env-name>-ceiling``)
+DIAGNOSTICS_DIR = Path("docs") / "agents" / "diagnostics"
 
 
 # -- ship ------------------------------------------------------------------------------------
@@ -275,6 +277,19 @@ def task_table_note(env_id: str) -> str:
     return "; no controller beat the best constant action in the task table"
 
 
+def ceiling_note(env_id: str) -> str:
+    """``"; the controller is within D ± SE of the return no policy passes"``
+    where a ceiling record (:mod:`agents.ceiling`) bounds the id's return,
+    else empty."""
+    name = env_id.split("/")[-1]
+    path = DIAGNOSTICS_DIR / f"{name}-ceiling" / "ceiling.json"
+    if not path.is_file():
+        return ""
+    below = json.loads(path.read_text())["summary"]["heuristic"]["below_ceiling"]
+    return (f"; the controller is within {_pm(below)} of the return no policy passes "
+            f"([ceiling](/reference-agents.md#why-an-agent-cannot-win-{name.lower()}))")
+
+
 def markdown(record: dict) -> str:
     """``benchmark.md``: one row per id (:func:`details_markdown` has the
     paired differences of each)."""
@@ -306,7 +321,7 @@ def markdown(record: dict) -> str:
         hours = f"{a['wall_seconds'] / 60:.0f} min" if a.get("wall_seconds") else "?"
         soft = " (soft ice)" if a["env_kwargs"].get("stiffness_scale", 1.0) != 1.0 else ""
         d = row["differences"][best]
-        solved = task_table_note(row["id"])
+        solved = task_table_note(row["id"]) + ceiling_note(row["id"])
         lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
                      f"{a['algo'].upper()}, seed "
                      f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "

@@ -115,3 +115,17 @@ def test_records_of_other_ids_merge_in_the_order_of_the_ids(row):
     assert merged["command"] == "a` then `b" and merged["commit"] == "y"
     with pytest.raises(ValueError, match="episodes"):
         benchmark.merge([a, {**b, "episodes": 3}])
+
+
+def test_a_ceiling_record_notes_the_row(tmp_path, monkeypatch):
+    """A ceiling record (agents.ceiling) puts the controller's distance from
+    it into the id's row; an id without one gets no note."""
+    folder = tmp_path / "Convergence-v0-ceiling"
+    folder.mkdir()
+    (folder / "ceiling.json").write_text(json.dumps(
+        {"summary": {"heuristic": {"below_ceiling": {"mean": 0.0832, "sem": 0.0024}}}}))
+    monkeypatch.setattr(benchmark, "DIAGNOSTICS_DIR", tmp_path)
+    note = benchmark.ceiling_note("iceenvs/Convergence-v0")
+    assert "within 0.0832 ± 0.0024" in note
+    assert "#why-an-agent-cannot-win-convergence-v0" in note
+    assert benchmark.ceiling_note("iceenvs/WindDrift-v0") == ""
