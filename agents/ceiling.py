@@ -32,12 +32,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import shlex
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+
+from .diagnostics import add_episode_arguments, check_episodes, stamped
 
 __all__ = ["rate_limited_ceiling", "step_change", "analyse", "markdown", "plot", "main"]
 
@@ -105,13 +105,9 @@ def analyse(*, episodes: int = 20, seed: int = 50000, processes: int = 1,
     """The ceiling, the controller and the reference agent (when one is
     kept under ``root``) on episodes seeded ``seed`` + k."""
     from .benchmark import play
-    from .reference import EVAL_SEED, reference_dir
+    from .reference import reference_dir
 
-    if episodes < 2:
-        raise ValueError("episodes must be >= 2 (a standard error needs two)")
-    if seed <= EVAL_SEED < seed + episodes:
-        raise ValueError(f"episodes seeded {seed} + k would include the benchmark's "
-                         f"({EVAL_SEED} + k); choose other seeds")
+    check_episodes(episodes, seed)
     const, ceilings = _episode_ceilings(range(seed, seed + episodes))
     recipes = {"heuristic": ("baseline", "heuristic", {})}
     agent_dir = reference_dir(ENV_ID, root)
@@ -217,20 +213,14 @@ def plot(record: dict, path: Path) -> None:
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m agents.ceiling", description=__doc__.split(
         "\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--episodes", type=int, default=20)
-    p.add_argument("--seed", type=int, default=50000,
-                   help="episode k is seeded SEED + k (default: the tuning episodes)")
-    p.add_argument("--processes", type=int, default=1)
+    add_episode_arguments(p)
     p.add_argument("--reference", type=Path, default=None,
                    help="the folder of reference agents (default docs/agents/reference)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT)
-    p.add_argument("--no-progress", action="store_true")
     return p
 
 
 def main(argv: list[str] | None = None) -> dict:
-    from physics.provenance import source_commit
-
     raw = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     args = parser.parse_args(raw)
@@ -241,8 +231,7 @@ def main(argv: list[str] | None = None) -> dict:
                          progress=not args.no_progress, root=args.reference)
     except ValueError as err:
         parser.error(str(err))
-    record = dict(command=shlex.join(["python", "-m", "agents.ceiling", *raw]),
-                  commit=source_commit(), date=time.strftime("%Y-%m-%d"), **record)
+    record = stamped("agents.ceiling", raw, record)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "ceiling.json").write_text(json.dumps(record, indent=1) + "\n")
     (args.out / "ceiling.md").write_text(markdown(record))
