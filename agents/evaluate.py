@@ -2,7 +2,7 @@
 
     python -m agents.evaluate RUN_DIR [--episodes 20] [--seed S]
         [--baselines random,zero,heuristic[,constant]] [--constant FILE.json]
-        [--env-kwargs key=value ...] [--processes N] [--out DIR]
+        [--env-kwargs key=value ...] [--default-config] [--processes N] [--out DIR]
     python -m agents.evaluate --baseline NAME --env ID [--episodes N]
         [--env-kwargs key=value ...] [--constant FILE.json]
     python -m agents.evaluate --render DIR
@@ -14,8 +14,11 @@ policy sees observations normalised with the run's saved statistics
 environment is built with the run's ``env_kwargs`` but those of its
 training configuration alone (:data:`TRAINING_ONLY_KWARGS`: soft ice, which
 a run may train on and is evaluated without), with ``--env-kwargs`` set
-over them (the observation and action spaces must stay those of the run);
-the arguments are tried on one environment first, and a bad keyword exits
+over them (the observation and action spaces must stay those of the run).
+``--default-config`` plays it on the environment's default configuration
+instead, with only the run's own way of acting and observing
+(:data:`agents.rollouts.AGENT_KWARGS`), as the benchmark plays a reference
+agent. The arguments are tried on one environment first, and a bad keyword exits
 with status 2 and the environment's message.
 
 The baseline ``constant`` plays the best constant action of a grid search
@@ -73,7 +76,7 @@ from physics.provenance import source_commit
 from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, metric_header,
                       metric_unit, scaled, significant)
 from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
-                       rounded, run_episode, summarise, verdict)
+                       rounded, run_agent_kwargs, run_episode, summarise, verdict)
 
 #: the episodes behind an evaluation's record, beside it
 EPISODES = "episodes.json"
@@ -359,6 +362,10 @@ def build_parser(prog: str = "python -m agents.evaluate") -> argparse.ArgumentPa
     p.add_argument("--env", type=registered_env_id, metavar="ID",
                    help="environment id for --baseline (module:id for an environment that "
                         "module registers)")
+    p.add_argument("--default-config", action="store_true",
+                   help="play a trained run on the environment's default configuration, with "
+                        "only its own way of acting and observing (as the benchmark and the "
+                        "leaderboard play it), not the task it trained on")
     p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make arguments (VALUE is YAML); with RUN_DIR set over the "
                         "run's env_kwargs")
@@ -537,7 +544,9 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         except FileNotFoundError as err:
             parser.error(str(err))
         trained = TrainedPolicy(args.run_dir, args.checkpoint)
-        env_id, base_kwargs = trained.env_id, evaluation_kwargs(trained.env_kwargs)
+        env_id, base_kwargs = trained.env_id, (
+            run_agent_kwargs(args.run_dir) if args.default_config
+            else evaluation_kwargs(trained.env_kwargs))
         dropped = {k: v for k, v in trained.env_kwargs.items() if k not in base_kwargs}
         if dropped:
             print(f"the run trained with {_kwargs_words(dropped)}; it is evaluated on the "

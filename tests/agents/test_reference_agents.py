@@ -65,7 +65,7 @@ def test_evaluating_a_reference_agent_gives_the_records_first_episodes(name, tmp
     row = next(r for r in record["rows"] if r["id"] == f"iceenvs/{name}")
     evaluate_main([str(reference.reference_dir(name)), "--seed", str(record["seed"]),
                    "--episodes", "2", "--baselines", "zero", "--out", str(tmp_path),
-                   "--no-progress"])
+                   "--default-config", "--no-progress"])
     episodes = json.loads((tmp_path / "episodes.json").read_text())
     returns = [e["ret"] for e in next(v for k, v in episodes.items() if k != "zero")]
     assert returns == pytest.approx(row["first_returns"][AGENT], rel=1e-9, abs=1e-9)
