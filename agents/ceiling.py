@@ -115,14 +115,15 @@ def analyse(*, episodes: int = 20, seed: int = 50000, processes: int = 1,
         recipes[AGENT] = ("trained", str(agent_dir), {})
     runs = play(ENV_ID, recipes, episodes=episodes, seed=seed, processes=processes,
                 progress=progress)
-    rows = {"ceiling": dict(returns=[float(c.sum()) for c in ceilings],
-                            per_step=np.mean(ceilings, axis=0))}
+    ceilings = np.array(ceilings)
+    approach = ceilings < 1.0
+    rows = {"ceiling": dict(returns=[float(c) for c in ceilings.sum(axis=1)],
+                            per_step=ceilings.mean(axis=0))}
     for name, eps in runs.items():
         rewards = np.zeros((episodes, const["steps"]))
         for k, e in enumerate(eps):
             rewards[k, :len(e["rewards"])] = e["rewards"]   # a broken episode earns 0 after
-        approach = np.array([c < 1.0 for c in ceilings])
-        short = np.array(ceilings) - rewards
+        short = ceilings - rewards
         rows[name] = dict(returns=[float(r) for r in rewards.sum(axis=1)],
                           per_step=rewards.mean(axis=0),
                           approach=[float(s) for s in (short * approach).sum(axis=1)],

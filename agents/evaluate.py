@@ -76,7 +76,7 @@ from physics.provenance import source_commit
 from .metrics import (HEADLINE, LAST_STEP, TARGET_METRICS, env_name, format_pm, metric_header,
                       metric_unit, scaled, significant)
 from .rollouts import (TrainedPolicy, checkpoint_files, compare, evaluate, evaluate_in_processes,
-                       rounded, run_agent_kwargs, run_episode, summarise, verdict)
+                       rounded, run_episode, summarise, verdict)
 
 #: the episodes behind an evaluation's record, beside it
 EPISODES = "episodes.json"
@@ -545,7 +545,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
             parser.error(str(err))
         trained = TrainedPolicy(args.run_dir, args.checkpoint)
         env_id, base_kwargs = trained.env_id, (
-            run_agent_kwargs(args.run_dir) if args.default_config
+            dict(trained.agent_kwargs) if args.default_config
             else evaluation_kwargs(trained.env_kwargs))
         dropped = {k: v for k, v in trained.env_kwargs.items() if k not in base_kwargs}
         if dropped:
