@@ -24,17 +24,13 @@ Episodes default to the tuning episodes (50000 + k), never the benchmark's.
 from __future__ import annotations
 
 import argparse
-import json
-import sys
-from pathlib import Path
 
 import numpy as np
 
-from .diagnostics import add_episode_arguments, check_episodes, stamped
+from .diagnostics import check_episodes, diagnostic_parser, run_diagnostic
 
 __all__ = ["Twin", "twins", "markdown", "main"]
 
-DIAGNOSTICS_DIR = Path("docs") / "agents" / "diagnostics"
 
 
 class Twin:
@@ -121,42 +117,21 @@ def markdown(record: dict) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m agents.chaos", description=__doc__.split(
-        "\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--env", required=True, help="an environment id, e.g. iceenvs/FloeClustering-v0")
+    p = diagnostic_parser("agents.chaos", __doc__, "chaos")
     p.add_argument("--policy", default="heuristic", help="the baseline and its twin")
     p.add_argument("--others", nargs="*", default=["zero"],
                    help="baselines compared with the policy beside the twin")
     p.add_argument("--epsilon", type=float, default=1e-6)
-    add_episode_arguments(p)
-    p.add_argument("--out", type=Path, default=None,
-                   help="default docs/agents/diagnostics/<env-name>-chaos")
     return p
 
 
 def main(argv: list[str] | None = None) -> dict:
-    import iceenvs
-
-    raw = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    args = parser.parse_args(raw)
-    if args.env not in iceenvs.ENV_IDS:
-        parser.error(f"--env: {args.env!r} is not one of {', '.join(iceenvs.ENV_IDS)}")
-    if args.processes < 1:
-        parser.error("--processes must be >= 1")
-    try:
-        record = twins(args.env, policy=args.policy, epsilon=args.epsilon,
-                       episodes=args.episodes, seed=args.seed, processes=args.processes,
-                       progress=not args.no_progress, others=tuple(args.others))
-    except ValueError as err:
-        parser.error(str(err))
-    record = stamped("agents.chaos", raw, record)
-    out = args.out or DIAGNOSTICS_DIR / f"{args.env.split('/')[-1]}-chaos"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "chaos.json").write_text(json.dumps(record, indent=1) + "\n")
-    (out / "chaos.md").write_text(markdown(record))
-    print(markdown(record))
-    print(f"wrote {out / 'chaos.md'}")
+    record, _ = run_diagnostic(
+        "agents.chaos", "chaos", build_parser(), argv,
+        lambda args: twins(args.env, policy=args.policy, epsilon=args.epsilon,
+                           episodes=args.episodes, seed=args.seed, processes=args.processes,
+                           progress=not args.no_progress, others=tuple(args.others)),
+        markdown)
     return record
 
 
