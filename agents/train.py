@@ -123,6 +123,9 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                    help="episodes per evaluation (default 5)")
     p.add_argument("--save-freq", type=int, default=50_000,
                    help="checkpoint every this many steps, all envs together (0: never)")
+    p.add_argument("--conf", type=Path, default=None, metavar="FILE",
+                   help="a YAML file whose entry for the id (such as a study's best.yaml) "
+                        "takes the place of its entry in agents/hyperparams/<algo>.yaml")
     p.add_argument("--hyperparams", nargs="+", default=[], metavar="KEY=VALUE",
                    help="override hyperparameters; VALUE is YAML, KEY may be dotted "
                         "(env_kwargs.n_floes=50)")
@@ -192,7 +195,7 @@ def parse_args(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Nam
 
 # -- step 2: hyperparameters and environment arguments ----------------------------------------
 def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | None = None,
-                     n_envs: int | None = None, env_kwargs=()) -> dict:
+                     n_envs: int | None = None, env_kwargs=(), conf: Path | None = None) -> dict:
     """The resolved hyperparameters of a run.
 
     Parameters
@@ -210,6 +213,10 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     env_kwargs : iterable of str
         ``key=value`` strings (``--env-kwargs``) set over ``env_kwargs``
         after ``overrides`` (:func:`agents.envs.parse_key_values`).
+    conf : path, optional
+        A YAML file with an entry for ``env_id`` (such as a study's
+        ``best.yaml``, :mod:`agents.tune`) that takes the place of the id's
+        entry in ``agents/hyperparams/<algo>.yaml``.
 
     Returns
     -------
@@ -227,7 +234,7 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     with open(HYPERPARAMS_DIR / f"{algo}.yaml") as fh:
         table = yaml.safe_load(fh)
     hp = copy.deepcopy(table.get("default", {}))
-    hp.update(copy.deepcopy(table.get(env_id, {})))
+    hp.update(copy.deepcopy(table.get(env_id, {}) if conf is None else read_conf(conf, env_id)))
     hp = parse_key_values(overrides, into=hp, option="--hyperparams")
     if hp.get("env_kwargs") is not None and not isinstance(hp["env_kwargs"], dict):
         raise ValueError(f"hyperparameter env_kwargs must be a mapping, got "
@@ -265,6 +272,19 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     hp.setdefault("policy", "MlpPolicy")
     hp.setdefault("env_kwargs", {})
     return hp
+
+
+def read_conf(path: Path, env_id: str) -> dict:
+    """The entry of ``env_id`` in the YAML file ``path`` (``--conf``)."""
+    try:
+        with open(path) as fh:
+            table = yaml.safe_load(fh)
+    except (OSError, yaml.YAMLError) as err:
+        raise ValueError(f"--conf {path}: cannot read it as YAML: {err}") from None
+    if not isinstance(table, dict) or not isinstance(table.get(env_id), dict):
+        keys = ", ".join(map(str, table)) if isinstance(table, dict) else "none"
+        raise ValueError(f"--conf {path} has no entry for {env_id} (its entries: {keys})")
+    return table[env_id]
 
 
 def _schedule(value):
@@ -653,7 +673,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.train") ->
     args = parse_args(parser, argv)
     try:
         hp = read_hyperparams(args.algo, args.env, args.hyperparams, timesteps=args.timesteps,
-                              n_envs=args.n_envs, env_kwargs=args.env_kwargs)
+                              n_envs=args.n_envs, env_kwargs=args.env_kwargs, conf=args.conf)
     except ValueError as err:
         parser.error(str(err))
     check_run_dir(parser, args)

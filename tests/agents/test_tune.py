@@ -10,6 +10,7 @@ pytest.importorskip("optuna")
 pytest.importorskip("stable_baselines3")
 
 from agents import reference, tune
+from agents.train import read_hyperparams
 from cli_checks import assert_refused
 from test_agents import ITD, SMALL
 
@@ -42,6 +43,18 @@ def test_a_two_trial_study_writes_its_record(tmp_path):
     for name in ("study.md", "study.png"):
         assert (tmp_path / "study" / name).stat().st_size > 0
     assert "Best trial" in (tmp_path / "study" / "study.md").read_text()
+    # and agents.train takes it in place of the id's entry
+    hp = read_hyperparams("ppo", ITD, conf=tmp_path / "study" / "best.yaml")
+    assert hp["learning_rate"] == entry["learning_rate"] and "pretrain" not in hp
+
+
+def test_a_conf_file_without_the_id_is_refused(tmp_path):
+    conf = tmp_path / "other.yaml"
+    conf.write_text("iceenvs/Other-v0: {gamma: 0.9}\n")
+    with pytest.raises(ValueError, match="no entry for iceenvs/ThicknessDistribution-v0"):
+        read_hyperparams("ppo", ITD, conf=conf)
+    with pytest.raises(ValueError, match="cannot read"):
+        read_hyperparams("ppo", ITD, conf=tmp_path / "missing.yaml")
 
 
 def test_tuning_episodes_are_not_the_benchmarks():
