@@ -182,8 +182,8 @@ def markdown(record: dict) -> str:
     lines = [f"`{record['command']}` (commit `{record['commit']}`, {record['date']}, "
              f"{record['seconds']:.0f} s). {record['episodes']} episodes seeded "
              f"{record['seed']} + k. Every {record['every']} steps the oracle keeps the best of "
-             f"the {b}'s action and that action moved by ± {record['delta']:g} on one entry, "
-             f"scored by a rollout of {record['horizon']} steps on an exact copy; the chaos "
+             f"the {b} baseline's action and that action moved by ± {record['delta']:g} on one "
+             f"entry, scored by a rollout of {record['horizon']} steps on an exact copy; the chaos "
              f"oracle chooses among moves of {record['epsilon']:g} × a normal draw. Returns are "
              f"mean ± standard error; differences are paired by episode.", "",
              "| policy | return |", "|---|---|"]
