@@ -290,6 +290,29 @@ def ceiling_note(env_id: str) -> str:
             f"([ceiling](/reference-agents.md#why-an-agent-cannot-win-{name.lower()}))")
 
 
+def oracle_note(env_id: str) -> str:
+    """``"; a search on the true model gains D ± SE over the controller
+    beyond foresight of the chaos, ..."`` where an oracle record
+    (:mod:`agents.oracle`) exists for the id, with the smallest gain the
+    benchmark resolves where a chaos record (:mod:`agents.chaos`) exists;
+    else empty."""
+    from .chaos import resolvable
+    from .reference import EVAL_EPISODES
+
+    name = env_id.split("/")[-1]
+    path = DIAGNOSTICS_DIR / f"{name}-oracle" / "oracle.json"
+    if not path.is_file():
+        return ""
+    d = json.loads(path.read_text())["differences"]["oracle − chaos oracle"]
+    note = (f"; a search on the true model gains {_pm(dict(mean=d['diff'], sem=d['sem']))} "
+            f"over the controller beyond foresight of the chaos")
+    chaos = DIAGNOSTICS_DIR / f"{name}-chaos" / "chaos.json"
+    if chaos.is_file():
+        limit = resolvable(json.loads(chaos.read_text()), EVAL_EPISODES)
+        note += f"; the benchmark's {EVAL_EPISODES} episodes resolve gains of {limit:.2g} or more"
+    return note + f" ([oracle](/reference-agents.md#what-a-policy-could-gain-{name.lower()}))"
+
+
 def markdown(record: dict) -> str:
     """``benchmark.md``: one row per id (:func:`details_markdown` has the
     paired differences of each)."""
@@ -321,7 +344,7 @@ def markdown(record: dict) -> str:
         hours = f"{a['wall_seconds'] / 60:.0f} min" if a.get("wall_seconds") else "?"
         soft = " (soft ice)" if a["env_kwargs"].get("stiffness_scale", 1.0) != 1.0 else ""
         d = row["differences"][best]
-        solved = task_table_note(row["id"]) + ceiling_note(row["id"])
+        solved = task_table_note(row["id"]) + ceiling_note(row["id"]) + oracle_note(row["id"])
         lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
                      f"{a['algo'].upper()}, seed "
                      f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "

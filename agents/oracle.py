@@ -44,7 +44,7 @@ from .diagnostics import check_episodes, diagnostic_parser, run_diagnostic
 
 __all__ = ["RolloutOracle", "oracles", "markdown", "plot", "main"]
 
-#: the policies of a record, in the order of its tables
+#: the policies of a record beside the baseline, in the order of its tables
 POLICIES = ("oracle", "chaos oracle")
 
 
@@ -199,22 +199,24 @@ def markdown(record: dict) -> str:
 
 
 def plot(record: dict, path: Path) -> None:
+    """Every episode's paired differences (the record's three), with their
+    means ± two standard errors."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    returns = {n: np.array(r) for n, r in record["episode_returns"].items()}
     b = record["base"]
-    base = np.array(record["episode_returns"][b])
-    fig, ax = plt.subplots(figsize=(6.4, 3.4), constrained_layout=True)
-    for k, (name, colour) in enumerate(zip(POLICIES, ("C0", "C3"))):
-        d = np.array(record["episode_returns"][name]) - base
-        jitter = np.linspace(-0.15, 0.15, d.size)
-        ax.plot(k + jitter, d, "o", color=colour, alpha=0.7, label=name)
+    pairs = [("oracle", b), ("chaos oracle", b), ("oracle", "chaos oracle")]
+    fig, ax = plt.subplots(figsize=(7.0, 3.4), constrained_layout=True)
+    for k, ((x, y), colour) in enumerate(zip(pairs, ("C0", "C3", "C2"))):
+        d = returns[x] - returns[y]
+        ax.plot(k + np.linspace(-0.15, 0.15, d.size), d, "o", color=colour, alpha=0.7)
         ax.errorbar(k + 0.3, d.mean(), yerr=2 * d.std(ddof=1) / np.sqrt(d.size), fmt="s",
                     color="k", capsize=4)
     ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.set_xticks(range(len(POLICIES)), [f"{n} − {b}" for n in POLICIES])
+    ax.set_xticks(range(len(pairs)), [f"{x} − {y}" for x, y in pairs])
     ax.set_ylabel("return difference per episode")
     ax.set_title(f"{record['env']}: search on exact copies (black: mean ± 2 SE)", fontsize=9)
     fig.savefig(path, dpi=110)

@@ -129,3 +129,24 @@ def test_a_ceiling_record_notes_the_row(tmp_path, monkeypatch):
     assert "within 0.0832 ± 0.0024" in note
     assert "#why-an-agent-cannot-win-convergence-v0" in note
     assert benchmark.ceiling_note("iceenvs/WindDrift-v0") == ""
+
+
+def test_an_oracle_record_notes_the_row(tmp_path, monkeypatch):
+    """An oracle record (agents.oracle) puts what the true model buys beyond
+    foresight of the chaos into the row, with the chaos record's resolvable
+    gain where there is one."""
+    folder = tmp_path / "MarginalIceZone-v0-oracle"
+    folder.mkdir()
+    (folder / "oracle.json").write_text(json.dumps(
+        {"differences": {"oracle − chaos oracle": {"diff": 7.18, "sem": 3.0}}}))
+    monkeypatch.setattr(benchmark, "DIAGNOSTICS_DIR", tmp_path)
+    note = benchmark.oracle_note("iceenvs/MarginalIceZone-v0")
+    assert "gains 7.18 ± 3.0 over the controller" in note and "resolve" not in note
+    assert "#what-a-policy-could-gain-marginalicezone-v0" in note
+    (tmp_path / "MarginalIceZone-v0-chaos").mkdir()
+    (tmp_path / "MarginalIceZone-v0-chaos" / "chaos.json").write_text(
+        json.dumps({"twin_std": 10.0}))
+    # two standard errors of a spread of 10 over the benchmark's 40 episodes
+    assert "40 episodes resolve gains of 3.2 or more" in benchmark.oracle_note(
+        "iceenvs/MarginalIceZone-v0")
+    assert benchmark.oracle_note("iceenvs/WindDrift-v0") == ""
