@@ -131,7 +131,7 @@ def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
     ``out``, default ``docs/agents/reference/<env-name>``) and write
     ``seeds.json`` beside it; returns the reference directory."""
     from .reference import (EVAL_EPISODES, EVAL_SEED, KEPT_FILES, MAX_BYTES, TUNE_EVAL_SEED,
-                            reference_dir)
+                            drop_optimizer_states, reference_dir)
     from .rollouts import stats
 
     evaluation_episodes = evaluation_episodes or EVAL_EPISODES
@@ -180,6 +180,12 @@ def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
                                                    *map(str, run_dirs)]))
     (target / "seeds.json").write_text(json.dumps(record, indent=1) + "\n")
     size = sum(p.stat().st_size for p in target.rglob("*") if p.is_file())
+    if size > MAX_BYTES:
+        saved = drop_optimizer_states(target / "model.zip",
+                                      yaml.safe_load((target / "args.yaml").read_text())["algo"])
+        size -= saved
+        print(f"dropped the optimisers' moments from the kept model ({saved / 1024:.0f} kB): "
+              f"it plays as trained, and fine-tuning it starts them afresh", flush=True)
     print(f"kept seed {best['seed']} of {len(seeds)} in {target} ({size / 1024:.0f} kB); "
           f"benchmark returns across seeds {', '.join(f'{m:.4g}' for m in means)}", flush=True)
     if size > MAX_BYTES:

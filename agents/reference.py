@@ -26,7 +26,8 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = ["EVAL_SEED", "EVAL_EPISODES", "TUNE_TRAIN_SEED", "TUNE_EVAL_SEED", "TRAIN_SEEDS",
-           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir", "load_reference"]
+           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir", "load_reference",
+           "drop_optimizer_states"]
 
 #: the benchmark's episodes are seeded EVAL_SEED + k, k < EVAL_EPISODES
 EVAL_SEED = 40_000
@@ -73,3 +74,24 @@ def load_reference(env: str, root: str | Path | None = None):
         raise FileNotFoundError(f"no reference agent for {env}; the reference agents: "
                                 f"{', '.join(have) or 'none'}")
     return TrainedPolicy(folder)
+
+
+def drop_optimizer_states(model_zip: Path, algo: str) -> int:
+    """Save the model in ``model_zip`` again without its optimisers' moments
+    (Adam's running averages: as large as the networks, twice over, and not
+    needed to play); returns the bytes saved. Fine-tuning such a model
+    starts the moments afresh. SAC's six networks with their moments pass
+    :data:`MAX_BYTES`; without them they do not."""
+    from .train import algo_class
+
+    model_zip = Path(model_zip)
+    before = model_zip.stat().st_size
+    model = algo_class(algo).load(model_zip, device="cpu")
+    for holder in (model.policy, getattr(model.policy, "actor", None),
+                   getattr(model.policy, "critic", None), model):
+        for name in ("optimizer", "ent_coef_optimizer"):
+            optimizer = getattr(holder, name, None) if holder is not None else None
+            if optimizer is not None:
+                optimizer.state.clear()
+    model.save(model_zip)
+    return before - model_zip.stat().st_size

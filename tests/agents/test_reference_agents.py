@@ -69,3 +69,21 @@ def test_evaluating_a_reference_agent_gives_the_records_first_episodes(name, tmp
     episodes = json.loads((tmp_path / "episodes.json").read_text())
     returns = [e["ret"] for e in next(v for k, v in episodes.items() if k != "zero")]
     assert returns == pytest.approx(row["first_returns"][AGENT], rel=1e-9, abs=1e-9)
+
+
+def test_dropping_the_optimiser_moments_keeps_the_policy(tmp_path):
+    """A kept SAC model without Adam's moments is smaller and acts exactly
+    as before (the networks are untouched)."""
+    import numpy as np
+    from stable_baselines3 import SAC
+
+    model = SAC("MlpPolicy", "Pendulum-v1", learning_starts=64, batch_size=32, seed=3,
+                device="cpu", policy_kwargs=dict(net_arch=[32, 32]))
+    model.learn(128)
+    path = tmp_path / "model.zip"
+    model.save(path)
+    obs = np.random.default_rng(0).uniform(-1.0, 1.0, (16, 3)).astype(np.float32)
+    before, _ = model.predict(obs, deterministic=True)
+    assert reference.drop_optimizer_states(path, "sac") > 0
+    after, _ = SAC.load(path, device="cpu").predict(obs, deterministic=True)
+    np.testing.assert_array_equal(after, before)
