@@ -99,9 +99,9 @@ def markdown(record: dict) -> str:
              f"Each set's kept seed was chosen on 20 selection episodes (seeded 50000 + k); "
              f"returns are on the benchmark's {record['evaluation_episodes']}. \"Kept\" pairs "
              f"the kept seeds by episode; \"by seed\" pairs each training seed's mean with "
-             f"the {ref} seed of the same number. Mean ± standard error.", "",
-             "| training | seeds | steps a seed | minutes a seed | kept seed | across seeds | "
-             f"kept − {ref} | by seed − {ref} |", "|---|---|---|---|---|---|---|---|"]
+             f"the seed of the same number of the reference, {ref}. Mean ± standard error.",
+             "", "| training | seeds | steps a seed | minutes a seed | kept seed | across seeds | "
+             "kept − reference | by seed − reference |", "|---|---|---|---|---|---|---|---|"]
     for row in record["rows"]:
         a = row["across_seeds"]
         kept = row.get("kept_vs_reference")

@@ -40,7 +40,7 @@ def test_differences_are_paired_by_episode_and_by_seed(tmp_path):
     assert row["seeds_vs_reference"]["diff"] == pytest.approx(5.0 / 3.0)
     assert row["seeds_vs_reference"]["n"] == 3
     text = (out / "alternatives.md").read_text()
-    assert "kept − PPO" in text and "| SAC | 3 |" in text
+    assert "kept − reference" in text and "reference, PPO" in text and "| SAC | 3 |" in text
 
 
 def test_sets_that_cannot_be_compared_are_refused(tmp_path):
