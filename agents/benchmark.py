@@ -302,7 +302,7 @@ def oracle_note(env_id: str) -> str:
     (:mod:`agents.oracle`) exists for the id, with the smallest gain the
     benchmark resolves where a chaos record (:mod:`agents.chaos`) exists;
     else empty."""
-    from .chaos import resolvable
+    from .diagnostics import resolvable
     from .reference import EVAL_EPISODES
 
     name = env_id.split("/")[-1]

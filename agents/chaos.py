@@ -27,9 +27,9 @@ import argparse
 
 import numpy as np
 
-from .diagnostics import check_episodes, diagnostic_parser, run_diagnostic
+from .diagnostics import check_episodes, diagnostic_parser, resolvable, run_diagnostic
 
-__all__ = ["Twin", "twins", "markdown", "main"]
+__all__ = ["Twin", "twins", "resolvable", "markdown", "main"]
 
 
 
@@ -82,12 +82,6 @@ def twins(env_id: str, *, policy: str = "heuristic", epsilon: float = 1e-6,
                 returns={n: stats(np.array([e["ret"] for e in eps])) for n, eps in runs.items()},
                 episode_returns={n: [round(e["ret"], 4) for e in eps] for n, eps in runs.items()},
                 differences=differences, twin_std=float(np.std(twin, ddof=1)))
-
-
-def resolvable(record: dict, episodes: int = 40) -> float:
-    """Two standard errors of the twins' difference over ``episodes``
-    episodes: the smallest gain a paired benchmark of that size resolves."""
-    return 2.0 * record["twin_std"] / np.sqrt(episodes)
 
 
 def markdown(record: dict) -> str:

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import shlex
 import sys
 import time
 from pathlib import Path
 
 __all__ = ["DIAGNOSTICS_DIR", "add_episode_arguments", "check_episodes", "diagnostic_parser",
-           "parse_arguments", "run_diagnostic", "stamped", "write_record"]
+           "parse_arguments", "resolvable", "run_diagnostic", "stamped", "write_record"]
 
 #: where the diagnostics' records live, one directory ``<env-name>-<kind>`` each
 DIAGNOSTICS_DIR = Path("docs") / "agents" / "diagnostics"
@@ -37,6 +38,12 @@ def diagnostic_parser(module: str, doc: str, kind: str) -> argparse.ArgumentPars
     p.add_argument("--out", type=Path, default=None,
                    help=f"default docs/agents/diagnostics/<env-name>-{kind}")
     return p
+
+
+def resolvable(record: dict, episodes: int = 40) -> float:
+    """Two standard errors of the twins' difference over ``episodes``
+    episodes: the smallest gain a paired benchmark of that size resolves."""
+    return 2.0 * record["twin_std"] / math.sqrt(episodes)
 
 
 def check_episodes(episodes: int, seed: int) -> None:
