@@ -148,6 +148,10 @@ def build_parser(prog: str = "python -m agents.tune") -> argparse.ArgumentParser
                    help="fixed hyperparameters, set before the search's draws (which win)")
     p.add_argument("--env-kwargs", nargs="+", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make arguments, over the YAML's env_kwargs")
+    p.add_argument("--warm-start", action="store_true",
+                   help="start every trial from the warm start of the hyperparameters (their "
+                        "pretrain entry: a clone of a baseline), as the id's reference agent "
+                        "may; without it the entry is dropped and trials start at random")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     return p
 
@@ -256,6 +260,11 @@ def run_trial(trial, args: argparse.Namespace, base_hp: dict) -> float:
     try:
         model = algo_class(args.algo)(hp["policy"], env, seed=seed, device="cpu", verbose=0,
                                       **algo_kwargs(hp))
+        if hp.get("pretrain"):
+            from .pretrain import pretrain
+
+            pretrain(model, env, args.env, hp["env_kwargs"], hp["pretrain"],
+                     gamma=float(hp.get("gamma", 0.99)))
         report = _trial_callback(trial, scorer, max(args.trial_timesteps // args.evaluations, 1),
                                  scores)
         callbacks = [report]
@@ -350,6 +359,14 @@ def study_record(study, args: argparse.Namespace, base_hp: dict, argv: list[str]
         best=best, importances=importances(study), trials=trials))
 
 
+def _warm_start_words(hp: dict) -> str:
+    settings = hp.get("pretrain")
+    if not settings:
+        return ""
+    return (f" from a clone of the {settings['teacher']} ({settings['episodes']} episodes, "
+            f"anchor {settings['anchor']:g})")
+
+
 def markdown(record: dict) -> str:
     """``study.md``: the settings, the best trial, the importances and every trial."""
     c = record["counts"]
@@ -358,7 +375,8 @@ def markdown(record: dict) -> str:
              f"{record['host']['cpu']} ({record['host']['logical_cpus']} logical CPUs), "
              f"{record['date']}, in {record['wall_seconds']:.0f} s.", "",
              f"{len(record['trials'])} trials: {c['COMPLETE']} complete, {c['PRUNED']} pruned, "
-             f"{c['FAIL']} failed. A trial trains {record['budget']['trial_timesteps']} steps "
+             f"{c['FAIL']} failed. A trial trains {record['budget']['trial_timesteps']} steps"
+             f"{_warm_start_words(record['base_hyperparams'])} "
              f"and is scored {record['budget']['evaluations']} times on the same "
              f"{record['budget']['eval_episodes']} episodes (seeded "
              f"{record['seeds']['episodes']}); its value is its last score. Sampler: "
@@ -448,8 +466,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.tune") -> 
         check_env_kwargs(args.env, base_hp["env_kwargs"], seed=0)
     except ValueError as err:
         parser.error(str(err))
-    if base_hp.pop("pretrain", None):
-        print("tuning without the warm start of the YAML (pretrain)", flush=True)
+    if args.warm_start and not base_hp.get("pretrain"):
+        parser.error("--warm-start: the hyperparameters hold no pretrain entry (set one with "
+                     "--hyperparams 'pretrain={teacher: heuristic}')")
+    if not args.warm_start and base_hp.pop("pretrain", None):
+        print("tuning without the warm start of the YAML (pretrain; --warm-start keeps it)",
+              flush=True)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     storage = None
     if args.storage is not None:

@@ -15,12 +15,12 @@ from cli_checks import assert_refused
 from test_agents import ITD, SMALL
 
 
-def _study(out, *extra):
+def _study(out, *extra, hyperparams=()):
     small = [f"{k}={v}" for k, v in SMALL[ITD].items()]
     return tune.main(["--env", ITD, "--algo", "ppo", "--trials", "2", "--trial-timesteps",
                       "256", "--evaluations", "2", "--eval-episodes", "1", "--out", str(out),
-                      "--no-progress", "--hyperparams", "n_envs=1", "--env-kwargs", *small,
-                      *extra])
+                      "--no-progress", "--hyperparams", "n_envs=1", *hyperparams,
+                      "--env-kwargs", *small, *extra])
 
 
 def test_a_two_trial_study_writes_its_record(tmp_path):
@@ -48,6 +48,16 @@ def test_a_two_trial_study_writes_its_record(tmp_path):
     assert hp["learning_rate"] == entry["learning_rate"] and "pretrain" not in hp
 
 
+def test_a_warm_started_study_clones_before_each_trial(tmp_path):
+    record = _study(tmp_path / "warm", "--warm-start",
+                    hyperparams=["pretrain={teacher: zero, episodes: 1}"])
+    assert record["counts"]["COMPLETE"] == 2
+    assert record["base_hyperparams"]["pretrain"]["teacher"] == "zero"
+    assert "from a clone of the zero (1 episodes" in (tmp_path / "warm" / "study.md").read_text()
+    entry = yaml.safe_load((tmp_path / "warm" / "best.yaml").read_text())[ITD]
+    assert entry["pretrain"]["teacher"] == "zero"     # --conf best.yaml warm-starts too
+
+
 def test_a_conf_file_without_the_id_is_refused(tmp_path):
     conf = tmp_path / "other.yaml"
     conf.write_text("iceenvs/Other-v0: {gamma: 0.9}\n")
@@ -70,6 +80,8 @@ def test_tuning_episodes_are_not_the_benchmarks():
     (["--env", ITD, "--algo", "ppo", "--minutes", "-1"], "--minutes must be a positive"),
     (["--env", ITD, "--algo", "ppo", "--hyperparams", "n_stepz=3"], "unknown hyperparameters"),
     (["--env", ITD, "--algo", "a2c"], "invalid choice"),
+    (["--env", ITD, "--algo", "ppo", "--warm-start", "--hyperparams", "pretrain=null"],
+     "no pretrain entry"),
 ])
 def test_bad_input_is_refused_before_a_trial(argv, words, capsys, tmp_path):
     assert_refused(tune.main, argv, [words], tmp_path / "x", capsys)
