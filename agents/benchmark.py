@@ -49,6 +49,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from .diagnostics import DIAGNOSTICS_DIR  # the ceiling, chaos and oracle records the rows note
+
 __all__ = ["ship", "benchmark_id", "markdown", "details_markdown", "main", "DEFAULT_OUT", "AGENT"]
 
 DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
@@ -56,8 +58,6 @@ DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
 AGENT = "agent"
 #: where the best constant action of each id is kept (agents.tasks)
 TASKS_DIR = Path("docs") / "agents" / "tasks"
-#: diagnostics of why an agent loses (:mod:`agents.ceiling` writes ``<env-name>-ceiling``)
-DIAGNOSTICS_DIR = Path("docs") / "agents" / "diagnostics"
 
 
 # -- ship ------------------------------------------------------------------------------------

@@ -37,12 +37,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .diagnostics import add_episode_arguments, check_episodes, stamped
+from .diagnostics import DIAGNOSTICS_DIR, add_episode_arguments, check_episodes, stamped
 
 __all__ = ["rate_limited_ceiling", "step_change", "analyse", "markdown", "plot", "main"]
 
 ENV_ID = "iceenvs/Convergence-v0"
-DEFAULT_OUT = Path("docs/agents/diagnostics/Convergence-v0-ceiling")
+DEFAULT_OUT = DIAGNOSTICS_DIR / "Convergence-v0-ceiling"
 AGENT = "agent"
 
 
