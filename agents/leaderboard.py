@@ -46,7 +46,7 @@ import numpy as np
 
 from physics.provenance import source_commit
 
-from .metrics import METRIC_UNITS, significant
+from .metrics import METRIC_UNITS, rounding_noise, significant
 
 __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "record_commands",
            "plot_board", "main",
@@ -105,6 +105,29 @@ def host_signature() -> str:
         cpu = "?"
     return (f"{platform.machine()}, numpy {np.__version__} ({simd}), "
             f"numba {numba.__version__} ({cpu})")
+
+
+#: which of the two impulse ratios a reader should read, and why they can disagree
+RATIO_NOTE = (
+    "**Which ratio to read.** The *ratio of means* (the policy's mean impulse per metre "
+    "over the straight line's on the same fields) ranks the policies: it weighs each "
+    "field by the ice there is to meet. The mean of the per-field ratios weighs every "
+    "field alike, and a field on which the straight line happened to meet little ice "
+    "gives a large ratio whatever the policy did, so one such field can carry the mean; "
+    "it shows how the ratio varies between fields. A † marks a policy whose two ratios "
+    "lie on opposite sides of 1.")
+
+
+def ratios_disagree(s: dict) -> bool:
+    """Whether a policy's mean of per-field impulse-per-metre ratios and its
+    ratio of means (its summary ``s`` of :func:`summarise_board`) lie on
+    opposite sides of 1: one says it meets more ice than the straight
+    line, the other less."""
+    per_field = (s.get("ratio_impulse_per_metre") or {}).get("mean", math.nan)
+    of_means = s.get("ipm_ratio_of_means", math.nan)
+    if not (math.isfinite(per_field) and math.isfinite(of_means)):
+        return False
+    return (per_field - 1.0) * (of_means - 1.0) < 0
 
 
 def _final(e, key):
@@ -206,7 +229,11 @@ def _pm(s: dict, scale: float = 1.0, digits: int = 3) -> str:
 
 def _plus_minus(value: float, error: float, digits: int = 3) -> str:
     """``value`` to ``digits`` significant figures and ``error`` to two,
-    neither with its integer part rounded."""
+    neither with its integer part rounded; an error that is only the
+    rounding of floats (:func:`agents.metrics.rounding_noise`: the straight
+    line's ratio to itself) as 0."""
+    if rounding_noise(value, error):
+        error = 0.0
     return f"{significant(value, digits, whole=True)} ± {significant(error, 2, whole=True)}"
 
 
@@ -227,9 +254,13 @@ def recipe_lines(report: dict) -> list[str]:
     recipes = report.get("recipes")
     if recipes:
         commits = report.get("commits") or {}
-        return ["| policy | recipe | commit |", "|---|---|---|",
-                *(f"| {name} | `{cmd}` | {commits.get(name) or '–'} |"
-                  for name, cmd in recipes.items()), ""]
+        # policies played by one command at one commit share a row
+        rows: dict[tuple, list[str]] = {}
+        for name, cmd in recipes.items():
+            rows.setdefault((cmd, commits.get(name) or "–"), []).append(name)
+        return ["| policies | recipe | commit |", "|---|---|---|",
+                *(f"| {', '.join(names)} | `{cmd}` | {commit} |"
+                  for (cmd, commit), names in rows.items()), ""]
     commands = list(dict.fromkeys(record_commands(report)))
     return [f"Commands, in order: {'; '.join(f'`{c}`' for c in commands)}.", ""]
 
@@ -261,7 +292,8 @@ def board_markdown(report: dict) -> str:
              *_agent_lines(report.get("agent_kwargs") or {}),
              "Means ± standard errors over the fields. Ratios are to the straight line on "
              "the same field (mean of the per-field ratios); *ratio of means* is the mean "
-             "impulse per metre over the straight line's.", ""]
+             "impulse per metre over the straight line's.", "",
+             RATIO_NOTE, ""]
     verdict = route_choice_pays(summary, report["planners"])
     lines += ["### Does route choice pay?", "",
               f"Route choice pays when the best planner meets at most {ROUTE_CHOICE_RATIO} "
@@ -306,7 +338,8 @@ def board_markdown(report: dict) -> str:
                   "| plan [ms] |", "|---" * (len(NORMALISED) + 5) + "|"]
         for name, s in policies.items():
             cells = [name] + [_pm(s.get(f"ratio_{k}"), 1.0, 3) for k in NORMALISED]
-            cells.append(f"{s.get('ipm_ratio_of_means', math.nan):.3f}")
+            of_means = s.get("ipm_ratio_of_means", math.nan)
+            cells.append(f"{of_means:.3f}" + (" †" if ratios_disagree(s) else ""))
             for key, scale in (("paired_return", 1.0), ("paired_impulse_per_metre", 1e3)):
                 cells.append(_paired_cell(None if name == "straight" else s.get(key), scale))
             cells.append(_pm(s.get("plan_ms"), 1.0, 2))

@@ -189,15 +189,29 @@ def significant(x: float, digits: int = 3, whole: bool = False) -> str:
     return _fixed(x, max(decimals, 0) if whole else decimals)
 
 
+#: an error at most this fraction of its value is the rounding of floats (a
+#: quantity the same in every episode, summed along different paths), not a spread
+ROUNDING_NOISE = 1e-9
+
+
+def rounding_noise(value: float, error: float) -> bool:
+    """Whether ``error`` is no spread but the rounding of floats about
+    ``value`` (at most :data:`ROUNDING_NOISE` × |value|): such an error
+    shows as ``± 0``, not as ``± 0.0000000000017``."""
+    return math.isfinite(error) and abs(error) <= ROUNDING_NOISE * abs(value)
+
+
 def format_pm(mean: float, error: float, digits: int = 3, error_digits: int = 2) -> str:
     """``"143.6 ± 2.1"``: ``mean`` to ``digits`` significant figures, or to
     the last decimal of ``error`` (shown to ``error_digits`` significant
     figures) where that shows more, yet never more than two decimals
     beyond the error's nor more than six significant figures; no
-    exponent; an integer without error as it is. NaN shows as ``"–"``."""
+    exponent; an integer without error as it is, and an error that is only
+    the rounding of floats (:func:`rounding_noise`) as ``± 0``. NaN shows as
+    ``"–"``."""
     if not math.isfinite(mean):
         return "–"
-    if not math.isfinite(error) or error <= 0:
+    if not math.isfinite(error) or error <= 0 or rounding_noise(mean, error):
         if float(mean).is_integer() and abs(mean) < 1e6:     # a count the same in every episode
             return f"{int(mean)} ± 0"
         return f"{significant(mean + 0.0, digits)} ± 0"

@@ -211,3 +211,52 @@ def test_default_outputs_stay_out_of_the_docs():
     for out in (leaderboard.build_parser().get_default("out"), tasks.DEFAULT_OUT):
         assert out.parts[0] == "runs", out
     assert evaluate.build_parser().get_default("out") is None      # the run's own directory
+
+
+def _field(ret, ipm):
+    final = {key: 1.0e6 for key in leaderboard.NORMALISED}
+    final.update(impulse_per_metre=ipm, path_length=1100.0, success=1.0)
+    return {"seed": 0, "ret": ret, "length": 275, "terminated": True, "final": final,
+            "decision_ms": 0.1}
+
+
+def test_the_two_impulse_ratios_can_disagree_and_the_board_marks_it():
+    # the straight line meets little ice on field 0 and much on field 1; the policy
+    # meets 5 times the first and half the second: per-field ratios 5 and 0.5 (mean
+    # 2.75 > 1) against a ratio of means 55 000 / 101 000 < 1
+    board = {"0.4": {"straight": [_field(100.0, 1.0e3), _field(50.0, 1.0e5)],
+                     "ppo": [_field(99.0, 5.0e3), _field(70.0, 5.0e4)]}}
+    summary = leaderboard.summarise_board(board)
+    s = summary["0.4"]["ppo"]
+    assert s["ratio_impulse_per_metre"]["mean"] == pytest.approx(2.75, rel=1e-12)
+    assert s["ipm_ratio_of_means"] == pytest.approx(5.5e4 / 1.01e5, rel=1e-12)
+    assert leaderboard.ratios_disagree(s)
+    assert not leaderboard.ratios_disagree(summary["0.4"]["straight"])
+    report = {"summary": summary, "planners": ["straight"], "env": "test", "env_kwargs": {},
+              "episodes": 2, "seed": 0, "machine": "m", "date": "d", "wall_s": 1.0,
+              "recipes": {"straight": "cmd a", "ppo": "cmd b"}, "episodes_detail": board}
+    text = leaderboard.board_markdown(report)
+    assert "| 0.545 † |" in text and "| 1.000 |" in text
+    assert leaderboard.RATIO_NOTE in text
+
+
+def test_policies_of_one_command_share_a_recipe_row():
+    report = {"recipes": {"straight": "cmd a", "swath": "cmd a", "ppo": "cmd b"},
+              "commits": {"straight": "abc", "swath": "abc", "ppo": "abc"}}
+    lines = leaderboard.recipe_lines(report)
+    assert lines[2:4] == ["| straight, swath | `cmd a` | abc |", "| ppo | `cmd b` | abc |"]
+    # another commit is another row
+    report["commits"]["swath"] = "def"
+    assert len(leaderboard.recipe_lines(report)) == 2 + 3 + 1
+
+
+def test_an_error_of_rounding_shows_as_zero():
+    from agents.metrics import format_pm
+
+    # the straight line's ratio to itself, summed along two paths
+    assert leaderboard._plus_minus(1.0000000000000002, 1.7e-12) == "1.00 ± 0"
+    assert format_pm(0.4000000000000001, 1.2e-17) == "0.400 ± 0"
+    assert format_pm(2.0, 4.3e-11) == "2 ± 0"
+    # a real spread, however small against the value, is kept
+    assert leaderboard._plus_minus(1.0, 1.7e-6) == "1.00 ± 0.0000017"
+    assert format_pm(0.00596026, 1.4e-7) == "0.00596026 ± 0.00000014"
