@@ -73,35 +73,10 @@ import time
 import numpy as np
 from numba import njit
 
+from iceenvs.costmap import impulse_costmap
 from iceenvs.ship_controllers import StraightLinePolicy
 
 __all__ = ["LatticePlanner", "impulse_costmap", "lattice_route", "PLANNERS"]
-
-
-@njit(cache=True)
-def impulse_costmap(x0, y0, nx, ny, cell, px, py, reach, impulse, cone=False):
-    """Cost density [N s/m] on a grid of ``nx`` × ``ny`` cells of side
-    ``cell`` [m] whose corner is (``x0``, ``y0``): each floe spreads its
-    ``impulse`` over the disc of radius ``reach`` about (``px``, ``py``),
-    so that the line integral through the centre is the impulse: evenly
-    (density impulse / (2 reach)) or, with ``cone``, as a cone (density
-    impulse (1 − ρ/reach) / reach at distance ρ from the centre)."""
-    cost = np.zeros((nx, ny))
-    for i in range(px.size):
-        r = reach[i]
-        d = impulse[i] / (2.0 * r)
-        lo_x = max(int(math.floor((px[i] - r - x0) / cell)), 0)
-        hi_x = min(int(math.floor((px[i] + r - x0) / cell)), nx - 1)
-        lo_y = max(int(math.floor((py[i] - r - y0) / cell)), 0)
-        hi_y = min(int(math.floor((py[i] + r - y0) / cell)), ny - 1)
-        for a in range(lo_x, hi_x + 1):
-            cx = x0 + (a + 0.5) * cell - px[i]
-            for b in range(lo_y, hi_y + 1):
-                cy = y0 + (b + 0.5) * cell - py[i]
-                q = cx * cx + cy * cy
-                if q <= r * r:
-                    cost[a, b] += 2.0 * d * (1.0 - math.sqrt(q) / r) if cone else d
-    return cost
 
 
 @njit(cache=True)

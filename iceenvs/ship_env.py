@@ -69,6 +69,7 @@ from physics.checks import check_range
 from physics.hertz import hull_contact_time
 
 from .base import HertzEnv, sanitise_action
+from .costmap import costmap_samples, costmap_scan, costmap_shape, costmap_space
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactivePlanner, StraightLinePolicy
@@ -114,7 +115,7 @@ CONTROLS = {
     "thrust": ("dynamic", ("thrust", "yaw_moment")),
 }
 
-OBS_TYPES = ("vector", "image", "dict")
+OBS_TYPES = ("vector", "image", "dict", "costmap", "costmap_dict")
 #: the column of the time below the beset speed in a row of episode sums
 SLOW_TIME = SUM_COLUMNS.index("slow_time")
 
@@ -190,9 +191,12 @@ class ShipEnv(HertzEnv):
     Arguments common to the ship environments
     -----------------------------------------
     control : str — the action set-up (a key of :data:`CONTROLS` the task offers)
-    obs_type : "vector", "image" or "dict"
+    obs_type : "vector", "image", "dict", "costmap" or "costmap_dict"
     image_size : int — pixels of a side of the image observation
     image_extent : float — metres of a side of the image observation
+    costmap_cell, costmap_behind, costmap_ahead : float [m] — the cells of
+    the costmap observation (:mod:`iceenvs.costmap`) and how far it reaches
+    behind the ship and ahead of it (across: the channel's width)
     lidar_sectors : int, lidar_range : float [m] — the sector lidar
     local_radius : float [m] — radius of the local ice measures
     length, width : float [m] — the box; channel_width [m] — the channel
@@ -228,7 +232,8 @@ class ShipEnv(HertzEnv):
                  length: float = 400.0, width: float = 200.0, channel_width: float = 150.0,
                  goal_distance: float = 300.0, preset=HERMAN2013,
                  control_interval: float = 2.0, colour_scale: float = 1.0,
-                 free_drift: bool = True, **kwargs):
+                 free_drift: bool = True, costmap_cell: float = 5.0,
+                 costmap_behind: float = 20.0, costmap_ahead: float = 300.0, **kwargs):
         if control not in self.controls:
             raise ValueError(f"control must be one of {self.controls}, got {control!r}")
         if obs_type not in OBS_TYPES:
@@ -259,6 +264,11 @@ class ShipEnv(HertzEnv):
         self.obs_type = obs_type
         self.image_size = int(image_size)
         self.image_extent = float(image_extent)
+        #: (rows, columns) of the costmap observation (checks its arguments)
+        self.costmap_size = costmap_shape(costmap_cell, costmap_behind, costmap_ahead,
+                                          channel_width)
+        self.costmap_cell = float(costmap_cell)
+        self.costmap_behind, self.costmap_ahead = float(costmap_behind), float(costmap_ahead)
         self.lidar_sectors = int(lidar_sectors)
         self.lidar_range = float(lidar_range)
         self.local_radius = float(local_radius)
@@ -284,6 +294,10 @@ class ShipEnv(HertzEnv):
         elif obs_type == "dict":
             self.observation_space = gym.spaces.Dict({"vector": vector_space,
                                                       "image": image_space})
+        elif obs_type.startswith("costmap"):
+            space = costmap_space(self.costmap_size)
+            self.observation_space = space if obs_type == "costmap" else gym.spaces.Dict(
+                {"costmap": space, "vector": vector_space})
 
     # -- geometry -------------------------------------------------------------------
     @property
@@ -465,6 +479,10 @@ class ShipEnv(HertzEnv):
     def _vector(self, now: dict):
         if self.obs_type == "vector":
             return super()._vector(now)
+        if self.obs_type == "costmap":
+            return self.costmap()
+        if self.obs_type == "costmap_dict":
+            return {"costmap": self.costmap(), "vector": super()._vector(now)}
         image = self._image()
         if self.obs_type == "image":
             return image
@@ -477,6 +495,24 @@ class ShipEnv(HertzEnv):
                                ship.vertices, self.goal_x, size=self.image_size,
                                extent=self.image_extent,
                                box_lengths=(sim.box.lx, sim.box.ly), periodic=sim.box.periodic)
+
+    def costmap(self) -> np.ndarray:
+        """The costmap of the ice about the ship now (the observation
+        ``obs_type="costmap"``, :func:`iceenvs.costmap.ice_costmap`): the
+        floes weighed by :meth:`expected_impulses`, the hull's half-beam
+        added to their radii, cells of `costmap_cell` from `costmap_behind`
+        behind the ship to `costmap_ahead` ahead, the channel's width
+        across."""
+        sim = self.sim
+        x, y = sim.ship.position
+        rows, cols = self.costmap_size
+        box = sim.box
+        return costmap_scan(float(x), float(y), sim.positions, sim.radii,
+                            self.expected_impulses(sim.masses), 0.5 * float(self._ship.hull.beam),
+                            self.goal_x, self.centre_y, 0.5 * self.channel_width,
+                            self.costmap_ahead, self.costmap_cell, rows, cols,
+                            costmap_samples(self.costmap_cell), float(box.lx), float(box.ly),
+                            bool(box.periodic[0]), bool(box.periodic[1]))
 
     @property
     def _metrics(self) -> dict:

@@ -180,6 +180,10 @@ def _nearby(ship_xy, positions, radii, reach, lengths, periodic):
     return d[near], radii[near]
 
 
+#: the checks of the sensors' arguments, for the other sensors of the package
+check_pose, check_floes, check_box = _check_pose, _check_floes, _check_box
+
+
 def _expand(item, lo, hi):
     """Every (item, index) pair of the index ranges [lo, hi]."""
     count = hi - lo + 1

@@ -5,9 +5,10 @@ cache (see :mod:`physics._jit_cache`); the first run of an environment or
 of ``make demo`` otherwise spends a minute or two compiling. This module
 builds every registered environment on a small instance, resets it and
 steps it with a few random actions, does the same with the native vector
-environment of each that has one (training's, for several environments),
-then runs ``python -m physics.demo`` on a few floes and a short Hertz run
-on the multi-threaded kernels, so that
+environment of each that has one (training's, for several environments)
+and with the costmap observation of a ship environment, then runs
+``python -m physics.demo`` on a few floes and a short Hertz run on the
+multi-threaded kernels, so that
 later runs load everything from the cache. It prints one line per item and
 the total time; an item that fails is reported and the others still run
 (the exit status is then 1).
@@ -118,6 +119,32 @@ def warm_vector_env(env_id: str, steps: int = 5, seed: int = 0, num_envs: int = 
     return ""
 
 
+def warm_costmap(steps: int = 5, seed: int = 0) -> str:
+    """The costmap observation (``obs_type="costmap"``, :mod:`iceenvs.costmap`)
+    on the first ship environment, small, reset and stepped ``steps``
+    times: its kernels run only for that observation."""
+    import gymnasium as gym
+
+    from . import ENV_IDS
+    from .facts import env_facts
+
+    for env_id in ENV_IDS:
+        kwargs = dict(env_facts(env_id).small)
+        env = gym.make(env_id, **kwargs)
+        ship = hasattr(env.unwrapped, "costmap")
+        env.close()
+        if ship:
+            env = gym.make(env_id, obs_type="costmap", **kwargs)
+            try:
+                env.action_space.seed(seed)
+                env.reset(seed=seed)
+                random_steps(env, steps)
+            finally:
+                env.close()
+            return f" ({env_id})"
+    return " (no ship environment)"
+
+
 def warm_demo() -> str:
     """``python -m physics.demo`` with 30 floes pressed on the wall for 2
     model seconds and a ship transit of 2 model seconds, its output
@@ -156,6 +183,7 @@ def items(steps: int = 5) -> list[tuple[str, Callable[[], str | None]]]:
     out += [(f"{env_id}, native vector environment",
              lambda env_id=env_id: warm_vector_env(env_id, steps))
             for env_id in ENV_IDS if env_spec(env_id).vector_entry_point is not None]
+    out.append(("costmap observation", lambda: warm_costmap(steps)))
     out.append(("physics.demo", warm_demo))
     out.append(("Hertz engine, parallel kernels", lambda: warm_parallel(steps)))
     return out
