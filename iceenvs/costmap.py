@@ -277,3 +277,105 @@ def ice_costmap(ship_xy, positions, radii, impulses, *, half_beam: float, goal_x
     return costmap_scan(xy[0], xy[1], p, r, w, float(half_beam), float(goal_x),
                         float(centre_y), 0.5 * float(channel_width), float(ahead),
                         float(cell), rows, cols, costmap_samples(cell), lx, ly, per[0], per[1])
+
+
+# -- the picture of the documentation ---------------------------------------------------------
+
+#: colours of the impulse channel, from 0 to its largest value in the picture
+_RAMP = np.array([[13, 8, 60], [60, 40, 140], [150, 60, 140], [235, 110, 70], [250, 230, 90]],
+                 dtype=float)
+#: colours of the masks: outside the channel, past the goal line, both, neither
+_MASK_COLOURS = {"outside": (200, 70, 70), "beyond": (60, 200, 90), "both": (220, 200, 60),
+                 "neither": (24, 26, 32)}
+
+
+def _ramp(values: np.ndarray, top: float) -> np.ndarray:
+    t = np.clip(values / top, 0.0, 1.0) * (len(_RAMP) - 1)
+    k = np.minimum(t.astype(int), len(_RAMP) - 2)
+    f = (t - k)[..., None]
+    return ((1.0 - f) * _RAMP[k] + f * _RAMP[k + 1]).round().astype(np.uint8)
+
+
+def _as_seen_from_above(channel: np.ndarray, scale: int) -> np.ndarray:
+    """A channel turned as the frames show the channel: x (ahead) to the
+    right, port up, each cell ``scale`` pixels square."""
+    turned = channel.T[:, ::-1]
+    return np.repeat(np.repeat(turned, scale, axis=0), scale, axis=1)
+
+
+def costmap_picture(seed: int = 0, scale: int = 15) -> np.ndarray:
+    """The picture of the documentation: a small ShipNavigation-v1 whose
+    ship has turned to port and sailed into the ice; its frame (the view
+    that follows the ship, from 20 m behind it to 300 m ahead, as the
+    costmap), then the impulse channel and the masks of the costmap,
+    turned the same way (x to the right, port up)."""
+    import gymnasium as gym
+
+    from . import ENV_IDS
+    from .facts import env_facts, env_spec
+    from .rendering import annotate
+    from .ship_navigation_v1 import ShipNavigationV1Env
+
+    entry = f"{ShipNavigationV1Env.__module__}:{ShipNavigationV1Env.__name__}"
+    env_id = next(i for i in ENV_IDS if env_spec(i).entry_point == entry)
+    env = gym.make(env_id, **{**dict(env_facts(env_id).small), "goal_distance": 350.0},
+                   obs_type="costmap", control="course", render_mode="rgb_array",
+                   view_behind=20.0, view_ahead=300.0)
+    try:
+        obs, _ = env.reset(seed=seed)
+        for k in range(30):
+            obs = env.step(np.array([0.6 if k < 12 else -0.3], dtype=np.float32))[0]
+        frame = env.render()
+        u = env.unwrapped
+        x, y = (float(v) for v in u.sim.ship.position)
+        rows, cols = u.costmap_size
+    finally:
+        env.close()
+    top = max(float(obs[0].max()), 1e-9)
+    ice = annotate(_ramp(_as_seen_from_above(obs[0], scale), top), side="bottom", text=[
+        "channel 0: impulse density",
+        f"log(1 + c / {COSTMAP_SCALE:,.0f} N s/m)",
+        f"dark 0, bright {top:.2f}",
+        f"{rows} × {cols} cells of {u.costmap_cell:g} m",
+        f"ship at x = {x:.0f} m, y = {y:.0f} m",
+        f"x from {x - u.costmap_behind:.0f} m to {x + u.costmap_ahead:.0f} m",
+        f"y from {y - 0.5 * cols * u.costmap_cell:.0f} m to "
+        f"{y + 0.5 * cols * u.costmap_cell:.0f} m"])
+    outside = _as_seen_from_above(obs[1], scale) > 0.5
+    beyond = _as_seen_from_above(obs[2], scale) > 0.5
+    masks = np.empty((*outside.shape, 3), dtype=np.uint8)
+    for name, where in (("neither", ~outside & ~beyond), ("outside", outside & ~beyond),
+                        ("beyond", beyond & ~outside), ("both", outside & beyond)):
+        masks[where] = _MASK_COLOURS[name]
+    masks = annotate(masks, side="bottom", legend=[
+        (_MASK_COLOURS["outside"], "channel 1: outside the channel", "band"),
+        (_MASK_COLOURS["beyond"], "channel 2: past the goal line", "band"),
+        (_MASK_COLOURS["both"], "both", "band")])
+    width = max(p.shape[1] for p in (frame, ice, masks))
+    pad = [np.pad(p, ((0, 8), (0, width - p.shape[1]), (0, 0))) for p in (frame, ice, masks)]
+    return np.concatenate(pad, axis=0)
+
+
+def main(argv=None) -> int:
+    import argparse
+    from pathlib import Path
+
+    from PIL import Image
+
+    p = argparse.ArgumentParser(prog="python -m iceenvs.costmap",
+                                description="Draw the costmap observation beside the ice it "
+                                            "shows (the picture of the observation page).")
+    p.add_argument("--out", type=Path, required=True, help="the folder of costmap.png")
+    p.add_argument("--seed", type=int, default=0, help="the episode's seed (default 0)")
+    args = p.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "costmap.png"
+    Image.fromarray(costmap_picture(args.seed)).save(path, optimize=True)
+    print(f"written: {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())

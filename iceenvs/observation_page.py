@@ -41,6 +41,84 @@ obs, info = env.reset(seed=0)
 print(names.index("goal_sin"), obs[names.index("goal_sin")])
 env.close()
 ```
+
+The lidar of the ship environments (`lidar_distance_k`,
+`lidar_concentration_k`) looks over the half plane ahead of the ship: its
+K sectors (`lidar_sectors`: 9 in ShipNavigation-v0 and ShipBeset-v0, 15 in
+ShipNavigation-v1) split the field of view of 180° centred on the heading
+into equal wedges, counted anticlockwise seen from above. Sector 0 is to
+starboard: its central ray points heading − 90° + (k + ½) · 180° / K for
+sector k, so sector 0 looks 80° to starboard with 9 sectors (84° with 15),
+the middle sector (4 of 9, 7 of 15) straight ahead and the last one as far
+to port.
+
+## The costmap (ship environments)
+
+`obs_type="costmap"` gives every ship environment an observation for a
+convolutional policy: a map of the ice that the lattice planner costs
+(`agents.planners.LatticePlanner`), `Box(float32, (3, rows, cols))`;
+`obs_type="costmap_dict"` gives `Dict({"costmap": ..., "vector": ...})`,
+the map beside the default vector. Both work in the native vector
+environments. `iceenvs.costmap` builds it, with one compiled kernel that
+the planner shares.
+
+**The grid.** It lies in the channel frame: x along the channel towards the
+goal line, y across it, to port. Cells of `costmap_cell` (5 m) reach from
+`costmap_behind` (20 m) behind the ship's centroid to `costmap_ahead`
+(300 m) ahead of it, and across the channel's width, centred on the ship's
+y: 64 × 40 cells in ShipNavigation-v1 (channel 200 m wide), 64 × 30 in
+ShipNavigation-v0. Row 0 is the farthest ahead and column 0 the farthest to
+port: drawn with row 0 at the top, the map is the ice seen from above with
+the goal direction up and port to the left. The centre of the cell of row
+i and column j is x = x_ship + ahead − (i + ½) · cell, y = y_ship +
+cols · cell / 2 − (j + ½) · cell. The grid does not turn with the ship;
+the vector holds its heading.
+
+**The channels.**
+
+0. `impulse`: the planner's cost density c [N s/m]. Each floe's expected
+   collision impulse J [N s] (a head-on hit at the ship's full speed,
+   `expected_impulses`) is spread as a cone over the disc of radius
+   R = r + B/2 about its centre (r its radius, B the beam):
+   c = J (1 − ρ / R) / R at distance ρ from the centre, so that a route
+   through the centre meets J and a glancing one less. The densities of the
+   floes add up, averaged over 2 × 2 samples of each cell (2.5 m apart;
+   the samples are at most 2.5 m apart for any cell). Stored as
+   log(1 + c / 12 500 N s/m), clipped at 10: about 0 to 3 in v1's fields.
+1. `outside_channel`: 1 where the cell's centre lies outside the channel,
+   more than channel_width / 2 from its centre line across, else 0.
+2. `beyond_goal`: 1 where the cell's centre lies past the goal line,
+   x > goal_x, else 0.
+
+The scale 12 500 N s/m is the ice impulse that one metre sailed is worth in
+ShipNavigation-v1's reward, so a cell of value log 2 ≈ 0.69 costs a route
+through it as much in ice as in time. Summing c · cell down a column
+approximates the impulse that a straight route there would meet. The map is
+a sensor: only floes whose enlarged disc reaches into it count. ShipNavigation-v1's
+channel is periodic across, so the map shows the ice beyond its edges
+through the floes' periodic images, as the swath sensor sees it, and channel
+1 says where the channel ends. Making the map costs about a twentieth of a
+step of ShipNavigation-v1.
+
+```python
+import gymnasium as gym
+import iceenvs  # noqa: F401
+
+env = gym.make("iceenvs/ShipNavigation-v1", obs_type="costmap")
+obs, info = env.reset(seed=0)
+print(obs.shape, env.observation_space.shape)   # (3, 64, 40) twice
+env.close()
+```
+
+The picture shows a small ShipNavigation-v1 after a turn to port: the frame
+that follows the ship over the costmap's reach, then channel 0 and the masks,
+turned the same way (x to the right, port up). It is written by
+
+```bash
+python -m iceenvs.costmap --out docs/figures/costmap
+```
+
+![The costmap of ShipNavigation-v1 beside the ice it shows](figures/costmap/costmap.png)
 """
 
 
