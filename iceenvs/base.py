@@ -56,6 +56,7 @@ from physics.hertz import hertz_time_step, scaled_contact
 from physics.markdown import table_row
 
 from .observations import FLOE_FEATURES, Feature, observation_vectors
+from .snapshots import Snapshot, restore_snapshot, take_snapshot
 
 __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "sanitise_actions", "choice", "scaled_contact", "hertz_time_step",
@@ -238,6 +239,15 @@ class ControlEnv(gym.Env):
     drawn: tuple[str, ...] = ()
     _renderer = None
     horizon = None
+    #: what an episode changes (:mod:`iceenvs.snapshots`): the members a
+    #: snapshot holds; each subclass lists the ones it adds
+    episode_members: tuple[str, ...] = ("_np_random", "_np_random_seed", "episode", "_steps",
+                                        "_last_action", "_prev", "_obs")
+    #: what changes in an episode but is no state of it: caches that a restore
+    #: rebuilds, work buffers written whole before they are read
+    episode_caches: tuple[str, ...] = ()
+    #: settings of the frames, which a snapshot's configuration check ignores
+    render_settings: tuple[str, ...] = ("render_mode", "colour_scale", "_renderer")
 
     @property
     def reward_bounds(self) -> tuple[float, float]:
@@ -442,6 +452,43 @@ class ControlEnv(gym.Env):
             self.render()
         return self._obs.copy(), reward, terminated, False, info
 
+    # -- snapshots ----------------------------------------------------------------------------
+    def snapshot(self) -> Snapshot:
+        """The state of the episode now, as a :class:`~iceenvs.snapshots.Snapshot`
+        that :meth:`restore` brings back: the engine (floes, contact
+        history, neighbour lists, ship, box, time), the drawn task, the step
+        count, the last measurement and observation, the episode's sums and
+        the random generator (which the next episode's draw reads). After a
+        restore the same actions give the same observations, rewards,
+        terminations and infos, bit for bit. Copies: later steps leave the
+        snapshot as it was. The configuration is not in it.
+
+        Raises ``RuntimeError`` before the first ``reset``."""
+        if not self._ready():
+            raise RuntimeError("call reset() before snapshot(): there is no episode to save")
+        return take_snapshot(self)
+
+    def restore(self, snapshot: Snapshot) -> None:
+        """Bring back the episode of ``snapshot`` (taken by :meth:`snapshot` of
+        this environment or of another made with the same arguments), as it
+        was when it was taken; the snapshot stays as it is and can be
+        restored again. Gymnasium's ``TimeLimit`` wrapper counts its steps
+        apart: restore on ``env.unwrapped`` and step it there (its own step
+        count, ``info["steps"]``, is restored).
+
+        Raises ``RuntimeError`` before the first ``reset``, ``TypeError``
+        for anything but a snapshot and ``ValueError`` for a snapshot of
+        another environment class or configuration."""
+        if not self._ready():
+            raise RuntimeError("call reset() before restore(): restore into an environment "
+                               "that has begun an episode")
+        self._set_members(restore_snapshot(self, snapshot))
+
+    def _set_members(self, state: dict) -> None:
+        """Set the episode members ``state`` (fresh copies); a subclass
+        rebuilds its caches (:attr:`episode_caches`)."""
+        self.__dict__.update(state)
+
     # -- rendering ----------------------------------------------------------------------------
     def render(self):
         if self.render_mode is None:
@@ -507,6 +554,7 @@ class FloeEnv(ControlEnv):
     #: the environment draws each episode's field itself, and with it the number
     #: of floes (it passes ``n_floes=None``)
     own_field = False
+    episode_members = ("sim",)
 
     def __init__(self, *, n_floes: int | None, preset: PaperPreset, control_interval: float,
                  reward_fn=None, reward_params: dict | None = None,
@@ -608,6 +656,7 @@ class HertzEnv(FloeEnv):
     """
 
     impact_speed = 1.0
+    episode_members = ("_contacts",)
     #: the class its native vector environment derives from (:func:`iceenvs.vector.vector_class`);
     #: None: :class:`iceenvs.vector.HertzVectorEnv`
     vector_base = None

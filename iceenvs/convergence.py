@@ -158,6 +158,8 @@ class ConvergenceEnv(HertzEnv):
         small={"n_floes": 60})
     impact_speed = 0.5
 
+    episode_members = ("box",)
+
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 2.0,
                  colour_scale: float = 0.05, **kwargs):
         super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,

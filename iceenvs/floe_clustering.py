@@ -150,6 +150,8 @@ class FloeClusteringEnv(FloeEnv):
         small={"n_floes": 150},
         speed_target=200)
 
+    episode_members = ("forcing", "_contacts", "_window")
+
     def __init__(self, n_floes: int = 300, preset=HERMAN2011, control_interval: float = 5.0,
                  cluster_gap: float = 0.1, **kwargs):
         if kwargs.get("stiffness_scale", 1.0) != 1.0:

@@ -174,6 +174,8 @@ class MarginalIceZoneEnv(HertzEnv):
         controllers={"heuristic": MarginalIceZoneController},
         small={"n_floes": 60})
 
+    episode_members = ("forcing",)
+
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
                  colour_scale: float = 0.2, **kwargs):
         super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,

@@ -225,6 +225,18 @@ class ShipEnv(HertzEnv):
     own_field = True
     #: the goal line lies ahead along +x; the channel is centred on the box
     start_x = 50.0
+    episode_members = ("forcing", "n_floes", "impact_speed", "_ship", "_damping",
+                       "_hull_length", "_track", "_sums", "_floes_hit", "_field_concentration",
+                       "plan_overlay")
+    #: the step as a batch of one, rebuilt from the episode (:meth:`_set_members`)
+    episode_caches = ("_one", "_one_sums", "_begun")
+    render_settings = ("_view", "view_behind", "view_ahead")
+
+    def _set_members(self, state: dict) -> None:
+        # the sums in place: a native vector environment's table holds them
+        self._sums[:] = state.pop("_sums")
+        super()._set_members(state)
+        self._begun = False          # the next step begins its batch from the episode
 
     def __init__(self, *, control: str = "yaw", obs_type: str = "vector", image_size: int = 64,
                  image_extent: float = 150.0, lidar_sectors: int = 9,

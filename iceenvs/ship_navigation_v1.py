@@ -270,6 +270,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                     speed_target=50,
                     controllers={**ShipNavigationEnv.facts.controllers, "swath": SwathPlanner})
 
+    episode_members = ("leads", "_swath_weights")
+
     def __init__(self, *, length: float = 1500.0, width: float = 200.0,
                  channel_width: float = 200.0, goal_distance: float = 1100.0,
                  lidar_sectors: int = 15, lidar_range: float = 250.0, swath_rays: int = 9,

@@ -290,6 +290,10 @@ class ThicknessDistributionEnv(ControlEnv):
         speed_target=5000)
     task_parameters = _TASK
 
+    episode_members = ("model",)
+    #: the observation's work buffer, written whole before it is read
+    episode_caches = ("_vec",)
+
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
                  n_classes: int = GODLOVITCH.n_classes, dh: float = GODLOVITCH.class_width,
                  days_per_step: float = GODLOVITCH.time_step,

@@ -191,6 +191,66 @@ class HertzVectorEnv(VectorEnv):
         """After sub-environment k started a new episode (a subclass that
         keeps per-episode rows updates them)."""
 
+    # -- snapshots ------------------------------------------------------------------------
+    def snapshot(self, index: int | None = None):
+        """The state of sub-environment ``index``'s episode now
+        (:meth:`iceenvs.base.ControlEnv.snapshot`), or with ``index`` None
+        a tuple of every sub-environment's.
+
+        A sub-environment whose episode ended in a step was reset in that
+        step (``AutoresetMode.SAME_STEP``): its snapshot holds the new
+        episode from its first observation, with the random generator that
+        drew it; the last observation and info of the episode that ended
+        (``info["final_obs"]``, ``info["final_info"]``) are not in it. Its
+        step count is in it, so the truncation after ``max_episode_steps``
+        comes at the same step after a restore.
+
+        Raises ``RuntimeError`` before the first ``reset`` and
+        ``ValueError`` for an index that is not a sub-environment's."""
+        if not self._ready:
+            raise RuntimeError("call reset() before snapshot(): there is no episode to save")
+        if index is None:
+            return tuple(env.snapshot() for env in self.envs)
+        return self.envs[self._index(index)].snapshot()
+
+    def restore(self, snapshot, index: int | None = None) -> None:
+        """Bring back sub-environment ``index``'s episode from ``snapshot``
+        (of a sub-environment of a vector environment made with the same
+        arguments, or of a single environment made with them); the others
+        go on as they are. With ``index`` None, ``snapshot`` is the tuple of
+        :meth:`snapshot` and every sub-environment is restored. The next
+        steps give the restored sub-environments the observations, rewards,
+        ends and infos they had after the snapshot, bit for bit, given the
+        same actions.
+
+        Raises ``RuntimeError`` before the first ``reset``, ``ValueError``
+        for a bad index, a tuple of another length, or a snapshot of another
+        environment or configuration, and ``TypeError`` for anything but a
+        snapshot."""
+        if not self._ready:
+            raise RuntimeError("call reset() before restore(): restore into an environment "
+                               "that has begun its episodes")
+        if index is None:
+            if not isinstance(snapshot, (tuple, list)) or len(snapshot) != self.num_envs:
+                raise ValueError(f"restore without an index takes the tuple of "
+                                 f"{self.num_envs} snapshots that snapshot() returns, got "
+                                 f"{type(snapshot).__name__}"
+                                 + (f" of {len(snapshot)}" if isinstance(snapshot, (tuple, list))
+                                    else ""))
+            for k, one in enumerate(snapshot):
+                self.restore(one, k)
+            return
+        k = self._index(index)
+        self.envs[k].restore(snapshot)
+        self._reset_row(k)
+
+    def _index(self, index) -> int:
+        if (isinstance(index, bool) or not isinstance(index, (int, np.integer))
+                or not 0 <= index < self.num_envs):
+            raise ValueError(f"index must be that of a sub-environment, 0 to "
+                             f"{self.num_envs - 1}, got {index!r}")
+        return int(index)
+
     def render(self):
         """The frame of sub-environment ``render_env`` (``render_mode``
         "rgb_array"), or ``None``."""

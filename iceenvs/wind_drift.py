@@ -171,6 +171,8 @@ class WindDriftEnv(HertzEnv):
         controllers={"heuristic": WindDriftController},
         small={"n_floes": 60})
 
+    episode_members = ("forcing",)
+
     def __init__(self, n_floes: int = 200, preset=HERMAN2013, control_interval: float = 5.0,
                  **kwargs):
         super().__init__(n_floes=n_floes, preset=preset, control_interval=control_interval,

@@ -459,6 +459,16 @@ class HertzSimulation(FloeProperties):
         self._verlet_list = value
         self._verlet_slot = self._verlet_home = None
 
+    def __getstate__(self) -> dict:
+        """The state a copy (``copy.deepcopy``, pickle) takes: the current
+        Verlet list, without the batch's typed list it may lie in (the copy
+        is in no batch)."""
+        state = self.__dict__.copy()
+        state["_verlet_list"] = self._verlet
+        state.pop("_verlet_slot", None)
+        state.pop("_verlet_home", None)
+        return state
+
     # -- running -------------------------------------------------------------
     @property
     def _step_mode(self) -> int:
