@@ -314,10 +314,10 @@ def costmap_picture(seed: int = 0, scale: int = 15) -> np.ndarray:
     from . import ENV_IDS
     from .facts import env_facts, env_spec
     from .rendering import annotate
-    from .ship_navigation_v1 import ShipNavigationV1Env
 
-    entry = f"{ShipNavigationV1Env.__module__}:{ShipNavigationV1Env.__name__}"
-    env_id = next(i for i in ENV_IDS if env_spec(i).entry_point == entry)
+    # the id whose class lives in the module of ShipNavigation-v1
+    module = f"{__package__}.ship_navigation_v1:"
+    env_id = next(i for i in ENV_IDS if str(env_spec(i).entry_point).startswith(module))
     env = gym.make(env_id, **{**dict(env_facts(env_id).small), "goal_distance": 350.0},
                    obs_type="costmap", control="course", render_mode="rgb_array",
                    view_behind=20.0, view_ahead=300.0)
