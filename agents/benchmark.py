@@ -203,7 +203,7 @@ def _baseline_recipes(env_id: str) -> dict:
 
     from .baselines import baseline_names, load_results
     from .metrics import env_name
-    from .planners import PLANNERS
+    from .planners import ON_REQUEST, PLANNERS
 
     recipes = {name: ("baseline", name, {}) for name in ("zero", "random")}
     search = TASKS_DIR / f"constant_{env_name(env_id)}.json"
@@ -213,6 +213,8 @@ def _baseline_recipes(env_id: str) -> dict:
     recipes["heuristic"] = ("baseline", "heuristic", {})
     own = env_facts(env_id).controllers
     for name in baseline_names(env_id):
+        if name in ON_REQUEST:
+            continue
         if name in PLANNERS or (name in own and own[name] is not own.get("heuristic")):
             recipes[name] = ("baseline", name, {})
     return recipes

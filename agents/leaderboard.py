@@ -398,10 +398,13 @@ def default_policies(env_id: str) -> list[str]:
     """The baselines a leaderboard of ``env_id`` runs by default: the
     straight line, the environment's other controllers and the planners
     of :mod:`agents.planners` (not the generic ones, nor ``heuristic``,
-    another name of ``reactive``)."""
+    another name of ``reactive``, nor the planners played only when named,
+    :data:`agents.planners.ON_REQUEST`)."""
     from .baselines import GENERIC, baseline_names
+    from .planners import ON_REQUEST
 
-    return [n for n in baseline_names(env_id) if n not in GENERIC and n != "heuristic"]
+    return [n for n in baseline_names(env_id)
+            if n not in GENERIC and n != "heuristic" and n not in ON_REQUEST]
 
 
 def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.ArgumentParser:

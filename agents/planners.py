@@ -1,6 +1,6 @@
 """Route planners of the ship environments that read the ice (privileged).
 
-Four planner baselines steer the ship environments
+Five planner baselines steer the ship environments
 (``iceenvs/ShipNavigation-v0``, ``-v1`` and ``iceenvs/ShipBeset-v0``;
 ``swath`` only v1, which has the swath sensor):
 
@@ -15,6 +15,9 @@ name            planner                                                     read
                 lattice with the ship's turning limit, the ice costed by     its sensor range
                 the collision impulse it would take, replanned every few
                 steps and followed by pure pursuit
+``rollout``     :class:`RolloutPlanner`: the lattice's route and the same   the floes, and
+                route moved sideways, each tried by rollouts of the          the episode
+                episode from a snapshot; the best by reward is followed      stepped ahead
 ==============  ==========================================================  ================
 
 The first three are the environments' own controllers
@@ -76,7 +79,7 @@ from numba import njit
 from iceenvs.costmap import impulse_costmap
 from iceenvs.ship_controllers import StraightLinePolicy
 
-__all__ = ["LatticePlanner", "impulse_costmap", "lattice_route", "PLANNERS"]
+__all__ = ["LatticePlanner", "RolloutPlanner", "ON_REQUEST", "impulse_costmap", "lattice_route", "PLANNERS"]
 
 
 @njit(cache=True)
@@ -256,8 +259,13 @@ class LatticePlanner(StraightLinePolicy):
         y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
         slope = int(round(math.tan(max(min(heading, 1.2), -1.2)) * stage_cells))
         slope = max(min(slope, max_slope), -max_slope)
-        ys, _ = lattice_route(cost, cell, stage_cells, n_stages, below, slope, max_slope,
-                              y_low, y_high, 1.0 / self.metre_cost)
+        ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, slope, max_slope,
+                                  y_low, y_high, 1.0 / self.metre_cost)
+        if not math.isfinite(total):
+            # heading for an edge too steeply to turn within the lattice's slope steps
+            # (a ship another controller steered there): plan from a straight heading
+            ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, 0, max_slope,
+                                      y_low, y_high, 1.0 / self.metre_cost)
         route = np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]])
         self.decision_times.append(time.perf_counter() - t0)
         if self.show:
@@ -285,5 +293,122 @@ class LatticePlanner(StraightLinePolicy):
         return self._steer(bearing, self._reader(obs))
 
 
+class RolloutPlanner(LatticePlanner):
+    """The lattice planner with its route checked, and moved sideways, by
+    rollouts from a snapshot of the episode (``rollout``; privileged).
+
+    The lattice planner (:class:`agents.planners.LatticePlanner`) prices the
+    ice by the impulse of a head-on collision with each floe at rest, and a
+    route by that price plus its length. What the ship then meets differs:
+    floes pushed ahead pile up, the hull glances off, the stern swings. The
+    rollout planner checks the lattice's route against the environment
+    itself. At each replan it plans the lattice's route, then tries it and
+    the same route moved sideways by each of ``offsets`` (default ±6 m):
+    from a snapshot of the episode (:meth:`iceenvs.base.ControlEnv.snapshot`)
+    it follows each candidate for ``rollout_steps`` steps (default 15, 30 s
+    of model time, 60 m) with the lattice planner's pure pursuit, sums the
+    rewards, restores the episode, and keeps the candidate of the highest
+    sum. The unshifted route is a candidate, so over each rollout's window
+    the plan kept earns at least what the lattice's would: what the rollout
+    planner gains over the lattice on the leaderboard is what that
+    one-window foresight buys, and an upper mark for a learner that imitates
+    it.
+
+    It reads what the lattice reads (every floe within its range) and, more,
+    steps the environment forward: a planner with a perfect model, listed as
+    privileged beside the lattice. Each plan costs ``1 + len(offsets)``
+    rollouts of ``rollout_steps`` steps.
+
+    Parameters
+    ----------
+    env, seed : as :class:`~agents.planners.LatticePlanner`
+    offsets : sequence of float [m]
+        Lateral shifts of the lattice's route tried beside it (0 is always
+        tried).
+    rollout_steps : int
+        Steps of each rollout.
+    **kwargs : the lattice planner's
+    """
+
+    reads_environment = "its floes, and steps copies of the episode forward"
+
+    def __init__(self, env, seed: int = 0, *, offsets=(-6.0, 6.0), rollout_steps: int = 15,
+                 **kwargs):
+        super().__init__(env, seed, **kwargs)
+        if not hasattr(self.unwrapped, "snapshot"):
+            raise ValueError(f"RolloutPlanner needs an environment with snapshot and restore, "
+                             f"got {type(self.unwrapped).__name__}")
+        shifts = [float(o) for o in offsets]
+        if not all(math.isfinite(o) for o in shifts):
+            raise ValueError(f"offsets must be finite numbers, got {offsets!r}")
+        self.offsets = (0.0, *sorted({o for o in shifts if o != 0.0}))
+        if isinstance(rollout_steps, bool) or int(rollout_steps) != rollout_steps \
+                or rollout_steps < 1:
+            raise ValueError(f"rollout_steps must be an integer >= 1, got {rollout_steps!r}")
+        self.rollout_steps = int(rollout_steps)
+        #: per plan: the offset kept [m] and every candidate's rollout return
+        self.choices: list[tuple[float, tuple[float, ...]]] = []
+        self._seen = None
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self.choices = []
+
+    def act(self, obs):
+        self._seen = obs            # what the rollouts start from
+        return super().act(obs)
+
+    def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
+        """The action that steers for the point ``lookahead`` ahead on
+        ``route`` (the lattice planner's pure pursuit)."""
+        ship = self.unwrapped.sim.ship
+        position = np.asarray(ship.position, dtype=float)
+        target_x = position[0] + self.lookahead
+        target_y = float(np.interp(target_x, route[:, 0], route[:, 1]))
+        bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
+        bearing = math.atan2(math.sin(bearing), math.cos(bearing))
+        return self._steer(bearing, self._reader(obs))
+
+    def _rollout(self, route: np.ndarray) -> float:
+        """The summed reward of following ``route`` for ``rollout_steps``
+        steps from now (the episode is restored after)."""
+        u = self.unwrapped
+        obs, total = self._seen, 0.0
+        for _ in range(self.rollout_steps):
+            obs, reward, terminated, truncated, _ = u.step(self._pursue(route, obs))
+            total += float(reward)
+            if terminated or truncated:
+                break
+        return total
+
+    def plan(self) -> np.ndarray:
+        route = super().plan()
+        t0 = time.perf_counter()
+        u = self.unwrapped
+        half = 0.5 * u.channel_width - self.edge_margin
+        low, high = u.centre_y - half, u.centre_y + half
+        snap = u.snapshot()
+        returns = []
+        for offset in self.offsets:
+            # restore first: a restore puts copies in the episode, so the rollouts step
+            # those and leave alone the objects the caller holds (act's ship)
+            u.restore(snap)
+            shifted = route.copy()
+            shifted[1:, 1] = np.clip(route[1:, 1] + offset, low, high)
+            returns.append(self._rollout(shifted))
+        u.restore(snap)
+        best = int(np.argmax(returns))
+        self.choices.append((self.offsets[best], tuple(returns)))
+        route = route.copy()
+        route[1:, 1] = np.clip(route[1:, 1] + self.offsets[best], low, high)
+        self.decision_times[-1] += time.perf_counter() - t0
+        if self.show:
+            u.plan_overlay = (route, u.plan_overlay[1])
+        return route
+
+
 #: the planners of this module: baseline name → class ``(env, seed)``
-PLANNERS = {"lattice": LatticePlanner}
+PLANNERS = {"lattice": LatticePlanner, "rollout": RolloutPlanner}
+#: planners that benchmarks, task tables and leaderboards play only when named
+#: (each of their plans costs rollouts of the episode)
+ON_REQUEST = frozenset({"rollout"})

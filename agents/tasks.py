@@ -67,7 +67,7 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
     from .baselines import ConstantPolicy, baseline_names, make_baseline
     from .baselines import load_results
     from .constant import search_constant_actions
-    from .planners import PLANNERS
+    from .planners import ON_REQUEST, PLANNERS
     from .rollouts import TrainedPolicy, compare, evaluate, summarise
     from .metrics import env_name
 
@@ -89,8 +89,8 @@ def analyse(env_id: str, *, episodes: int, grid: int, seeds: int, processes: int
         policies["constant"] = ConstantPolicy(env, EVAL_SEED, action=results[0]["action"])
         # the environment's other controllers (the ship's straight line) and the planners
         own = env_facts(env_id).controllers
-        planners = [n for n in baseline_names(env_id) if n in PLANNERS or (
-            n in own and own[n] is not own.get("heuristic"))]
+        planners = [n for n in baseline_names(env_id) if n not in ON_REQUEST and (
+            n in PLANNERS or (n in own and own[n] is not own.get("heuristic")))]
         for name in planners:
             policies[name] = make_baseline(name, env, EVAL_SEED)
         for name, (run_dir, checkpoint) in (trained or {}).items():

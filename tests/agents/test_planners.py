@@ -1,0 +1,98 @@
+"""The privileged planners (agents.planners): the lattice near an edge, and the rollouts."""
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from agents.planners import LatticePlanner
+from agents.planners import RolloutPlanner
+from small_envs import SMALL
+
+NAV = "iceenvs/ShipNavigation-v1"
+KWARGS = {**SMALL[NAV], "length": 300.0, "goal_distance": 150.0}
+
+
+def _sail(policy_class, seed=3, **kwargs):
+    env = gym.make(NAV, **KWARGS)
+    policy = policy_class(env, 0, **kwargs)
+    obs, _ = env.reset(seed=seed)
+    policy.reset(seed)
+    rewards, observations, done = [], [obs], False
+    while not done:
+        obs, reward, terminated, truncated, _ = env.step(policy.predict(obs)[0])
+        rewards.append(reward)
+        observations.append(obs)
+        done = terminated or truncated
+    env.close()
+    return policy, np.array(rewards), np.array(observations)
+
+
+def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
+    """Rolled out and restored at every plan, the episode is the lattice
+    planner's, bit for bit: the rollouts change nothing of it."""
+    planner, rewards, observations = _sail(RolloutPlanner, offsets=(), rollout_steps=6)
+    _, lattice_rewards, lattice_observations = _sail(LatticePlanner)
+    np.testing.assert_array_equal(rewards, lattice_rewards)
+    np.testing.assert_array_equal(observations, lattice_observations)
+    assert planner.choices and all(offset == 0.0 for offset, _ in planner.choices)
+
+
+def test_each_plan_keeps_the_candidate_of_the_best_rollout():
+    planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=6)
+    assert planner.offsets == (0.0, -6.0, 6.0)
+    for offset, returns in planner.choices:
+        assert len(returns) == 3 and returns[planner.offsets.index(offset)] == max(returns)
+    assert len(planner.choices) == len(planner.decision_times)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"offsets": (float("nan"),)}, "offsets must be finite"),
+    ({"rollout_steps": 0}, "rollout_steps must be an integer >= 1"),
+    ({"rollout_steps": 2.5}, "rollout_steps must be an integer >= 1"),
+])
+def test_refused_arguments(kwargs, message):
+    env = gym.make(NAV, **KWARGS)
+    with pytest.raises(ValueError, match=message):
+        RolloutPlanner(env, 0, **kwargs)
+
+
+def test_the_lattice_plans_for_a_ship_heading_steeply_for_the_edge():
+    """Steered hard to port and then straight (as a rollout's candidate may
+    leave it), the ship heads for the edge too steeply for the lattice's
+    slope steps: the route from its heading does not exist (infinite cost),
+    and the planner plans from a straight heading instead of failing."""
+    import math
+
+    from agents.planners import lattice_route
+
+    env = gym.make(NAV, **SMALL[NAV])
+    env.reset(seed=0)
+    u = env.unwrapped
+    for k in range(60):
+        env.step(np.array([1.0 if k < 10 else 0.0], dtype=np.float32))
+        if u.sim.ship.position[1] > u.centre_y + 0.5 * u.channel_width - 28.0:
+            break
+    planner = LatticePlanner(env, 0)
+    cell = planner.lateral_step
+    stage_cells = int(round(planner.stage_length / cell))
+    max_slope = int(round(planner.max_slope * stage_cells))
+    steep = min(int(round(math.tan(u.sim.ship.heading) * stage_cells)), max_slope)
+    # the lattice's own grid about the ship: rows up to the edge margin
+    room = int((u.centre_y + 0.5 * u.channel_width - planner.edge_margin
+                - u.sim.ship.position[1]) / cell)
+    cost = np.zeros((10 * stage_cells, room + 41))
+    _, total = lattice_route(cost, cell, stage_cells, 10, 40, steep, max_slope, 0, 40 + room, 0.0)
+    assert math.isinf(total)
+    route = planner.plan()
+    assert np.isfinite(route).all()
+    assert route[:, 1].max() <= u.centre_y + 0.5 * u.channel_width - planner.edge_margin
+    env.close()
+
+
+def test_the_rollout_planner_is_played_only_when_named():
+    from agents import benchmark, leaderboard
+    from agents.baselines import baseline_names
+
+    assert "rollout" in baseline_names(NAV)
+    assert "rollout" not in leaderboard.default_policies(NAV)
+    assert "lattice" in leaderboard.default_policies(NAV)
+    assert "rollout" not in benchmark._baseline_recipes(NAV)
