@@ -16,7 +16,7 @@ import copy
 from pathlib import Path
 
 __all__ = ["EnvFactory", "make_vec_env", "load_normalization", "parse_key_values",
-           "make_checked_env", "check_env_kwargs"]
+           "make_checked_env", "check_env_kwargs", "normalize_for_space"]
 
 
 def _set_dotted(mapping: dict, key: str, value) -> None:
@@ -197,6 +197,40 @@ def native_vector_env(env_id: str, n_envs: int, env_kwargs: dict | None = None):
                                         **(env_kwargs or {})))
 
 
+def normalize_for_space(normalize: dict, space) -> dict:
+    """The arguments of :class:`VecNormalize` for observations of ``space``:
+    maps (a ``Box`` of three axes: a costmap, an image) are left out of
+    the observation statistics, since the environment scales them itself
+    and a running mean and deviation per cell would make each cell's scale
+    its own (and divide an image the policy divides by 255 again).
+
+    A map observation is not normalised (``norm_obs`` false); a ``Dict``
+    observation normalises its other parts (``norm_obs_keys``), unless the
+    arguments name the keys themselves. Rewards are normalised as asked.
+
+    >>> from gymnasium.spaces import Box, Dict
+    >>> space = Dict({"costmap": Box(0, 5, (3, 64, 40)), "vector": Box(-1, 1, (8,))})
+    >>> normalize_for_space({"norm_obs": True}, space)
+    {'norm_obs': True, 'norm_obs_keys': ['vector']}
+    """
+    from gymnasium.spaces import Dict
+
+    from .observations import is_map_space
+
+    normalize = dict(normalize)
+    if not normalize.get("norm_obs", True):
+        return normalize
+    if is_map_space(space):
+        normalize["norm_obs"] = False
+    elif isinstance(space, Dict) and normalize.get("norm_obs_keys") is None:
+        keys = [key for key, part in space.spaces.items() if not is_map_space(part)]
+        if keys:
+            normalize["norm_obs_keys"] = keys
+        else:
+            normalize["norm_obs"] = False
+    return normalize
+
+
 def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None = None,
                  normalize: dict | None = None, training: bool = True,
                  stats_path: str | Path | None = None, vectorization: str = "auto"):
@@ -214,7 +248,8 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
         Passed to :func:`gymnasium.make`.
     normalize : dict, optional
         Keyword arguments of :class:`VecNormalize` (``None``: no
-        normalisation).
+        normalisation); maps in the observation are left out of its
+        observation statistics (:func:`normalize_for_space`).
     training : bool
         ``False`` builds an evaluation stack: statistics frozen, rewards
         not normalised.
@@ -257,7 +292,7 @@ def make_vec_env(env_id: str, *, n_envs: int, seed: int, env_kwargs: dict | None
     if stats_path is not None and Path(stats_path).exists():
         venv = VecNormalize.load(str(stats_path), venv)
     elif normalize is not None:
-        venv = VecNormalize(venv, **normalize)
+        venv = VecNormalize(venv, **normalize_for_space(normalize, venv.observation_space))
     if isinstance(venv, VecNormalize) and not training:
         venv.training = False
         venv.norm_reward = False

@@ -58,6 +58,8 @@ import time
 
 import numpy as np
 
+from . import observations as obs_rows
+
 __all__ = ["PRETRAIN_DEFAULTS", "COLLECT_PART", "BudgetTooShort", "pretrain_settings",
            "Demonstrations", "collect", "prime_normalization", "fit_policy", "BehaviourAnchor",
            "pretrain"]
@@ -118,19 +120,21 @@ def pretrain_settings(value) -> dict | None:
 
 
 class Demonstrations:
-    """A teacher's decisions: raw observations ``obs`` (n, …), actions
+    """A teacher's decisions: raw observations ``obs`` (n, …; a dict of such
+    arrays for a ``Dict`` observation), actions
     ``actions`` (n, k), rewards ``rewards`` (n,) and ``episode_starts``
     (n,), True at the first step of each episode; ``episodes`` is their
     number."""
 
     def __init__(self, obs, actions, rewards, episode_starts):
-        self.obs = np.asarray(obs, dtype=np.float32)
+        self.obs = obs_rows.stack(list(obs)) if isinstance(obs, (list, tuple)) else \
+            obs_rows.as_float32(obs)
         self.actions = np.asarray(actions, dtype=np.float32)
         self.rewards = np.asarray(rewards, dtype=np.float64)
         self.episode_starts = np.asarray(episode_starts, dtype=bool)
 
     def __len__(self) -> int:
-        return len(self.obs)
+        return obs_rows.length(self.obs)
 
     @property
     def episodes(self) -> int:
@@ -191,7 +195,7 @@ def collect(env_id: str, env_kwargs: dict, teacher: str, episodes: int, seed: in
                 done, first = False, True
                 while not done:
                     action = np.asarray(policy.predict(obs)[0], dtype=np.float32)
-                    obs_list.append(np.array(obs, dtype=np.float32))
+                    obs_list.append(obs_rows.as_float32(obs, copy=True))
                     actions.append(action.reshape(env.action_space.shape))
                     starts.append(first)
                     obs, reward, terminated, truncated, _ = env.step(action)
@@ -210,7 +214,10 @@ def prime_normalization(vec_normalize, demos: Demonstrations, gamma: float) -> N
     """Start the statistics of a ``VecNormalize`` from the demonstrations:
     observations (when it normalises them) and discounted returns (when it
     normalises rewards)."""
-    if vec_normalize.norm_obs:
+    if vec_normalize.norm_obs and isinstance(vec_normalize.obs_rms, dict):
+        for key in vec_normalize.norm_obs_keys:       # a Dict observation: its keys normalised
+            vec_normalize.obs_rms[key].update(demos.obs[key])
+    elif vec_normalize.norm_obs:
         vec_normalize.obs_rms.update(demos.obs)
     if vec_normalize.norm_reward:
         vec_normalize.ret_rms.update(demos.running_returns(gamma))
@@ -266,8 +273,9 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     import torch
 
     generator = torch.Generator().manual_seed(int(seed))
-    x = torch.as_tensor(obs, dtype=torch.float32)
-    y = torch.as_tensor(actions, dtype=torch.float32).reshape(len(x), -1)
+    x = obs_rows.as_tensor(obs)
+    n = obs_rows.length(x)
+    y = torch.as_tensor(actions, dtype=torch.float32).reshape(n, -1)
     policy.set_training_mode(True)
 
     actor = [*policy.pi_features_extractor.parameters(),
@@ -276,7 +284,10 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     if deadline is not None:
         now = time.perf_counter()
         actor_deadline = now + 0.5 * (deadline - now) if values is not None else deadline
-    report = {"actor_epochs": _fit(actor, lambda b: _action_mse(policy, x[b], y[b]), len(x),
+    def rows(b):
+        return obs_rows.take(x, b)
+
+    report = {"actor_epochs": _fit(actor, lambda b: _action_mse(policy, rows(b), y[b]), n,
                                    epochs, batch_size, learning_rate, generator, actor_deadline)}
     with torch.no_grad():
         report["action_mse"] = float(_action_mse(policy, x, y))
@@ -287,7 +298,7 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
         if not policy.share_features_extractor:
             critic += list(policy.vf_features_extractor.parameters())
         report["critic_epochs"] = _fit(
-            critic, lambda b: ((policy.predict_values(x[b]) - v[b]) ** 2).mean(), len(x),
+            critic, lambda b: ((policy.predict_values(rows(b)) - v[b]) ** 2).mean(), n,
             epochs, batch_size, learning_rate, generator, deadline)
         with torch.no_grad():
             report["value_mse"] = float(((policy.predict_values(x) - v) ** 2).mean())
@@ -333,10 +344,10 @@ class BehaviourAnchor:
         import torch
 
         idx = self.rng.integers(len(self.demos), size=min(self.batch_size, len(self.demos)))
-        obs = self.demos.obs[idx]
+        obs = obs_rows.take(self.demos.obs, idx)
         if self.normalizer is not None:
             obs = self.normalizer.normalize_obs(obs)
-        x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
+        x = obs_rows.as_tensor(obs)
         y = torch.as_tensor(self.demos.actions[idx]).reshape(len(idx), -1)
         return _action_mse(self.model.policy, x, y)
 

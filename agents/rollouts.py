@@ -24,6 +24,7 @@ import yaml
 
 from iceenvs.facts import env_facts
 
+from .observations import as_float32
 from .runs import checkpoint_paths_checked, trained_argument  # noqa: F401  (re-exported)
 
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
@@ -36,7 +37,7 @@ __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "
 #: trained run is evaluated with its own
 AGENT_KWARGS = ("control", "obs_type", "lidar_sectors", "lidar_range", "image_size",
                 "image_extent", "swath_rays", "swath_fan", "swath_bands", "swath_frame",
-                "swath_edge", "course_guard")
+                "swath_edge", "course_guard", "costmap_cell", "costmap_behind", "costmap_ahead")
 
 
 def run_agent_kwargs(run_dir: str | Path) -> dict:
@@ -88,9 +89,9 @@ class TrainedPolicy:
         """Nothing to reset: the policy is memoryless."""
 
     def predict(self, obs, state=None, episode_start=None, deterministic: bool = True):
-        obs = np.asarray(obs, dtype=np.float32)
+        obs = as_float32(obs)
         if self.normalization is not None:
-            obs = self.normalization.normalize_obs(obs).astype(np.float32)
+            obs = as_float32(self.normalization.normalize_obs(obs))
         return self.model.predict(obs, deterministic=deterministic)
 
 

@@ -125,7 +125,8 @@ def build_parser(prog: str = "python -m agents.train") -> argparse.ArgumentParse
                    help="checkpoint every this many steps, all envs together (0: never)")
     p.add_argument("--conf", type=Path, default=None, metavar="FILE",
                    help="a YAML file whose entry for the id (such as a study's best.yaml) "
-                        "takes the place of its entry in agents/hyperparams/<algo>.yaml")
+                        "takes the place of its entry in agents/hyperparams/<algo>.yaml; a bare "
+                        "name not found here is one of agents/hyperparams/ (ppo-costmap.yaml)")
     p.add_argument("--hyperparams", nargs="+", default=[], metavar="KEY=VALUE",
                    help="override hyperparameters; VALUE is YAML, KEY may be dotted "
                         "(env_kwargs.n_floes=50)")
@@ -225,8 +226,9 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
     Raises
     ------
     ValueError
-        For a malformed override or an unknown key (the message lists the
-        valid ones). The environment arguments are not checked here
+        For a malformed override, an unknown key (the message lists the
+        valid ones) or an unknown ``policy_kwargs.features_extractor_class``.
+        The environment arguments are not checked here
         (:func:`agents.envs.check_env_kwargs` does).
     """
     from .envs import parse_key_values
@@ -256,6 +258,11 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
         if not isinstance(hp.get(key), int) or hp[key] < 1:
             raise ValueError(f"hyperparameter {key} must be an integer >= 1, got "
                              f"{hp.get(key)!r}")
+    policy_kwargs = hp.get("policy_kwargs") or {}
+    if isinstance(policy_kwargs, dict) and policy_kwargs.get("features_extractor_class"):
+        from .extractors import extractor_class
+
+        extractor_class(policy_kwargs["features_extractor_class"])    # a known name
     from .pretrain import pretrain_settings
 
     pretrain = pretrain_settings(hp.pop("pretrain", None))
@@ -275,7 +282,12 @@ def read_hyperparams(algo: str, env_id: str, overrides=(), *, timesteps: int | N
 
 
 def read_conf(path: Path, env_id: str) -> dict:
-    """The entry of ``env_id`` in the YAML file ``path`` (``--conf``)."""
+    """The entry of ``env_id`` in the YAML file ``path`` (``--conf``); a bare
+    file name that is not a file here names one of ``agents/hyperparams/``
+    (``--conf ppo-costmap.yaml``)."""
+    path = Path(path)
+    if not path.is_file() and len(path.parts) == 1 and (HYPERPARAMS_DIR / path).is_file():
+        path = HYPERPARAMS_DIR / path
     try:
         with open(path) as fh:
             table = yaml.safe_load(fh)
@@ -301,7 +313,8 @@ def _schedule(value):
 
 def algo_kwargs(hp: dict) -> dict:
     """Constructor arguments of the algorithm from resolved hyperparameters
-    (learning-rate schedules, activation names, ``train_freq`` lists)."""
+    (learning-rate schedules, activation names, feature extractor names of
+    :data:`agents.extractors.EXTRACTORS`, ``train_freq`` lists)."""
     import torch
 
     kw = {k: v for k, v in hp.items() if k not in SPECIAL_KEYS}
@@ -312,6 +325,10 @@ def algo_kwargs(hp: dict) -> dict:
         pk["activation_fn"] = getattr(torch.nn, {"tanh": "Tanh", "relu": "ReLU",
                                                  "elu": "ELU"}.get(pk["activation_fn"].lower(),
                                                                     pk["activation_fn"]))
+    if isinstance(pk.get("features_extractor_class"), str):
+        from .extractors import extractor_class
+
+        pk["features_extractor_class"] = extractor_class(pk["features_extractor_class"])
     if pk:
         kw["policy_kwargs"] = pk
     if isinstance(kw.get("train_freq"), list):

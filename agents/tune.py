@@ -49,8 +49,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-__all__ = ["sample_ppo", "sample_sac", "SAMPLERS", "STARTUP_TRIALS", "build_parser", "main",
-           "study_record", "default_out"]
+__all__ = ["sample_ppo", "sample_sac", "SAMPLERS", "trial_hyperparams", "STARTUP_TRIALS",
+           "build_parser", "main", "study_record", "default_out"]
 
 #: trials run to completion before the pruner may stop one
 STARTUP_TRIALS = 3
@@ -101,6 +101,16 @@ def sample_sac(trial) -> dict:
 
 #: the search space of each algorithm
 SAMPLERS = {"ppo": sample_ppo, "sac": sample_sac}
+
+
+def trial_hyperparams(base_hp: dict, drawn: dict) -> dict:
+    """A trial's hyperparameters: those drawn over the base entry's, with
+    the drawn ``policy_kwargs`` set over the base's key by key, so that what
+    the search does not draw (a feature extractor and its arguments) stays."""
+    hp = {**base_hp, **drawn}
+    if "policy_kwargs" in drawn:
+        hp["policy_kwargs"] = {**(base_hp.get("policy_kwargs") or {}), **drawn["policy_kwargs"]}
+    return hp
 
 
 def default_out(env_id: str, algo: str) -> Path:
@@ -186,6 +196,7 @@ class _Scorer:
         self.seed = seed
 
     def __call__(self, model) -> float:
+        from .observations import as_float32
         from .rollouts import run_episode
 
         vec_normalize = model.get_vec_normalize_env()
@@ -195,9 +206,9 @@ class _Scorer:
                 pass
 
             def predict(self, obs, state=None, episode_start=None, deterministic=True):
-                obs = np.asarray(obs, dtype=np.float32)
+                obs = as_float32(obs)
                 if vec_normalize is not None:
-                    obs = vec_normalize.normalize_obs(obs).astype(np.float32)
+                    obs = as_float32(vec_normalize.normalize_obs(obs))
                 return model.predict(obs, deterministic=True)
 
         returns = [run_episode(self.env, Live(), self.seed + k, None)["ret"]
@@ -247,7 +258,7 @@ def run_trial(trial, args: argparse.Namespace, base_hp: dict) -> float:
     from .train import algo_class, algo_kwargs, normalize_kwargs
 
     drawn = SAMPLERS[args.algo](trial)
-    hp = {**base_hp, **drawn}
+    hp = trial_hyperparams(base_hp, drawn)
     hp["n_timesteps"] = args.trial_timesteps
     seed = TUNE_TRAIN_SEED + trial.number
     trial.set_user_attr("train_seed", seed)
@@ -341,8 +352,8 @@ def study_record(study, args: argparse.Namespace, base_hp: dict, argv: list[str]
     if complete:
         b = study.best_trial
         best = dict(number=b.number, value=b.value, params=b.params,
-                    hyperparams=_jsonable({**base_hp, **SAMPLERS[args.algo](
-                        optuna.trial.FixedTrial(b.params))}))
+                    hyperparams=_jsonable(trial_hyperparams(base_hp, SAMPLERS[args.algo](
+                        optuna.trial.FixedTrial(b.params)))))
     return _jsonable(dict(
         env=args.env, algo=args.algo, command=shlex.join(["python", "-m", "agents.tune", *argv]),
         commit=source_commit(), host=host_info(), date=time.strftime("%Y-%m-%d"),
