@@ -140,7 +140,7 @@ def dagger(model, norm, env_id: str, env_kwargs: dict, demos, settings: dict, ga
         played), ``mean_return`` of its episodes, the fit
         (:func:`agents.pretrain.fit_policy`) and ``seconds``.
     """
-    from .pretrain import fit_policy, prime_normalization
+    from .pretrain import refit
 
     rounds, episodes = settings["rounds"], settings["episodes"]
     records = []
@@ -156,16 +156,8 @@ def dagger(model, norm, env_id: str, env_kwargs: dict, demos, settings: dict, ga
             model.policy, norm, env_id, env_kwargs, settings["teacher"], episodes,
             settings["seed"] + r * episodes, beta, progress=progress, label=f"DAgger round {r}")
         demos = aggregate(demos, new)
-        obs, scale = demos.obs, 1.0
-        if norm is not None:
-            prime_normalization(norm, new, gamma)
-            obs = norm.normalize_obs(demos.obs)
-            if norm.norm_reward:
-                scale = float(np.sqrt(norm.ret_rms.var + norm.epsilon))
-        fit = fit_policy(model.policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
-                         epochs=settings["epochs"], batch_size=settings["batch_size"],
-                         learning_rate=float(settings["learning_rate"]),
-                         seed=settings["seed"] + r, deadline=deadline)
+        fit = refit(model.policy, norm, demos, new, gamma, settings, settings["seed"] + r,
+                    deadline)
         records.append({"round": r, "beta": beta, "decisions": len(new),
                         "teacher_share": round(share, 4),
                         "mean_return": float(np.mean(returns)), **fit,

@@ -30,6 +30,13 @@ hyperparameter starts PPO from a copy of the planner instead:
    (Rajeswaran et al., 2018). The term's value is logged as
    ``train/anchor_mse``.
 
+6. **DAgger** (optional, ``rounds`` > 0). After the clone, ``rounds``
+   rounds of dataset aggregation (:mod:`agents.dagger`): the student
+   drives ``episodes`` new episodes, the teacher's action played instead
+   with probability ``beta``:sup:`r` in round r, the teacher labels every
+   visited state, and the student is fitted again to all the labels so
+   far. The anchor then holds PPO near the aggregated labels.
+
 The hyperparameter is a mapping, e.g. in ``agents/hyperparams/ppo.yaml``::
 
     pretrain:
@@ -61,12 +68,13 @@ import numpy as np
 from . import observations as obs_rows
 
 __all__ = ["PRETRAIN_DEFAULTS", "COLLECT_PART", "BudgetTooShort", "pretrain_settings",
-           "Demonstrations", "collect", "prime_normalization", "fit_policy", "BehaviourAnchor",
-           "pretrain"]
+           "Demonstrations", "collect", "prime_normalization", "fit_policy", "refit",
+           "BehaviourAnchor", "pretrain"]
 
 #: settings of ``pretrain`` that may be left out
 PRETRAIN_DEFAULTS = {"episodes": 60, "seed": 30000, "epochs": 50, "batch_size": 256,
-                     "learning_rate": 1.0e-3, "anchor": 0.0, "share": 0.5}
+                     "learning_rate": 1.0e-3, "anchor": 0.0, "share": 0.5, "rounds": 0,
+                     "beta": 0.5}
 #: part of the warm start's share of a budget that the demonstrations may use
 #: (the rest is the fit's)
 COLLECT_PART = 0.85
@@ -116,6 +124,13 @@ def pretrain_settings(value) -> dict | None:
         raise ValueError(f"pretrain share (of a --minutes budget) must be a number in (0, 1), "
                          f"got {share!r}")
     settings["share"] = float(share)
+    rounds = settings["rounds"]
+    if isinstance(rounds, bool) or not isinstance(rounds, int) or rounds < 0:
+        raise ValueError(f"pretrain rounds (of DAgger) must be an integer >= 0, got {rounds!r}")
+    beta = settings["beta"]
+    if isinstance(beta, bool) or not isinstance(beta, (int, float)) or not 0 <= beta <= 1:
+        raise ValueError(f"pretrain beta must be a number in [0, 1], got {beta!r}")
+    settings["beta"] = float(beta)
     return settings
 
 
@@ -369,6 +384,26 @@ class BehaviourAnchor:
         self._handle.remove()
 
 
+def refit(policy, norm, demos: Demonstrations, added: Demonstrations, gamma: float,
+          settings: dict, seed: int, deadline: float | None = None) -> dict:
+    """Fit ``policy`` to the demonstrations ``demos`` (:func:`fit_policy`,
+    with the ``epochs``, ``batch_size`` and ``learning_rate`` of
+    ``settings``) on observations normalised by ``norm`` (a
+    ``VecNormalize`` or None), after priming its statistics with the
+    demonstrations ``added`` since the last fit; the values are the
+    returns to go on the normalised reward scale."""
+    obs, scale = demos.obs, 1.0
+    if norm is not None:
+        prime_normalization(norm, added, gamma)
+        obs = norm.normalize_obs(demos.obs)
+        if norm.norm_reward:
+            scale = float(np.sqrt(norm.ret_rms.var + norm.epsilon))
+    return fit_policy(policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
+                      epochs=settings["epochs"], batch_size=settings["batch_size"],
+                      learning_rate=float(settings["learning_rate"]), seed=seed,
+                      deadline=deadline)
+
+
 def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: float,
              progress: bool = False, deadline: float | None = None) -> dict:
     """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
@@ -394,17 +429,14 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
     demos = collect(env_id, env_kwargs, settings["teacher"], settings["episodes"],
                     settings["seed"], progress=progress, deadline=collect_by)
     collected = time.perf_counter()
-    obs, scale = demos.obs, 1.0
     norm = env if isinstance(env, VecNormalize) else None
-    if norm is not None:
-        prime_normalization(norm, demos, gamma)
-        obs = norm.normalize_obs(demos.obs)
-        if norm.norm_reward:
-            scale = float(np.sqrt(norm.ret_rms.var + norm.epsilon))
-    report = fit_policy(model.policy, obs, demos.actions, demos.returns_to_go(gamma, scale),
-                        epochs=settings["epochs"], batch_size=settings["batch_size"],
-                        learning_rate=float(settings["learning_rate"]), seed=settings["seed"],
-                        deadline=deadline)
+    report = refit(model.policy, norm, demos, demos, gamma, settings, settings["seed"],
+                   deadline)
+    if settings["rounds"]:
+        from .dagger import dagger
+
+        demos, report["dagger"] = dagger(model, norm, env_id, env_kwargs, demos, settings,
+                                         gamma, progress=progress, deadline=deadline)
     if settings["anchor"] > 0:
         BehaviourAnchor(model, demos, norm, settings["anchor"], settings["batch_size"],
                         seed=settings["seed"] + 1)

@@ -86,3 +86,36 @@ def test_a_dagger_round_runs_on_a_ppo_student():
     for r in records:
         assert 0.0 <= r["teacher_share"] <= 1.0 and np.isfinite(r["action_mse"])
     env.close()
+
+
+def test_agents_train_runs_dagger_rounds_in_its_warm_start(tmp_path):
+    """The pretrain hyperparameter with rounds: the clone of the lattice
+    planner on the costmap, one DAgger round, then PPO; pretrain.yaml
+    records the round."""
+    import yaml
+
+    from agents import train
+
+    out = tmp_path / "run"
+    train.main(["--env", NAV, "--algo", "ppo", "--conf", "ppo-costmap.yaml",
+                "--timesteps", "128", "--n-envs", "1", "--seed", "0", "--out", str(out),
+                "--no-progress", "--eval-freq", "0", "--save-freq", "0",
+                "--hyperparams", "n_steps=64", "batch_size=64", "n_epochs=1",
+                "pretrain={teacher: lattice, episodes: 1, epochs: 2, rounds: 1, beta: 0.5}",
+                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items())])
+    report = yaml.safe_load((out / "pretrain.yaml").read_text())
+    assert report["rounds"] == 1 and len(report["dagger"]) == 1
+    round_1 = report["dagger"][0]
+    assert round_1["beta"] == 0.5 and round_1["decisions"] > 0
+
+
+@pytest.mark.parametrize("value, message", [
+    ({"teacher": "lattice", "rounds": -1}, "rounds .* must be an integer >= 0"),
+    ({"teacher": "lattice", "rounds": 1.5}, "rounds .* must be an integer >= 0"),
+    ({"teacher": "lattice", "beta": 2.0}, r"beta must be a number in \[0, 1\]"),
+])
+def test_bad_dagger_settings_are_refused(value, message):
+    from agents.pretrain import pretrain_settings
+
+    with pytest.raises(ValueError, match=message):
+        pretrain_settings(value)
