@@ -16,8 +16,9 @@ name            planner                                                     read
                 the collision impulse it would take, replanned every few
                 steps and followed by pure pursuit
 ``rollout``     :class:`RolloutPlanner`: the lattice's route and the same   the floes, and
-                route moved sideways, each tried by rollouts of the          the episode
-                episode from a snapshot; the best by reward is followed      stepped ahead
+                route moved sideways, each followed to the next plan and     the episode
+                the lattice after, in rollouts of the episode from a         stepped ahead
+                snapshot; the best by reward is followed
 ==============  ==========================================================  ================
 
 The first three are the environments' own controllers
@@ -294,45 +295,52 @@ class LatticePlanner(StraightLinePolicy):
 
 
 class RolloutPlanner(LatticePlanner):
-    """The lattice planner with its route checked, and moved sideways, by
-    rollouts from a snapshot of the episode (``rollout``; privileged).
+    """The lattice planner improved by rollouts of the episode (``rollout``;
+    privileged): a rollout algorithm with the lattice planner as its base
+    policy (Bertsekas, *Rollout, Policy Iteration, and Distributed
+    Reinforcement Learning*, 2020).
 
-    The lattice planner (:class:`agents.planners.LatticePlanner`) prices the
-    ice by the impulse of a head-on collision with each floe at rest, and a
-    route by that price plus its length. What the ship then meets differs:
-    floes pushed ahead pile up, the hull glances off, the stern swings. The
-    rollout planner checks the lattice's route against the environment
-    itself. At each replan it plans the lattice's route, then tries it and
-    the same route moved sideways by each of ``offsets`` (default ±6 m):
-    from a snapshot of the episode (:meth:`iceenvs.base.ControlEnv.snapshot`)
-    it follows each candidate for ``rollout_steps`` steps (default 15, 30 s
-    of model time, 60 m) with the lattice planner's pure pursuit, sums the
-    rewards, restores the episode, and keeps the candidate of the highest
-    sum. The unshifted route is a candidate, so over each rollout's window
-    the plan kept earns at least what the lattice's would: what the rollout
-    planner gains over the lattice on the leaderboard is what that
-    one-window foresight buys, and an upper mark for a learner that imitates
+    The lattice planner prices the ice by the impulse of a head-on
+    collision with each floe at rest, and a route by that price plus its
+    length. What the ship then meets differs: floes pushed ahead pile up,
+    the hull glances off, the stern swings. At each replan the rollout
+    planner plans the lattice's route and tries it and the same route
+    moved sideways by each of ``offsets`` (default ±6 m): from a snapshot
+    of the episode (:meth:`iceenvs.base.ControlEnv.snapshot`) it follows
+    the candidate for the ``replan_steps`` steps until the next plan (the
+    lattice planner's pure pursuit), then lets a fresh lattice planner
+    steer on, for ``rollout_steps`` steps in all (default 30: 60 s of model
+    time, 120 m), sums the rewards, restores the episode, and follows the
+    candidate of the highest sum until the next replan.
+
+    The unshifted candidate is the lattice planner itself, so each choice
+    is scored against what the lattice would earn over the same window.
+    With rollouts to the end of the episode the rollout algorithm never
+    earns less than its base policy in a deterministic environment; over a
+    window of 60 s it is a bet on that window. What it gains over the
+    lattice on the leaderboard is what exact foresight adds to the
+    lattice's price of the ice: an upper mark for a learner that imitates
     it.
 
-    It reads what the lattice reads (every floe within its range) and, more,
-    steps the environment forward: a planner with a perfect model, listed as
+    It reads what the lattice reads (every floe within its range) and steps
+    the episode forward: a planner with a perfect model, listed as
     privileged beside the lattice. Each plan costs ``1 + len(offsets)``
     rollouts of ``rollout_steps`` steps.
 
     Parameters
     ----------
-    env, seed : as :class:`~agents.planners.LatticePlanner`
+    env, seed : as :class:`LatticePlanner`
     offsets : sequence of float [m]
-        Lateral shifts of the lattice's route tried beside it (0 is always
-        tried).
+        Lateral shifts of the lattice's route tried beside it (0, the
+        lattice's own, is always tried).
     rollout_steps : int
-        Steps of each rollout.
+        Steps of each rollout (at least ``replan_steps``).
     **kwargs : the lattice planner's
     """
 
     reads_environment = "its floes, and steps copies of the episode forward"
 
-    def __init__(self, env, seed: int = 0, *, offsets=(-6.0, 6.0), rollout_steps: int = 15,
+    def __init__(self, env, seed: int = 0, *, offsets=(-6.0, 6.0), rollout_steps: int = 30,
                  **kwargs):
         super().__init__(env, seed, **kwargs)
         if not hasattr(self.unwrapped, "snapshot"):
@@ -343,9 +351,11 @@ class RolloutPlanner(LatticePlanner):
             raise ValueError(f"offsets must be finite numbers, got {offsets!r}")
         self.offsets = (0.0, *sorted({o for o in shifts if o != 0.0}))
         if isinstance(rollout_steps, bool) or int(rollout_steps) != rollout_steps \
-                or rollout_steps < 1:
-            raise ValueError(f"rollout_steps must be an integer >= 1, got {rollout_steps!r}")
+                or rollout_steps < self.replan_steps:
+            raise ValueError(f"rollout_steps must be an integer >= replan_steps "
+                             f"({self.replan_steps}), got {rollout_steps!r}")
         self.rollout_steps = int(rollout_steps)
+        self._base_kwargs = dict(kwargs, show=False)
         #: per plan: the offset kept [m] and every candidate's rollout return
         self.choices: list[tuple[float, tuple[float, ...]]] = []
         self._seen = None
@@ -360,22 +370,29 @@ class RolloutPlanner(LatticePlanner):
 
     def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
         """The action that steers for the point ``lookahead`` ahead on
-        ``route`` (the lattice planner's pure pursuit)."""
+        ``route`` (the lattice planner's pure pursuit), clipped to the
+        action space."""
         ship = self.unwrapped.sim.ship
         position = np.asarray(ship.position, dtype=float)
         target_x = position[0] + self.lookahead
         target_y = float(np.interp(target_x, route[:, 0], route[:, 1]))
         bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
         bearing = math.atan2(math.sin(bearing), math.cos(bearing))
-        return self._steer(bearing, self._reader(obs))
+        space = self.action_space
+        return np.clip(self._steer(bearing, self._reader(obs)), space.low,
+                       space.high).astype(space.dtype)
 
     def _rollout(self, route: np.ndarray) -> float:
-        """The summed reward of following ``route`` for ``rollout_steps``
-        steps from now (the episode is restored after)."""
+        """The summed reward of following ``route`` until the next plan and
+        the lattice planner after, ``rollout_steps`` steps in all (on the
+        episode as it is now; the caller restores it)."""
         u = self.unwrapped
+        base = LatticePlanner(self.env, self.seed, **self._base_kwargs)
         obs, total = self._seen, 0.0
-        for _ in range(self.rollout_steps):
-            obs, reward, terminated, truncated, _ = u.step(self._pursue(route, obs))
+        for k in range(self.rollout_steps):
+            action = self._pursue(route, obs) if k < self.replan_steps else \
+                base.predict(obs)[0]
+            obs, reward, terminated, truncated, _ = u.step(action)
             total += float(reward)
             if terminated or truncated:
                 break

@@ -29,7 +29,7 @@ def _sail(policy_class, seed=3, **kwargs):
 def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
     """Rolled out and restored at every plan, the episode is the lattice
     planner's, bit for bit: the rollouts change nothing of it."""
-    planner, rewards, observations = _sail(RolloutPlanner, offsets=(), rollout_steps=6)
+    planner, rewards, observations = _sail(RolloutPlanner, offsets=(), rollout_steps=8)
     _, lattice_rewards, lattice_observations = _sail(LatticePlanner)
     np.testing.assert_array_equal(rewards, lattice_rewards)
     np.testing.assert_array_equal(observations, lattice_observations)
@@ -37,7 +37,7 @@ def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
 
 
 def test_each_plan_keeps_the_candidate_of_the_best_rollout():
-    planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=6)
+    planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=8)
     assert planner.offsets == (0.0, -6.0, 6.0)
     for offset, returns in planner.choices:
         assert len(returns) == 3 and returns[planner.offsets.index(offset)] == max(returns)
@@ -46,8 +46,8 @@ def test_each_plan_keeps_the_candidate_of_the_best_rollout():
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"offsets": (float("nan"),)}, "offsets must be finite"),
-    ({"rollout_steps": 0}, "rollout_steps must be an integer >= 1"),
-    ({"rollout_steps": 2.5}, "rollout_steps must be an integer >= 1"),
+    ({"rollout_steps": 4}, "rollout_steps must be an integer >= replan_steps"),
+    ({"rollout_steps": 7.5}, "rollout_steps must be an integer >= replan_steps"),
 ])
 def test_refused_arguments(kwargs, message):
     env = gym.make(NAV, **KWARGS)
