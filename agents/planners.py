@@ -245,9 +245,11 @@ class LatticePlanner(StraightLinePolicy):
         half = 0.5 * u.channel_width - self.edge_margin
         low_y, high_y = u.centre_y - half, u.centre_y + half
         # grid rows: y = y0 + (b + 0.5) cell, aligned so that the ship's y is a row centre
-        below = int(math.ceil((y - low_y) / cell)) + 1
+        # (a ship within the edge margin, where another controller took it, has no
+        # rows on that side of it but its own and the next)
+        below = max(int(math.ceil((y - low_y) / cell)), 0) + 1
         y0 = y - (below + 0.5) * cell
-        ny = below + int(math.ceil((high_y - y) / cell)) + 2
+        ny = below + max(int(math.ceil((high_y - y) / cell)), 0) + 2
         nx = n_stages * stage_cells
         ice = u.ice_near(math.hypot(reach_x, max(y - low_y, high_y - y)) + 60.0)
         beam = float(u.ship.hull.beam)

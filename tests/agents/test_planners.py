@@ -96,3 +96,24 @@ def test_the_rollout_planner_is_played_only_when_named():
     assert "rollout" not in leaderboard.default_policies(NAV)
     assert "lattice" in leaderboard.default_policies(NAV)
     assert "rollout" not in benchmark._baseline_recipes(NAV)
+
+
+def test_the_lattice_plans_for_a_ship_within_the_edge_margin():
+    """A ship that another controller (a learner in DAgger) took within
+    ``edge_margin`` of the edge still gets a route from where it is, never
+    farther out."""
+    env = gym.make(NAV, **SMALL[NAV])
+    env.reset(seed=0)
+    u = env.unwrapped
+    planner = LatticePlanner(env, 0)
+    edge = u.centre_y + 0.5 * u.channel_width
+    for k in range(80):
+        env.step(np.array([1.0 if k < 10 else 0.0], dtype=np.float32))
+        if u.sim.ship.position[1] > edge - 0.5 * planner.edge_margin:
+            break
+    y = u.sim.ship.position[1]
+    assert edge - planner.edge_margin < y < edge
+    route = planner.plan()
+    assert np.isfinite(route).all() and route[0, 1] == pytest.approx(y, abs=1e-9)
+    assert route[:, 1].max() <= y + 1e-9
+    env.close()
