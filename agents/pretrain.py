@@ -420,7 +420,9 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
     -------
     dict
         The settings, ``decisions``, ``episodes_sailed``, the fit
-        (:func:`fit_policy`) and ``collect_seconds`` and ``fit_seconds``.
+        (:func:`fit_policy`) and ``collect_seconds`` of the clone and
+        ``fit_seconds`` (the DAgger rounds included); with DAgger rounds, ``dagger`` (a record per round,
+        :func:`agents.dagger.dagger`) and ``aggregated_decisions``.
     """
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -432,14 +434,16 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
     norm = env if isinstance(env, VecNormalize) else None
     report = refit(model.policy, norm, demos, demos, gamma, settings, settings["seed"],
                    deadline)
+    clone = demos
     if settings["rounds"]:
         from .dagger import dagger
 
         demos, report["dagger"] = dagger(model, norm, env_id, env_kwargs, demos, settings,
                                          gamma, progress=progress, deadline=deadline)
+        report["aggregated_decisions"] = len(demos)
     if settings["anchor"] > 0:
         BehaviourAnchor(model, demos, norm, settings["anchor"], settings["batch_size"],
                         seed=settings["seed"] + 1)
-    return {**settings, "decisions": len(demos), "episodes_sailed": demos.episodes, **report,
+    return {**settings, "decisions": len(clone), "episodes_sailed": clone.episodes, **report,
             "collect_seconds": round(collected - start, 1),
             "fit_seconds": round(time.perf_counter() - collected, 1)}
