@@ -307,7 +307,7 @@ class RolloutPlanner(LatticePlanner):
     length. What the ship then meets differs: floes pushed ahead pile up,
     the hull glances off, the stern swings. At each replan the rollout
     planner plans the lattice's route and tries it and the same route
-    moved sideways by each of ``offsets`` (default ±6 m): from a snapshot
+    moved sideways by each of ``offsets`` (default ±4 and ±10 m): from a snapshot
     of the episode (:meth:`iceenvs.base.ControlEnv.snapshot`) it follows
     the candidate for the ``replan_steps`` steps until the next plan (the
     lattice planner's pure pursuit), then lets a fresh lattice planner
@@ -329,6 +329,11 @@ class RolloutPlanner(LatticePlanner):
     privileged beside the lattice. Each plan costs ``1 + len(offsets)``
     rollouts of ``rollout_steps`` steps.
 
+    The defaults were chosen on fields apart from the leaderboard's (seeded
+    40000 + k, A = 0.3 and 0.4) among ±6 m with 30 or 50 steps and ±4 and
+    ±10 m with 30: with 50 steps the bet lost fields to the lattice, and
+    the four offsets gained most.
+
     Parameters
     ----------
     env, seed : as :class:`LatticePlanner`
@@ -342,7 +347,8 @@ class RolloutPlanner(LatticePlanner):
 
     reads_environment = "its floes, and steps copies of the episode forward"
 
-    def __init__(self, env, seed: int = 0, *, offsets=(-6.0, 6.0), rollout_steps: int = 30,
+    def __init__(self, env, seed: int = 0, *, offsets=(-10.0, -4.0, 4.0, 10.0),
+                 rollout_steps: int = 30,
                  **kwargs):
         super().__init__(env, seed, **kwargs)
         if not hasattr(self.unwrapped, "snapshot"):

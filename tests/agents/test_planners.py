@@ -38,7 +38,7 @@ def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
 
 def test_each_plan_keeps_the_candidate_of_the_best_rollout():
     planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=8)
-    assert planner.offsets == (0.0, -6.0, 6.0)
+    assert planner.offsets == (0.0, -6.0, 6.0)  # the offsets asked for, 0 first
     for offset, returns in planner.choices:
         assert len(returns) == 3 and returns[planner.offsets.index(offset)] == max(returns)
     assert len(planner.choices) == len(planner.decision_times)
