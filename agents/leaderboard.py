@@ -29,6 +29,12 @@ record)::
         [--merge [--replace NAMES]]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
+    python -m agents.leaderboard --render --against swath [--group NAME=P1,P2,P3] [--out DIR]
+
+``--against NAME`` writes ``against-NAME.md``: every policy's return paired
+with NAME's field by field, at each concentration and over all, where
+``--group`` makes one policy of several (a learner's training seeds: its
+return on a field is the mean of theirs).
 """
 from __future__ import annotations
 
@@ -49,6 +55,7 @@ from physics.provenance import source_commit
 from .metrics import METRIC_UNITS, rounding_noise, significant
 
 __all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "record_commands",
+           "grouped", "against_markdown",
            "plot_board", "main",
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
@@ -407,6 +414,66 @@ def default_policies(env_id: str) -> list[str]:
             if n not in GENERIC and n != "heuristic" and n not in ON_REQUEST]
 
 
+def grouped(board: dict, groups: dict) -> dict:
+    """``board`` with a policy for each group (name → its member policies,
+    e.g. one trained run's seeds): on each field the mean of its members'
+    returns, so that a learner's seeds are compared as one policy, paired
+    by field. Members missing from the board are an error."""
+    out = {}
+    for a, policies in board.items():
+        out[a] = dict(policies)
+        for name, members in groups.items():
+            missing = [m for m in members if m not in policies]
+            if missing:
+                raise ValueError(f"group {name}: {', '.join(missing)} not on the board "
+                                 f"(policies: {', '.join(policies)})")
+            rows = [policies[m] for m in members]
+            out[a][name] = [{"seed": e[0]["seed"], "ret": float(np.mean([x["ret"] for x in e])),
+                             "final": {}} for e in zip(*rows)]
+    return out
+
+
+def against_markdown(board: dict, reference: str, groups: dict | None = None) -> str:
+    """A table of every policy's return paired with ``reference``'s on the
+    same fields (policy − reference, mean ± standard error; *beats* /
+    *loses*: by more than two standard errors), at each concentration and
+    over all together; groups (:func:`grouped`) as policies of their own."""
+    from .rollouts import compare
+
+    board = grouped(board, groups or {})
+    concentrations = list(board)
+    if reference not in board[concentrations[0]]:
+        raise ValueError(f"--against {reference}: not on the board "
+                         f"(policies: {', '.join(board[concentrations[0]])})")
+    names = [n for n in board[concentrations[0]] if n != reference]
+    lines = [f"Return − {reference}'s on the same fields (mean ± standard error over the "
+             f"fields; *beats* / *loses*: by more than two standard errors"
+             + ("; a group's return on a field is the mean of its members': "
+                + "; ".join(f"{g} = {', '.join(m)}" for g, m in groups.items())
+                if groups else "") + "):", "",
+             "| policy | " + " | ".join(f"A = {a}" for a in concentrations) + " | all |",
+             "|---" * (len(concentrations) + 2) + "|"]
+    for name in names:
+        cells = []
+        for a in concentrations:
+            c = compare(board[a][name], board[a][reference])
+            cells.append(_paired_cell(c, 1.0).replace(" (beats)", " beats")
+                         + (" loses" if c["loses"] else ""))
+        every = compare([e for a in concentrations for e in board[a][name]],
+                        [e for a in concentrations for e in board[a][reference]])
+        cells.append(_paired_cell(every, 1.0).replace(" (beats)", " beats")
+                     + (" loses" if every["loses"] else ""))
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _group_argument(item: str) -> tuple[str, list[str]]:
+    name, sep, members = item.partition("=")
+    if not sep or not name or not members:
+        raise argparse.ArgumentTypeError(f"a group is NAME=POLICY,POLICY,..., got {item!r}")
+    return name, [m for m in members.split(",") if m]
+
+
 def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -433,6 +500,13 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--merge", action="store_true",
                    help="keep the policies of the JSON in --out (same environment, arguments, "
                         "concentrations and fields) and run only the others")
+    p.add_argument("--against", default="", metavar="NAMES",
+                   help="with --render: for each comma-separated policy NAME, write "
+                        "against-NAME.md, every policy's return paired with NAME's")
+    p.add_argument("--group", action="append", default=[], type=_group_argument,
+                   metavar="NAME=POLICY,POLICY,...",
+                   help="with --against: a policy whose return on a field is the mean of "
+                        "its members' (a trained run's seeds), repeatable")
     p.add_argument("--replace", default="", metavar="NAMES",
                    help="with --merge: comma-separated policies to run again and replace "
                         "though the JSON has them")
@@ -514,6 +588,15 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         if episodes is not None:            # summarised again, with this version's statistics
             report = summarised(report, episodes)
         _write(report, out)
+        against = [n for n in args.against.split(",") if n]
+        if against and episodes is None:
+            parser.error(f"--against pairs episodes, and {out / EPISODES} does not exist")
+        for name in against:
+            try:
+                text = against_markdown(episodes, name, dict(args.group))
+            except ValueError as err:
+                parser.error(str(err))
+            (out / f"against-{name}.md").write_text(text)
         return report
 
     import numba

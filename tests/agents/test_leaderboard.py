@@ -260,3 +260,27 @@ def test_an_error_of_rounding_shows_as_zero():
     # a real spread, however small against the value, is kept
     assert leaderboard._plus_minus(1.0, 1.7e-6) == "1.00 ± 0.0000017"
     assert format_pm(0.00596026, 1.4e-7) == "0.00596026 ± 0.00000014"
+
+
+def test_policies_are_paired_with_any_other_and_seeds_grouped():
+    board = {"0.2": {"straight": [_field(100.0, 1.0), _field(50.0, 1.0)],
+                     "a": [_field(99.0, 1.0), _field(70.0, 1.0)],
+                     "b": [_field(103.0, 1.0), _field(56.0, 1.0)]},
+             "0.3": {"straight": [_field(80.0, 1.0), _field(60.0, 1.0)],
+                     "a": [_field(84.0, 1.0), _field(66.0, 1.0)],
+                     "b": [_field(82.0, 1.0), _field(64.0, 1.0)]}}
+    # the group of a and b: on each field the mean of their returns
+    group = leaderboard.grouped(board, {"ab": ["a", "b"]})
+    assert [e["ret"] for e in group["0.2"]["ab"]] == [101.0, 63.0]
+    text = leaderboard.against_markdown(board, "straight", {"ab": ["a", "b"]})
+    rows = {line.split(" | ")[0][2:]: line for line in text.splitlines() if line.startswith("| ")}
+    # a at 0.2: differences −1 and +20, mean 9.5 ± 10.5; over all −1, 20, 4 and 6: 7.25 ± 4.5
+    assert "| 9.50 ± 10 |" in rows["a"]
+    assert rows["a"].endswith("| 7.25 ± 4.5 |")
+    # ab at 0.3: differences 3 and 5, mean 4 ± 1: better by 4 standard errors
+    assert "| 4.00 ± 1.0 beats |" in rows["ab"]
+    assert "straight" not in rows
+    with pytest.raises(ValueError, match="group ab: c not on the board"):
+        leaderboard.grouped(board, {"ab": ["a", "c"]})
+    with pytest.raises(ValueError, match="--against swath: not on the board"):
+        leaderboard.against_markdown(board, "swath")
