@@ -414,6 +414,25 @@ def default_policies(env_id: str) -> list[str]:
             if n not in GENERIC and n != "heuristic" and n not in ON_REQUEST]
 
 
+#: what :func:`agents.rollouts.run_episode` counts of a ship's steps, where it can
+EPISODE_COUNTS = ("outside_steps", "guard_overrides")
+
+
+def _counts(episodes: list[dict]) -> list[str]:
+    """The mean steps outside the channel per field, and the share of steps
+    on which the course guard overrode the command ("–" where not counted)."""
+    cells = []
+    for key in EPISODE_COUNTS:
+        if not episodes or not all(key in e for e in episodes):
+            cells.append("–")
+        elif key == "outside_steps":
+            cells.append(f"{np.mean([e[key] for e in episodes]):.1f}")
+        else:
+            share = sum(e[key] for e in episodes) / max(sum(e["length"] for e in episodes), 1)
+            cells.append(f"{share:.1%}")
+    return cells
+
+
 def grouped(board: dict, groups: dict) -> dict:
     """``board`` with a policy for each group (name → its member policies,
     e.g. one trained run's seeds): on each field the mean of its members'
@@ -428,8 +447,10 @@ def grouped(board: dict, groups: dict) -> dict:
                 raise ValueError(f"group {name}: {', '.join(missing)} not on the board "
                                  f"(policies: {', '.join(policies)})")
             rows = [policies[m] for m in members]
-            out[a][name] = [{"seed": e[0]["seed"], "ret": float(np.mean([x["ret"] for x in e])),
-                             "final": {}} for e in zip(*rows)]
+            out[a][name] = [{"seed": e[0]["seed"], "final": {},
+                             **{key: float(np.mean([x[key] for x in e]))
+                                for key in ("ret", "length", *EPISODE_COUNTS)
+                                if all(key in x for x in e)}} for e in zip(*rows)]
     return out
 
 
@@ -451,8 +472,9 @@ def against_markdown(board: dict, reference: str, groups: dict | None = None) ->
              + ("; a group's return on a field is the mean of its members': "
                 + "; ".join(f"{g} = {', '.join(m)}" for g, m in groups.items())
                 if groups else "") + "):", "",
-             "| policy | " + " | ".join(f"A = {a}" for a in concentrations) + " | all |",
-             "|---" * (len(concentrations) + 2) + "|"]
+             "| policy | " + " | ".join(f"A = {a}" for a in concentrations)
+             + " | all | steps outside the channel (per field) | guard overrides (of steps) |",
+             "|---" * (len(concentrations) + 4) + "|"]
     for name in names:
         cells = []
         for a in concentrations:
@@ -463,6 +485,7 @@ def against_markdown(board: dict, reference: str, groups: dict | None = None) ->
                         [e for a in concentrations for e in board[a][reference]])
         cells.append(_paired_cell(every, 1.0).replace(" (beats)", " beats")
                      + (" loses" if every["loses"] else ""))
+        cells += _counts([e for a in concentrations for e in board[a][name]])
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 

@@ -113,10 +113,29 @@ def episode_task(env, info: dict) -> dict[str, float]:
     return out
 
 
+def _course_guard(env):
+    """For a ship commanded by course with a course guard, ``overrides(action)``:
+    1 when the autopilot will hold another course than the one commanded
+    (:meth:`iceenvs.ship_navigation_v1.ShipNavigationV1Env.guarded_course`),
+    else 0; None for any other environment."""
+    u = env.unwrapped
+    if getattr(u, "control", None) != "course" or not hasattr(u, "guarded_course") \
+            or (getattr(u, "episode", None) or {}).get("course_guard") is None:
+        return None
+
+    def overrides(action) -> int:
+        course = float(np.clip(np.ravel(action)[0], -1.0, 1.0)) * u.episode["max_course"]
+        return int(abs(u.guarded_course(course) - course) > 1e-9)
+    return overrides
+
+
 def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     """One episode from ``reset(seed=seed)``: return, length, final physics
     metrics, the per-step rewards and main metric, and the task
-    parameters drawn for the episode (``task``: :func:`episode_task`)."""
+    parameters drawn for the episode (``task``: :func:`episode_task`); for
+    a ship in a channel, the steps it ended outside (``outside_steps``) and,
+    commanded by course with a guard, the steps on which the guard held
+    another course than the one commanded (``guard_overrides``)."""
     logged_metrics = env_facts(env.spec.id).logged_metrics
     obs, info = env.reset(seed=seed)
     task = episode_task(env, info)
@@ -124,11 +143,16 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     rewards, trace = [], []
     final = logged_metrics(info)
     thinking = 0.0
+    guard = _course_guard(env)
+    overrides = outside = 0
     while True:
         t0 = time.perf_counter()
         action, _ = policy.predict(obs, deterministic=True)
         thinking += time.perf_counter() - t0
+        if guard is not None:
+            overrides += guard(action)
         obs, reward, terminated, truncated, info = env.step(action)
+        outside += abs(info.get("physics", {}).get("channel_offset", 0.0)) > 1.0
         rewards.append(float(reward))
         metrics = logged_metrics(info)
         final = metrics or final
@@ -138,6 +162,10 @@ def run_episode(env, policy, seed: int, main_metric: str | None) -> dict:
     out = dict(seed=seed, ret=float(np.sum(rewards)), length=len(rewards),
                terminated=bool(terminated), final=final, rewards=rewards, trace=trace,
                decision_ms=1e3 * thinking / max(len(rewards), 1), task=task)
+    if "channel_offset" in info.get("physics", {}):
+        out["outside_steps"] = int(outside)
+    if guard is not None:
+        out["guard_overrides"] = int(overrides)
     plans = getattr(policy, "decision_times", None)
     if plans:
         out["plan_ms"] = 1e3 * float(np.mean(plans))

@@ -276,7 +276,7 @@ def test_policies_are_paired_with_any_other_and_seeds_grouped():
     rows = {line.split(" | ")[0][2:]: line for line in text.splitlines() if line.startswith("| ")}
     # a at 0.2: differences −1 and +20, mean 9.5 ± 10.5; over all −1, 20, 4 and 6: 7.25 ± 4.5
     assert "| 9.50 ± 10 |" in rows["a"]
-    assert rows["a"].endswith("| 7.25 ± 4.5 |")
+    assert "| 7.25 ± 4.5 | – | – |" in rows["a"]
     # ab at 0.3: differences 3 and 5, mean 4 ± 1: better by 4 standard errors
     assert "| 4.00 ± 1.0 beats |" in rows["ab"]
     assert "straight" not in rows
@@ -284,3 +284,32 @@ def test_policies_are_paired_with_any_other_and_seeds_grouped():
         leaderboard.grouped(board, {"ab": ["a", "c"]})
     with pytest.raises(ValueError, match="--against swath: not on the board"):
         leaderboard.against_markdown(board, "swath")
+
+
+def test_the_steps_outside_and_the_guards_overrides_are_counted():
+    """agents.rollouts counts them per episode; the comparison shows the
+    mean per field and the share of steps, a group's the mean of its members'."""
+    import gymnasium as gym
+
+    from agents.baselines import ConstantPolicy
+    from agents.rollouts import run_episode
+    from small_envs import SMALL
+
+    nav = "iceenvs/ShipNavigation-v1"
+    # full port course under a guard of 150 m in a channel 200 m wide: overridden
+    env = gym.make(nav, **{**SMALL[nav], "control": "course", "course_guard": 150.0})
+    episode = run_episode(env, ConstantPolicy(env, 0, action=[1.0]), 3, None)
+    assert 0 < episode["guard_overrides"] <= episode["length"]
+    assert episode["outside_steps"] == 0
+    env.close()
+    # yaw control without a guard: a circle of 100 m radius leaves the channel, nothing is
+    # overridden
+    env = gym.make(nav, **SMALL[nav])
+    episode = run_episode(env, ConstantPolicy(env, 0, action=[0.5]), 3, None)
+    assert "guard_overrides" not in episode and episode["outside_steps"] > 0
+    env.close()
+    field = dict(_field(1.0, 1.0), length=100, outside_steps=4, guard_overrides=10)
+    other = dict(_field(2.0, 1.0), length=100, outside_steps=0, guard_overrides=0)
+    board = {"0.2": {"straight": [_field(0.0, 1.0)], "a": [field], "b": [other]}}
+    text = leaderboard.against_markdown(board, "straight", {"ab": ["a", "b"]})
+    assert "| 4.0 | 10.0% |" in text and "| 2.0 | 5.0% |" in text
