@@ -385,6 +385,21 @@ def test_learning_curve_from_progress_csv(tmp_path):
     assert (run / "learning_curve.png").stat().st_size > 1000
     with pytest.raises(SystemExit):
         curves_main([str(tmp_path / "missing")])
+    # the seeds of a recipe on one figure, with their DAgger rounds
+    from agents.curves import dagger_rounds
+
+    other = tmp_path / "other"
+    (other / "logs").mkdir(parents=True)
+    (other / "logs" / "progress.csv").write_text((run / "logs" / "progress.csv").read_text())
+    (other / "pretrain.yaml").write_text(
+        "dagger:\n- {round: 1, beta: 0.5, mean_return: 10.0}\n"
+        "- {round: 2, beta: 0.25, mean_return: 12.0}\n")
+    assert dagger_rounds(other) == [(1, 0.5, 10.0), (2, 0.25, 12.0)] and dagger_rounds(run) == []
+    with pytest.raises(SystemExit):
+        curves_main([str(run), str(other)])              # several need --out
+    figure = tmp_path / "seeds.png"
+    assert curves_main([str(run), str(other), "--out", str(figure)]) == figure
+    assert figure.stat().st_size > 1000
 
 
 def test_a_checkpoint_is_evaluated_on_its_own(ppo_runs, tmp_path, capsys):
