@@ -405,12 +405,15 @@ def refit(policy, norm, demos: Demonstrations, added: Demonstrations, gamma: flo
 
 
 def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: float,
-             progress: bool = False, deadline: float | None = None) -> dict:
+             progress: bool = False, deadline: float | None = None, rounds=None) -> dict:
     """Warm-start ``model`` (an SB3 actor-critic such as PPO) on the
     training stack ``env`` from the demonstrations of ``settings["teacher"]``
     (steps 1-5 of the module's description).
 
-    With ``settings["anchor"]`` > 0, a :class:`BehaviourAnchor` on the
+    With ``settings["rounds"]`` > 0, ``rounds`` (:func:`agents.dagger.dagger`,
+    which this module does not import, since it builds on this one) runs the
+    DAgger rounds after the clone. With ``settings["anchor"]`` > 0, a
+    :class:`BehaviourAnchor` on the
     same demonstrations is left on the model's optimiser for PPO. With
     ``deadline`` (a ``time.perf_counter`` value: the end of the warm
     start's share of a budget) the demonstrations end by
@@ -436,9 +439,10 @@ def pretrain(model, env, env_id: str, env_kwargs: dict, settings: dict, gamma: f
                    deadline)
     clone = demos
     if settings["rounds"]:
-        from .dagger import dagger
-
-        demos, report["dagger"] = dagger(model, norm, env_id, env_kwargs, demos, settings,
+        if rounds is None:
+            raise ValueError("pretrain rounds > 0 need the DAgger rounds: pass "
+                             "rounds=agents.dagger.dagger")
+        demos, report["dagger"] = rounds(model, norm, env_id, env_kwargs, demos, settings,
                                          gamma, progress=progress, deadline=deadline)
         report["aggregated_decisions"] = len(demos)
     if settings["anchor"] > 0:

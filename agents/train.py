@@ -518,6 +518,7 @@ def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path,
     if args.init_from is not None:
         print("no warm start: the run starts from --init-from", flush=True)
         return None
+    from .dagger import dagger
     from .pretrain import COLLECT_PART, BudgetTooShort, pretrain
 
     settings = hp["pretrain"]
@@ -534,7 +535,7 @@ def warm_start(args: argparse.Namespace, hp: dict, model, env, run_dir: Path,
     try:
         report = pretrain(model, env, args.env, hp["env_kwargs"], settings,
                           gamma=float(hp.get("gamma", 0.99)), progress=not args.no_progress,
-                          deadline=deadline)
+                          deadline=deadline, rounds=dagger)
     except BudgetTooShort as err:
         # the share must hold the set-up so far and one episode, in COLLECT_PART of it
         needed = (time.perf_counter() - started) / COLLECT_PART / settings["share"]
