@@ -21,7 +21,8 @@ tables) and ``leaderboard.png`` (impulse per metre and return against
 concentration), and the episodes behind it, ``episodes.json`` (every
 episode's final metrics: what ``--merge`` pairs new policies with, and
 ``--render`` summarises again; large, and not committed with a documented
-record)::
+record). The record keeps its summaries to eight significant figures (its
+tables show at most four), and ``--render`` writes it back so::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
@@ -519,7 +520,8 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
     p.add_argument("--out", type=Path, default=DEFAULT_OUT,
                    help=f"output directory (default {DEFAULT_OUT})")
     p.add_argument("--render", action="store_true",
-                   help="write the table and the plot again from the JSON in --out")
+                   help="write the table and the plot again from the JSON in --out (and the "
+                        "JSON, its summaries to 8 significant figures)")
     p.add_argument("--merge", action="store_true",
                    help="keep the policies of the JSON in --out (same environment, arguments, "
                         "concentrations and fields) and run only the others")
@@ -553,11 +555,29 @@ def read_board(out: Path) -> tuple[dict, dict | None]:
     return report, episodes
 
 
+#: significant figures a record keeps of its summaries (its tables show at most
+#: four); the episodes behind them keep every digit
+RECORD_DIGITS = 8
+
+
+def rounded(value):
+    """``value`` with every float in it to :data:`RECORD_DIGITS` significant
+    figures (dicts and lists gone through)."""
+    if isinstance(value, float):
+        return float(f"{value:.{RECORD_DIGITS}g}") if math.isfinite(value) else value
+    if isinstance(value, dict):
+        return {k: rounded(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [rounded(v) for v in value]
+    return value
+
+
 def summarised(report: dict, board: dict) -> dict:
-    """``report`` with the summaries and the pooled comparison of ``board``."""
+    """``report`` with the summaries and the pooled comparison of ``board``
+    (:func:`rounded`)."""
     summary = summarise_board(board)
-    return {**report, "summary": summary,
-            "pooled": pooled_comparison(board) if len(summary) > 1 else {}}
+    return {**report, "summary": rounded(summary),
+            "pooled": rounded(pooled_comparison(board)) if len(summary) > 1 else {}}
 
 
 def _mergeable(parser, args, out: Path, conc, env_kwargs, again) -> dict:
@@ -609,7 +629,14 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
             parser.error(f"--render: {path} does not exist")
         report, episodes = read_board(out)
         if episodes is not None:            # summarised again, with this version's statistics
+            if not (out / EPISODES).exists():   # a record that held its episodes keeps them
+                (out / EPISODES).write_text(json.dumps(episodes))
             report = summarised(report, episodes)
+        else:
+            report = {**report, "summary": rounded(report["summary"])}
+            if report.get("pooled") is not None:
+                report["pooled"] = rounded(report["pooled"])
+        (out / RECORD).write_text(json.dumps(report))
         _write(report, out)
         against = [n for n in args.against.split(",") if n]
         if against and episodes is None:

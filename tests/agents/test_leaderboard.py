@@ -313,3 +313,10 @@ def test_the_steps_outside_and_the_guards_overrides_are_counted():
     board = {"0.2": {"straight": [_field(0.0, 1.0)], "a": [field], "b": [other]}}
     text = leaderboard.against_markdown(board, "straight", {"ab": ["a", "b"]})
     assert "| 4.0 | 10.0% |" in text and "| 2.0 | 5.0% |" in text
+
+
+def test_a_record_keeps_its_summaries_to_eight_significant_figures():
+    value = {"a": [1.2345678912345, float("nan")], "b": {"c": -0.000123456789123}, "d": 3}
+    out = leaderboard.rounded(value)
+    assert out["a"][0] == 1.2345679 and math.isnan(out["a"][1])
+    assert out["b"]["c"] == -0.00012345679 and out["d"] == 3
