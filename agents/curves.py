@@ -128,8 +128,10 @@ def plot_seeds(run_dirs, path: str | Path) -> Path:
             if rounds[run]:
                 r, _, ret = zip(*rounds[run])
                 ax0.plot(r, ret, "o-", color=f"C{k}", lw=1.2, label=run.name)
+        ax0.set_xticks(sorted({r for run in runs for r, _, _ in rounds[run]}))
         ax0.set(xlabel="DAgger round r (the teacher plays with probability β^r)",
-                ylabel="mean return of the round's episodes", title="DAgger")
+                ylabel="mean return of the round's episodes (its own fields)",
+                title="DAgger")
         ax0.grid(alpha=0.3)
         ax0.legend(fontsize=8)
     path = Path(path)
