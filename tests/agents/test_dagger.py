@@ -119,3 +119,33 @@ def test_bad_dagger_settings_are_refused(value, message):
 
     with pytest.raises(ValueError, match=message):
         pretrain_settings(value)
+
+
+def test_the_students_error_on_fields_it_never_saw(tmp_path):
+    """A student trained by agents.train (one round) is held against its
+    teacher on new fields; with the teacher's own run as its data the
+    held-out error is a mean of squares, never negative, and the command
+    writes its table."""
+    import json
+
+    from agents import dagger as dagger_module
+    from agents import train
+
+    out = tmp_path / "run"
+    train.main(["--env", NAV, "--algo", "ppo", "--conf", "ppo-costmap-dagger.yaml",
+                "--timesteps", "64", "--n-envs", "1", "--seed", "0", "--out", str(out),
+                "--no-progress", "--eval-freq", "0", "--save-freq", "64",
+                "--hyperparams", "n_steps=64", "batch_size=64", "n_epochs=1",
+                "pretrain={teacher: lattice, episodes: 1, epochs: 2, rounds: 1}",
+                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items())])
+    table = tmp_path / "held-out.md"
+    rows = dagger_module.main([str(out), "--checkpoint", "0", "--episodes", "1", "--seed", "7",
+                               "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items()),
+                               "--out", str(table)])
+    row = rows[0]
+    assert row["teacher"] == "lattice" and row["decisions"] > 0
+    assert row["held_out_mse"] >= 0 and row["variance"] > 0
+    assert "| run | held-out error |" in table.read_text()
+    assert json.loads(table.with_suffix(".json").read_text())["rows"][0]["seed"] == 7
+    with pytest.raises(SystemExit):
+        dagger_module.main([str(tmp_path / "missing")])
