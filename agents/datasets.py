@@ -186,16 +186,14 @@ def demonstrations(dataset):
 
 
 def build_parser(prog: str = "python -m agents.datasets") -> argparse.ArgumentParser:
-    from .envs import registered_env_id
+    from .envs import episode_arguments, registered_env_id
 
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--env", required=True, type=registered_env_id, help="environment id")
     p.add_argument("--teacher", required=True,
                    help="baseline that sails the episodes (e.g. lattice, swath)")
-    p.add_argument("--episodes", type=int, default=20, help="episodes (20)")
-    p.add_argument("--seed", type=int, default=30000, help="episode k is seeded SEED + k")
-    p.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
-                   help="gymnasium.make keywords (e.g. obs_type=costmap_dict)")
+    episode_arguments(p, episodes=20, seed=30000,
+                      kwargs_help="gymnasium.make keywords (e.g. obs_type=costmap_dict)")
     p.add_argument("--root", type=Path, default=DEFAULT_ROOT,
                    help=f"Minari's datasets folder ({DEFAULT_ROOT})")
     p.add_argument("--name", default=None,

@@ -16,6 +16,7 @@ import copy
 from pathlib import Path
 
 __all__ = ["EnvFactory", "make_vec_env", "load_normalization", "parse_key_values",
+           "episode_arguments",
            "make_checked_env", "check_env_kwargs", "normalize_for_space"]
 
 
@@ -311,3 +312,12 @@ def load_normalization(stats_path: str | Path, env_id: str, env_kwargs: dict | N
     vn.training = False
     vn.norm_reward = False
     return vn
+
+
+def episode_arguments(p, *, episodes: int, seed: int, kwargs_help: str) -> None:
+    """Add ``--episodes``, ``--seed`` (episode k seeded SEED + k) and
+    ``--env-kwargs`` to the parser ``p`` of a command that sails a planner's
+    episodes."""
+    p.add_argument("--episodes", type=int, default=episodes, help=f"episodes ({episodes})")
+    p.add_argument("--seed", type=int, default=seed, help="episode k is seeded SEED + k")
+    p.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE", help=kwargs_help)

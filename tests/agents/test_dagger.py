@@ -1,4 +1,5 @@
-"""DAgger (agents.dagger): who drives, who labels, and a round that runs."""
+"""DAgger (agents.dagger): who drives, who labels, a round that runs, and the
+student against its teacher on fields it was not fitted on (agents.held_out)."""
 import numpy as np
 import pytest
 
@@ -9,6 +10,20 @@ from small_envs import SMALL
 NAV = "iceenvs/ShipNavigation-v1"
 # a short transit: about 60 steps of the small field
 KWARGS = {**SMALL[NAV], "length": 300.0, "goal_distance": 150.0}
+
+
+def train_with_a_round(out, *, timesteps: int, save_freq: int):
+    """agents.train with the costmap recipe on a short field: the lattice's
+    clone from one episode, one DAgger round (beta 0.5), then PPO."""
+    from agents import train
+
+    train.main(["--env", NAV, "--algo", "ppo", "--conf", "ppo-costmap.yaml",
+                "--timesteps", str(timesteps), "--n-envs", "1", "--seed", "0", "--out", str(out),
+                "--no-progress", "--eval-freq", "0", "--save-freq", str(save_freq),
+                "--hyperparams", "n_steps=64", "batch_size=64", "n_epochs=1",
+                "pretrain={teacher: lattice, episodes: 1, epochs: 2, rounds: 1, beta: 0.5}",
+                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items())])
+    return out
 
 
 class Constant:
@@ -94,15 +109,7 @@ def test_agents_train_runs_dagger_rounds_in_its_warm_start(tmp_path):
     records the round."""
     import yaml
 
-    from agents import train
-
-    out = tmp_path / "run"
-    train.main(["--env", NAV, "--algo", "ppo", "--conf", "ppo-costmap.yaml",
-                "--timesteps", "128", "--n-envs", "1", "--seed", "0", "--out", str(out),
-                "--no-progress", "--eval-freq", "0", "--save-freq", "0",
-                "--hyperparams", "n_steps=64", "batch_size=64", "n_epochs=1",
-                "pretrain={teacher: lattice, episodes: 1, epochs: 2, rounds: 1, beta: 0.5}",
-                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items())])
+    out = train_with_a_round(tmp_path / "run", timesteps=128, save_freq=0)
     report = yaml.safe_load((out / "pretrain.yaml").read_text())
     assert report["rounds"] == 1 and len(report["dagger"]) == 1
     round_1 = report["dagger"][0]
@@ -121,6 +128,7 @@ def test_bad_dagger_settings_are_refused(value, message):
         pretrain_settings(value)
 
 
+
 def test_the_students_error_on_fields_it_never_saw(tmp_path):
     """A student trained by agents.train (one round) is held against its
     teacher on new fields; with the teacher's own run as its data the
@@ -128,18 +136,11 @@ def test_the_students_error_on_fields_it_never_saw(tmp_path):
     writes its table."""
     import json
 
-    from agents import dagger as dagger_module
-    from agents import train
+    from agents.held_out import main as held_out_main
 
-    out = tmp_path / "run"
-    train.main(["--env", NAV, "--algo", "ppo", "--conf", "ppo-costmap-dagger.yaml",
-                "--timesteps", "64", "--n-envs", "1", "--seed", "0", "--out", str(out),
-                "--no-progress", "--eval-freq", "0", "--save-freq", "64",
-                "--hyperparams", "n_steps=64", "batch_size=64", "n_epochs=1",
-                "pretrain={teacher: lattice, episodes: 1, epochs: 2, rounds: 1}",
-                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items())])
+    out = train_with_a_round(tmp_path / "run", timesteps=64, save_freq=64)
     table = tmp_path / "held-out.md"
-    rows = dagger_module.main([str(out), "--checkpoint", "0", "--episodes", "1", "--seed", "7",
+    rows = held_out_main([str(out), "--checkpoint", "0", "--episodes", "1", "--seed", "7",
                                "--env-kwargs", *(f"{k}={v}" for k, v in KWARGS.items()),
                                "--out", str(table)])
     row = rows[0]
@@ -148,4 +149,4 @@ def test_the_students_error_on_fields_it_never_saw(tmp_path):
     assert "| run | held-out error |" in table.read_text()
     assert json.loads(table.with_suffix(".json").read_text())["rows"][0]["seed"] == 7
     with pytest.raises(SystemExit):
-        dagger_module.main([str(tmp_path / "missing")])
+        held_out_main([str(tmp_path / "missing")])
