@@ -289,8 +289,15 @@ class LatticePlanner(StraightLinePolicy):
             self.route = self.plan()
             self._age = 0
         self._age += 1
+        return self._pursue(self.route, obs)
+
+    def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
+        """The action that steers for the point ``lookahead`` ahead on
+        ``route`` (pure pursuit), from the ship's pose now."""
+        ship = self.unwrapped.sim.ship
+        position = np.asarray(ship.position, dtype=float)
         target_x = position[0] + self.lookahead
-        target_y = float(np.interp(target_x, self.route[:, 0], self.route[:, 1]))
+        target_y = float(np.interp(target_x, route[:, 0], route[:, 1]))
         bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
         bearing = math.atan2(math.sin(bearing), math.cos(bearing))
         return self._steer(bearing, self._reader(obs))
@@ -376,30 +383,17 @@ class RolloutPlanner(LatticePlanner):
         self._seen = obs            # what the rollouts start from
         return super().act(obs)
 
-    def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
-        """The action that steers for the point ``lookahead`` ahead on
-        ``route`` (the lattice planner's pure pursuit), clipped to the
-        action space."""
-        ship = self.unwrapped.sim.ship
-        position = np.asarray(ship.position, dtype=float)
-        target_x = position[0] + self.lookahead
-        target_y = float(np.interp(target_x, route[:, 0], route[:, 1]))
-        bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
-        bearing = math.atan2(math.sin(bearing), math.cos(bearing))
-        space = self.action_space
-        return np.clip(self._steer(bearing, self._reader(obs)), space.low,
-                       space.high).astype(space.dtype)
-
     def _rollout(self, route: np.ndarray) -> float:
         """The summed reward of following ``route`` until the next plan and
         the lattice planner after, ``rollout_steps`` steps in all (on the
         episode as it is now; the caller restores it)."""
         u = self.unwrapped
         base = LatticePlanner(self.env, self.seed, **self._base_kwargs)
+        space = self.action_space
         obs, total = self._seen, 0.0
         for k in range(self.rollout_steps):
-            action = self._pursue(route, obs) if k < self.replan_steps else \
-                base.predict(obs)[0]
+            action = np.clip(self._pursue(route, obs), space.low, space.high).astype(
+                space.dtype) if k < self.replan_steps else base.predict(obs)[0]
             obs, reward, terminated, truncated, _ = u.step(action)
             total += float(reward)
             if terminated or truncated:

@@ -71,12 +71,13 @@ def random_steps(env, steps: int) -> None:
             env.reset()
 
 
-def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
+def warm_env(env_id: str, steps: int = 5, seed: int = 0, **extra) -> str:
     """Make ``env_id`` at the small size of its facts
     (:attr:`iceenvs.facts.EnvFacts.small`: the kernels' types do not depend
-    on the sizes), reset it and take ``steps`` random actions (resetting
-    when an episode ends). Falls back to the default constructor if the
-    small-instance arguments are not accepted."""
+    on the sizes), with the keywords ``extra`` beside them, reset it and
+    take ``steps`` random actions (resetting when an episode ends). Falls
+    back to the default size if the small-instance arguments are not
+    accepted."""
     import gymnasium as gym
 
     from .facts import env_facts
@@ -84,10 +85,10 @@ def warm_env(env_id: str, steps: int = 5, seed: int = 0) -> str:
     kwargs = dict(env_facts(env_id).small)
     note = ""
     try:
-        env = gym.make(env_id, **kwargs)
+        env = gym.make(env_id, **kwargs, **extra)
     except TypeError:
         note = " (default size: the small-instance arguments were refused)"
-        env = gym.make(env_id)
+        env = gym.make(env_id, **extra)
     try:
         env.action_space.seed(seed)
         env.reset(seed=seed)
@@ -122,26 +123,13 @@ def warm_vector_env(env_id: str, steps: int = 5, seed: int = 0, num_envs: int = 
 def warm_costmap(steps: int = 5, seed: int = 0) -> str:
     """The costmap observation (``obs_type="costmap"``, :mod:`iceenvs.costmap`)
     on the first ship environment, small, reset and stepped ``steps``
-    times: its kernels run only for that observation."""
-    import gymnasium as gym
-
+    times (:func:`warm_env`): its kernels run only for that observation."""
     from . import ENV_IDS
-    from .facts import env_facts
+    from .facts import env_creator
 
     for env_id in ENV_IDS:
-        kwargs = dict(env_facts(env_id).small)
-        env = gym.make(env_id, **kwargs)
-        ship = hasattr(env.unwrapped, "costmap")
-        env.close()
-        if ship:
-            env = gym.make(env_id, obs_type="costmap", **kwargs)
-            try:
-                env.action_space.seed(seed)
-                env.reset(seed=seed)
-                random_steps(env, steps)
-            finally:
-                env.close()
-            return f" ({env_id})"
+        if hasattr(env_creator(env_id), "costmap"):
+            return warm_env(env_id, steps, seed, obs_type="costmap") + f" ({env_id})"
     return " (no ship environment)"
 
 
