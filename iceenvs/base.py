@@ -50,7 +50,7 @@ import gymnasium as gym
 import numpy as np
 
 from physics import PaperPreset
-from physics.checks import check_range
+from physics.input_checks import check_range
 from physics.engine import FloeEngine
 from physics.hertz import hertz_time_step, scaled_contact
 from physics.markdown import table_row

@@ -66,7 +66,7 @@ import math
 import numpy as np
 from numba import njit
 
-from physics.checks import check_range
+from physics.input_checks import check_range
 
 from .ship_sensors import check_box, check_floes, check_pose
 

@@ -65,7 +65,7 @@ import gymnasium as gym
 import numpy as np
 
 from physics import HERMAN2013, ice_fields
-from physics.checks import check_range
+from physics.input_checks import check_range
 from physics.hertz import hull_contact_time
 
 from .base import HertzEnv, sanitise_action

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from physics.checks import check_range
+from physics.input_checks import check_range
 from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, TransitBox, navigation_field
 
 from .base import TaskParameter, choice, interval, number, revised_task, task_table

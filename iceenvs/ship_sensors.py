@@ -93,7 +93,7 @@ import math
 import numpy as np
 from numba import njit
 
-from physics.checks import check_range
+from physics.input_checks import check_range
 from physics.domain import minimum_image
 
 __all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "channel_room",

@@ -8,7 +8,7 @@ import math
 import gymnasium as gym
 import numpy as np
 
-from physics.checks import check_range
+from physics.input_checks import check_range
 from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
 from physics.params import GODLOVITCH
 

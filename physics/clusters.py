@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box
 from .observables import check_positions, near_pairs
 

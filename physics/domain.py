@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .checks import check_range
+from .input_checks import check_range
 
 __all__ = ["Box", "PeriodicBox", "DeformingPeriodicBox", "ChannelBox", "WalledBox",
            "KernelBox", "minimum_image", "wrap_coordinate"]

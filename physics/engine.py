@@ -46,7 +46,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box
 from .floes import FloeField, max_overlap
 from .forcing import Forcing

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box, PeriodicBox, minimum_image, wrap_coordinate
 from .neighbors import choose_cell_size, pair_list, radius_rank
 

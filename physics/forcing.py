@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import NONNEG, POSITIVE, check_fields, check_range
+from .input_checks import NONNEG, POSITIVE, check_fields, check_range
 
 __all__ = ["Forcing", "ForcingParams", "DragCoefficients", "steady_drift"]
 

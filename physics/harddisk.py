@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import harddisk_kernels as K
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box, PeriodicBox
 from .engine import (FailureReason, FloeProperties, SimulationError, checked_motion,
                      engine_from_preset, snapshot)

@@ -28,7 +28,7 @@ import numpy as np
 
 from . import hertz_kernels as K
 from . import hull_contact as HC
-from .checks import check_range
+from .input_checks import check_range
 from .contact import ContactLaw, contact_time, hertz_stiffness
 from .domain import Box
 from .engine import FailureReason, FloeProperties, SimulationError, engine_from_preset

@@ -39,7 +39,7 @@ from statistics import NormalDist
 
 import numpy as np
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box
 from .floes import FloeField, place_floes, power_law_diameters, spatial_order
 

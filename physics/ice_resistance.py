@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from .checks import check_range
+from .input_checks import check_range
 from .params import GRAVITY
 
 #: Zuev's coefficients of B/h, Fr_h and Fr_h²

@@ -67,7 +67,7 @@ from collections.abc import Callable
 import numpy as np
 from numba import njit
 
-from .checks import check_range
+from .input_checks import check_range
 from .params import GODLOVITCH
 
 __all__ = ["constant_kernel", "exponential_kernel", "multiplicative_kernel", "additive_kernel",

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field as dc_field
 import numpy as np
 from numba import njit
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import PeriodicBox, minimum_image, wrap_coordinate
 from .floes import FloeField, max_overlap
 from .neighbors import build_pair_list_serial, choose_cell_size, radius_rank

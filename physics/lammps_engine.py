@@ -75,7 +75,7 @@ import time as _time
 import numpy as np
 
 from . import mpi
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box, ChannelBox, DeformingPeriodicBox, PeriodicBox, WalledBox
 from .engine import (FailureReason, FloeProperties, SimulationError, check_time_step,
                      checked_hertz_arguments, neighbour_cut, positions_in_box)

@@ -44,7 +44,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .checks import check_range
+from .input_checks import check_range
 from .domain import Box
 from .neighbors import choose_cell_size, pair_list, radius_rank
 

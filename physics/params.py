@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .checks import NONNEG, POSITIVE, check_fields, check_range
+from .input_checks import NONNEG, POSITIVE, check_fields, check_range
 from .floes import make_floe_field
 from .forcing import Forcing, ForcingParams
 

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import hull_contact as HC
-from .checks import check_range
+from .input_checks import check_range
 from .hull import MODEL_HULL, PSV_HULL, RESEARCH_HULL, Hull
 from .params import GRAVITY
 # the transit channel and its fields live with the other ice fields; kept importable here

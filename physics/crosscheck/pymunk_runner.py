@@ -87,7 +87,7 @@ import math
 import numpy as np
 import pymunk
 
-from ..checks import check_range
+from ..input_checks import check_range
 from ..domain import Box
 from ..floes import FloeField, max_overlap
 from ..forcing import Forcing
