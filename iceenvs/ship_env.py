@@ -66,7 +66,6 @@ import numpy as np
 
 from physics import HERMAN2013, ice_fields
 from physics.input_checks import check_range
-from physics.hertz import hull_contact_time
 
 from .base import HertzEnv, sanitise_action
 from .costmap import costmap_samples, costmap_scan, costmap_shape, costmap_space
@@ -384,7 +383,7 @@ class ShipEnv(HertzEnv):
 
     def _make_sim(self, rng):
         from physics import HertzSimulation
-        from physics.hertz import hertz_time_step
+        from physics.hertz import ship_time_step
 
         field, box, forcing = self._ice(rng)
         self.forcing = forcing
@@ -396,12 +395,9 @@ class ShipEnv(HertzEnv):
         self._hull_length = self._ship.hull.length
         drift = float(np.max(np.hypot(field.velocities[:, 0], field.velocities[:, 1]))) \
             if field.n else 0.0
-        impact = (1.0 + self.contact.restitution) * max(self.max_speed, self._start_speed()) \
-            + 2.0 * drift
-        dt = min(hertz_time_step(field, box, self.contact, impact, self.preset.time_step,
-                                 self.stiffness_scale),
-                 0.1 * hull_contact_time(field.radii, field.thickness, field.density,
-                                         self.contact, impact))
+        impact, dt = ship_time_step(field, box, self.contact,
+                                    max(self.max_speed, self._start_speed()), drift,
+                                    self.preset.time_step, self.stiffness_scale)
         sim = HertzSimulation(field, box, self.contact, forcing, dt=dt, impact_speed=impact,
                               parallel=False, ship=self._ship,
                               skip_resting=not self.free_drift, free_drift=self.free_drift,

@@ -109,6 +109,42 @@ def hull_contact_time(radius, thickness, density, contact: ContactParams, speed:
                                      speed)))
 
 
+def ship_contact_time(field: FloeField, box: Box, contact: ContactParams, impact_speed: float,
+                      ship_speed: float | None = None) -> tuple[float, str]:
+    """The shortest contact time [s] the time step of ``field`` in ``box``
+    must resolve, and which contacts set it (words for a message): the
+    floes hitting each other (and the walls) at ``impact_speed`` [m/s] and,
+    where a ship sails at ``ship_speed`` [m/s], a floe hitting its hull at
+    the larger of ``impact_speed`` and the ship's speed."""
+    t_c = minimum_contact_time(field.radii, field.thickness, field.density, contact, impact_speed,
+                               walls=not all(box.periodic))
+    what = f"the smallest floes at impact speed {impact_speed:g} m/s"
+    if ship_speed is not None:
+        speed = max(impact_speed, abs(ship_speed))
+        t_hull = hull_contact_time(field.radii, field.thickness, field.density, contact, speed)
+        if t_hull < t_c:
+            t_c = t_hull
+            what = f"the smallest floes hitting the hull at {speed:g} m/s"
+    return t_c, what
+
+
+def ship_time_step(field: FloeField, box: Box, contact: ContactParams, ship_speed: float,
+                   drift: float, preset_dt: float, stiffness_scale: float) -> tuple[float, float]:
+    """(impact speed [m/s], time step [s]) of a ship sailing at up to
+    ``ship_speed`` [m/s] into ``field``, whose floes drift at up to
+    ``drift`` [m/s]. The impact speed is (1 + e) ``ship_speed`` + 2
+    ``drift`` (e the restitution: a floe the hull knocks ahead leaves at up
+    to (1 + e) times its speed, and two drifting floes meet at up to twice
+    their drift); the time step is the preset's ``preset_dt`` for the
+    contact law softened by ``stiffness_scale`` (× stiffness_scale^(−2/5),
+    as :func:`hertz_time_step`), never above a tenth of the shortest contact
+    time at that impact speed, of the hull's contacts included
+    (:func:`ship_contact_time`)."""
+    impact = (1.0 + contact.restitution) * ship_speed + 2.0 * drift
+    t_c, _ = ship_contact_time(field, box, contact, impact, ship_speed)
+    return impact, min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
+
+
 def scaled_contact(contact: ContactParams, stiffness_scale: float) -> ContactParams:
     """The contact law with Young's modulus multiplied by ``stiffness_scale``
     in (0, 1] (a softer contact allows a longer time step: Δt ∝ E^(−2/5))."""
@@ -270,15 +306,8 @@ class HertzSimulation(FloeProperties):
         n = f.n
 
         # time step against the shortest contact time
-        t_c = minimum_contact_time(f.radii, f.thickness, f.density, contact, impact_speed,
-                                   walls=not all(box.periodic))
-        what = f"the smallest floes at impact speed {impact_speed:g} m/s"
-        if ship is not None:
-            speed = max(impact_speed, abs(ship.speed))
-            t_hull = hull_contact_time(f.radii, f.thickness, f.density, contact, speed)
-            if t_hull < t_c:
-                t_c = t_hull
-                what = f"the smallest floes hitting the hull at {speed:g} m/s"
+        t_c, what = ship_contact_time(f, box, contact, impact_speed,
+                                      None if ship is None else ship.speed)
         check_time_step(self.dt, t_c, what)
         self.min_contact_time = t_c
 

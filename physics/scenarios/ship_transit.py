@@ -76,7 +76,7 @@ The time step is a tenth of the shortest Hertz contact time of the
 smallest floe hitting the hull or another floe at (1 + e) × the ship's
 speed (a floe knocked ahead leaves at up to that speed), and never above
 the Herman (2013) Δt scaled by ``stiffness_scale``^(−2/5)
-(:func:`physics.hertz.hertz_time_step`). With the true material
+(:func:`physics.hertz.ship_time_step`). With the true material
 (``stiffness_scale`` = 1) that is about 1 ms at 1–4 m/s.
 """
 from __future__ import annotations
@@ -92,7 +92,7 @@ from ..engine import FloeEngine
 from ..floes import (FloeField, PlacementError, max_overlap, place_floes, power_law_diameters,
                      spatial_order)
 from ..forcing import steady_drift
-from ..hertz import HertzSimulation, hertz_time_step, hull_contact_time
+from ..hertz import HertzSimulation, ship_time_step
 from ..hull_contact import LOG_COLUMNS
 from ..ice_resistance import power_law_fit
 from ..params import HERMAN2013
@@ -319,11 +319,8 @@ def build_simulation(p: dict, case: dict, seed: int, *, skip_resting: bool = Tru
                           density=field.density)
         drift = float(np.mean(np.hypot(u[:, 0], u[:, 1])))
     contact = contact_law(p)
-    impact = (1.0 + contact.restitution) * v + 2.0 * drift
-    dt = min(hertz_time_step(field, box, contact, impact, HERMAN2013.time_step,
-                             p["stiffness_scale"]),
-             0.1 * hull_contact_time(field.radii, field.thickness, field.density, contact,
-                                     impact))
+    impact, dt = ship_time_step(field, box, contact, v, drift, HERMAN2013.time_step,
+                                p["stiffness_scale"])
     dynamic = bool(case["dynamic"])
     ship = transit_ship(p)("dynamic" if dynamic else "prescribed",
                            position=(geo["x_ship"], geo["y_ship"]), speed=v,
