@@ -39,8 +39,8 @@ from .floes import FloeField
 from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .hertz_batch import run_many
-from .hertz_free_drift import DEFAULT_WINDOW, TALLY, run_steps_free
-from .hertz_resting import run_steps_resting
+from .hertz_free_drift import DEFAULT_WINDOW, TALLY
+from .hertz_step import run_every_floe_parallel, run_steps
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, LocalIce, Stress, fabric, stress
 from .params import ContactParams, PaperPreset
@@ -501,7 +501,7 @@ class HertzSimulation(FloeProperties):
     # -- running -------------------------------------------------------------
     @property
     def _step_mode(self) -> int:
-        """The serial step (:func:`physics.hertz_batch.run_many`): 0 full,
+        """The serial step's form (:data:`physics.hertz_step.MODES`): 0 full,
         1 skipping the resting floes, 2 free drift, 3 free drift stepped
         (:attr:`free_iterate`)."""
         if self.free_drift:
@@ -523,18 +523,16 @@ class HertzSimulation(FloeProperties):
         left = n
         while left > 0:
             args = self._kernel_arguments(left)
-            if self.skip_resting:
-                done, status, nreb, self._verlet, self.n_awake = run_steps_resting(
-                    args[0], self.dt, self.time, *args[1:6], self._verlet, args[6])
-            elif self.free_drift:
-                done, status, nreb, self._verlet, self.n_awake = run_steps_free(
-                    args[0], self.dt, self.time, *args[1:6], self._verlet, args[6],
-                    self.free_window, self.free_tally, self.free_iterate)
+            if self.parallel:
+                with threads_within_cores(True):
+                    done, status, nreb, self._verlet = run_every_floe_parallel(
+                        args[0], self.dt, self.time, args[1:], self._verlet, self.n_chunks)
             else:
-                with threads_within_cores(self.parallel):
-                    done, status, nreb, self._verlet = K.run_steps(
-                        args[0], self.dt, self.time, *args[1:6], self._verlet, self.parallel,
-                        self.n_chunks, args[6])
+                done, status, nreb, self._verlet, awake = run_steps(
+                    self._step_mode, args[0], self.dt, self.time, args[1:], self._verlet,
+                    self.free_window, self.free_tally)
+                if awake >= 0:
+                    self.n_awake = awake
             left = self._after_run(done, status, nreb, left)
         self._check_status(HertzStatus(status))
 

@@ -4,10 +4,8 @@ vector environments of :mod:`iceenvs.vector`), and :func:`ice_near_many`,
 the ice around a point of each (the ship environments' local ice).
 
 The simulations share no array, so one ``prange`` over them runs each one's
-serial step (:func:`physics.hertz_kernels.run_steps`, or
-:func:`physics.hertz_resting.run_steps_resting` for one that skips the floes
-at rest, or :func:`physics.hertz_free_drift.run_steps_free` for one whose
-free floes drift in closed form) on its own thread, with no two iterations writing the same memory.
+serial step in its own form (:func:`physics.hertz_step.run_steps`) on its
+own thread, with no two iterations writing the same memory.
 """
 from __future__ import annotations
 
@@ -16,9 +14,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .hertz_free_drift import run_steps_free
-from .hertz_kernels import ice_energy, ice_within, run_steps, state_finite
-from .hertz_resting import run_steps_resting
+from .hertz_kernels import ice_energy, ice_within, state_finite
+from .hertz_step import run_steps
 
 __all__ = ["run_many", "ice_near_many", "ICE_NEAR"]
 
@@ -45,19 +42,11 @@ def run_many(n_steps, dt, time, mode, window, tally, runs, verlets, done, status
     the results."""
     for m in prange(len(runs)):
         k = np.int64(m)                     # typed lists take signed indices
-        floes, law, wall_law, drive, box, ship = runs[k]
-        if mode[k] == 1:
-            d, s, r, verlet, a = run_steps_resting(n_steps[k], dt[k], time[k], floes, law,
-                                                   wall_law, drive, box, verlets[k], ship)
-            n_awake[k] = a
-        elif mode[k] >= 2:
-            d, s, r, verlet, a = run_steps_free(n_steps[k], dt[k], time[k], floes, law,
-                                                wall_law, drive, box, verlets[k], ship, window[k],
-                                                tally[k], mode[k] == 3)
-            n_awake[k] = a
-        else:
-            d, s, r, verlet = run_steps(n_steps[k], dt[k], time[k], floes, law, wall_law, drive,
-                                        box, verlets[k], False, 1, ship)
+        run = runs[k]
+        floes, ship = run[0], run[5]
+        d, s, r, verlet, a = run_steps(mode[k], n_steps[k], dt[k], time[k], run, verlets[k],
+                                       window[k], tally[k])
+        n_awake[k] = a
         done[k] = d
         status[k] = s
         n_rebuilds[k] = r

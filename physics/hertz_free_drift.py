@@ -37,7 +37,7 @@ list cannot touch while the list holds, and the list's expiry test covers
 the free floes through a bound (D_0 + S t)² on their distance from the
 list's centre, which is held fixed through the window. The engaged floes
 take the step of
-:func:`physics.hertz_resting.resting_steps`: the same arithmetic, over them
+:class:`physics.hertz_step.AwakeFloes`: the same arithmetic, over them
 and their pairs alone.
 
 **Guards.** E_j and H are assumptions, checked at every step: each engaged
@@ -83,20 +83,17 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, STATUS_NON_FINITE, STATUS_OK, STATUS_SHIP_LOG_FULL,
-                            Kick, begin_step, drift_bound, end_run, first_half, floe_drag, floe_rows,
-                            force_buffers, from_order_key, kick_drift_floe, list_expired,
-                            max_keep_nan, min_image_step, order_key, pass_status, path_slack,
-                            rebuild_in_run, rigid_drift_bound, wall_overlap, wide_floe_test,
-                            wide_floes_pass)
-from .hertz_resting import Awake, awake_wall_forces, live_pair_forces, pair_index
+from .hertz_kernels import (KICK_FASTMATH, Kick, drift_bound, floe_drag, from_order_key,
+                            kick_drift_floe, max_keep_nan, min_image_step, order_key, path_slack,
+                            rigid_drift_bound, wall_overlap, wide_floe_test)
+from .hertz_resting import pair_index
 from .hull import disc_hull_contact
-from .hull_contact import (S_FLOE_TRAVEL, S_X, S_Y, hull_forces, hull_point_speed,
+from .hull_contact import (S_X, S_Y, hull_point_speed,
                            set_world_hull)
 
-__all__ = ["DEFAULT_WINDOW", "TALLY", "drift_sums", "run_steps_free"]
+__all__ = ["DEFAULT_WINDOW", "TALLY", "drift_sums", "classify", "sync_free", "repair"]
 
-#: what :func:`run_steps_free` counts: the windows, those that the hull's
+#: what :func:`physics.hertz_step.run_windows` counts: the windows, those that the hull's
 #: guard ended, the engaged floe-steps, the steps, the engaged floes given a
 #: new line within a window and the free floes engaged within one
 #: (:func:`repair`)
@@ -719,209 +716,6 @@ def repair(n_broken, floes, fbuf, tbuf, drive, table, box, verlet, awake, pairs,
                 stack[top] = i
                 top += 1
     return ok, n_new, n_lines, unseen
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def window_steps(step, end, dt, time, floes, law, wall_law, drive, box, verlet, ship,
-                 work, awake, pairs, path, wall_due, fbuf, tbuf, table, lines, bounds, mark,
-                 iterate):
-    """The steps of one window, from ``step`` up to ``end`` at most (module
-    docstring). ``bounds`` = (H, s_max of the free floes, D_0, S, the hull's
-    speed bound, the margin of the tests) of :func:`classify`.
-
-    Returns (next step, steps done, status, whether the list expired,
-    whether the ship's log is full, box lengths of the last step, engaged
-    floe-steps, lines renewed). On return the free floes are up to date
-    and, unless the list expired, the last step is complete."""
-    big_h, s_free, d0, s_test = bounds[0], bounds[1], bounds[2], bounds[3]
-    hull_speed, margin = bounds[4], bounds[5]
-    n_free = awake.count[1]
-    window_start = step
-    span = (end - step) * dt
-    dt_kick0 = 0.5 * dt if step == 0 else dt
-    px = box.periodic_x
-    py = box.periodic_y
-    walls = not (px and py)
-    done = 0
-    status = STATUS_OK
-    log_full = False
-    expired = False
-    lx = 0.0
-    ly = 0.0
-    hull_path = 0.0
-    unseen_told = 0.0
-    engaged_steps = 0
-    n_lines = 0
-    n_engaged = 0
-    centre = verlet.centre
-    broken_list = pairs.stack
-    while step < end:
-        status, kick = begin_step(box, time, step, dt, centre, ship)
-        if status != STATUS_OK:
-            break
-        lx, ly = kick.lx, kick.ly
-        if ship.active:
-            hull_path += dt * hull_point_speed(ship) * (1.0 + 1e-12)
-        n_broken = 0
-        if n_free == 0:
-            worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
-        else:
-            worst, mx, my, vmax2, n_broken = engaged_pass(
-                work, verlet.ref, drive, kick, awake, path, lines,
-                (step + 1 - window_start) * dt, broken_list)
-        engaged_steps += awake.count[0]
-        done += 1
-        step += 1
-        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != STATUS_OK:
-            break
-        last = step >= end
-        hull_broken = False
-        if n_free > 0:
-            elapsed = (step - window_start) * dt
-            reach = d0 + s_test * elapsed
-            worst = max(worst, reach * reach)
-            hull_broken = hull_path > big_h
-            if n_broken > 0 and not hull_broken:
-                # floes that left their lines: new lines, and the floes and
-                # pairs they may reach engaged and live from this step on
-                ok, n_new, n_renewed, unseen = repair(
-                    n_broken, floes, fbuf, tbuf, drive, table, box, verlet, awake, pairs,
-                    lines, mark, path, dt, dt_kick0, step - window_start, span, hull_speed,
-                    margin, iterate)
-                if not ok:
-                    status = STATUS_NON_FINITE
-                    break
-                n_free -= n_new
-                n_lines += n_renewed
-                n_engaged += n_new
-                if ship.active and unseen > unseen_told:
-                    # a hull list built earlier in the window saw them where
-                    # it began
-                    ship.state[S_FLOE_TRAVEL] += unseen - unseen_told
-                    unseen_told = unseen
-                if n_free == 0:
-                    # no free floe left: no guard either, so every pair is live
-                    all_pairs_live(verlet, awake, pairs)
-            last = last or hull_broken
-            if last and n_free > 0:
-                if not sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt,
-                                 dt_kick0, step - window_start, iterate, verlet.ref):
-                    status = STATUS_NON_FINITE
-                    break
-                n_free = 0
-        if walls:
-            awake_wall_forces(awake, floes, wall_law, box, dt, path, wall_due, fbuf, tbuf)
-        if ship.active:
-            floe_speed = max(math.sqrt(vmax2), s_free)
-            if n_free > 0:
-                log_full = not hull_forces(ship, floes, box, time + step * dt, dt, floe_speed,
-                                           fbuf, tbuf, awake.flag)
-            else:
-                log_full = not hull_forces(ship, floes, box, time + step * dt, dt, floe_speed,
-                                           fbuf, tbuf)
-        if n_free > 0:
-            worst = engaged_wide_pass(floes.pos, verlet, lx, ly, px, py, kick.cx, kick.cy,
-                                      worst, pairs.wide)
-        elif verlet.wide.shape[0] > 0:
-            worst = wide_floes_pass(floes.pos, verlet, lx, ly, px, py, kick.cx, kick.cy,
-                                    kick.cx, kick.cy, worst)
-        if list_expired(worst, lx, ly, verlet):
-            if n_free > 0:
-                if not sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt,
-                                 dt_kick0, step - window_start, iterate, verlet.ref):
-                    status = STATUS_NON_FINITE
-                    break
-            expired = True
-            break
-        if hull_broken:
-            # the hull's guard failed: a free floe may touch an engaged one now
-            all_pairs_live(verlet, awake, pairs)
-        live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
-        if log_full:
-            status = STATUS_SHIP_LOG_FULL
-            break
-        if last:
-            # a pair of this step may have woken a floe of the synced ones
-            # (no matter: all are up to date and the next window sorts them)
-            awake.count[1] = 0
-            break
-    if n_free > 0 and done > 0:
-        sync_free(floes, fbuf, tbuf, drive, table, box, awake, lines, path, dt, dt_kick0,
-                  step - window_start, iterate, verlet.ref)
-    if ship.active:
-        # a hull list built in the window saw the free floes where the
-        # window began: count their travel since then as the floes' travel
-        ship.state[S_FLOE_TRAVEL] += s_free * (step - window_start) * dt
-    return step, done, status, expired, log_full, lx, ly, engaged_steps, n_lines, n_engaged
-
-
-@njit(cache=True, error_model="numpy")
-def run_steps_free(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, window,
-                   tally, iterate=False):
-    """:func:`physics.hertz_kernels.run_steps` on the serial path, with the
-    free floes of each window of ``window`` steps drifting in closed form
-    (module docstring). Adds to ``tally`` (:data:`TALLY`) the windows, those
-    that the hull's guard ended early, the engaged floe-steps, the steps,
-    the lines renewed and the floes engaged within a window. With
-    ``iterate`` the free floes are stepped one step at a time
-    (:func:`sync_free`). Returns (steps done, status, number of list rebuilds, the Verlet list
-    now, number of floes engaged in the last window)."""
-    px = box.periodic_x
-    py = box.periodic_y
-    n = floes.pos.shape[0]
-    buffers = force_buffers(n)
-    buffers.force[:] = floes.force
-    buffers.torque[:] = floes.torque
-    fbuf, tbuf = buffers.force, buffers.torque
-    work = floe_rows(floes, 0, n, buffers)
-    awake = Awake(np.ones(n, dtype=np.uint8), np.empty(n, dtype=np.int64),
-                  np.empty(n, dtype=np.int64), np.zeros(3, dtype=np.int64))
-    pairs = new_pairs(verlet)
-    path = np.zeros(n)
-    wall_due = np.full(n, -np.inf)
-    mark = np.zeros(n, dtype=np.uint8)
-    lines = np.empty((n, 6))
-    table = drift_table(floes, drive, dt)
-    bounds = np.zeros(6)
-    n_rebuilds = 0
-    done = 0
-    status = STATUS_OK
-    step = 0
-    n_engaged = n
-    while step < n_steps:
-        dt_kick = 0.5 * dt if step == 0 else dt
-        end = min(n_steps, step + window)
-        classify(floes, fbuf, tbuf, table, box, verlet, ship, dt, dt_kick, end - step, awake,
-                 pairs, mark, lines, bounds)
-        tally[0] += 1
-        step, d, status, expired, log_full, lx, ly, engaged_steps, n_lines, n_new = window_steps(
-            step, end, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
-            awake, pairs, path, wall_due, fbuf, tbuf, table, lines, bounds, mark, iterate)
-        n_engaged = awake.count[0]
-        done += d
-        tally[2] += engaged_steps
-        tally[3] += d
-        tally[4] += n_lines
-        tally[5] += n_new
-        if step < end and not expired:
-            tally[1] += 1
-        if status != STATUS_OK:
-            break
-        if not expired:
-            continue
-        verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, False, ship, box.deforming, dt)
-        n_rebuilds += 1
-        pairs = new_pairs(verlet)
-        all_pairs_live(verlet, awake, pairs)
-        awake_all(awake, n)
-        live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
-        awake.count[1] = 0
-        if log_full:
-            status = STATUS_SHIP_LOG_FULL
-            break
-    end_run(floes, fbuf, tbuf, done, dt, ship)
-    return done, status, n_rebuilds, verlet, n_engaged
 
 
 @njit(cache=True, error_model="numpy")

@@ -63,13 +63,13 @@ from numba.extending import intrinsic
 
 from .contact import hertz_mindlin_force
 from .domain import box_lengths_at, minimum_image
-from .hull_contact import (hull_forces, ship_closing_kick, ship_floe_skins,
+from .hull_contact import (ship_closing_kick, ship_floe_skins,
                            ship_kick_drift)
 from .neighbors import build_pair_list, build_pair_list_serial, transfer_history
 
 
 class HertzStatus(IntEnum):
-    """How :func:`run_steps` ended."""
+    """How a run (:func:`physics.hertz_step.run_steps`) ended."""
 
     #: every step done
     OK = 0
@@ -949,29 +949,6 @@ def list_expired(worst, lx, ly, verlet):
     return 2.0 * math.sqrt(worst) + shrink * max_cut >= verlet.skin
 
 
-@njit(cache=True, error_model="numpy")
-def ship_after_kick(ship, floes, box, verlet, time, dt, vmax2, lx, ly, cx, cy, mx, my, worst,
-                    buffers):
-    """What a step does between the floes' kick–drift pass and the expiry
-    test of their list when there is a ship or a floe with a wider skin:
-    the hull's contacts (:func:`~physics.hull_contact.hull_forces` at
-    ``time``, the time after the step, with the pass's largest squared
-    speed ``vmax2``; its forces added to ``buffers``), then
-    the pass over the wide-skinned floes (:func:`wide_floes_pass`, with the
-    old centre (cx, cy) and the pass's sums of the displacements (mx, my)).
-    Returns (the new largest squared displacement, whether the ship's
-    collision log is full)."""
-    log_full = False
-    if ship.active:
-        log_full = not hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), buffers.force,
-                                   buffers.torque)
-    if verlet.wide.shape[0] > 0:
-        n = floes.pos.shape[0]
-        worst = wide_floes_pass(floes.pos, verlet, lx, ly, box.periodic_x, box.periodic_y, cx, cy,
-                                mx / n, my / n, worst)
-    return worst, log_full
-
-
 @njit(cache=True, error_model="numpy", _nrt=False)
 def wide_floes_pass(pos, verlet, lx, ly, px, py, cx, cy, cx_new, cy_new, worst):
     """The expiry test of the floes with a skin s_i wider than the list's s
@@ -1108,111 +1085,6 @@ def rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, deforming, dt)
         return rebuild(floes, verlet, lx, ly, px, py, parallel,
                        ship_floe_skins(ship, floes, verlet.skin, dt, lx, ly, px, py))
     return rebuild(floes, verlet, lx, ly, px, py, parallel)
-
-
-@njit(cache=True, error_model="numpy")
-def run_steps(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, parallel, n_chunks,
-              ship):
-    """Advance the floes by ``n_steps`` velocity-Verlet steps.
-
-    Between two steps of one call the second half kick of a step and the
-    first half kick of the next are done together (leapfrog form); the state
-    returned is synchronised (velocities at full steps) and
-    ``floes.force``, ``floes.torque`` hold the forces of the last step.
-    ``box.lengths`` is updated in place for a deforming box; the Verlet
-    list is rebuilt whenever the displacement criterion of
-    :mod:`physics.neighbors` could be violated.
-
-    ``n_chunks`` is the number of chunks of the parallel path
-    (:func:`chunk_count`; ignored by the serial path): its kick–drift pass
-    and its pair loop each run as one parallel region over that many
-    chunks, whatever the number of threads, and the new state depends on
-    the chunks, not on the threads.
-
-    ``ship`` is a :class:`~physics.hull_contact.ShipBundle` (inactive
-    without a ship). With a ship every step also moves the ship before the
-    floes' kick–drift pass and adds the hull contacts after it
-    (:mod:`physics.hull_contact`).
-
-    Returns (steps done, status (a :class:`HertzStatus` value), number of
-    list rebuilds, the Verlet list now). A status other than OK stops the
-    run early: non-finite state, a blow-up, a deforming box at its
-    concentration limit, or a full collision log of the ship.
-    """
-    px = box.periodic_x
-    py = box.periodic_y
-    walls = not (px and py)
-    n = floes.pos.shape[0]
-    n_chunks = n_chunks if parallel else 1
-    buffers = force_buffers(n)
-    buffers.force[:] = floes.force
-    buffers.torque[:] = floes.torque
-    # the serial kick–drift pass kicks with the buffer
-    work = floe_rows(floes, 0, n, buffers)
-    n_rebuilds = 0
-    chunks = pair_chunks(verlet, n_chunks)
-    # the serial step skips the looks at pairs and walls that cannot touch
-    # (the paths of owner_pairs, wall_forces); the parallel one looks at all
-    path = np.zeros(n)
-    due = np.full(verlet.nbr.shape[0], -np.inf)
-    wall_due = np.full(n, -np.inf)
-    skip = not (parallel or box.deforming)
-    done = 0
-    status = STATUS_OK
-    log_full = False
-    step = 0
-    while step < n_steps:
-        status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
-        if status != STATUS_OK:
-            break
-        lx, ly = kick.lx, kick.ly
-        if parallel:
-            worst, mx, my, vmax2 = first_half_parallel(n_chunks, floes, buffers, chunks,
-                                                       verlet.ref, drive, kick)
-        else:
-            worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, path)
-        done += 1
-        step += 1
-        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != STATUS_OK:
-            break
-        if walls:
-            if parallel:
-                wall_forces_parallel(floes, wall_law, box, dt, buffers.force, buffers.torque)
-            elif skip:
-                wall_forces(0, n, floes, wall_law, box, dt, buffers.force, buffers.torque, path,
-                            wall_due)
-            else:
-                wall_forces(0, n, floes, wall_law, box, dt, buffers.force, buffers.torque)
-        if ship.active or verlet.wide.shape[0] > 0:
-            worst, log_full = ship_after_kick(ship, floes, box, verlet, time + step * dt, dt,
-                                              vmax2, lx, ly, kick.cx, kick.cy, mx, my, worst,
-                                              buffers)
-        verlet.centre[0] = mx / n
-        verlet.centre[1] = my / n
-        if list_expired(worst, lx, ly, verlet):
-            verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, parallel, ship, box.deforming,
-                                    dt)
-            chunks = pair_chunks(verlet, n_chunks)
-            due = np.full(verlet.nbr.shape[0], -np.inf)
-            n_rebuilds += 1
-        # drag and wall forces are already in the buffer; add the pair forces
-        if parallel:
-            pair_forces_parallel(chunks, floes, law, box, verlet, dt, buffers)
-        elif skip:
-            owners = chunks.owners
-            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
-                        buffers.torque, 0, 0, None, None, path, due)
-        else:
-            owners = chunks.owners
-            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, buffers.force,
-                        buffers.torque)
-        if log_full:
-            status = STATUS_SHIP_LOG_FULL
-            break
-    gather_cut(0, n, chunks, buffers.force, buffers.torque)
-    end_run(floes, buffers.force, buffers.torque, done, dt, ship)
-    return done, status, n_rebuilds, verlet
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -2,7 +2,7 @@
 
 A floe with v = 0, ω = 0 and zero total force stays exactly where it is
 under velocity Verlet (x += Δt · 0, v += Δt/2 · 0). At the start of a run
-(:func:`run_steps_resting`) a floe is *resting* when
+(:func:`physics.hertz_step.run_awake`) a floe is *resting* when
 
 * its velocity, angular velocity, force and torque (those of the last
   step, with which the run's first half kick is done) are all zero,
@@ -23,7 +23,7 @@ with an awake floe touches it or the hull pushes it (a non-zero hull force
 in its force buffer); it cannot touch a wall without moving. From the next
 step on it is integrated as any other and stays awake to the end of the
 run. Everything else is the step of
-:func:`physics.hertz_kernels.run_steps` (serial path): the per-floe
+:func:`physics.hertz_step.run_every_floe` (serial path): the per-floe
 arithmetic is the same, and a resting floe would have come out of it
 unchanged. Only the sums of the displacements in the list's expiry test
 are added in another order (the resting floes add zeros): they can differ
@@ -38,7 +38,7 @@ no force and leaves its history at zero, so skipping it changes nothing;
 touching pairs and pairs whose gap is used up are looked at every step, as
 before. The walls are skipped the same way: a floe found clear of every
 wall is looked at again once its path could have closed the smallest gap.
-The full serial step of :func:`~physics.hertz_kernels.run_steps` skips the
+The full serial step of :func:`~physics.hertz_step.run_every_floe` skips the
 same looks.
 
 The cost of a step is that of the awake floes and of their pairs that are
@@ -55,14 +55,13 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, STATUS_OK, STATUS_SHIP_LOG_FULL, apart_until,
-                            begin_step, drift_bound, first_half, floe_drag, floe_rows, floe_walls,
-                            floe_walls_skipping, force_buffers, from_order_key, end_run,
-                            kick_drift_floe, list_expired, listed_pair, max_keep_nan, order_key,
-                            pass_status, rebuild_in_run, wall_overlap, wide_floes_pass)
-from .hull_contact import C_CAND, hull_forces
+from .hertz_kernels import (KICK_FASTMATH, apart_until, drift_bound, first_half, floe_drag,
+                            floe_walls, floe_walls_skipping, from_order_key, kick_drift_floe,
+                            listed_pair, max_keep_nan, order_key, wall_overlap)
+from .hull_contact import C_CAND
 
-__all__ = ["Awake", "LivePairs", "run_steps_resting"]
+__all__ = ["Awake", "LivePairs", "find_awake", "live_pairs", "first_half_awake",
+           "live_pair_forces"]
 
 
 class Awake(NamedTuple):
@@ -387,112 +386,3 @@ def hull_wakes(ship, awake, force, torque):
             wake(i, awake)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf):
-    """The end of a step: the forces of the live pairs added to the drag and
-    wall forces already in the buffer, and the floes they woke made live."""
-    live_pair_forces(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
-    if awake.count[1] > 0:
-        add_woken(awake, verlet, pairs)
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def resting_steps(step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work,
-                  awake, pairs, path, wall_due, fbuf, tbuf):
-    """The steps of :func:`run_steps_resting` from ``step`` on, until the run
-    is done, fails, or the Verlet list expires (the caller rebuilds it and
-    finishes that step). Compiled without reference counting (it allocates
-    nothing): in a loop of this length Numba's counting of every array taken
-    from a bundle cost as much as the rest of a step of a ship among a few
-    floes.
-
-    Returns (next step, steps done, status, whether the list expired, whether
-    the ship's log is full, box lengths of the last step)."""
-    px = box.periodic_x
-    py = box.periodic_y
-    walls = not (px and py)
-    n = floes.pos.shape[0]
-    done = 0
-    status = STATUS_OK
-    log_full = False
-    expired = False
-    lx = 0.0
-    ly = 0.0
-    while step < n_steps:
-        status, kick = begin_step(box, time, step, dt, verlet.centre, ship)
-        if status != STATUS_OK:
-            break
-        lx, ly = kick.lx, kick.ly
-        worst, mx, my, vmax2 = first_half_awake(work, verlet.ref, drive, kick, awake, path)
-        done += 1
-        step += 1
-        status = pass_status(worst, mx, my, vmax2, dt, verlet.skin)
-        if status != STATUS_OK:
-            break
-        if walls:
-            awake_wall_forces(awake, floes, wall_law, box, dt, path, wall_due, fbuf, tbuf)
-        if ship.active:
-            log_full = not hull_forces(ship, floes, box, time + step * dt, dt, math.sqrt(vmax2),
-                                       fbuf, tbuf)
-            hull_wakes(ship, awake, fbuf, tbuf)
-        if verlet.wide.shape[0] > 0:
-            worst = wide_floes_pass(floes.pos, verlet, lx, ly, px, py, kick.cx, kick.cy,
-                                    mx / n, my / n, worst)
-        verlet.centre[0] = mx / n
-        verlet.centre[1] = my / n
-        if list_expired(worst, lx, ly, verlet):
-            expired = True
-            break
-        pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
-        if log_full:
-            status = STATUS_SHIP_LOG_FULL
-            break
-    return step, done, status, expired, log_full, lx, ly
-
-
-@njit(cache=True, error_model="numpy")
-def run_steps_resting(n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship):
-    """:func:`physics.hertz_kernels.run_steps` on the serial path over the
-    awake floes and live pairs only (see the module docstring): the steps
-    run in :func:`resting_steps`, and here the list rebuilds (which
-    allocate) and the end of the step whose list expired.
-
-    Returns (steps done, status, number of list rebuilds, the Verlet list
-    now, number of floes awake at the end)."""
-    px = box.periodic_x
-    py = box.periodic_y
-    n = floes.pos.shape[0]
-    buffers = force_buffers(n)
-    buffers.force[:] = floes.force
-    buffers.torque[:] = floes.torque
-    fbuf, tbuf = buffers.force, buffers.torque
-    work = floe_rows(floes, 0, n, buffers)
-    awake = find_awake(floes, drive, box, verlet)
-    pairs = live_pairs(verlet, awake)
-    path = np.zeros(n)
-    wall_due = np.full(n, -np.inf)
-    n_rebuilds = 0
-    done = 0
-    status = STATUS_OK
-    step = 0
-    while step < n_steps:
-        step, d, status, expired, log_full, lx, ly = resting_steps(
-            step, n_steps, dt, time, floes, law, wall_law, drive, box, verlet, ship, work, awake,
-            pairs, path, wall_due, fbuf, tbuf)
-        done += d
-        if not expired:
-            break
-        verlet = rebuild_in_run(floes, verlet, lx, ly, px, py, False, ship, box.deforming, dt)
-        n_rebuilds += 1
-        # the new wide floes are integrated (their shadow positions must
-        # be in the kick-drift pass); the pending floes' pairs are live
-        for k in range(verlet.wide.shape[0]):
-            wake(verlet.wide[k], awake)
-        pairs = live_pairs(verlet, awake)
-        add_woken(awake, verlet, pairs)
-        pair_phase(pairs, awake, floes, law, box, verlet, dt, path, fbuf, tbuf)
-        if log_full:
-            status = STATUS_SHIP_LOG_FULL
-            break
-    end_run(floes, fbuf, tbuf, done, dt, ship)
-    return done, status, n_rebuilds, verlet, awake.count[0]
