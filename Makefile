@@ -61,16 +61,16 @@ test-slow: setup
 BENCH_SUITES := hertz hertz_phases harddisk observables itd environments vector ship resting \
 	free_drift sensors scaling where_time_goes
 bench: setup
-	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite || exit 1; done
+	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.bench_$$suite || exit 1; done
 
 # the records the documentation shows: every suite written with --docs to
 # docs/benchmarks/ (and the fast step's equivalence test on the other ship
 # environments beside ShipNavigation-v1's), the README's headline figures
 # from them, the cross-check report and the generated observation page
 records: setup
-	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.$$suite --docs || exit 1; done
+	for suite in $(BENCH_SUITES); do $(PY) -m benchmarks.bench_$$suite --docs || exit 1; done
 	for env in ShipNavigation-v0 ShipBeset-v0; do \
-	  $(PY) -m benchmarks.free_drift --docs --env iceenvs/$$env --variants fast || exit 1; done
+	  $(PY) -m benchmarks.bench_free_drift --docs --env iceenvs/$$env --variants fast || exit 1; done
 	$(PY) -m benchmarks.headline
 	$(PY) -m physics.crosscheck all --out docs/crosscheck --force
 	$(PY) -m iceenvs.observation_page

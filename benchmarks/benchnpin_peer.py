@@ -8,7 +8,7 @@ What is measured
 ----------------
 Sustained environment steps per second of BenchNPIN's ship-navigation
 environment ``ship-ice-v0`` (PyPI package ``benchnpin`` 0.1.1) in its default
-configuration, with the protocol of :mod:`benchmarks.environments`: the
+configuration, with the protocol of :mod:`benchmarks.bench_environments`: the
 action space is seeded, the environment is reset with the seed, a warm-up of
 a reset and a few random steps is left untimed (there is nothing to compile,
 so no further untimed seconds), then ``runs`` consecutive runs
@@ -130,7 +130,7 @@ CHILD_ENV = {
     "PYTHONNOUSERSITE": "1",
 }
 
-#: Untimed random steps of the warm-up, as in :mod:`benchmarks.environments`.
+#: Untimed random steps of the warm-up, as in :mod:`benchmarks.bench_environments`.
 WARMUP_STEPS = 5
 
 #: The measuring script prints its result on one line that starts with this.

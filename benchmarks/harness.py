@@ -47,7 +47,7 @@ from collections.abc import Callable, Sequence
 import numba
 import numpy as np
 
-from . import SUITES
+from . import SUITES, suite_module
 
 #: timed rounds per process; within a round the configurations take turns
 REPEATS = 5
@@ -455,10 +455,10 @@ def in_checkout(path: Path) -> str:
 
 def suite_parser(suite: str, description: str,
                  prog: str | None = None) -> argparse.ArgumentParser:
-    """The command-line parser of ``python -m benchmarks.<suite>`` (shown as
+    """The command-line parser of ``python -m benchmarks.bench_<suite>`` (shown as
     ``prog`` when given, e.g. ``seaice bench <suite>``), with ``--quiet`` and
     the options of :func:`add_common_options`."""
-    parser = argparse.ArgumentParser(prog=prog or f"python -m benchmarks.{suite}",
+    parser = argparse.ArgumentParser(prog=prog or f"python -m {suite_module(suite)}",
                                      description=description,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quiet", action="store_true", help="print only the result")

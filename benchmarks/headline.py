@@ -130,7 +130,7 @@ def _free_drift_rows(record: dict) -> list[list[str]]:
     one core each, two side by side), from the main record of the suite
     (not the pilot's, not an extension's over fewer concentrations, not
     another environment's)."""
-    from .free_drift import ENV_ID, ENVS, REFERENCE
+    from .bench_free_drift import ENV_ID, ENVS, REFERENCE
 
     settings = record["data"].get("settings", {})
     stats = record["data"].get("statistics")

@@ -41,7 +41,8 @@ COMMANDS = {
     "demo": (None, "an engine run, then a training run (as make demo)"),
 }
 
-#: benchmark suite → one-line description; ``seaice bench SUITE`` runs benchmarks.SUITE
+#: benchmark suite → one-line description; ``seaice bench SUITE`` runs its module
+#: (:func:`bench_module`)
 BENCH_SUITES = {
     "hertz": "floe-steps/s of the Hertz engine at A = 0.7 and jammed",
     "hertz_phases": "each phase of a Hertz step on its own",
@@ -60,6 +61,18 @@ BENCH_SUITES = {
     "free_drift": "the free-drift step against the exact one: paired episode statistics, env steps/s",
     "headline": "put the headline figures of the records into the README",
 }
+
+#: the entries of :data:`BENCH_SUITES` that are tools beside the suites, not suites
+BENCH_TOOLS = ("headline",)
+
+
+def bench_module(name: str) -> str:
+    """The module that ``seaice bench NAME`` runs: ``benchmarks.bench_NAME``
+    for a suite (as ``benchmarks.suite_module`` names it, which this
+    cannot import before it has found the checkout), ``benchmarks.NAME``
+    for a tool of :data:`BENCH_TOOLS`."""
+    return f"benchmarks.{name}" if name in BENCH_TOOLS else f"benchmarks.bench_{name}"
+
 
 #: the variable that names the source checkout whose suites ``seaice bench`` runs
 #: (default: the current directory, when it holds ``benchmarks/``)
@@ -124,8 +137,8 @@ def benchmarks_checkout() -> Path | None:
 
 
 def _bench(argv: list[str], prog: str) -> int:
-    entries = {name: (f"benchmarks.{name}:main", text) for name, text in BENCH_SUITES.items()}
-    parser = _parser(prog, "Run one benchmark suite (python -m benchmarks.SUITE).", entries,
+    entries = {name: (f"{bench_module(name)}:main", text) for name, text in BENCH_SUITES.items()}
+    parser = _parser(prog, "Run one benchmark suite (python -m benchmarks.bench_SUITE).", entries,
                      "suite", epilog=f"{prog} SUITE --help shows the options of a suite.\n\n"
                                      f"The suites come with a source checkout, not with the "
                                      f"installed package: run\n{prog} from the root of a "
@@ -136,15 +149,16 @@ def _bench(argv: list[str], prog: str) -> int:
     except ValueError as exc:
         parser.error(str(exc))
     if root is not None and str(root) not in sys.path:
-        sys.path.insert(0, str(root))        # as python -m benchmarks.SUITE from the root
+        sys.path.insert(0, str(root))        # as python -m benchmarks.bench_SUITE from the root
+    module = bench_module(suite)
     try:
-        importlib.import_module(f"benchmarks.{suite}")
+        importlib.import_module(module)
     except ModuleNotFoundError as exc:
-        if exc.name not in ("benchmarks", f"benchmarks.{suite}"):
+        if exc.name not in ("benchmarks", module):
             raise
         parser.error(f"the benchmark suites are not installed with seaice-gym: they come with "
                      f"a source checkout. Run `{prog} {suite}` (or `python -m "
-                     f"benchmarks.{suite}`) from the root of a checkout, or set "
+                     f"{module}`) from the root of a checkout, or set "
                      f"{SOURCE_VARIABLE} to that root.")
     return _call(entries[suite][0], argv[1:], f"{prog} {suite}")
 

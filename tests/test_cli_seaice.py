@@ -120,10 +120,11 @@ def test_demo_runs_the_engine_demo_then_the_training_demo(monkeypatch):
 def test_bench_forwards_to_the_suite(monkeypatch, capsys):
     benchmarks = pytest.importorskip("benchmarks")
     for suite in cli.BENCH_SUITES:
-        importlib.import_module(f"benchmarks.{suite}")     # every listed suite exists
+        importlib.import_module(cli.bench_module(suite))   # every listed suite exists
+    assert all(cli.bench_module(s) == benchmarks.suite_module(s) for s in benchmarks.SUITES)
     assert set(cli.BENCH_SUITES) >= set(getattr(benchmarks, "SUITES", ()))
     seen = []
-    monkeypatch.setattr(importlib.import_module("benchmarks.itd"), "main",
+    monkeypatch.setattr(importlib.import_module("benchmarks.bench_itd"), "main",
                         lambda argv: seen.append(argv) or 0)
     assert cli.main(["bench", "itd", "--quick"]) == 0 and seen == [["--quick"]]
     code, out, _ = _exit(["bench", "--help"], capsys)
@@ -135,11 +136,11 @@ def test_without_the_benchmarks_bench_says_where_they_are_and_the_rest_works(mon
     monkeypatch.chdir(tmp_path)                                # not a checkout
     monkeypatch.delenv(cli.SOURCE_VARIABLE, raising=False)
     monkeypatch.setitem(sys.modules, "benchmarks", None)       # and not on the module path
-    monkeypatch.delitem(sys.modules, "benchmarks.hertz", raising=False)
+    monkeypatch.delitem(sys.modules, "benchmarks.bench_hertz", raising=False)
     code, _, err = _exit(["bench", "hertz"], capsys)
     assert code == 2 and "Traceback" not in err
     assert "not installed" in err and "source checkout" in err
-    for hint in ("`seaice bench hertz`", "`python -m benchmarks.hertz`", "from the root",
+    for hint in ("`seaice bench hertz`", "`python -m benchmarks.bench_hertz`", "from the root",
                  cli.SOURCE_VARIABLE):
         assert hint in err, hint
     assert _exit(["bench", "--help"], capsys)[0] == 0
@@ -158,11 +159,11 @@ def test_bench_runs_the_suites_of_the_checkout_in_the_current_directory_or_named
         monkeypatch, tmp_path, named):
     """A checkout (here a stand-in with one suite) in the current directory,
     or named by the variable from elsewhere, comes first on the module path,
-    as ``python -m benchmarks.SUITE`` from its root."""
+    as ``python -m benchmarks.bench_SUITE`` from its root."""
     checkout = tmp_path / "checkout"
     (checkout / "benchmarks").mkdir(parents=True)
     (checkout / "benchmarks" / "__init__.py").write_text("")
-    (checkout / "benchmarks" / "itd.py").write_text(
+    (checkout / "benchmarks" / "bench_itd.py").write_text(
         "seen = []\n\ndef main(argv):\n    seen.append(argv)\n    return 5\n")
     if named:
         monkeypatch.setenv(cli.SOURCE_VARIABLE, str(checkout))
@@ -171,13 +172,13 @@ def test_bench_runs_the_suites_of_the_checkout_in_the_current_directory_or_named
         monkeypatch.delenv(cli.SOURCE_VARIABLE, raising=False)
         monkeypatch.chdir(checkout)
     monkeypatch.setattr(sys, "path", list(sys.path))
-    for name in ("benchmarks", "benchmarks.itd"):
+    for name in ("benchmarks", "benchmarks.bench_itd"):
         monkeypatch.delitem(sys.modules, name, raising=False)
     assert cli.benchmarks_checkout() == checkout.resolve()
     # --no-json: should the real suite run instead, it writes nothing
     assert cli.main(["bench", "itd", "--quick", "--no-json"]) == 5
-    suite = sys.modules["benchmarks.itd"]
-    assert Path(suite.__file__).resolve() == (checkout / "benchmarks" / "itd.py").resolve()
+    suite = sys.modules["benchmarks.bench_itd"]
+    assert Path(suite.__file__).resolve() == (checkout / "benchmarks" / "bench_itd.py").resolve()
     assert suite.seen == [["--quick", "--no-json"]]
 
 

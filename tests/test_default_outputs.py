@@ -10,7 +10,7 @@ import re
 
 import pytest
 
-from benchmarks import SUITES
+from benchmarks import SUITES, suite_module
 
 COMMANDS = {
     "agents.train": ["--help"],
@@ -22,7 +22,7 @@ COMMANDS = {
     "physics.demo": ["--help"],
     "physics.crosscheck.report": ["all", "--help"],
     "physics.scenarios.cli": ["run", "--help"],
-    **{f"benchmarks.{suite}": ["--help"] for suite in SUITES if suite != "lammps_scaling"},
+    **{suite_module(suite): ["--help"] for suite in SUITES if suite != "lammps_scaling"},
 }
 # "default" followed by the path it names, as the help texts spell it
 DEFAULT = re.compile(r"\(default:?\s+([^\s),;]+)")
@@ -45,7 +45,7 @@ def test_no_default_output_lands_in_the_docs(module, capsys):
 
 @pytest.mark.parametrize("module, out", [
     ("physics.crosscheck.report", "runs/crosscheck"),
-    ("benchmarks.itd", "runs/benchmarks/itd.json"),
+    ("benchmarks.bench_itd", "runs/benchmarks/itd.json"),
     ("agents.leaderboard", "runs/leaderboard"),
     ("physics.demo", "runs/demo"),
 ])

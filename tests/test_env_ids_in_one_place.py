@@ -28,16 +28,16 @@ SHARED = {"iceenvs/__init__.py", "iceenvs/rewards.py"}
 #: tasks whose episodes the free_drift suite runs under each engine step;
 #: the ceiling of Convergence-v0's return, which its rate limit sets
 EXPERIMENTS = {"agents/ceiling.py": {"iceenvs/Convergence-v0"},
-               "benchmarks/environments.py": {"iceenvs/ShipNavigation-v0",
+               "benchmarks/bench_environments.py": {"iceenvs/ShipNavigation-v0",
                                              "iceenvs/ShipNavigation-v1",
                                              "iceenvs/WindDrift-v0", "iceenvs/Convergence-v0"},
-               "benchmarks/vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
+               "benchmarks/bench_vector.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
                                         "iceenvs/ShipBeset-v0", "iceenvs/WindDrift-v0"},
-               "benchmarks/resting.py": {"iceenvs/ShipNavigation-v0"},
-               "benchmarks/sensors.py": {"iceenvs/ShipNavigation-v1"},
-               "benchmarks/scaling.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"},
-               "benchmarks/where_time_goes.py": {"iceenvs/ShipNavigation-v1"},
-               "benchmarks/free_drift.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
+               "benchmarks/bench_resting.py": {"iceenvs/ShipNavigation-v0"},
+               "benchmarks/bench_sensors.py": {"iceenvs/ShipNavigation-v1"},
+               "benchmarks/bench_scaling.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1"},
+               "benchmarks/bench_where_time_goes.py": {"iceenvs/ShipNavigation-v1"},
+               "benchmarks/bench_free_drift.py": {"iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1",
                                             "iceenvs/ShipBeset-v0"},
                "agents/leaderboard.py": {"iceenvs/ShipNavigation-v1"}}
 

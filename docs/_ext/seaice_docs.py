@@ -247,7 +247,7 @@ def _cell(value) -> str:
 
 def scaling_figure(record: dict, path: Path) -> bool:
     """The speed-up over one thread against Numba threads of each workload
-    of a scaling record (``benchmarks.scaling``), one panel each, beside the
+    of a scaling record (``benchmarks.bench_scaling``), one panel each, beside the
     ceiling loop and the ideal line, as a PNG at ``path`` (rewritten only
     when it changes). Returns ``False``, writing nothing, when the record
     has no timed workload beside the ceiling loop."""
@@ -304,7 +304,7 @@ _SHARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"
 
 def where_time_goes_figure(record: dict, path: Path) -> bool:
     """Horizontal stacked bars of the shares of a where_time_goes record
-    (``benchmarks.where_time_goes``): a late engine substep under the exact
+    (``benchmarks.bench_where_time_goes``): a late engine substep under the exact
     step (its kick–drift pass, live-pair loop and the rest) and under the
     fast step (classification, closed form, list rebuilds, the engaged
     floes' steps), and PPO training in each configuration (engine,
@@ -315,7 +315,7 @@ def where_time_goes_figure(record: dict, path: Path) -> bool:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from benchmarks.where_time_goes import SHARE_LABELS, SHARES
+    from benchmarks.bench_where_time_goes import SHARE_LABELS, SHARES
 
     data = record["data"]
     bars = []
@@ -366,7 +366,7 @@ _METRIC_MARKERS = ("o", "s", "D", "v")
 
 
 def free_drift_figure(record: dict, path: Path) -> bool:
-    """The equivalence test of a free_drift record (``benchmarks.free_drift``),
+    """The equivalence test of a free_drift record (``benchmarks.bench_free_drift``),
     one panel per step compared with the exact one: for each concentration,
     policy and metric, the centre of the per-field differences relative to
     the exact mean with its interval (the statistic the control chose),
@@ -377,7 +377,7 @@ def free_drift_figure(record: dict, path: Path) -> bool:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from benchmarks.free_drift import CONTROL, METRICS
+    from benchmarks.bench_free_drift import CONTROL, METRICS
 
     stats = record["data"].get("statistics")
     if not stats or not stats.get("rows"):
@@ -452,7 +452,7 @@ def generate_benchmarks(out: Path, directory: Path) -> None:
                 "exact and under the fast step, and PPO training on its native vector "
                 "environment in each configuration, from the tables above.")
         elif r["suite"] == "free_drift":
-            from benchmarks.free_drift import ENV_ID
+            from benchmarks.bench_free_drift import ENV_ID
 
             settings = r["data"]["settings"]
             env = settings.get("env", ENV_ID)

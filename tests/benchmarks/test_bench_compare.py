@@ -1,4 +1,4 @@
-"""``python -m benchmarks.compare``: the old revision's worktree is made
+"""``python -m benchmarks.bench_compare``: the old revision's worktree is made
 and always removed, and a quick comparison runs each workload on both
 trees, the packages of each imported from its own tree."""
 from __future__ import annotations
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import compare, harness
+from benchmarks import bench_compare, harness
 
-REPO = Path(compare.__file__).resolve().parents[1]
+REPO = Path(bench_compare.__file__).resolve().parents[1]
 
 
 def _worktrees() -> str:
@@ -29,7 +29,7 @@ pytestmark = pytest.mark.skipif(not (REPO / ".git").exists() or not _has_history
 
 
 def test_worktree_is_removed_after_an_error():
-    tree = compare.Worktree("HEAD")
+    tree = bench_compare.Worktree("HEAD")
     with pytest.raises(KeyboardInterrupt):
         with tree as path:
             assert (path / "physics" / "__init__.py").is_file()
@@ -45,11 +45,11 @@ def test_worktree_is_removed_after_an_error():
 
 def test_bad_revision_and_suites_are_refused(tmp_path):
     with pytest.raises(SystemExit):
-        compare.main(["--against", "no-such-revision-xyz", "--no-json"])
+        bench_compare.main(["--against", "no-such-revision-xyz", "--no-json"])
     with pytest.raises(SystemExit):
-        compare.main(["--against", "HEAD", "--suites", "hertz,nope", "--no-json"])
+        bench_compare.main(["--against", "HEAD", "--suites", "hertz,nope", "--no-json"])
     with pytest.raises(SystemExit):
-        compare.main(["--against", "HEAD", "--rounds", "0", "--no-json"])
+        bench_compare.main(["--against", "HEAD", "--rounds", "0", "--no-json"])
 
 
 @pytest.mark.slow
@@ -57,7 +57,7 @@ def test_quick_comparison_against_head(tmp_path):
     """Hard discs and one environment, two rounds, against HEAD (a minute
     or more: the old tree's kernels compile on first use)."""
     path = tmp_path / "compare.json"
-    assert compare.main(["--against", "HEAD", "--quick", "--quiet", "--rounds", "2",
+    assert bench_compare.main(["--against", "HEAD", "--quick", "--quiet", "--rounds", "2",
                          "--suites", "harddisk,environments", "--ids", "ThicknessDistribution-v0",
                          "--json", str(path)]) == 0
     record = json.loads(path.read_text())

@@ -1,4 +1,4 @@
-"""``python -m benchmarks.environments`` on one fast environment with short
+"""``python -m benchmarks.bench_environments`` on one fast environment with short
 runs (a smoke test; the figures themselves come from the full benchmark)."""
 from __future__ import annotations
 
@@ -6,14 +6,14 @@ import json
 
 import pytest
 
-from benchmarks import environments, harness
+from benchmarks import bench_environments, harness
 
 
 def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
     path = tmp_path / "bench" / "environments.json"
     argv = ["--ids", "ThicknessDistribution-v0", "--seconds", "0.5", "--runs", "2",
             "--warmup", "0", "--json", str(path)]
-    assert environments.main(argv) == 0
+    assert bench_environments.main(argv) == 0
     record = json.loads(path.read_text())
     harness.validate_record(record)
     assert set(record) >= {"command", "machine", "date", "data"}
@@ -43,17 +43,17 @@ def test_sustained_benchmark_writes_the_table_and_the_json(tmp_path, capsys):
 
 def test_unknown_ids_are_refused(tmp_path):
     with pytest.raises(SystemExit):
-        environments.main(["--ids", "NoSuchEnv-v0", "--json", str(tmp_path / "x.json")])
+        bench_environments.main(["--ids", "NoSuchEnv-v0", "--json", str(tmp_path / "x.json")])
 
 
 def test_quick_option_shortens_the_runs(tmp_path):
     path = tmp_path / "environments.json"
-    assert environments.main(["--quick", "--quiet", "--ids", "ThicknessDistribution-v0",
+    assert bench_environments.main(["--quick", "--quiet", "--ids", "ThicknessDistribution-v0",
                               "--json", str(path)]) == 0
     record = json.loads(path.read_text())
     assert record["data"]["quick"] is True
-    assert record["data"]["settings"] == dict(environments.QUICK, seed=0,
-                                              warmup_steps=environments.WARMUP_STEPS, threads=1)
+    assert record["data"]["settings"] == dict(bench_environments.QUICK, seed=0,
+                                              warmup_steps=bench_environments.WARMUP_STEPS, threads=1)
     t = record["tables"][0]
     assert len(t["rows"]) == 1 and len(t["rows"][0]) == len(t["columns"])
 
@@ -63,10 +63,10 @@ def test_a_failing_environment_is_reported_not_raised(monkeypatch):
         raise harness.ChildError("measure_env failed in its process:\nValueError: broken")
 
     monkeypatch.setattr(harness, "spawn_call", failing)
-    row = environments._child("iceenvs/WindDrift-v0", 1.0, 1, 0, 0.0)
+    row = bench_environments._child("iceenvs/WindDrift-v0", 1.0, 1, 0, 0.0)
     assert row == dict(id="iceenvs/WindDrift-v0", failed="ValueError: broken")
-    cells = environments.env_row(row)
-    assert len(cells) == len(environments.COLUMNS) and "failed" in cells[1]
+    cells = bench_environments.env_row(row)
+    assert len(cells) == len(bench_environments.COLUMNS) and "failed" in cells[1]
 
 
 def test_peer_table_sets_v1_beside_benchnpin_and_reads_older_records():
@@ -78,10 +78,10 @@ def test_peer_table_sets_v1_beside_benchnpin_and_reads_older_records():
                     floes=100)
 
     result = dict(peer=peer, default=ours(600.0), peer_like=ours(800.0), v1=ours(60.0))
-    rows = environments.peer_table(result)["rows"]
+    rows = bench_environments.peer_table(result)["rows"]
     assert [r[0].split("`")[1] for r in rows] == ["ship-ice-v0", "ShipNavigation-v0",
                                                   "ShipNavigation-v0", "ShipNavigation-v1"]
     # the ratio to BenchNPIN's mean, and its range from the extreme runs
     assert rows[3][-1] == "12.0 (8.0–18.0)"
     del result["v1"]
-    assert len(environments.peer_table(result)["rows"]) == 3
+    assert len(bench_environments.peer_table(result)["rows"]) == 3

@@ -1,4 +1,4 @@
-"""``python -m benchmarks.free_drift --quick``: the equivalence test of the
+"""``python -m benchmarks.bench_free_drift --quick``: the equivalence test of the
 ship's steps. Its statistics are checked against hand calculations (the
 intervals, the choice of statistic by the control, the verdicts), and the
 quick run's record and the documentation's tables and figure of it are
@@ -12,7 +12,7 @@ import numba
 import numpy as np
 import pytest
 
-from benchmarks import free_drift as fd, harness
+from benchmarks import bench_free_drift as fd, harness
 from docs_extension import benchmarks_page
 
 

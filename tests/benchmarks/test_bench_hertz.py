@@ -1,4 +1,4 @@
-"""The Hertz benchmarks (``benchmarks.hertz``, ``benchmarks.hertz_phases``)
+"""The Hertz benchmarks (``benchmarks.bench_hertz``, ``benchmarks.bench_hertz_phases``)
 on small fields: every configuration is timed in every round, the tables
 report what was measured, and a ``--quick`` run writes a valid record (a
 smoke test; the figures themselves come from the full benchmark)."""
@@ -12,8 +12,8 @@ import numba
 import pytest
 
 from benchmarks import harness
-from benchmarks import hertz as bench
-from benchmarks import hertz_phases as phases
+from benchmarks import bench_hertz as bench
+from benchmarks import bench_hertz_phases as phases
 from benchmarks.harness import render_table
 
 
@@ -50,7 +50,7 @@ def test_table_reports_rows_ratios_and_ceilings():
 
 
 def test_phase_benchmark_times_every_phase_and_configuration(tmp_path):
-    """``python -m benchmarks.hertz_phases`` on 400 floes: one row per phase
+    """``python -m benchmarks.bench_hertz_phases`` on 400 floes: one row per phase
     and kernel configuration, positive times, the serial kernels' speed-up
     over themselves exactly 1, and a table that shows them."""
     result = phases.bench_phases(n=400, seed=1, passes=5, cache_dir=tmp_path, quiet=True)

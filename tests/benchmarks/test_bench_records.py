@@ -3,6 +3,7 @@ layout, its Markdown, the README's headline block, and quick runs of the
 hard-disc, observables and ITD suites."""
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 from pathlib import Path
@@ -10,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import benchmarks
-from benchmarks import harddisk, harness, headline, itd, observables, sensors
+from benchmarks import bench_harddisk, bench_itd, bench_observables, bench_sensors, harness, headline
 
 
 def _record(suite="hertz", **changes):
@@ -96,7 +97,19 @@ def test_suite_dispatch(tmp_path):
     assert json.loads(path.read_text())["suite"] == "itd"
 
 
-@pytest.mark.parametrize("module", [harddisk, observables, itd, sensors])
+def test_no_module_of_the_benchmarks_shares_a_name_with_one_of_the_library():
+    """A suite's module is benchmarks.bench_SUITE, so that ``hertz`` in a
+    traceback or an import is the engine's module, never its benchmark's."""
+    root = Path(benchmarks.__file__).parent
+    library = {p.stem for package in ("physics", "iceenvs", "agents", "seaice_gym")
+               for p in (root.parent / package).rglob("*.py")} - {"__init__", "__main__"}
+    ours = {p.stem for p in root.glob("*.py")} - {"__init__"}
+    assert not ours & library
+    for suite in benchmarks.SUITES:
+        assert importlib.util.find_spec(benchmarks.suite_module(suite)), suite
+
+
+@pytest.mark.parametrize("module", [bench_harddisk, bench_observables, bench_itd, bench_sensors])
 def test_quick_run_writes_a_valid_record(module, tmp_path):
     path = tmp_path / f"{module.SUITE}.json"
     assert module.main(["--quick", "--quiet", "--json", str(path)]) == 0

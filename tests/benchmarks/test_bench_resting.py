@@ -1,4 +1,4 @@
-"""The resting-floes benchmark (``benchmarks.resting``): one reference
+"""The resting-floes benchmark (``benchmarks.bench_resting``): one reference
 transit with the option on and off gives the same statistics, and a
 ``--quick`` run writes a valid record (a smoke test; the figures come from
 the full benchmark)."""
@@ -9,7 +9,7 @@ import json
 import pytest
 
 from benchmarks import harness
-from benchmarks import resting as bench
+from benchmarks import bench_resting as bench
 
 
 @pytest.mark.parametrize("concentration, dynamic", [(0.3, False), (0.6, True)],

@@ -1,4 +1,4 @@
-"""``python -m benchmarks.scaling --quick``: every workload is timed on every
+"""``python -m benchmarks.bench_scaling --quick``: every workload is timed on every
 thread count asked, in every round, its speed-ups are over one thread, and
 the documentation draws the record's figure (a smoke test; the figures come
 from the full benchmark)."""
@@ -10,33 +10,33 @@ import math
 import numba
 import pytest
 
-from benchmarks import harness, scaling
+from benchmarks import bench_scaling, harness
 from docs_extension import docs_extension
 
 pytest.importorskip("stable_baselines3")
 
 
 def test_thread_counts_and_workloads_from_the_command_line():
-    assert scaling.default_threads(1) == [1]
-    assert scaling.default_threads(2) == [1, 2]
-    assert scaling.default_threads(16) == [1, 2, 4, 8, 16]
-    assert scaling.default_threads(12) == [1, 2, 4, 8, 12]     # the top one, not a power of 2
-    assert scaling.parse_threads("4,2") == [1, 2, 4]            # one thread is always timed
+    assert bench_scaling.default_threads(1) == [1]
+    assert bench_scaling.default_threads(2) == [1, 2]
+    assert bench_scaling.default_threads(16) == [1, 2, 4, 8, 16]
+    assert bench_scaling.default_threads(12) == [1, 2, 4, 8, 12]     # the top one, not a power of 2
+    assert bench_scaling.parse_threads("4,2") == [1, 2, 4]            # one thread is always timed
     for bad in ("0", "two", ""):
         with pytest.raises(ValueError, match="--threads"):
-            scaling.parse_threads(bad)
-    assert scaling.parse_workloads(None) == list(scaling.WORKLOADS)
-    assert scaling.parse_workloads("ppo,hertz-jammed,ceiling") == \
+            bench_scaling.parse_threads(bad)
+    assert bench_scaling.parse_workloads(None) == list(bench_scaling.WORKLOADS)
+    assert bench_scaling.parse_workloads("ppo,hertz-jammed,ceiling") == \
         ["ceiling", "hertz-jammed", "ppo-v0"]
-    assert scaling.parse_workloads("vector") == ["vector-v0", "vector-v1"]
+    assert bench_scaling.parse_workloads("vector") == ["vector-v0", "vector-v1"]
     with pytest.raises(ValueError, match="unknown workload"):
-        scaling.parse_workloads("hertz,gpu")
+        bench_scaling.parse_workloads("hertz,gpu")
 
 
 def test_bad_options_are_refused(capsys):
     for argv in (["--workloads", "nope"], ["--threads", "0"], ["--rounds", "0"]):
         with pytest.raises(SystemExit):
-            scaling.main(argv + ["--no-json"])
+            bench_scaling.main(argv + ["--no-json"])
     assert "unknown workload" in capsys.readouterr().err
 
 
@@ -46,22 +46,22 @@ def test_quick_run_times_every_workload_on_every_thread_count(tmp_path):
     threads = [1, 2] if numba.config.NUMBA_NUM_THREADS >= 2 else [1]
     path = tmp_path / "scaling.json"
     torch_threads, numba_threads = torch.get_num_threads(), numba.get_num_threads()
-    assert scaling.main(["--quick", "--quiet", "--threads", ",".join(map(str, threads)),
+    assert bench_scaling.main(["--quick", "--quiet", "--threads", ",".join(map(str, threads)),
                          "--cache-dir", str(tmp_path), "--json", str(path)]) == 0
     # the quick run, in this process, leaves both thread counts as they were
     assert (torch.get_num_threads(), numba.get_num_threads()) == (torch_threads, numba_threads)
     record = json.loads(path.read_text(encoding="utf-8"))
     harness.validate_record(record)
-    assert record["suite"] == scaling.SUITE and record["title"] == scaling.TITLE
+    assert record["suite"] == bench_scaling.SUITE and record["title"] == bench_scaling.TITLE
     assert record["command"].startswith("seaice bench scaling --quick")
     for key in ("cpu", "logical_cpus", "numpy", "numba", "python"):
         assert record["machine"][key], key
     assert record["date"] and record["wall_seconds"] > 0.0
     data = record["data"]
-    rounds = scaling.QUICK["rounds"]
+    rounds = bench_scaling.QUICK["rounds"]
     assert data["quick"] is True and data["threads"] == threads
-    assert data["workloads"] == list(scaling.WORKLOADS)
-    assert [r["workload"] for r in data["results"]] == list(scaling.WORKLOADS)
+    assert data["workloads"] == list(bench_scaling.WORKLOADS)
+    assert [r["workload"] for r in data["results"]] == list(bench_scaling.WORKLOADS)
     for res in data["results"]:
         assert "failed" not in res, res
         assert res["unit"] and res["label"] and res["n"] > 0
@@ -89,11 +89,11 @@ def test_quick_run_times_every_workload_on_every_thread_count(tmp_path):
         assert 1.0 <= float(row[3]) <= min(16.0, 1.0 / s) + 0.05
     assert rates["columns"] == ["workload", "unit"] + columns
     assert speedups["columns"] == ["workload"] + columns
-    assert len(rates["rows"]) == len(speedups["rows"]) == len(scaling.WORKLOADS)
+    assert len(rates["rows"]) == len(speedups["rows"]) == len(bench_scaling.WORKLOADS)
     assert all(row[1] == "1.00" for row in speedups["rows"])
     assert speedups["rows"][0][0].startswith("ceiling")
     text = harness.render_markdown(record)
-    assert text.startswith(f"## {scaling.TITLE}\n") and "### Speed-up over one thread" in text
+    assert text.startswith(f"## {bench_scaling.TITLE}\n") and "### Speed-up over one thread" in text
 
 
 def _synthetic_record(workloads=("ceiling", "hertz-loose", "ppo-v0")):
@@ -108,9 +108,9 @@ def _synthetic_record(workloads=("ceiling", "hertz-loose", "ppo-v0")):
                             rows=rows))
     results.append(dict(workload="vector-v1", label="broken", unit="env steps/s", n=2,
                         failed="exit 1"))
-    tables = [scaling.rates_table(results, threads, 1),
-              scaling.speedup_table(results, threads, 1, cores=2)]
-    return harness.make_record("scaling", scaling.TITLE, scaling.DESCRIPTION,
+    tables = [bench_scaling.rates_table(results, threads, 1),
+              bench_scaling.speedup_table(results, threads, 1, cores=2)]
+    return harness.make_record("scaling", bench_scaling.TITLE, bench_scaling.DESCRIPTION,
                                "seaice bench scaling", tables,
                                dict(threads=threads, results=results, quick=False), 1.0)
 

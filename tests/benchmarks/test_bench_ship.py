@@ -1,4 +1,4 @@
-"""The ship benchmark (``benchmarks.ship``) on small fields: the same floe
+"""The ship benchmark (``benchmarks.bench_ship``) on small fields: the same floe
 field with and without the ship, a cleared slot, the cost table from
 known figures, and a ``--quick`` run that writes a valid record (a smoke
 test; the figures themselves come from the full benchmark)."""
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from benchmarks import harness
-from benchmarks import ship as bench
+from benchmarks import bench_ship as bench
 from benchmarks.harness import render_table
 
 

@@ -1,4 +1,4 @@
-"""``python -m benchmarks.vector --quick``: every way of stepping and of
+"""``python -m benchmarks.bench_vector --quick``: every way of stepping and of
 training runs and lands in the record (a smoke test; the figures come from
 the full benchmark)."""
 from __future__ import annotations
@@ -7,14 +7,14 @@ import json
 
 import pytest
 
-from benchmarks import harness, vector
+from benchmarks import bench_vector, harness
 
 pytest.importorskip("stable_baselines3")
 
 
 def test_quick_run_writes_every_configuration(tmp_path, capsys):
     path = tmp_path / "vector.json"
-    assert vector.main(["--quick", "--quiet", "--ids", "ShipNavigation-v0", "--json",
+    assert bench_vector.main(["--quick", "--quiet", "--ids", "ShipNavigation-v0", "--json",
                         str(path)]) == 0
     record = json.loads(path.read_text())
     harness.validate_record(record)
@@ -39,7 +39,7 @@ def test_quick_run_writes_every_configuration(tmp_path, capsys):
 
 def test_an_environment_without_a_native_vector_env_is_refused(capsys):
     with pytest.raises(SystemExit):
-        vector.main(["--ids", "ThicknessDistribution-v0", "--no-json"])
+        bench_vector.main(["--ids", "ThicknessDistribution-v0", "--no-json"])
     assert "has no native vector environment" in capsys.readouterr().err
 
 
@@ -58,7 +58,7 @@ def test_engine_clock_times_the_engine_calls_and_puts_them_back():
     envs = gym.make_vec("iceenvs/ShipNavigation-v0", num_envs=2,
                         vectorization_mode="vector_entry_point", concentration=0.05)
     envs.reset(seed=0)
-    with vector._EngineClock() as clock:
+    with bench_vector._EngineClock() as clock:
         env.step(env.action_space.sample())
         envs.step(envs.action_space.sample())
     sim = env.unwrapped.sim

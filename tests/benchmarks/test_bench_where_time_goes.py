@@ -1,4 +1,4 @@
-"""``python -m benchmarks.where_time_goes --quick``: the record of a late
+"""``python -m benchmarks.bench_where_time_goes --quick``: the record of a late
 ShipNavigation-v1 substep in parts, of its episode and of PPO on it, whose
 parts add up and whose shares are fractions, and the documentation's tables
 and figure of it (a smoke test; the figures come from the full benchmark)."""
@@ -10,7 +10,7 @@ import math
 import numba
 import pytest
 
-from benchmarks import harness, where_time_goes as wtg
+from benchmarks import bench_where_time_goes as wtg, harness
 from docs_extension import benchmarks_page
 
 pytest.importorskip("stable_baselines3")

@@ -503,7 +503,7 @@ def test_the_default_engine_step_is_the_one_the_equivalence_test_supports(env_id
     import json
     from pathlib import Path
 
-    from benchmarks import free_drift as fd
+    from benchmarks import bench_free_drift as fd
 
     docs = Path(__file__).resolve().parents[2] / "docs" / "benchmarks"
     path = fd.record_path(docs / f"{fd.SUITE}.json", env_id)

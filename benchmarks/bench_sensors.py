@@ -1,7 +1,7 @@
-"""What the ship's sensors cost: ``python -m benchmarks.sensors``
+"""What the ship's sensors cost: ``python -m benchmarks.bench_sensors``
 (``seaice bench sensors``).
 
-    python -m benchmarks.sensors [--concentrations 0.2 0.3 0.4 0.5] [--seed 1]
+    python -m benchmarks.bench_sensors [--concentrations 0.2 0.3 0.4 0.5] [--seed 1]
                                  [--calls 2000] [--quiet] [--quick] [--json PATH | --no-json]
 """
 from __future__ import annotations

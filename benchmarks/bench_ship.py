@@ -1,7 +1,7 @@
-"""The cost of a ship among the floes: ``python -m benchmarks.ship``
+"""The cost of a ship among the floes: ``python -m benchmarks.bench_ship``
 (``seaice bench ship``).
 
-    python -m benchmarks.ship [--floes 2000 20000] [--steps STEPS] [--seed 1]
+    python -m benchmarks.bench_ship [--floes 2000 20000] [--steps STEPS] [--seed 1]
                               [--processes 3] [--quiet] [--quick]
                               [--json PATH | --no-json]
 """

@@ -1,7 +1,7 @@
 """This tree against another revision, side by side: ``python -m
-benchmarks.compare --against REV`` (``seaice bench compare``).
+benchmarks.bench_compare --against REV`` (``seaice bench compare``).
 
-    python -m benchmarks.compare --against REV [--suites hertz,harddisk,environments]
+    python -m benchmarks.bench_compare --against REV [--suites hertz,harddisk,environments]
                                  [--rounds 5] [--ids WindDrift-v0 ...] [--quick]
                                  [--cache-dir .bench_cache] [--quiet]
                                  [--json PATH | --no-json]
@@ -155,8 +155,8 @@ def _load_field(path: str):
 
 def _hertz_child(path: str, steps: int, dt: float, segments: int) -> list[float]:
     """Best floe-steps/s of every kernel configuration over ``segments``
-    rounds (see :func:`benchmarks.hertz.time_configs`)."""
-    from .hertz import time_configs, warm_sims
+    rounds (see :func:`benchmarks.bench_hertz.time_configs`)."""
+    from .bench_hertz import time_configs, warm_sims
 
     configs, sims = warm_sims(path, dt)
     return [max(r) for r in time_configs(configs, sims, steps, segments)]
@@ -166,7 +166,7 @@ def _harddisk_child(path: str, kind: str, collisions: int, chunk: float,
                     segments: int) -> list[float]:
     """Best collisions/s over ``segments`` runs of ``collisions`` collisions,
     after a warm-up advance."""
-    from . import harddisk as H
+    from . import bench_harddisk as H
 
     field, box = _load_field(path)
     sim = H.elastic_sim(field, box) if kind == "elastic" else H.herman_sim(field, box)
@@ -176,8 +176,8 @@ def _harddisk_child(path: str, kind: str, collisions: int, chunk: float,
 
 def _environment_child(env_id: str, seconds: float, runs: int, seed: int,
                        warmup: float) -> list[float]:
-    """Sustained steps/s (see :func:`benchmarks.environments.measure_env`)."""
-    from .environments import measure_env
+    """Sustained steps/s (see :func:`benchmarks.bench_environments.measure_env`)."""
+    from .bench_environments import measure_env
 
     return [measure_env(env_id, seconds, runs, seed, warmup)["mean"]]
 
@@ -191,7 +191,7 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
     if "hertz" in suites:
         import numba
 
-        from .hertz import kernel_configs, prepared_cases
+        from .bench_hertz import kernel_configs, prepared_cases
 
         labels = [f"{k}, {t} thread{'s' * (t > 1)}"
                   for k, _, t in kernel_configs(numba.config.NUMBA_NUM_THREADS)]
@@ -201,7 +201,7 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
                             args=(str(path), sizes["steps"], dt, sizes["segments"]),
                             threads=numba.config.NUMBA_NUM_THREADS))
     if "harddisk" in suites:
-        from . import harddisk as H
+        from . import bench_harddisk as H
 
         field, box = H.gas_field(sizes["gas_floes"], 0.5, seed)
         sim = H.elastic_sim(field, box)
@@ -223,7 +223,7 @@ def prepare(suites, sizes: dict, work: Path, cache_dir: Path, seed: int = 1, ids
     if "environments" in suites:
         from iceenvs import ENV_IDS
 
-        from .environments import resolve_ids
+        from .bench_environments import resolve_ids
 
         for env_id in (resolve_ids(ids, ENV_IDS) if ids else ENV_IDS):
             out.append(dict(name=env_id, labels=["one thread"], unit="steps/s",

@@ -1,6 +1,6 @@
-"""Floes at rest cost nothing, and change nothing: ``python -m benchmarks.resting``.
+"""Floes at rest cost nothing, and change nothing: ``python -m benchmarks.bench_resting``.
 
-    python -m benchmarks.resting [--seeds 10] [--env-steps 100] [--quiet] [--quick]
+    python -m benchmarks.bench_resting [--seeds 10] [--env-steps 100] [--quiet] [--quick]
                                  [--json PATH | --no-json]
 """
 from __future__ import annotations

@@ -1,7 +1,7 @@
-"""Speed-up against the number of Numba threads: ``python -m benchmarks.scaling``
+"""Speed-up against the number of Numba threads: ``python -m benchmarks.bench_scaling``
 (``seaice bench scaling``).
 
-    python -m benchmarks.scaling [--threads 1,2,4,...] [--workloads ceiling,hertz,vector,ppo]
+    python -m benchmarks.bench_scaling [--threads 1,2,4,...] [--workloads ceiling,hertz,vector,ppo]
                                  [--rounds 5] [--floes 20000] [--large-floes 200000]
                                  [--steps 2000] [--ceiling-floes 200000]
                                  [--ceiling-steps 1000] [--envs 64] [--vector-steps 20]
@@ -193,10 +193,10 @@ def _ceiling_runs(spec: dict, threads: list[int]) -> tuple[list, dict]:
 
 def _hertz_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
     """A warmed-up parallel simulation of the saved field per thread count
-    (:func:`benchmarks.hertz.warm_sim`); the timed segments: ``steps``
+    (:func:`benchmarks.bench_hertz.warm_sim`); the timed segments: ``steps``
     steps. Also returns a function that gives the contacts per floe and the
     list rebuilds per segment after the timing."""
-    from .hertz import segment_rate, warm_sim
+    from .bench_hertz import segment_rate, warm_sim
 
     sims = []
     for k in threads:
@@ -231,7 +231,7 @@ def _vector_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
 
     import iceenvs  # noqa: F401  (registers the ids)
 
-    from .vector import random_actions
+    from .bench_vector import random_actions
 
     n, steps = spec["n"], spec["steps"]
     copies = []
@@ -286,7 +286,7 @@ def serial_share(env, rng, n: int, steps: int) -> dict:
     law a step on p threads is at most 1 / (s + (1 − s) / p) times faster."""
     import importlib
 
-    from .vector import random_actions
+    from .bench_vector import random_actions
 
     spent = [0.0]
     saved = []
@@ -317,7 +317,7 @@ def serial_share(env, rng, n: int, steps: int) -> dict:
 def _ppo_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
     """A PPO model on its own native vector environment per thread count,
     all seeded alike, after one untimed rollout and update (as
-    :func:`benchmarks.vector.measure_training` trains); the timed segments:
+    :func:`benchmarks.bench_vector.measure_training` trains); the timed segments:
     ``learn`` of at least ``steps`` more training steps. PyTorch runs on one
     thread, as the training command sets it (its threads and Numba's would
     otherwise share the cores), so that only Numba's threads change."""
@@ -326,7 +326,7 @@ def _ppo_runs(spec: dict, threads: list[int]) -> tuple[list, dict, Callable]:
 
     from agents.envs import make_vec_env
 
-    from .vector import ROLLOUT
+    from .bench_vector import ROLLOUT
 
     n = spec["n"]
     n_steps = max((spec["rollout"] or ROLLOUT) // n, 8)
@@ -408,7 +408,7 @@ def workload_specs(keys, st: dict, seed: int, cache_dir: Path, quiet: bool) -> d
     unit, and what :func:`time_workload` needs)."""
     from physics.params import HERMAN2013
 
-    from .hertz import loose_state, prepared_cases
+    from .bench_hertz import loose_state, prepared_cases
 
     specs = {}
     for key in keys:

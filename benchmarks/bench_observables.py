@@ -1,7 +1,7 @@
-"""Wall time of the observables: ``python -m benchmarks.observables``
+"""Wall time of the observables: ``python -m benchmarks.bench_observables``
 (``seaice bench observables``).
 
-    python -m benchmarks.observables [--seed 1] [--quiet] [--quick] [--json PATH | --no-json]
+    python -m benchmarks.bench_observables [--seed 1] [--quiet] [--quick] [--json PATH | --no-json]
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
-"""Time of each phase of a Hertz step: ``python -m benchmarks.hertz_phases``
+"""Time of each phase of a Hertz step: ``python -m benchmarks.bench_hertz_phases``
 (``seaice bench hertz_phases``).
 
-    python -m benchmarks.hertz_phases [--floes 20000] [--passes 2000] [--seed 1]
+    python -m benchmarks.bench_hertz_phases [--floes 20000] [--passes 2000] [--seed 1]
                                       [--cache-dir .bench_cache] [--quiet] [--quick]
                                       [--json PATH | --no-json]
 """
@@ -19,7 +19,7 @@ from physics.params import HERMAN2013
 
 from . import harness
 from .harness import REPEATS
-from .hertz import kernel_configs, loose_state, warm_sim
+from .bench_hertz import kernel_configs, loose_state, warm_sim
 
 SUITE = "hertz_phases"
 TITLE = "Phases of a Hertz step"
@@ -85,7 +85,7 @@ REBUILD = len(PHASES) - 1
 def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
                  cache_dir: Path | None = None, quiet: bool = False) -> dict:
     """Wall time of each phase of a Hertz step at Ā = 0.7 (the field of
-    :func:`benchmarks.hertz.bench_hertz`): the kick–drift pass, the pair
+    :func:`benchmarks.bench_hertz.bench_hertz`): the kick–drift pass, the pair
     loop, both, and a Verlet-list rebuild, with the serial kernels, the
     parallel kernels on one thread and on all threads, taking turns in
     ``REPEATS`` rounds. Returns the field size ``n``, its listed pairs

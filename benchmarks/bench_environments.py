@@ -1,11 +1,11 @@
-"""Sustained environment steps per second: ``python -m benchmarks.environments``
+"""Sustained environment steps per second: ``python -m benchmarks.bench_environments``
 (``seaice bench environments``); the effect of the reduced-stiffness option:
-``python -m benchmarks.environments --stiffness``.
+``python -m benchmarks.bench_environments --stiffness``.
 
-    python -m benchmarks.environments [--ids WindDrift-v0 ...] [--seconds 20] [--runs 3]
+    python -m benchmarks.bench_environments [--ids WindDrift-v0 ...] [--seconds 20] [--runs 3]
                                       [--warmup 2] [--seed 0] [--quick] [--no-peer]
                                       [--json PATH | --no-json]
-    python -m benchmarks.environments --stiffness [--json PATH]
+    python -m benchmarks.bench_environments --stiffness [--json PATH]
 """
 from __future__ import annotations
 

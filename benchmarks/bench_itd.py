@@ -1,7 +1,7 @@
 """Wall time of the ice-thickness-distribution models: ``python -m
-benchmarks.itd`` (``seaice bench itd``).
+benchmarks.bench_itd`` (``seaice bench itd``).
 
-    python -m benchmarks.itd [--quiet] [--quick] [--json PATH | --no-json]
+    python -m benchmarks.bench_itd [--quiet] [--quick] [--json PATH | --no-json]
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The LAMMPS scaling benchmark (``benchmarks.lammps_scaling``) at a tiny
+"""The LAMMPS scaling benchmark (``benchmarks.bench_lammps_scaling``) at a tiny
 size: one measurement on one rank, the per-rank results of a fresh process,
 and the record built from measurements (its tables, its projection) that
 the documentation renders. The figures themselves come from the full run."""
@@ -9,7 +9,7 @@ import math
 import pytest
 
 from benchmarks import harness
-from benchmarks import lammps_scaling as bench
+from benchmarks import bench_lammps_scaling as bench
 from physics.lammps_library import lammps_available
 
 _OK, _REASON = lammps_available()

@@ -1,14 +1,14 @@
 """LAMMPS on MPI ranks against our engine on threads, LAMMPS's strong and
 weak scaling, and a projection to a basin-scale run:
-``python -m benchmarks.lammps_scaling`` (``seaice bench lammps_scaling``).
+``python -m benchmarks.bench_lammps_scaling`` (``seaice bench lammps_scaling``).
 
-    python -m benchmarks.lammps_scaling [--floes 200000] [--strong-floes 50000]
+    python -m benchmarks.bench_lammps_scaling [--floes 200000] [--strong-floes 50000]
                                         [--weak-floes 25000] [--seconds 30]
                                         [--scaling-seconds 20] [--rounds 3] [--seed 1]
                                         [--quiet] [--quick] [--json PATH | --no-json]
 
 Every configuration runs in a fresh process: our engine in ``python -m
-benchmarks.lammps_scaling --child SPEC PREFIX`` with a Numba pool of k
+benchmarks.bench_lammps_scaling --child SPEC PREFIX`` with a Numba pool of k
 threads, LAMMPS in ``mpiexec -n R`` of the same command, every rank running
 :func:`measure` on the same field (SPMD) and writing what it measured to
 ``PREFIX.rank<r>.json``. The fields are built once per size, before the
@@ -414,7 +414,7 @@ def launch(config: dict, field_path: str, seconds: float, workdir: str,
     spec.write_text(json.dumps(dict(engine=engine, field_path=field_path, seconds=seconds,
                                     threads=threads)))
     prefix = str(Path(workdir) / tag)
-    cmd = [sys.executable, "-m", "benchmarks.lammps_scaling", "--child", str(spec), prefix]
+    cmd = [sys.executable, "-m", "benchmarks.bench_lammps_scaling", "--child", str(spec), prefix]
     env = dict(os.environ, SEAICE_QUIET="1", PYTHONUNBUFFERED="1")
     root = str(Path(__file__).resolve().parents[1])
     env["PYTHONPATH"] = os.pathsep.join([root] + [p for p in env.get("PYTHONPATH", "").split(
@@ -814,9 +814,9 @@ def main(argv=None, prog: str | None = None) -> int:
                                                      PROJECTION["efficiency"].items()}),
              machine_note="2 logical CPUs shared with other work; 2-rank and 2-thread "
                           "figures are bounded by that",
-             launch=dict(lammps="mpiexec -n R python -m benchmarks.lammps_scaling --child "
+             launch=dict(lammps="mpiexec -n R python -m benchmarks.bench_lammps_scaling --child "
                                 "SPEC PREFIX", numba="NUMBA_NUM_THREADS=k python -m "
-                                "benchmarks.lammps_scaling --child SPEC PREFIX"),
+                                "benchmarks.bench_lammps_scaling --child SPEC PREFIX"),
              **results),
         time.perf_counter() - t0, machine=harness.machine_info(2))
     harness.finish(args, record)

@@ -1,7 +1,7 @@
-"""Floe-steps per second of the Hertz engine: ``python -m benchmarks.hertz``
+"""Floe-steps per second of the Hertz engine: ``python -m benchmarks.bench_hertz``
 (``seaice bench hertz``).
 
-    python -m benchmarks.hertz [--floes 20000] [--steps 2000] [--seed 1]
+    python -m benchmarks.bench_hertz [--floes 20000] [--steps 2000] [--seed 1]
                                [--memory-floes 100000] [--cache-dir .bench_cache]
                                [--processes 3] [--quiet] [--quick]
                                [--json PATH | --no-json]

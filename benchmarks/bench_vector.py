@@ -1,7 +1,7 @@
-"""Vectorised stepping and training side by side: ``python -m benchmarks.vector``
+"""Vectorised stepping and training side by side: ``python -m benchmarks.bench_vector``
 (``seaice bench vector``).
 
-    python -m benchmarks.vector [--ids ShipNavigation-v0 ...] [--sizes 1 8 16 32]
+    python -m benchmarks.bench_vector [--ids ShipNavigation-v0 ...] [--sizes 1 8 16 32]
                                 [--seconds 5] [--rounds 3] [--ppo-envs 16]
                                 [--ppo-steps 8192] [--no-ppo] [--quick]
                                 [--json PATH | --no-json]
@@ -417,7 +417,7 @@ def main(argv=None, prog: str | None = None) -> int:
     from iceenvs import ENV_IDS
     from iceenvs.facts import env_spec
 
-    from .environments import resolve_ids
+    from .bench_environments import resolve_ids
 
     parser = harness.suite_parser(SUITE, TITLE + ": " + DESCRIPTION, prog)
     parser.add_argument("--ids", nargs="+", metavar="ID",

@@ -1,7 +1,7 @@
 """The ship's steps against the exact one, an equivalence test:
-``python -m benchmarks.free_drift`` (``seaice bench free_drift``).
+``python -m benchmarks.bench_free_drift`` (``seaice bench free_drift``).
 
-    python -m benchmarks.free_drift [--parts statistics,speed] [--seeds 40]
+    python -m benchmarks.bench_free_drift [--parts statistics,speed] [--seeds 40]
                                     [--concentrations 0.2,0.3,0.4,0.5]
                                     [--policies straight,swath,lattice]
                                     [--variants fast,soft-0.1,soft-0.01] [--seed 10000]
@@ -125,7 +125,7 @@ question and the control, and judged on all its fields together with a
 95 % interval of the 20 %-trimmed mean (two one-sided tests at 2.5 %), so
 that the two looks at the row keep the chance of a false equivalence
 under 7.5 %. The step counts as equivalent on the row where this interval
-lies within the margin (`benchmarks.free_drift.supports`). The other
+lies within the margin (`benchmarks.bench_free_drift.supports`). The other
 metrics of the same fields come with it.
 """
 

@@ -1,7 +1,7 @@
 """Where the time of a ShipNavigation-v1 step and of PPO on it goes:
-``python -m benchmarks.where_time_goes`` (``seaice bench where_time_goes``).
+``python -m benchmarks.bench_where_time_goes`` (``seaice bench where_time_goes``).
 
-    python -m benchmarks.where_time_goes [--steps 200] [--rounds 5] [--every 20]
+    python -m benchmarks.bench_where_time_goes [--steps 200] [--rounds 5] [--every 20]
                                          [--trajectory-steps N] [--episode-seed 10001]
                                          [--envs 16] [--ppo-steps 4096] [--seed 0]
                                          [--parts substep,ppo]

@@ -1,7 +1,7 @@
 """Collisions per second of the hard-disc engine: ``python -m
-benchmarks.harddisk`` (``seaice bench harddisk``).
+benchmarks.bench_harddisk`` (``seaice bench harddisk``).
 
-    python -m benchmarks.harddisk [--seed 1] [--quiet] [--quick] [--json PATH | --no-json]
+    python -m benchmarks.bench_harddisk [--seed 1] [--quiet] [--quick] [--json PATH | --no-json]
 """
 from __future__ import annotations
 
