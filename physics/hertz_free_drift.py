@@ -83,8 +83,8 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, Kick, drift_bound, floe_drag, from_order_key,
-                            kick_drift_floe, max_keep_nan, min_image_step, order_key, path_slack,
+from .hertz_kernels import (KICK_FASTMATH, Kick, drift_bound, floe_drag, kick_drift_floe,
+                            kick_drift_pass, max_keep_nan, min_image_step, path_slack,
                             rigid_drift_bound, wall_overlap, wide_floe_test)
 from .hertz_resting import pair_index
 from .hull import disc_hull_contact
@@ -553,42 +553,14 @@ def iterate_floes(floes, fbuf, tbuf, drive, box, which, first, stop, flag, path,
 @njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy", _nrt=False)
 def engaged_pass(floes, ref, drive, kick, awake, path, lines, elapsed, broken):
     """The kick–drift of the engaged floes
-    (:func:`~physics.hertz_kernels.kick_drift_floe`, the same arithmetic),
+    (:func:`~physics.hertz_kernels.kick_drift_pass`, the same arithmetic),
     as :func:`physics.hertz_resting.first_half_awake` does it. The engaged
     floes that left their straight lines (``lines`` of :func:`classify`, at
     time ``elapsed`` into the window) by more than their budgets are written
     to ``broken``; returns (worst, Σ dx, Σ dy, largest squared speed, their
     number)."""
-    order, n_eng = awake.order, awake.count[0]
-    p = floes.pos.reshape(-1)
-    v = floes.vel.reshape(-1)
-    f = floes.force.reshape(-1)
-    r = ref.reshape(-1)
-    k = drive.coefficients.reshape(-1)
-    vmax2 = np.uint64(0)
-    worst = np.uint64(0)
-    n_broken = 0
-    sdx = 0.0
-    sdy = 0.0
-    step_length, slack = drift_bound(kick)
-    for q in range(n_eng):
-        i = order[q]
-        v2, e2, dx, dy = kick_drift_floe(i, p, v, f, floes.omega, floes.torque, floes.inv_mass,
-                                         floes.inv_inertia, r, k, drive, kick)
-        path[i] += math.sqrt(v2) * step_length + slack
-        mx = min_image_step(p[2 * i] - lines[i, 0], kick.lx, kick.periodic_x) - elapsed * lines[i, 2]
-        my = min_image_step(p[2 * i + 1] - lines[i, 1], kick.ly, kick.periodic_y) \
-            - elapsed * lines[i, 3]
-        if mx * mx + my * my > lines[i, 4] * lines[i, 4]:
-            broken[n_broken] = i
-            n_broken += 1
-        key = order_key(v2)
-        vmax2 = key if key > vmax2 else vmax2
-        key = order_key(e2)
-        worst = key if key > worst else worst
-        sdx += dx
-        sdy += dy
-    return from_order_key(worst), sdx, sdy, from_order_key(vmax2), n_broken
+    return kick_drift_pass(floes, ref, drive, kick, path, awake.order, awake.count[0], lines,
+                           elapsed, broken)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)

@@ -749,12 +749,32 @@ def first_half(floes, ref, drive, kick, path=None):
     the length of its drift, |v| Δt and the rounding of the new position
     (:func:`path_slack`), in a rigid box (a deforming one remaps the floes
     by more than they drift)."""
+    worst, sdx, sdy, vmax2, _ = kick_drift_pass(floes, ref, drive, kick, path)
+    return worst, sdx, sdy, vmax2
+
+
+@njit(cache=True, fastmath=KICK_FASTMATH, error_model="numpy", _nrt=False)
+def kick_drift_pass(floes, ref, drive, kick, path=None, order=None, count=0, lines=None,
+                    elapsed=0.0, broken=None):
+    """The kick–drift pass, written once: :func:`first_half` over all floes
+    (``order`` None: the loop vectorises), or over the floes
+    ``order[:count]`` alone (the awake floes of
+    :func:`physics.hertz_resting.first_half_awake`, the engaged floes of
+    :func:`physics.hertz_free_drift.engaged_pass`), with the same per-floe
+    arithmetic (:func:`kick_drift_floe`).
+
+    With ``lines`` (a free-drift window's straight lines and budgets, at
+    time ``elapsed`` into the window), the floes that left their lines by
+    more than their budgets are written to ``broken``. Returns (largest
+    squared distance from (cx, cy), Σ dx, Σ dy, largest squared speed,
+    the number of floes written to ``broken``)."""
     omega, torque = floes.omega, floes.torque
     inv_mass, inv_inertia = floes.inv_mass, floes.inv_inertia
     sx, sy = kick.sx, kick.sy
-    n = inv_mass.shape[0]
+    n = inv_mass.shape[0] if order is None else count
     if sx != 1.0 or sy != 1.0:
-        for i in range(n):
+        for q in range(n):
+            i = q if order is None else order[q]
             ref[i, 0] *= sx
             ref[i, 1] *= sy
     p = floes.pos.reshape(-1)
@@ -764,21 +784,31 @@ def first_half(floes, ref, drive, kick, path=None):
     k = drive.coefficients.reshape(-1)
     vmax2 = np.uint64(0)
     worst = np.uint64(0)
+    n_broken = 0
     sdx = 0.0
     sdy = 0.0
     step_length, slack = drift_bound(kick)
-    for i in range(n):
+    for q in range(n):
+        i = q if order is None else order[q]
         v2, e2, dx, dy = kick_drift_floe(i, p, v, f, omega, torque, inv_mass, inv_inertia, r, k,
                                          drive, kick)
         if path is not None:
             path[i] += math.sqrt(v2) * step_length + slack
+        if lines is not None:
+            mx = min_image_step(p[2 * i] - lines[i, 0], kick.lx, kick.periodic_x) \
+                - elapsed * lines[i, 2]
+            my = min_image_step(p[2 * i + 1] - lines[i, 1], kick.ly, kick.periodic_y) \
+                - elapsed * lines[i, 3]
+            if mx * mx + my * my > lines[i, 4] * lines[i, 4]:
+                broken[n_broken] = i
+                n_broken += 1
         key = order_key(v2)
         vmax2 = key if key > vmax2 else vmax2
         key = order_key(e2)
         worst = key if key > worst else worst
         sdx += dx
         sdy += dy
-    return from_order_key(worst), sdx, sdy, from_order_key(vmax2)
+    return from_order_key(worst), sdx, sdy, from_order_key(vmax2), n_broken
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -48,16 +48,15 @@ the live pairs.
 """
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from .domain import minimum_image
-from .hertz_kernels import (KICK_FASTMATH, apart_until, drift_bound, first_half, floe_drag,
-                            floe_walls, floe_walls_skipping, from_order_key, kick_drift_floe,
-                            listed_pair, max_keep_nan, order_key, wall_overlap)
+from .hertz_kernels import (KICK_FASTMATH, apart_until, first_half, floe_drag, kick_drift_pass,
+                            floe_walls, floe_walls_skipping, listed_pair, max_keep_nan,
+                            wall_overlap)
 from .hull_contact import C_CAND
 
 __all__ = ["Awake", "LivePairs", "find_awake", "live_pairs", "first_half_awake",
@@ -267,35 +266,10 @@ def first_half_awake(floes, ref, drive, kick, awake, path):
     n = floes.inv_mass.shape[0]
     if 2 * n_awake >= n:
         return first_half(floes, ref, drive, kick, path)
-    if kick.sx != 1.0 or kick.sy != 1.0:
-        for q in range(n_awake):
-            ref[order[q], 0] *= kick.sx
-            ref[order[q], 1] *= kick.sy
-    p = floes.pos.reshape(-1)
-    v = floes.vel.reshape(-1)
-    f = floes.force.reshape(-1)
-    r = ref.reshape(-1)
-    k = drive.coefficients.reshape(-1)
-    vmax2 = np.uint64(0)
-    worst = np.uint64(0)
-    sdx = 0.0
-    sdy = 0.0
-    step_length, slack = drift_bound(kick)
-    for q in range(n_awake):
-        i = order[q]
-        v2, e2, dx, dy = kick_drift_floe(i, p, v, f, floes.omega, floes.torque, floes.inv_mass,
-                                         floes.inv_inertia, r, k, drive, kick)
-        path[i] += math.sqrt(v2) * step_length + slack
-        key = order_key(v2)
-        vmax2 = key if key > vmax2 else vmax2
-        key = order_key(e2)
-        worst = key if key > worst else worst
-        sdx += dx
-        sdy += dy
-    e2_max = from_order_key(worst)
+    e2_max, sdx, sdy, vmax2, _ = kick_drift_pass(floes, ref, drive, kick, path, order, n_awake)
     if n_awake < n:
         e2_max = max_keep_nan(e2_max, kick.cx * kick.cx + kick.cy * kick.cy)
-    return e2_max, sdx, sdy, from_order_key(vmax2)
+    return e2_max, sdx, sdy, vmax2
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
