@@ -40,13 +40,14 @@ from statistics import NormalDist
 import numpy as np
 
 from .input_checks import check_range
-from .domain import Box
+from .domain import Box, PeriodicBox
 from .floes import FloeField, place_floes, power_law_diameters, spatial_order
 
 __all__ = ["LogMassSizes", "AUTO_ICENAV_SIZES", "floe_area_quantile", "draw_floe_areas",
            "covering_areas", "Lead", "field_keep_probability", "navigation_field",
            "MAX_PLACED_CONCENTRATION", "TransitBox", "FLOE_SIZE_LAWS", "transit_field",
-           "covering_diameters", "channel_field", "PLACEMENT_LIMIT"]
+           "covering_diameters", "channel_field", "PLACEMENT_LIMIT", "scaled_placement",
+           "place_then_compress"]
 
 
 @dataclass(frozen=True)
@@ -396,6 +397,48 @@ def covering_diameters(preset, sizes: str, lognormal, target_area: float,
 PLACEMENT_LIMIT = 0.8
 
 
+def scaled_placement(radii: np.ndarray, lengths, concentration: float,
+                     rng: np.random.Generator, *, thickness, density: float):
+    """The loose placement of :func:`place_then_compress` for floes of
+    radii ``radii`` [m] that cover ``concentration`` of a box of side
+    lengths ``lengths`` [m]: a function of a concentration c that places
+    them at random with ``rng``, at rest, in a periodic box of the same
+    shape that they cover at c (the sides times √(concentration / c)), and
+    returns (FloeField, PeriodicBox)."""
+    def place(c: float):
+        k = math.sqrt(concentration / c)
+        box = PeriodicBox(lengths[0] * k, lengths[1] * k)
+        loose = FloeField(place_floes(radii, box, rng), radii, thickness,
+                          np.zeros((radii.size, 2)), density=density)
+        return loose, box
+    return place
+
+
+def place_then_compress(place, concentration: float, limit: float, *, increment: float = 0.005,
+                        force_tol: float = 1e-3):
+    """Floes at a concentration above what random placement reaches:
+    placed loosely, then compressed. ``place(limit)`` places them at random,
+    at rest, at the concentration ``limit`` in a periodic box and returns
+    (FloeField, PeriodicBox) (:func:`scaled_placement`, or a preset's
+    :meth:`~physics.params.PaperPreset.floe_field`);
+    :func:`physics.jamming.compress_floes` then compresses them affinely to
+    ``concentration``, relaxing them with FIRE after every ``increment`` of
+    concentration to the force tolerance ``force_tol``. Below the field's
+    jamming point the floes end without overlaps; above it they form a
+    jammed packing in force balance (small overlaps).
+
+    Returns
+    -------
+    (FloeField, PeriodicBox, RelaxResult)
+        As :func:`~physics.jamming.compress_floes`: the floes at rest, the
+        compressed box and the last relaxation.
+    """
+    from .jamming import compress_floes
+
+    loose, box = place(limit)
+    return compress_floes(loose, box, concentration, increment=increment, force_tol=force_tol)
+
+
 def channel_field(preset, box, rng: np.random.Generator, *, concentration: float,
                   sizes: str = "power", lognormal=(1.0, 0.5), band: float | None = None,
                   keep=None) -> tuple[FloeField, float]:
@@ -434,19 +477,15 @@ def channel_field(preset, box, rng: np.random.Generator, *, concentration: float
     if concentration <= PLACEMENT_LIMIT or band is not None:
         pos = place_floes(r, region, rng)
     else:
-        from .domain import PeriodicBox
-        from .jamming import compress_floes
-
         if not all(box.periodic):
             raise ValueError(f"concentration {concentration:g} is above {PLACEMENT_LIMIT} "
                              f"and the box has walls: floes are compressed to it only in "
                              f"a periodic box")
         a = math.pi * float(np.sum(r ** 2)) / box.area
-        k = math.sqrt(a / PLACEMENT_LIMIT)
-        box0 = PeriodicBox(box.lx * k, box.ly * k)
-        loose = FloeField(place_floes(r, box0, rng), r, preset.thickness, np.zeros((r.size, 2)),
-                          density=preset.forcing.ice_density)
-        packed, box1, _ = compress_floes(loose, box0, a, increment=0.01, force_tol=1e-2)
+        place = scaled_placement(r, (box.lx, box.ly), a, rng, thickness=preset.thickness,
+                                 density=preset.forcing.ice_density)
+        packed, box1, _ = place_then_compress(place, a, PLACEMENT_LIMIT, increment=0.01,
+                                              force_tol=1e-2)
         pos = np.mod(packed.positions * (box.lx / box1.lx), [box.lx, box.ly])
     if keep is not None:
         mask = keep(pos, r)

@@ -31,6 +31,7 @@ from ..floes import FloeField
 from ..forcing import Forcing, steady_drift
 from ..hertz import hertz_time_step, scaled_contact
 from ..hertz_kernels import floe_drag
+from ..ice_fields import place_then_compress
 from ..observables import fabric, stress
 from ..params import HERMAN2013
 from . import plots
@@ -88,14 +89,14 @@ def _field(n: int, concentration: float, seed: int, *, aspect: float = 1.0, box_
     compressed that way: the floes are placed at the concentration itself,
     which works up to about 0.88 (beyond, placement fails with a
     :class:`physics.floes.PlacementError` saying so)."""
-    place = min(concentration, 0.85) if box_type is PeriodicBox else concentration
-    field, box = HERMAN2013.floe_field(n, place, seed=seed, aspect=aspect, box_type=box_type)
-    if concentration > place:
-        from ..jamming import compress_floes
-        # above the field's jamming point the result is a jammed packing in force
-        # balance (small overlaps), which the engine accepts as a start
-        field, box, _ = compress_floes(field, box, concentration, increment=0.005,
-                                       force_tol=1e-3)
+    def place(c: float):
+        return HERMAN2013.floe_field(n, c, seed=seed, aspect=aspect, box_type=box_type)
+
+    if box_type is not PeriodicBox or concentration <= 0.85:
+        return place(concentration)
+    # above the field's jamming point the result is a jammed packing in force
+    # balance (small overlaps), which the engine accepts as a start
+    field, box, _ = place_then_compress(place, concentration, 0.85)
     return field, box
 
 

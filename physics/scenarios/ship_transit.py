@@ -87,7 +87,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..domain import Box, PeriodicBox
+from ..domain import Box
 from ..engine import FloeEngine
 from ..floes import (FloeField, PlacementError, max_overlap, place_floes, power_law_diameters,
                      spatial_order)
@@ -96,7 +96,8 @@ from ..hertz import HertzSimulation, ship_time_step
 from ..hull_contact import LOG_COLUMNS
 from ..ice_resistance import power_law_fit
 from ..params import HERMAN2013
-from ..ice_fields import AUTO_ICENAV_SIZES, TransitBox, covering_areas
+from ..ice_fields import (AUTO_ICENAV_SIZES, TransitBox, covering_areas, place_then_compress,
+                          scaled_placement)
 from ..ship import psv_ship, research_ship
 from . import plots
 from .experiment import Experiment, register
@@ -255,14 +256,10 @@ def pack_ice(p: dict, concentration: float, seed: int, walls: bool = False):
             f"of a channel closed by walls across are placed directly, up to placement_limit "
             f"(the power-law fields cannot be placed between walls at 0.85: use at most 0.8)")
     else:
-        from ..jamming import compress_floes
-        k = math.sqrt(concentration / limit)
-        box0 = PeriodicBox(band * k, width * k)
-        pos0 = place_floes(r, box0, rng)
-        loose = FloeField(pos0, r, HERMAN2013.thickness, np.zeros((r.size, 2)),
-                          density=HERMAN2013.forcing.ice_density)
-        packed, box1, _ = compress_floes(loose, box0, concentration, increment=0.005,
-                                         force_tol=1e-3)
+        place = scaled_placement(r, (band, width), concentration, rng,
+                                 thickness=HERMAN2013.thickness,
+                                 density=HERMAN2013.forcing.ice_density)
+        packed, box1, _ = place_then_compress(place, concentration, limit)
         worst = max_overlap(packed.positions, r, box1)
         if worst > 0.01:
             # a jammed packing: released at the band's free edges it would
