@@ -215,13 +215,14 @@ def _fast_parts(sim, loops, n_sub: int):
     import copy
 
     from physics import hertz_free_drift as F
+    from physics.hertz_resting import Awake
 
     mine = copy.deepcopy(sim)
     n, floes, law, wall_law, drive, box, ship = mine._kernel_arguments(n_sub)
     verlet = mine._verlet
     nf = floes.pos.shape[0]
     fbuf, tbuf = floes.force.copy(), floes.torque.copy()
-    awake = F.Awake(np.ones(nf, dtype=np.uint8), np.empty(nf, dtype=np.int64),
+    awake = Awake(np.ones(nf, dtype=np.uint8), np.empty(nf, dtype=np.int64),
                     np.empty(nf, dtype=np.int64), np.zeros(3, dtype=np.int64))
     wp = F.new_pairs(verlet)
     mark = np.zeros(nf, dtype=np.uint8)

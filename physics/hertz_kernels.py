@@ -740,7 +740,7 @@ def first_half(floes, ref, drive, kick, path=None):
     floats, :func:`order_key`), and the (N, k) arrays are read as flat
     arrays: so it vectorises (AVX2/AVX-512), about 2.7 times as fast as the
     scalar loop (34 against 94 µs for 20000 floes on one thread,
-    ``python -m benchmarks.hertz_phases``). Its per-floe arithmetic is the
+    ``python -m benchmarks.bench_hertz_phases``). Its per-floe arithmetic is the
     same in the vector body and in the scalar remainder, so the new state
     does not depend on how the floes are cut into chunks; only the sums are
     reassociated.
