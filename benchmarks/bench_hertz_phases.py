@@ -97,13 +97,14 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
     dt = HERMAN2013.time_step
     sim = warm_sim(str(path), dt, parallel=False)
     box = sim.box.kernel_box(sim.time)
+    view = sim.kernel_view()
 
     def arrays(n_chunks):
-        f, v = sim._floes, sim._verlet
+        f, v = view.floes, view.verlet
         floes = f._replace(pos=f.pos.copy(), vel=f.vel.copy(), omega=f.omega.copy())
         verlet = v._replace(hist=v.hist.copy(), ref=v.ref.copy())
-        return (K.pair_chunks(verlet, n_chunks), floes, sim._law, box, verlet,
-                K.force_buffers(sim.n_floes), verlet.ref, sim._drive())
+        return (K.pair_chunks(verlet, n_chunks), floes, view.law, box, verlet,
+                K.force_buffers(sim.n_floes), verlet.ref, view.drive)
 
     configs = kernel_configs(threads_all)
     data = [arrays(sim.n_chunks if parallel else 1) for _, parallel, threads in configs]
@@ -114,7 +115,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
         t0 = time.perf_counter()
         if phase == REBUILD:
             for _ in range(count):
-                K.rebuild(sim._floes, sim._verlet, sim.box.lx, sim.box.ly, True, True, parallel)
+                K.rebuild(view.floes, view.verlet, sim.box.lx, sim.box.ly, True, True, parallel)
         else:
             _, kick, pairs = PHASES[phase]
             _phase_loop(count, parallel, kick, pairs, dt, *data[k], 0.0, True, 1.0)
@@ -143,7 +144,7 @@ def bench_phases(n: int = 20000, seed: int = 1, passes: int = 2000,
             rows.append(dict(phase=name, kernel=label, threads=threads,
                              seconds=float(np.median(times[:, k, phase])),
                              speedup=float(np.median(ratio)), speedup_best=float(ratio.max())))
-    return dict(n=n, n_pairs=int(sim._verlet.start[-1]), rows=rows)
+    return dict(n=n, n_pairs=int(view.verlet.start[-1]), rows=rows)
 
 
 def phases_table(result: dict) -> dict:

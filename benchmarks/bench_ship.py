@@ -174,7 +174,7 @@ def hull_kernel_times(sim: HertzSimulation, passes: int) -> dict:
     pass, without a list build) and of a build of the hull's list, on a
     copy of the ship of ``sim`` at its current state, and of a rebuild of
     the floes' own Verlet list (serial kernels)."""
-    b = sim.ship._bundle
+    b = sim.ship.kernel_bundle
     ship = b._replace(state=b.state.copy(), hist=b.hist.copy(), contact=b.contact.copy(),
                       cand=b.cand.copy(), counts=b.counts.copy(), log=b.log.copy(),
                       world_x=b.world_x.copy(), world_y=b.world_y.copy(),
@@ -183,7 +183,8 @@ def hull_kernel_times(sim: HertzSimulation, passes: int) -> dict:
     ship.state[HC.S_FLOE_TRAVEL] = 0.0
     box = sim.box.kernel_box(sim.time)
     force, torque = np.zeros((sim.n_floes, 2)), np.zeros(sim.n_floes)
-    floes = sim._floes                 # the kernels' own bundle of the live arrays
+    view = sim.kernel_view()           # the kernels' own bundles of the live arrays
+    floes = view.floes
     numba.set_num_threads(1)
     _hull_loop(2, ship, floes, box, sim.dt, force, torque)                  # compile
     _hull_build_loop(1, ship, floes.pos, floes.radius, box.lengths[0], box.lengths[1])
@@ -200,8 +201,8 @@ def hull_kernel_times(sim: HertzSimulation, passes: int) -> dict:
         ship.state[HC.S_HULL_TRAVEL] = 0.0
         t0 = time.perf_counter()
         for _ in range(max(1, builds // 4)):
-            K.rebuild(floes, sim._verlet, box.lengths[0], box.lengths[1], True, True, False,
-                      sim._verlet.skins)
+            K.rebuild(floes, view.verlet, box.lengths[0], box.lengths[1], True, True, False,
+                      view.verlet.skins)
         rebuild.append((time.perf_counter() - t0) / max(1, builds // 4))
     return dict(hull_step=float(np.median(step)), hull_build=float(np.median(build)),
                 floe_rebuild=float(np.median(rebuild)), candidates=int(ship.counts[HC.C_CAND]))
@@ -218,18 +219,18 @@ def _segment(sim: HertzSimulation, threads: int, steps: int):
     def go():
         numba.set_num_threads(threads)
         rebuilds = sim.n_rebuilds
-        builds = int(sim.ship._bundle.counts[HC.C_REBUILDS]) if sim.ship else 0
+        builds = int(sim.ship.kernel_bundle.counts[HC.C_REBUILDS]) if sim.ship else 0
         t0 = time.perf_counter()
         sim.step(steps)
         rate = sim.n_floes * steps / (time.perf_counter() - t0)
         out = dict(rate=rate, rebuilds=sim.n_rebuilds - rebuilds)
         if sim.ship is not None:
-            out["hull_builds"] = int(sim.ship._bundle.counts[HC.C_REBUILDS]) - builds
+            out["hull_builds"] = int(sim.ship.kernel_bundle.counts[HC.C_REBUILDS]) - builds
             touching = sim.ship.records()["contacts"][-steps:]
             out["touching"] = float(np.mean(touching))
             out["touch_steps"] = float(np.mean(touching > 0))
             out["collisions"] = int(sim.ship.collisions()["floe"].size)
-            out["candidates"] = int(sim.ship._bundle.counts[HC.C_CAND])
+            out["candidates"] = int(sim.ship.kernel_bundle.counts[HC.C_CAND])
             sim.ship.clear()
         return out
     return go

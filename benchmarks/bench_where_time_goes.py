@@ -203,7 +203,7 @@ def _make_env(small: bool):
 def _state(sim) -> dict:
     """Counts of the engine's present state."""
     return dict(floes=int(sim.n_floes), awake=int(sim.n_awake),
-                listed_pairs=int(sim._verlet.nbr.size), contacts=len(sim.contacts()),
+                listed_pairs=int(sim.kernel_view().verlet.nbr.size), contacts=len(sim.contacts()),
                 time=float(sim.time))
 
 
@@ -218,8 +218,9 @@ def _fast_parts(sim, loops, n_sub: int):
     from physics.hertz_resting import Awake
 
     mine = copy.deepcopy(sim)
-    n, floes, law, wall_law, drive, box, ship = mine._kernel_arguments(n_sub)
-    verlet = mine._verlet
+    floes, law, wall_law, drive, verlet = mine.kernel_view()
+    box = mine.box.kernel_box(mine.time)
+    ship = mine.ship.bundle(n_sub)
     nf = floes.pos.shape[0]
     fbuf, tbuf = floes.force.copy(), floes.torque.copy()
     awake = Awake(np.ones(nf, dtype=np.uint8), np.empty(nf, dtype=np.int64),
@@ -297,25 +298,25 @@ def substep_breakdown(steps: int = 200, rounds: int = REPEATS, seed: int = EPISO
 
             loops = _loops()
             kicks, pairs_loop = loops["kicks"], loops["pairs"]
-            floes = exact._floes._replace(pos=exact._pos.copy(), vel=exact._vel.copy(),
-                                          omega=exact._omega.copy(),
-                                          force=exact._force.copy(),
-                                          torque=exact._torque.copy())
-            verlet = exact._verlet._replace(ref=exact._verlet.ref.copy(),
-                                            hist=exact._verlet.hist.copy())
+            view = exact.kernel_view()
+            own = view.floes
+            floes = own._replace(pos=own.pos.copy(), vel=own.vel.copy(), omega=own.omega.copy(),
+                                 force=own.force.copy(), torque=own.torque.copy())
+            verlet = view.verlet._replace(ref=view.verlet.ref.copy(),
+                                          hist=view.verlet.hist.copy())
             box = exact.box.kernel_box(exact.time)
             # Δt = 0: the same pass over the same, unchanging state
             kick = K.Kick(0.0, 0.0, box.lengths[0], box.lengths[1], box.periodic_x,
                           box.periodic_y, 1.0, 1.0, 0.0, 0.0)
             path = np.zeros(exact.n_floes)
-            drive = exact._drive()
+            drive = view.drive
             # the floes awake and the live pairs as the engine's next run
             # finds them at its start
             awake = R.find_awake(floes, drive, box, verlet)
             n_awake = int(awake.count[0])
             live = R.live_pairs(verlet, awake)
             kicks(floes, verlet.ref, drive, kick, awake, path, 2)     # compile
-            pairs_loop(live, awake, floes, exact._law, box, verlet, exact.dt, path,
+            pairs_loop(live, awake, floes, view.law, box, verlet, exact.dt, path,
                        floes.force, floes.torque, 1)
             fast_parts, n_free = _fast_parts(fast, loops, n_sub)
             fast.step(n_sub)                                        # untimed: loaded
@@ -336,7 +337,7 @@ def substep_breakdown(steps: int = 200, rounds: int = REPEATS, seed: int = EPISO
 
             def pair_loop():
                 t0 = time.perf_counter()
-                pairs_loop(live, awake, floes, exact._law, box, verlet, exact.dt, path,
+                pairs_loop(live, awake, floes, view.law, box, verlet, exact.dt, path,
                            floes.force, floes.torque, n_sub)
                 return (time.perf_counter() - t0) / n_sub
 
@@ -391,7 +392,7 @@ def episode_trajectory(every: int = 20, max_steps: int | None = None,
                     spent, block = 0.0, 0
             sim = u.sim
             m = np.asarray(sim.field.masses, dtype=float)
-            b = np.asarray(sim._drag[:, 1], dtype=float)
+            b = np.asarray(sim.kernel_view().drive.coefficients[:, 1], dtype=float)
             tau = m[b > 0] / b[b > 0]
         finally:
             env.close()

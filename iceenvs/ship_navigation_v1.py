@@ -349,7 +349,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             about = float(ship.heading) if self.swath_frame == "heading" else 0.0
             sums = swath_scan(x, y, about, sim.positions, sim.radii,
                               env._swath_weights, self.swath_rays, self.swath_fan,
-                              0.5 * env._ship.hull.beam, self.swath_bands, float(box.lx),
+                              0.5 * env.ship.hull.beam, self.swath_bands, float(box.lx),
                               float(box.ly), box.periodic[0], box.periodic[1])
             out[k, :n_sums] = sums.T.ravel()
             if self.swath_edge:

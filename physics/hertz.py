@@ -21,6 +21,7 @@ import dataclasses
 import math
 import os
 import weakref
+from typing import NamedTuple
 from contextlib import contextmanager
 
 import numba
@@ -161,6 +162,17 @@ def hertz_time_step(field: FloeField, box: Box, contact: ContactParams, impact_s
     t_c = minimum_contact_time(field.radii, field.thickness, field.density, contact, impact_speed,
                                walls=not all(box.periodic))
     return min(preset_dt * stiffness_scale ** -0.4, 0.1 * t_c)
+
+
+class KernelView(NamedTuple):
+    """The compiled kernels' bundles of a simulation's live state
+    (:meth:`HertzSimulation.kernel_view`)."""
+
+    floes: K.Floes
+    law: ContactLaw
+    wall_law: ContactLaw
+    drive: K.Drive
+    verlet: K.VerletList
 
 
 class HertzSimulation(FloeProperties):
@@ -551,6 +563,13 @@ class HertzSimulation(FloeProperties):
             self.ship.refresh()
         return n
 
+    def kernel_view(self) -> KernelView:
+        """The bundles the compiled kernels take, over the simulation's own
+        arrays (not copies), for benchmarks and tests that call one kernel
+        alone (``benchmarks/bench_hertz_phases.py``): a kernel that writes
+        into them changes the simulation."""
+        return KernelView(self._floes, self._law, self._wall_law, self._drive(), self._verlet)
+
     def _kernel_arguments(self, left: int) -> tuple:
         """(steps of the next kernel run, floes, law, wall law, drive, box,
         ship bundle) for a run with ``left`` steps to go. With a ship the run
@@ -593,7 +612,7 @@ class HertzSimulation(FloeProperties):
                 FailureReason.UNSTABLE, self.time)
         if finite is None:
             finite = (np.all(np.isfinite(self._pos)) and np.all(np.isfinite(self._vel))
-                      and (self.ship is None or np.all(np.isfinite(self.ship._bundle.state))))
+                      and (self.ship is None or np.all(np.isfinite(self.ship.kernel_bundle.state))))
         if status is HertzStatus.NON_FINITE or not finite:
             raise SimulationError(
                 f"non-finite floe state at t = {self.time:.6g} s (step {self.n_steps}); "
@@ -691,7 +710,7 @@ class HertzSimulation(FloeProperties):
         frame) [m] and the overlap [m]. Empty without a ship."""
         if self.ship is None:
             return np.zeros(0, dtype=np.int64), np.zeros((0, 9))
-        return HC.hull_contact_list(self.ship._bundle, self._floes,
+        return HC.hull_contact_list(self.ship.kernel_bundle, self._floes,
                                     self.box.kernel_box(self.time))
 
     def ship_loads(self, start: float | None = None, end: float | None = None) -> ShipLoads:

@@ -344,6 +344,13 @@ class ShipState:
         self._log = []
 
     # -- compiled step -------------------------------------------------------
+    @property
+    def kernel_bundle(self) -> HC.ShipBundle:
+        """The compiled kernels' bundle of the ship's live state (not a
+        copy: the kernels write into it), for benchmarks and tests that call
+        a hull kernel alone; :meth:`bundle` readies it for a run."""
+        return self._bundle
+
     def bundle(self, n_steps: int) -> HC.ShipBundle:
         """The bundle for a run of ``n_steps`` (a fresh record buffer, whose
         rows the run writes; :meth:`drain` keeps those it wrote)."""
