@@ -1,16 +1,23 @@
 """Route planners of the ship environments that read the ice (privileged).
 
-Five planner baselines steer the ship environments
+A planner (``*Planner``) may read privileged state, here the floes
+themselves, where a controller of :mod:`iceenvs` (``*Controller``) needs
+only the environment; both satisfy the :class:`agents.policy.Policy`
+protocol. Five baselines steer the ship environments
 (``iceenvs/ShipNavigation-v0``, ``-v1`` and ``iceenvs/ShipBeset-v0``;
-``swath`` only v1, which has the swath sensor):
+``swath`` only v1, which has the swath sensor), three controllers and the
+two planners of this module:
 
 ==============  ==========================================================  ================
-name            planner                                                     reads
+name            controller or planner                                       reads
 ==============  ==========================================================  ================
-``straight``    full speed straight for the goal line                       the observation
-``reactive``    steer for the least obstructed sector of the ice lidar      the observation
-``swath``       steer for the swath sensor's course of least ice plus       the observation
-                the price of its extra length (greedy, every step)
+``straight``    ``StraightLineController``: full speed straight for the     the observation
+                goal line
+``reactive``    ``ReactiveController``: steer for the least obstructed      the observation
+                sector of the ice lidar
+``swath``       ``SwathController``: steer for the swath sensor's course    the observation
+                of least ice plus the price of its extra length (greedy,
+                every step)
 ``lattice``     :class:`LatticePlanner`: the cheapest route over a state    the floes within
                 lattice with the ship's turning limit, the ice costed by     its sensor range
                 the collision impulse it would take, replanned every few
@@ -22,14 +29,15 @@ name            planner                                                     read
 ==============  ==========================================================  ================
 
 The first three are the environments' own controllers
-(:mod:`iceenvs.ship_controllers`). The lattice planner follows the
-lattice planner of AUTO-IceNav (de Schaetzen et al., IEEE Transactions on
-Robotics, 2025) in its parts: a lattice of motion primitives the ship can
-follow, a cost of path length plus a weight times the ice the hull's
-swath meets, a receding horizon and a path-tracking controller. It reads
-the floes through :meth:`iceenvs.ship_env.ShipEnv.ice_near` (privileged
-information, as AUTO-IceNav's planners read the floe polygons of their
-simulator); a policy sees only its observation.
+(:mod:`iceenvs.ship_controllers`); the planners build on them. The
+lattice planner follows the lattice planner of AUTO-IceNav (de Schaetzen
+et al., IEEE Transactions on Robotics, 2025) in its parts: a lattice of
+motion primitives the ship can follow, a cost of path length plus a
+weight times the ice the hull's swath meets, a receding horizon and a
+path-tracking controller. It reads the floes through
+:meth:`iceenvs.ship_env.ShipEnv.ice_near` (privileged information, as
+AUTO-IceNav's planners read the floe polygons of their simulator); a
+policy sees only its observation.
 
 **The lattice.** Stages every ``stage_length`` (30 m) along the route
 (+x, towards the goal line), lateral positions every ``lateral_step``
@@ -66,7 +74,7 @@ each N s, so one metre is worth ``impulse_scale · time_weight /
 AUTO-IceNav's) or to the goal line, every ``replan_steps`` steps (5, 10 s
 of model time) or when the ship is more than ``max_off_route`` (10 m) off
 its route; the ship steers for the point ``lookahead`` (30 m) ahead on
-it, as :class:`~iceenvs.ship_controllers.StraightLinePolicy` steers for
+it, as :class:`~iceenvs.ship_controllers.StraightLineController` steers for
 the goal. ``decision_times`` holds the wall time of each plan [s].
 """
 from __future__ import annotations
@@ -78,7 +86,7 @@ import numpy as np
 from numba import njit
 
 from iceenvs.costmap import impulse_costmap
-from iceenvs.ship_controllers import StraightLinePolicy
+from iceenvs.ship_controllers import StraightLineController
 
 __all__ = ["LatticePlanner", "RolloutPlanner", "ON_REQUEST", "impulse_costmap", "lattice_route", "PLANNERS"]
 
@@ -152,7 +160,7 @@ def lattice_route(cost, cell, stage_cells, n_stages, y_start, slope_start, max_s
 DEFAULT_METRE_COST = 12_500.0
 
 
-class LatticePlanner(StraightLinePolicy):
+class LatticePlanner(StraightLineController):
     """Plan the cheapest route through the ice over a state lattice and
     follow it (see :mod:`agents.planners`).
 

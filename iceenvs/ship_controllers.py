@@ -1,8 +1,14 @@
-"""Controllers of the ship environments: the straight line to the goal, a
-reactive planner on the ice lidar (``"straight"`` and ``"reactive"`` in
-the facts of :mod:`iceenvs.ship_navigation` and :mod:`iceenvs.ship_beset`)
-and a greedy planner on the swath sensor (``"swath"`` in the facts of
-:mod:`iceenvs.ship_navigation_v1`). All three read only the observation.
+"""Controllers of the ship environments: the straight line to the goal
+(``"straight"``), steering for the least obstructed sector of the ice
+lidar (``"reactive"``; both in the facts of :mod:`iceenvs.ship_navigation`
+and :mod:`iceenvs.ship_beset`) and a greedy choice of the swath sensor's
+courses (``"swath"``, in the facts of :mod:`iceenvs.ship_navigation_v1`).
+
+They are controllers in the project's sense: they need only the
+environment (its observation and public attributes, no privileged
+state), their names end in ``Controller``, and they satisfy the
+:class:`agents.policy.Policy` protocol. The planners that read the floes
+are in :mod:`agents.planners`.
 """
 from __future__ import annotations
 
@@ -13,10 +19,10 @@ import numpy as np
 from .controllers import Controller
 from .ship_sensors import swath_courses
 
-__all__ = ["StraightLinePolicy", "ReactivePlanner", "SwathPlanner"]
+__all__ = ["StraightLineController", "ReactiveController", "SwathController"]
 
 
-class StraightLinePolicy(Controller):
+class StraightLineController(Controller):
     """A ship sailing straight for the goal line at full speed.
 
     The heading error is the bearing of the goal direction in the ship
@@ -99,7 +105,7 @@ class StraightLinePolicy(Controller):
         return np.clip(self.act(obs), space.low, space.high).astype(space.dtype), None
 
 
-class ReactivePlanner(StraightLinePolicy):
+class ReactiveController(StraightLineController):
     """Steer for the least obstructed sector of the ice lidar.
 
     Each sector k of the lidar (central bearing θ_k) scores
@@ -107,7 +113,7 @@ class ReactivePlanner(StraightLinePolicy):
     to the first floe edge, c_k the ice concentration of the sector and
     θ_goal the bearing of the goal; the ship steers for the best sector
     (bearings beyond 60° of the goal are clipped there) as
-    :class:`StraightLinePolicy` steers for the goal.
+    :class:`StraightLineController` steers for the goal.
     """
 
     turn_cost = 0.5
@@ -127,14 +133,14 @@ class ReactivePlanner(StraightLinePolicy):
                                          goal + self.max_off_goal)), get)
 
 
-class SwathPlanner(StraightLinePolicy):
+class SwathController(StraightLineController):
     """Steer for the course of the swath sensor that costs least: a greedy
-    planner on the observation (ShipNavigation-v1).
+    controller on the observation (ShipNavigation-v1).
 
     The swath sensor (:func:`iceenvs.ship_sensors.ice_swath`) gives, for
     each course k of its fan, the expected collision impulse S_k [N s] of
     the floes the hull's swath along it would meet, per band of distance
-    ahead. Every step the planner scores each course
+    ahead. Every step the controller scores each course
 
         S_near + ``far_weight`` S_far + c (L / cos φ_k − L)
 
@@ -146,7 +152,7 @@ class SwathPlanner(StraightLinePolicy):
     its ice: the course will likely change before the ship is there. A
     course that would take the centroid closer than ``margin`` (15 m) to
     the channel's edge within ``lookahead`` (150 m) pays 10⁹ N s per metre
-    beyond that line, so the planner keeps to the channel when it can and
+    beyond that line, so the controller keeps to the channel when it can and
     otherwise turns back the most. With the sensor's room in the channel
     (v1's ``swath_edge=True``) it reads the edge from the observation's
     rooms instead: a course that leaves the channel within ``lookahead``
@@ -155,7 +161,7 @@ class SwathPlanner(StraightLinePolicy):
     (:meth:`iceenvs.ship_env.ShipEnv.course_yaw_rate`: the heading error
     over `course_time`, 20 s), commanding its yaw rate under
     ``control="yaw"``, so that it sails the same path with either action
-    (the thrust controls steer for it as :class:`StraightLinePolicy` steers
+    (the thrust controls steer for it as :class:`StraightLineController` steers
     for the goal). Turned faster, the hull would sweep its sides through
     the ice.
 
@@ -234,3 +240,10 @@ class SwathPlanner(StraightLinePolicy):
             rate = u.course_yaw_rate((best - goal) / e["max_course"], -goal)
             return np.array([rate / e["max_yaw_rate"]])
         return self._steer(best, get)
+
+
+# The names before this release: user code and saved policies (``module:Class``
+# references) may name them.
+StraightLinePolicy = StraightLineController
+ReactivePlanner = ReactiveController
+SwathPlanner = SwathController

@@ -71,7 +71,7 @@ from .base import HertzEnv, sanitise_action
 from .costmap import costmap_samples, costmap_scan, costmap_shape, costmap_space
 from .facts import EnvFacts
 from .observations import Feature
-from .ship_controllers import ReactivePlanner, StraightLinePolicy
+from .ship_controllers import ReactiveController, StraightLineController
 from .ship_measures import (METRICS, SUM_COLUMNS, ShipBatch, ShipVectorEnv, as_measurement,
                             measure_names, measure_ships, metric_values)
 from .ship_sensors import occupancy_image
@@ -124,12 +124,12 @@ def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
     ``metrics``, ``main_metric``, ``small`` and any other field of
     :class:`~iceenvs.facts.EnvFacts`) with what every ship task shares: the
     episode metrics of :data:`METRICS`, the ice impulse per metre compared
-    like the return (lower is better), and the planners of
+    like the return (lower is better), and the controllers of
     :mod:`iceenvs.ship_controllers` (``"heuristic"`` is the reactive one)."""
     return EnvFacts(summary=summary, metrics=metrics, main_metric=main_metric, small=small,
                     episode_metrics=METRICS, compared_metric=("impulse_per_metre", True),
-                    controllers={"heuristic": ReactivePlanner, "straight": StraightLinePolicy,
-                                 "reactive": ReactivePlanner}, **more)
+                    controllers={"heuristic": ReactiveController, "straight": StraightLineController,
+                                 "reactive": ReactiveController}, **more)
 
 
 #: below this concentration the floes are placed directly; above it they are

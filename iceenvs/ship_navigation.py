@@ -108,7 +108,7 @@ class ShipNavigationEnv(ShipEnv):
       straight line, since every metre off it costs progress. How much
       that can gain is small at the default settings: at A = 0.4 the
       straight line loses about 11 of a return of 70 to the ice, and
-      swerving round one floe meets the next (the reactive planner and the
+      swerving round one floe meets the next (the reactive controller and the
       documented PPO run do worse than the straight line; see the docs'
       training page). Larger `impulse_weight` values make the ice count
       for more.

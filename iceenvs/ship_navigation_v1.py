@@ -13,7 +13,7 @@ from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, TransitBox, navigation_f
 
 from .base import TaskParameter, choice, interval, number, revised_task, task_table
 from .observations import Feature, feature_table
-from .ship_controllers import SwathPlanner
+from .ship_controllers import SwathController
 from .ship_env import CONTROLS, ICE_LOADS, ship_features
 from .ship_sensors import (channel_room, check_bands, course_with_room, swath_courses,
                             swath_scan)
@@ -159,8 +159,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
       every concentration (the ship's speed is imposed).
     * *Does route choice pay?* That is measured, not specified here: the
       docs' page "Ship navigation: does route choice pay?" ranks the
-      straight line, the swath planner
-      (:class:`iceenvs.ship_controllers.SwathPlanner`, which decides on the
+      straight line, the swath controller
+      (:class:`iceenvs.ship_controllers.SwathController`, which decides on the
       observation alone), the lattice planner (:mod:`agents.planners`,
       which reads the floes) and PPO on the same seeded fields
       (`python -m agents.leaderboard`), with the default two leads and
@@ -268,7 +268,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                     summary="cross a kilometre of pack ice (AUTO-IceNav's fields)",
                     small={"concentration": 0.2, "length": 450.0, "goal_distance": 300.0},
                     speed_target=50,
-                    controllers={**ShipNavigationEnv.facts.controllers, "swath": SwathPlanner})
+                    controllers={**ShipNavigationEnv.facts.controllers, "swath": SwathController})
 
     episode_members = ("leads", "_swath_weights")
 

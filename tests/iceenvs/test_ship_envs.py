@@ -22,9 +22,9 @@ BESET = "iceenvs/ShipBeset-v0"
 def _straight(env, obs, steps=400):
     """Sail the straight-line baseline from ``obs`` to the end of the
     episode; returns the rewards, the last info and whether it terminated."""
-    from iceenvs.ship_controllers import StraightLinePolicy
+    from iceenvs.ship_controllers import StraightLineController
 
-    policy = StraightLinePolicy(env)
+    policy = StraightLineController(env)
     rewards = []
     for _ in range(steps):
         action, _ = policy.predict(obs)
@@ -138,6 +138,21 @@ def test_planners_steer_by_course(planner):
     assert len(set(actions)) > 1                   # it steered
 
 
+def test_the_ship_controllers_old_names_are_the_same_classes():
+    """User code and saved ``module:Class`` references may name the ship
+    controllers by their names before this release; those import the same
+    classes, and a reference by an old name builds the controller."""
+    from agents.policy import policy_class
+    from iceenvs import ship_controllers as sc
+
+    pairs = {"StraightLinePolicy": sc.StraightLineController,
+             "ReactivePlanner": sc.ReactiveController, "SwathPlanner": sc.SwathController}
+    for old, new in pairs.items():
+        assert getattr(sc, old) is new
+        assert policy_class(f"iceenvs.ship_controllers:{old}") is new
+    assert env_facts(NAV).controllers["straight"] is sc.StraightLineController
+
+
 def test_the_straight_line_is_the_same_path_with_either_steering_action():
     """The straight line commands zero yaw rate with control="yaw" and the
     goal direction's course with control="course": the same episode."""
@@ -168,9 +183,9 @@ def test_collision_impulses_are_bounded_by_the_contact_impulses():
         obs, _ = env.reset(seed=3)
         u = env.unwrapped
         resultant = contact = 0.0
-        from iceenvs.ship_controllers import StraightLinePolicy
+        from iceenvs.ship_controllers import StraightLineController
 
-        policy = StraightLinePolicy(env)
+        policy = StraightLineController(env)
         while True:
             action, _ = policy.predict(obs)
             obs, _, terminated, truncated, info = env.step(action)

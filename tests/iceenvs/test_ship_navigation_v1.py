@@ -362,7 +362,7 @@ def test_metre_cost_is_the_rewards_trade_off():
 
 
 @pytest.mark.parametrize("frame", ["heading", "goal"])
-def test_swath_planner_beats_the_straight_line_on_fixed_fields(frame):
+def test_swath_controller_beats_the_straight_line_on_fixed_fields(frame):
     """On 3 fixed fields at A = 0.3 (400 m of ice), the swath planner,
     reading only the observation, meets less ice impulse per metre than
     the straight line on every field, sailing at most 5 % further, and
@@ -371,7 +371,7 @@ def test_swath_planner_beats_the_straight_line_on_fixed_fields(frame):
     assert_beats_the_straight_line("swath", control="course", swath_frame=frame)
 
 
-def test_swath_planner_reads_the_edge_from_the_rooms():
+def test_swath_controller_reads_the_edge_from_the_rooms():
     """With ``swath_edge=True`` the swath planner takes the channel's edge
     from the observation: when every course but one shows no room, it
     commands that one (course control, the fan about the goal, so the
@@ -398,16 +398,16 @@ def test_swath_planner_reads_the_edge_from_the_rooms():
     assert_beats_the_straight_line("swath", control="course", swath_edge=True)
 
 
-def test_swath_planner_commands_the_same_turn_with_either_action():
+def test_swath_controller_commands_the_same_turn_with_either_action():
     """Under ``control="yaw"`` the planner commands the yaw rate that the
     course autopilot would turn at for the course it picks under
     ``control="course"``, from the same state: both environments sail the
     straight line (action 0 in either) until the planner would turn."""
-    from iceenvs.ship_controllers import SwathPlanner
+    from iceenvs.ship_controllers import SwathController
 
     envs = {c: gym.make(V1, concentration=0.4, control=c) for c in ("yaw", "course")}
     obs = {c: env.reset(seed=2)[0] for c, env in envs.items()}
-    planners = {c: SwathPlanner(env) for c, env in envs.items()}
+    planners = {c: SwathController(env) for c, env in envs.items()}
     try:
         for _ in range(100):
             rates = {}
@@ -445,13 +445,13 @@ def test_planners_that_read_the_environment_refuse_a_batch():
         env.close()
 
 
-def test_swath_planner_needs_the_swath_sensor():
-    from iceenvs.ship_controllers import SwathPlanner
+def test_swath_controller_needs_the_swath_sensor():
+    from iceenvs.ship_controllers import SwathController
 
     for env_id, kwargs in ((V1, dict(swath_rays=0)), ("iceenvs/ShipNavigation-v0", {})):
         env = gym.make(env_id, **kwargs)
         with pytest.raises(ValueError, match="swath sensor"):
-            SwathPlanner(env)
+            SwathController(env)
         env.close()
 
 
