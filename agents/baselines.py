@@ -3,11 +3,17 @@
 ``predict(obs, deterministic=True) -> (action, None)`` accepts one
 observation or a batch. Every baseline reads the *raw* observation of the
 environment (not a normalised one) and may keep state within an episode;
-``reset(seed)`` starts a new episode.
+``reset(seed)`` starts a new episode: every one satisfies the
+:class:`agents.policy.Policy` protocol.
 
-Three baselines apply to every environment; the others are the
-environment's own controllers, named in its facts
-(:class:`iceenvs.facts.EnvFacts`):
+The baselines follow one naming scheme. The generic ones of this module
+(``*Policy``: :class:`RandomPolicy`, :class:`ZeroPolicy`,
+:class:`ConstantPolicy`) need only the action space and apply to every
+environment. The environment's own controllers (``*Controller``, in
+:mod:`iceenvs`) need only the environment and are named in its facts
+(:class:`iceenvs.facts.EnvFacts`). The planners of :mod:`agents.planners`
+(``*Planner``) may read privileged state (the floes of a ship
+environment):
 
 ================  ==========================================================
 name              policy
@@ -18,7 +24,9 @@ name              policy
 ``heuristic``     the hand-written controller of the environment
 ``straight``      ship environments: full speed straight to the goal line
 ``reactive``      ship environments: steer for the least obstructed lidar sector
+``swath``         ShipNavigation-v1: steer for the swath sensor's course of least cost
 ``lattice``       ship environments: the lattice planner of :mod:`agents.planners`
+``rollout``       ship environments: the rollout planner of :mod:`agents.planners`
 ``module:Class``  a policy of one's own (:mod:`agents.policy`)
 ================  ==========================================================
 

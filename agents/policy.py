@@ -9,8 +9,12 @@ policy, the :class:`Policy` protocol:
   is ``None`` for a policy without memory);
 * ``reset(seed)``: a new episode starts, from ``env.reset(seed=seed)``.
 
-``close()`` is optional. Every baseline and planner of :mod:`agents.baselines`
-and a trained run (:class:`agents.rollouts.TrainedPolicy`) keep it.
+``close()`` is optional. Every baseline of :mod:`agents.baselines` keeps
+the protocol: the generic ``*Policy`` ones of that module (they need only
+the action space), the environments' ``*Controller`` ones of
+:mod:`iceenvs` (they need only the environment) and the ``*Planner`` ones
+of :mod:`agents.planners` (they may read privileged state); so does a
+trained run (:class:`agents.rollouts.TrainedPolicy`).
 
 A policy of one's own is named where a baseline's name is taken
 (``agents.leaderboard --policies``, ``agents.evaluate --baseline`` and

@@ -1,16 +1,22 @@
 """Hand-written controllers: the base of every environment's own controllers.
 
-A controller has the ``predict`` interface of a Stable-Baselines3 model,
-``predict(obs, deterministic=True) -> (action, None)``, for one observation
-or a batch; it reads the *raw* observation of the environment (not a
-normalised one), may keep state within an episode, and ``reset(seed)``
-starts a new episode. An environment names its controllers in its facts
-(:class:`iceenvs.facts.EnvFacts`), ``"heuristic"`` for the hand-written
-controller of its task; the controller classes live beside the
-environment they control (``WindDriftController`` in
-:mod:`iceenvs.wind_drift`, the ship planners in
-:mod:`iceenvs.ship_controllers`). :func:`agents.baselines.make_baseline`
-builds them by name with the generic baselines.
+A controller needs only the environment: it decides on the *raw*
+observation (not a normalised one) and the environment's public
+attributes, never on privileged state, so any policy could do the same;
+its class is named ``*Controller``. It has the ``predict`` interface of a
+Stable-Baselines3 model, ``predict(obs, deterministic=True) -> (action,
+None)``, for one observation or a batch, may keep state within an
+episode, and ``reset(seed)`` starts a new episode: it satisfies the
+:class:`agents.policy.Policy` protocol. An environment names its
+controllers in its facts (:class:`iceenvs.facts.EnvFacts`),
+``"heuristic"`` for the hand-written controller of its task; the
+controller classes live beside the environment they control
+(``WindDriftController`` in :mod:`iceenvs.wind_drift`, the ship
+controllers in :mod:`iceenvs.ship_controllers`). The planners of
+:mod:`agents.planners` (``*Planner``, which may read privileged state) and
+the generic baselines of :mod:`agents.baselines` (``*Policy``) build on
+:class:`Controller` too; :func:`agents.baselines.make_baseline` builds
+them all by name.
 """
 from __future__ import annotations
 
