@@ -83,16 +83,15 @@ def _sensor_calls(u) -> dict:
     on its present state: the swath and the image through the
     environment's own methods, the lidar, which the environment calls
     inside its compiled measurements, with the arguments they pass."""
-    from iceenvs.ship_sensors import lidar_scan
+    from iceenvs.ship_sensors import lidar_scan, scan_box
 
     sim = u.sim
-    ship = sim.ship
-    x, y = (float(v) for v in ship.position)
     box = sim.box
+    pose = sim.ship.motion                  # x, y and heading first, as a ship row of the measurements
+    setting = np.array([u.lidar_sectors, math.pi, u.lidar_range])
+    packed_box = scan_box(float(box.lx), float(box.ly), box.periodic)
     return {
-        "lidar": lambda: lidar_scan(x, y, float(ship.heading), sim.positions, sim.radii,
-                                    u.lidar_sectors, math.pi, u.lidar_range, float(box.lx),
-                                    float(box.ly), box.periodic[0], box.periodic[1]),
+        "lidar": lambda: lidar_scan(pose, sim.positions, sim.radii, setting, packed_box),
         "swath": lambda: u._extra_measures([u]),
         "image": u._image,
     }

@@ -43,11 +43,11 @@ from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
 from .base import PHYSICS_ERRORS
 from .observations import observation_vectors
-from .ship_sensors import lidar_scan
+from .ship_sensors import LIDAR_SETTING, SCAN_BOX, box_entries, lidar_scan
 from .vector import HertzVectorEnv, batch_infos, drive, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
-           "measure_names", "measure_ships", "measure_many", "step_sums",
+           "SHIP_COLUMNS", "SCENE", "measure_names", "measure_ships", "measure_many", "step_sums",
            "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipBatch",
            "ShipVectorEnv"]
 
@@ -96,6 +96,36 @@ _C = {name: k for k, name in enumerate(SUM_COLUMNS)}
     "normal_force", "force_magnitude_sum"))
 _FLOE, _IMPULSE_SURGE, _IMPULSE_SWAY, _FLOE_MASS = (LOG_COLUMNS.index(name) for name in (
     "floe", "impulse_surge", "impulse_sway", "floe_mass"))
+
+#: a ship's row of the parameters :func:`measure_many` reads: its motion
+#: (x, y, heading, Vx, Vy, yaw rate, as :attr:`physics.ship.Ship.motion`),
+#: its commands (thrust, yaw moment; read for a dynamic ship), the linear and
+#: the quadratic damping coefficients of surge, sway and yaw, its engine's
+#: time step, its hull length and its beset speed
+SHIP_COLUMNS = ("x", "y", "heading", "vx", "vy", "yaw_rate", "thrust", "yaw_moment",
+                "linear_surge", "linear_sway", "linear_yaw", "quadratic_surge", "quadratic_sway",
+                "quadratic_yaw", "dt", "hull_length", "beset_speed")
+#: what the ships of :func:`measure_many` share (a float array): the box
+#: (:data:`~iceenvs.ship_sensors.SCAN_BOX`), the lidar
+#: (:data:`~iceenvs.ship_sensors.LIDAR_SETTING`), the goal line, the
+#: channel's centre line and half-width [m], the control interval [s], and
+#: whether the engines have just advanced and whether the ships are dynamic
+#: (1.0) or not (0.0)
+SCENE = SCAN_BOX + LIDAR_SETTING + ("goal_x", "centre_y", "half_channel", "control_interval",
+                                    "advanced", "dynamic")
+# the columns and entries as constants of the compiled code (x, y, heading,
+# Vx, Vy and yaw rate first; a range as its start and its end)
+_THRUST, _YAW_MOMENT, _LINEAR, _QUADRATIC, _DT, _HULL_LENGTH, _BESET_SPEED = (
+    SHIP_COLUMNS.index(name) for name in ("thrust", "yaw_moment", "linear_surge",
+                                          "quadratic_surge", "dt", "hull_length", "beset_speed"))
+_BOX, _LIDAR, _LIDAR_END = 0, len(SCAN_BOX), len(SCAN_BOX) + len(LIDAR_SETTING)
+_SECTORS = _LIDAR + LIDAR_SETTING.index("sectors")
+_GOAL_X, _CENTRE_Y, _HALF_CHANNEL, _CONTROL_INTERVAL, _ADVANCED, _DYNAMIC = (
+    SCENE.index(name) for name in ("goal_x", "centre_y", "half_channel", "control_interval",
+                                   "advanced", "dynamic"))
+# where the pose, the step loads and the lidar (distance and concentration
+# interleaved) start in a row of measurements
+_AT_POSE, _AT_LOADS, _AT_LIDAR = 0, len(POSE), len(POSE) + len(LOADS)
 
 
 def measure_names(sectors: int, extra: tuple[str, ...] = ()) -> tuple[str, ...]:
@@ -148,67 +178,70 @@ def step_sums(rows, x0, y0, dynamic, thrust, yaw_moment, linear_damping, quadrat
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def measure_many(rows, advanced, dynamic, commands, damping, dt, hull_length, beset_speed,
-                 control_interval, positions, radii, floe_start, motion, sectors, max_range, lx,
-                 ly, periodic_x, periodic_y, goal_x, centre_y, half_channel, table, pose, loads,
-                 distance, concentration):
+def measure_many(rows, ships, positions, radii, floe_start, scene, table, raw):
     """The compiled part of :func:`measure_ships` for M ships, parallel over
     them (each writes only its own rows).
 
     Ship k has the step records ``rows[k]`` (a typed list of arrays), the
-    thrust and yaw moment ``commands[k]`` (read when ``dynamic``), the
-    damping coefficients ``damping[k]`` (linear, quadratic), the engine
-    step ``dt[k]``, the hull length ``hull_length[k]``, the beset speed
-    ``beset_speed[k]``, the floes ``positions[floe_start[k]:floe_start[k +
-    1]]`` and ``radii`` (likewise) and the (x, y, heading, Vx, Vy, yaw
-    rate) ``motion[k]``; ``table[k]`` is its row of episode sums. Writes
-    the pose entries (:data:`POSE`) into ``pose[k]``, the lidar (a field of
-    view of π cut into ``sectors`` sectors) into ``distance[k]`` and
-    ``concentration[k]`` and, when ``advanced``, the step loads
-    (:data:`LOADS` but the collisions) into ``loads[k]``, and adds the step
+    parameters ``ships[k]`` (:data:`SHIP_COLUMNS`), the floes
+    ``positions[floe_start[k]:floe_start[k + 1]]`` and ``radii``
+    (likewise) and its row of episode sums ``table[k]``; ``scene``
+    (:data:`SCENE`) is what the ships share. Writes into its row of
+    measurements ``raw[k]`` (the columns of :func:`measure_names`) the pose
+    entries (:data:`POSE`), the lidar (a field of view of π cut into the
+    scene's sectors) and, when the engines advanced, the step loads
+    (:data:`LOADS` but the collisions; zero otherwise), and adds the step
     to the sums: the ship's last position, ∫ ice surge force dt and the
     time below the beset speed (a dynamic ship)."""
-    for i in prange(motion.shape[0]):
+    advanced = scene[_ADVANCED] != 0.0
+    dynamic = scene[_DYNAMIC] != 0.0
+    goal_x, centre_y, half_channel = scene[_GOAL_X], scene[_CENTRE_Y], scene[_HALF_CHANNEL]
+    lidar, box = scene[_LIDAR:_LIDAR_END], scene[_BOX:_LIDAR]
+    sectors = int(scene[_SECTORS])
+    for i in prange(ships.shape[0]):
         m = np.int64(i)                     # typed lists take signed indices
-        x, y, psi, vx, vy, r = (motion[m, 0], motion[m, 1], motion[m, 2], motion[m, 3],
-                                motion[m, 4], motion[m, 5])
+        ship = ships[m]
+        x, y, psi, vx, vy, r = ship[0], ship[1], ship[2], ship[3], ship[4], ship[5]
         c, s = math.cos(psi), math.sin(psi)
-        pose[m, 0] = goal_x - x
-        pose[m, 1] = c
-        pose[m, 2] = -s
-        pose[m, 3] = (y - centre_y) / half_channel
-        pose[m, 4] = c * vx + s * vy
-        pose[m, 5] = -s * vx + c * vy
-        pose[m, 6] = r
+        out = raw[m]
+        out[_AT_POSE] = goal_x - x
+        out[_AT_POSE + 1] = c
+        out[_AT_POSE + 2] = -s
+        out[_AT_POSE + 3] = (y - centre_y) / half_channel
+        out[_AT_POSE + 4] = c * vx + s * vy
+        out[_AT_POSE + 5] = -s * vx + c * vy
+        out[_AT_POSE + 6] = r
         f0, f1 = floe_start[m], floe_start[m + 1]
-        d, a = lidar_scan(x, y, psi, positions[f0:f1], radii[f0:f1], sectors, math.pi, max_range,
-                          lx, ly, periodic_x, periodic_y)
-        distance[m, :] = d
-        concentration[m, :] = a
-        loads[m, :] = 0.0
+        d, a = lidar_scan(ship, positions[f0:f1], radii[f0:f1], lidar, box)
+        for j in range(sectors):
+            out[_AT_LIDAR + 2 * j] = d[j]
+            out[_AT_LIDAR + 2 * j + 1] = a[j]
+        for j in range(_AT_LOADS, _AT_LIDAR):
+            out[j] = 0.0
         rec = rows[m]
         n = rec.shape[0]
         if advanced and n > 0:
             surge, sway, moment, normal, peak, force, magnitude, energy, effort, path = step_sums(
-                rec, table[m, _SUM_X], table[m, _SUM_Y], dynamic, commands[m, 0],
-                commands[m, 1], damping[m, 0], damping[m, 1])
-            h = dt[m]
-            loads[m, 0] = surge / n
-            loads[m, 1] = sway / n
-            loads[m, 2] = moment / n
-            loads[m, 3] = normal / n / hull_length[m]
-            loads[m, 4] = peak / hull_length[m]
-            loads[m, 5] = force * h
-            loads[m, 6] = magnitude * h
-            loads[m, 7] = energy * h
-            loads[m, 8] = effort * h
-            loads[m, 9] = path
+                rec, table[m, _SUM_X], table[m, _SUM_Y], dynamic, ship[_THRUST],
+                ship[_YAW_MOMENT], ship[_LINEAR:_LINEAR + 3], ship[_QUADRATIC:_QUADRATIC + 3])
+            h = ship[_DT]
+            length = ship[_HULL_LENGTH]
+            out[_AT_LOADS] = surge / n
+            out[_AT_LOADS + 1] = sway / n
+            out[_AT_LOADS + 2] = moment / n
+            out[_AT_LOADS + 3] = normal / n / length
+            out[_AT_LOADS + 4] = peak / length
+            out[_AT_LOADS + 5] = force * h
+            out[_AT_LOADS + 6] = magnitude * h
+            out[_AT_LOADS + 7] = energy * h
+            out[_AT_LOADS + 8] = effort * h
+            out[_AT_LOADS + 9] = path
             table[m, _SUM_X] = rec[n - 1, _X]
             table[m, _SUM_Y] = rec[n - 1, _Y]
             table[m, _SUM_RESISTANCE] -= surge * h
         if advanced and dynamic:
-            if pose[m, 4] < beset_speed[m]:
-                table[m, _SUM_SLOW] += control_interval
+            if out[_AT_POSE + 4] < ship[_BESET_SPEED]:
+                table[m, _SUM_SLOW] += scene[_CONTROL_INTERVAL]
             else:
                 table[m, _SUM_SLOW] = 0.0
 
@@ -280,7 +313,9 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool,
     n = len(envs)
     sims = [env.sim for env in envs]
     ships = [sim.ship for sim in sims]
-    motion = np.stack([ship.motion for ship in ships])
+    dynamic = e0.mode == "dynamic"
+    params = _ship_rows(envs, sims, ships, dynamic and advanced)
+    motion = params[:, :6]
     floe_xy = [sim.positions for sim in sims]
     floe_r = [sim.radii for sim in sims]
     if advanced:
@@ -290,15 +325,11 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool,
             ship.clear()
     else:
         rows = [_NO_RECORDS] * n
-    dynamic = e0.mode == "dynamic"
-    commands = np.zeros((n, 2))
-    beset = np.zeros(n)
-    if dynamic and advanced:
-        for k, (env, ship) in enumerate(zip(envs, ships)):
-            c = ship.commands
-            commands[k] = c["thrust"], c["yaw_moment"]
-            beset[k] = env.episode["beset_speed"]
     box = sims[0].box
+    scene = np.array((*box_entries(float(box.lx), float(box.ly), box.periodic),
+                      e0.lidar_sectors, math.pi, e0.lidar_range, e0.goal_x, e0.centre_y,
+                      0.5 * e0.channel_width, e0.control_interval, advanced, dynamic),
+                     dtype=float)
     # the measurement's columns, written in place: pose, loads, lidar (distance
     # and concentration interleaved), local ice, the environment's own
     k = 2 * e0.lidar_sectors
@@ -307,13 +338,8 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool,
     raw = np.empty((n, len(e0.measure_names)))
     loads = raw[:, len(POSE):lid]
     kernel = measure_one if n == 1 else measure_many
-    kernel(_record_list(rows), advanced, dynamic, commands, _per_env(envs, "_damping"),
-           np.array([sim.dt for sim in sims]), _per_env(envs, "_hull_length"), beset,
-           e0.control_interval, _stacked(floe_xy, 2), np.concatenate(floe_r),
-           _starts([r.size for r in floe_r]), motion, e0.lidar_sectors, e0.lidar_range,
-           float(box.lx), float(box.ly), box.periodic[0], box.periodic[1], e0.goal_x,
-           e0.centre_y, 0.5 * e0.channel_width, table, raw[:, :len(POSE)], loads,
-           raw[:, lid:loc:2], raw[:, lid + 1:loc:2])
+    kernel(_record_list(rows), params, _stacked(floe_xy, 2), np.concatenate(floe_r),
+           _starts([r.size for r in floe_r]), scene, table, raw)
     if advanced:
         for m, env in enumerate(envs):
             if env.render_mode is not None and rows[m].shape[0]:   # the path on the frames
@@ -353,11 +379,24 @@ def _local_ice(envs, sims, motion, lists, out) -> None:
     out[:, 6] = near[:, 7]
 
 
-def _per_env(envs, name: str) -> np.ndarray:
-    """The attribute ``name`` of every environment, stacked."""
-    if len(envs) == 1:
-        return np.asarray(getattr(envs[0], name), dtype=float)[None]
-    return np.array([getattr(env, name) for env in envs], dtype=float)
+def _ship_rows(envs, sims, ships, commanded: bool) -> np.ndarray:
+    """The ships' rows of parameters (:data:`SHIP_COLUMNS`) for
+    :func:`measure_many`; the commands and the beset speed only where
+    ``commanded`` (a dynamic ship that has just advanced), else zero."""
+    out = np.zeros((len(envs), len(SHIP_COLUMNS)))
+    for row, env, sim, ship in zip(out, envs, sims, ships):
+        row[:6] = ship.motion
+        linear, quadratic = env._damping
+        row[_LINEAR:_LINEAR + 3] = linear
+        row[_QUADRATIC:_QUADRATIC + 3] = quadratic
+        row[_DT] = sim.dt
+        row[_HULL_LENGTH] = env._hull_length
+        if commanded:
+            c = ship.commands
+            row[_THRUST] = c["thrust"]
+            row[_YAW_MOMENT] = c["yaw_moment"]
+            row[_BESET_SPEED] = env.episode["beset_speed"]
+    return out
 
 
 def _add_collisions(envs, table, loads, logs):

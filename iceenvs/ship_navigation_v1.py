@@ -15,7 +15,7 @@ from .base import TaskParameter, choice, interval, number, revised_task, task_ta
 from .observations import Feature, feature_table
 from .ship_controllers import SwathController
 from .ship_env import CONTROLS, ICE_LOADS, ship_features
-from .ship_sensors import (channel_room, check_bands, course_with_room, swath_courses,
+from .ship_sensors import (channel_room, check_bands, course_with_room, scan_box, swath_courses,
                             swath_scan)
 from .ship_navigation import ShipNavigationEnv
 from .vector import vector_class
@@ -343,18 +343,20 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         n_sums = self.swath_rays * (len(self.swath_bands) - 1)
         for k, env in enumerate(envs):
             sim = env.sim
-            ship = sim.ship
-            x, y = (float(v) for v in ship.position)
+            # the swath's pose: the ship's (x, y, heading), or (x, y, 0) about +x
+            pose = sim.ship.motion
+            if self.swath_frame != "heading":
+                pose = np.array([pose[0], pose[1], 0.0])
             box = sim.box
-            about = float(ship.heading) if self.swath_frame == "heading" else 0.0
-            sums = swath_scan(x, y, about, sim.positions, sim.radii,
-                              env._swath_weights, self.swath_rays, self.swath_fan,
-                              0.5 * env.ship.hull.beam, self.swath_bands, float(box.lx),
-                              float(box.ly), box.periodic[0], box.periodic[1])
+            sums = swath_scan(pose, sim.positions, sim.radii, env._swath_weights,
+                              np.array([self.swath_rays, self.swath_fan,
+                                        0.5 * env.ship.hull.beam]),
+                              self.swath_bands, scan_box(float(box.lx), float(box.ly), box.periodic))
             out[k, :n_sums] = sums.T.ravel()
             if self.swath_edge:
-                out[k, n_sums:] = channel_room(y - env.centre_y, 0.5 * env.channel_width,
-                                               about + courses, float(self.swath_bands[-1]))
+                out[k, n_sums:] = channel_room(float(pose[1]) - env.centre_y,
+                                               0.5 * env.channel_width, float(pose[2]) + courses,
+                                               float(self.swath_bands[-1]))
         return out
 
     @staticmethod

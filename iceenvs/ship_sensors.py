@@ -9,6 +9,13 @@ so an environment calls them on whatever engine it runs; the lidar is
 compiled (:func:`lidar_scan`, the same without the checks of the
 arguments, is what an environment calls every step).
 
+The compiled sensors (:func:`lidar_scan`, :func:`swath_scan`) take their
+arguments packed in a few float arrays: the ship's pose (x, y, heading:
+the first entries of :attr:`physics.ship.Ship.motion`), the floes, the
+sensor's setting (:data:`LIDAR_SETTING`, :data:`SWATH_SETTING`) and the
+box (:data:`SCAN_BOX`, :func:`scan_box`), the entries named by these
+tuples.
+
 Frames. The ship frame has x forward (along the heading) and y to port;
 angles are anticlockwise seen from above. Along a periodic axis of a box
 of side lengths ``box_lengths`` every displacement is taken as its minimum
@@ -98,7 +105,8 @@ from physics.domain import minimum_image
 
 __all__ = ["ice_lidar", "lidar_scan", "ice_swath", "swath_scan", "swath_courses", "channel_room",
            "course_with_room",
-           "check_bands", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS"]
+           "check_bands", "occupancy_image", "LIDAR_RINGS", "LIDAR_RAYS", "SCAN_BOX",
+           "LIDAR_SETTING", "SWATH_SETTING", "scan_box", "box_entries"]
 
 #: radial sample points per lidar sector (the concentration grid)
 LIDAR_RINGS = 8
@@ -106,6 +114,33 @@ LIDAR_RINGS = 8
 LIDAR_RAYS = 4
 
 _TWO_PI = 2.0 * math.pi
+
+#: the entries of a box as the compiled sensors take it (a float array):
+#: the side lengths [m] and whether x and y are periodic (1.0) or not (0.0)
+SCAN_BOX = ("lx", "ly", "periodic_x", "periodic_y")
+#: the entries of a lidar's setting (a float array): the number of sectors,
+#: the field of view [rad] and the range [m]
+LIDAR_SETTING = ("sectors", "fov", "max_range")
+#: the entries of a swath sensor's setting (a float array): the number of
+#: courses, the fan [rad] and the half-beam [m]
+SWATH_SETTING = ("rays", "fan", "half_beam")
+# the entries as constants of the compiled code (a pose is x, y, heading)
+_LX, _LY, _PERIODIC_X, _PERIODIC_Y = range(len(SCAN_BOX))
+_SECTORS, _FOV, _MAX_RANGE = range(len(LIDAR_SETTING))
+_RAYS, _FAN, _HALF_BEAM = range(len(SWATH_SETTING))
+
+
+def box_entries(lx: float, ly: float, periodic) -> tuple[float, float, float, float]:
+    """The entries of :data:`SCAN_BOX` of the box of side lengths ``lx``,
+    ``ly`` [m] and periodicity ``periodic`` (x, y), for a packed array that
+    holds them among others."""
+    return lx, ly, 1.0 if periodic[0] else 0.0, 1.0 if periodic[1] else 0.0
+
+
+def scan_box(lx: float, ly: float, periodic) -> np.ndarray:
+    """The box of side lengths ``lx``, ``ly`` [m] and periodicity
+    ``periodic`` (x, y) as the compiled sensors take it (:data:`SCAN_BOX`)."""
+    return np.array(box_entries(lx, ly, periodic))
 
 
 # -- validation ------------------------------------------------------------------------------
@@ -243,8 +278,21 @@ def ice_lidar(ship_xy, heading: float, positions, radii, *, sectors: int = 9,
     lengths, per = _check_box(box_lengths, periodic)
     fov, max_range = float(fov), float(max_range)
 
+    return lidar_scan(np.array([xy[0], xy[1], heading]), p, r, np.array([k, fov, max_range]),
+                      _scan_box(lengths, per))
+
+
+def _scan_box(lengths, periodic) -> np.ndarray:
+    """:func:`scan_box` of checked lengths (None: no periodic axis, whose
+    length is never read)."""
     lx, ly = (1.0, 1.0) if lengths is None else (float(lengths[0]), float(lengths[1]))
-    return lidar_scan(xy[0], xy[1], heading, p, r, k, fov, max_range, lx, ly, per[0], per[1])
+    return scan_box(lx, ly, periodic)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _unpacked_box(box):
+    """(lx, ly, periodic_x, periodic_y) of a packed box (:data:`SCAN_BOX`)."""
+    return box[_LX], box[_LY], box[_PERIODIC_X] != 0.0, box[_PERIODIC_Y] != 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -262,11 +310,16 @@ def _grid_range(low, high, step, n):
 
 
 @njit(cache=True, error_model="numpy")
-def lidar_scan(x, y, heading, positions, radii, sectors, fov, max_range, lx, ly, periodic_x,
-               periodic_y):
+def lidar_scan(pose, positions, radii, setting, box):
     """:func:`ice_lidar` without the checks of its arguments: the ship at
-    (``x``, ``y``), the box of side lengths ``lx``, ``ly`` (used along the
-    periodic axes only). Returns (distance, concentration)."""
+    (x, y) = ``pose[:2]`` heading ``pose[2]``, the lidar's ``setting``
+    (:data:`LIDAR_SETTING`), the ``box`` (:data:`SCAN_BOX`; its side
+    lengths are read along the periodic axes only). Returns (distance,
+    concentration)."""
+    x, y, heading = pose[0], pose[1], pose[2]
+    sectors = int(setting[_SECTORS])
+    fov, max_range = setting[_FOV], setting[_MAX_RANGE]
+    lx, ly, periodic_x, periodic_y = _unpacked_box(box)
     n_ang = sectors * LIDAR_RAYS
     distance = np.full(sectors, max_range)
     covered = np.zeros((LIDAR_RINGS, n_ang), dtype=np.bool_)
@@ -375,9 +428,8 @@ def ice_swath(ship_xy, heading, positions, radii, weights, *, rays: int = 9,
                          f"floe), got shape {w.shape}")
     edges = check_bands("bands", bands)
     lengths, per = _check_box(box_lengths, periodic)
-    lx, ly = (1.0, 1.0) if lengths is None else (float(lengths[0]), float(lengths[1]))
-    return swath_scan(xy[0], xy[1], heading, p, r, w, k, float(fan), float(half_beam), edges,
-                      lx, ly, per[0], per[1])
+    return swath_scan(np.array([xy[0], xy[1], heading]), p, r, w,
+                      np.array([k, float(fan), float(half_beam)]), edges, _scan_box(lengths, per))
 
 
 def check_bands(name: str, bands) -> np.ndarray:
@@ -443,9 +495,15 @@ def swath_courses(rays: int, fan: float) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def swath_scan(x, y, heading, positions, radii, weights, rays, fan, half_beam, bands, lx, ly,
-               periodic_x, periodic_y):
-    """:func:`ice_swath` without the checks of its arguments."""
+def swath_scan(pose, positions, radii, weights, setting, bands, box):
+    """:func:`ice_swath` without the checks of its arguments: the ship at
+    (x, y) = ``pose[:2]``, the fan about the course ``pose[2]``, the
+    sensor's ``setting`` (:data:`SWATH_SETTING`) and the ``box``
+    (:data:`SCAN_BOX`)."""
+    x, y, heading = pose[0], pose[1], pose[2]
+    rays = int(setting[_RAYS])
+    fan, half_beam = setting[_FAN], setting[_HALF_BEAM]
+    lx, ly, periodic_x, periodic_y = _unpacked_box(box)
     nb = bands.size - 1
     out = np.zeros((rays, nb))
     far = bands[nb]

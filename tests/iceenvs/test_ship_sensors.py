@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from iceenvs.ship_sensors import (LIDAR_RAYS, LIDAR_RINGS, channel_room, course_with_room,
-                                  ice_lidar, ice_swath, lidar_scan, occupancy_image)
+                                  ice_lidar, ice_swath, lidar_scan, occupancy_image, scan_box)
 
 TWO_PI = 2.0 * math.pi
 
@@ -163,8 +163,8 @@ def test_unchecked_lidar_matches_evaluation_of_the_nearest_images():
         gap = np.hypot(*(images - np.asarray(ship)).transpose(2, 0, 1))
         nearest = images[np.arange(80), np.argmin(gap, axis=1)]
         keep = np.min(gap, axis=1) > radii + 0.5                    # the ship in open water
-        got = lidar_scan(ship[0], ship[1], heading, positions[keep], radii[keep], 7, 2.5, 120.0,
-                         lx, ly, *periodic)
+        got = lidar_scan(np.array([ship[0], ship[1], heading]), positions[keep], radii[keep],
+                         np.array([7, 2.5, 120.0]), scan_box(lx, ly, periodic))
         want = lidar_by_hand(np.asarray(ship), heading, nearest[keep], radii[keep], 7, 2.5, 120.0)
         assert np.min(got[0]) < 120.0 and np.max(got[1]) > 0.0       # it sees ice
         # 1e-9 m: the same ray-circle root in two algebraic forms
