@@ -41,7 +41,7 @@ from .forcing import Forcing
 from .hertz_kernels import HertzStatus
 from .hertz_batch import run_many
 from .hertz_free_drift import DEFAULT_WINDOW, TALLY
-from .hertz_step import run_every_floe_parallel, run_steps
+from .hertz_step import run_every_floe_parallel, run_one
 from .neighbors import choose_cell_size, radius_rank
 from .observables import Contacts, Fabric, LocalIce, Stress, fabric, stress
 from .params import ContactParams, PaperPreset
@@ -540,7 +540,7 @@ class HertzSimulation(FloeProperties):
                     done, status, nreb, self._verlet = run_every_floe_parallel(
                         args[0], self.dt, self.time, args[1:], self._verlet, self.n_chunks)
             else:
-                done, status, nreb, self._verlet, awake = run_steps(
+                done, status, nreb, self._verlet, awake = run_one(
                     self._step_mode, args[0], self.dt, self.time, args[1:], self._verlet,
                     self.free_window, self.free_tally)
                 if awake >= 0:

@@ -1,7 +1,9 @@
 """The velocity-Verlet step of the Hertz engine, written once.
 
 Every run of the engine (:meth:`physics.hertz.HertzSimulation.step`, the
-batches of :mod:`physics.hertz_batch`) goes through :func:`run_steps`, and
+batches of :mod:`physics.hertz_batch`) goes through one choice of the step's
+form (:func:`run_steps`, or :func:`run_one`, the same function run by
+Python for one simulation, so that only its form is compiled), and
 every step of every run through one loop, :func:`substeps`. A step is, in
 LAMMPS ``fix nve/sphere`` order:
 
@@ -33,7 +35,7 @@ Its type selects, when the loop is compiled, the form of each phase:
 counting) and stops when the run is done, fails, or the list expires. The
 run around it (:func:`run_steps`) rebuilds the list, which allocates,
 finishes the step whose list expired and goes on. The step's form is chosen
-in one place, :func:`run_steps`, from the simulation's mode (:data:`MODES`).
+in one place, ``_run_steps``, from the simulation's mode (:data:`MODES`).
 """
 from __future__ import annotations
 
@@ -57,7 +59,7 @@ from .hull_contact import S_FLOE_TRAVEL, hull_forces, hull_point_speed
 
 __all__ = ["MODES", "MODE_FULL", "MODE_RESTING", "MODE_FREE", "MODE_FREE_ITERATED",
            "EveryFloe", "EveryFloeParallel", "AwakeFloes", "WindowFloes", "substeps",
-           "run_steps"]
+           "run_steps", "run_one"]
 
 #: the step's forms, by their number in :func:`run_steps` (``HertzSimulation._step_mode``)
 MODES = ("full", "skip resting", "free drift", "free drift, stepped")
@@ -714,8 +716,7 @@ def run_windows(n_steps, dt, time, run, verlet, window, tally, iterate):
     return done, status, n_rebuilds, verlet, n_engaged
 
 
-@njit(cache=True, error_model="numpy")
-def run_steps(mode, n_steps, dt, time, run, verlet, window, tally):
+def _run_steps(mode, n_steps, dt, time, run, verlet, window, tally):
     """Advance the floes of ``run`` (floes, law, wall law, drive, box, ship
     bundle) by ``n_steps`` serial velocity-Verlet steps in the form
     ``mode`` (:data:`MODES`): the one place where the step's form is
@@ -743,3 +744,11 @@ def run_steps(mode, n_steps, dt, time, run, verlet, window, tally):
                            mode == MODE_FREE_ITERATED)
     done, status, n_rebuilds, verlet = run_every_floe(n_steps, dt, time, run, verlet)
     return done, status, n_rebuilds, verlet, -1
+
+
+#: the choice compiled, for the batches of :func:`physics.hertz_batch.run_many`
+#: (every form is compiled into it)
+run_steps = njit(cache=True, error_model="numpy")(_run_steps)
+#: the same choice run by Python, for one simulation: only the form it runs
+#: is compiled (a first step compiles about a minute less)
+run_one = _run_steps

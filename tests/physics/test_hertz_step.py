@@ -49,11 +49,15 @@ def test_one_kick_drift_pass():
 
 
 def test_one_place_chooses_the_form():
-    assert call_sites("run_awake") == [("hertz_step", "run_steps")]
-    assert call_sites("run_windows") == [("hertz_step", "run_steps")]
+    # run_steps (compiled, for batches) and run_one (by Python, for one
+    # simulation) are the same function, _run_steps
+    assert call_sites("run_awake") == [("hertz_step", "_run_steps")]
+    assert call_sites("run_windows") == [("hertz_step", "_run_steps")]
     # the loop runs from the runs of hertz_step alone
     assert {module for module, _ in call_sites("substeps")} == {"hertz_step"}
-    assert {module for module, _ in call_sites("run_steps")} == {"hertz", "hertz_batch"}
+    assert {module for module, _ in call_sites("run_steps")} == {"hertz_batch"}
+    assert {module for module, _ in call_sites("run_one")} == {"hertz"}
+    assert hertz_step.run_steps.py_func is hertz_step.run_one
 
 
 @pytest.mark.parametrize("flags, mode", [
