@@ -86,10 +86,9 @@ class EveryFloeParallel(NamedTuple):
 
     #: chunks of the parallel passes (:func:`~physics.hertz_kernels.chunk_count`)
     n_chunks: int
-    #: the chunks of the pair loop and the cut pairs' slots
+    #: the chunks of the pair loop and the cut pairs' slots (the parallel
+    #: step looks at every pair and wall: it keeps no paths)
     chunks: PairChunks
-    #: (N,) unused (the parallel step looks at every pair and wall)
-    path: np.ndarray
 
 
 class AwakeFloes(NamedTuple):
@@ -535,7 +534,7 @@ def _rebuilt(movers, run, verlet, lx, ly, dt):
             verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, True,
                                     ship, box.deforming, dt)
             return verlet, EveryFloeParallel(movers.n_chunks,
-                                             pair_chunks(verlet, movers.n_chunks), movers.path)
+                                             pair_chunks(verlet, movers.n_chunks))
     elif kind is AwakeFloes:
         def impl(movers, run, verlet, lx, ly, dt):
             floes, box, ship = run[0], run[4], run[5]
@@ -614,7 +613,7 @@ def run_every_floe_parallel(n_steps, dt, time, run, verlet, n_chunks):
     floes, ship = run[0], run[5]
     n = floes.pos.shape[0]
     buffers, work = start_run(run)
-    movers = EveryFloeParallel(n_chunks, pair_chunks(verlet, n_chunks), np.zeros(n))
+    movers = EveryFloeParallel(n_chunks, pair_chunks(verlet, n_chunks))
     done, status, n_rebuilds, verlet, movers = run_pieces(n_steps, dt, time, run, work, verlet,
                                                           movers)
     gather_cut(0, n, movers.chunks, buffers.force, buffers.torque)
