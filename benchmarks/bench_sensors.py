@@ -92,7 +92,7 @@ def _sensor_calls(u) -> dict:
     packed_box = scan_box(float(box.lx), float(box.ly), box.periodic)
     return {
         "lidar": lambda: lidar_scan(pose, sim.positions, sim.radii, setting, packed_box),
-        "swath": lambda: u._extra_measures([u]),
+        "swath": lambda: u.extra_values([u]),
         "image": u._image,
     }
 

@@ -26,8 +26,8 @@ __all__ = ["ENV_IDS"]
 # Every id is registered with its episode length: ``env.spec.max_episode_steps``
 # is set, Gymnasium's TimeLimit truncates the episodes, and
 # ``gymnasium.make(id, max_episode_steps=N)`` changes the length. The
-# environments never truncate on their own. An environment with a native
-# vector environment (iceenvs.vector) names it third: the class beside the
+# environments never truncate on their own. Every environment has a native
+# vector environment (iceenvs.vector), named third: the class beside the
 # environment's, and gymnasium.make_vec(id, num_envs=N,
 # vectorization_mode="vector_entry_point") builds it.
 _ENVS = {
@@ -35,9 +35,10 @@ _ENVS = {
     "Convergence-v0": ("iceenvs.convergence:ConvergenceEnv", 150, "ConvergenceVectorEnv"),
     "MarginalIceZone-v0": ("iceenvs.marginal_ice_zone:MarginalIceZoneEnv", 200,
                            "MarginalIceZoneVectorEnv"),
-    "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400, None),
+    "FloeClustering-v0": ("iceenvs.floe_clustering:FloeClusteringEnv", 400,
+                          "FloeClusteringVectorEnv"),
     "ThicknessDistribution-v0": ("iceenvs.thickness_distribution:ThicknessDistributionEnv", 360,
-                                 None),
+                                 "ThicknessDistributionVectorEnv"),
     "ShipNavigation-v0": ("iceenvs.ship_navigation:ShipNavigationEnv", 300,
                           "ShipNavigationVectorEnv"),
     "ShipBeset-v0": ("iceenvs.ship_beset:ShipBesetEnv", 300, "ShipBesetVectorEnv"),

@@ -1,26 +1,35 @@
-"""Shared plumbing of the environments: :class:`ControlEnv`, :class:`FloeEnv`
-and :class:`HertzEnv`.
+"""Shared plumbing of the environments: :class:`ControlEnv`, the base of
+every environment, and :class:`HertzEnv`, of the floe tasks over the Hertz
+engine.
 
-A floe environment owns one engine (``self.sim``), turns an action into
+An environment owns one engine (``self.sim``), turns an action into
 forcing, advances the engine by the control interval, measures the
 observables of :mod:`iceenvs.observations` and scores them with a reward
-function of :mod:`iceenvs.rewards`. Subclasses say only what differs:
+function of :mod:`iceenvs.rewards`. Its class declares its task:
 
 * ``task_parameters`` — the task's :class:`TaskParameter` table;
 * ``drawn`` — the task parameters drawn per episode from their
   ``<name>_range`` when left at ``None`` (or ``_draw_episode`` for another
   draw);
-* ``_make_sim(rng)`` — a new engine for an episode;
-* ``_apply_action(action)`` — the (clipped) action into forcing;
-* ``_measure()`` — the raw physical observables (dict of SI values);
-* ``_terminated(now)`` — task failure;
-* class attributes ``extra_features`` (entries after the common ones),
-  ``action_names``, ``reward_task_keys`` and the default ``reward_fn``.
+* ``make_sim(rng)`` — how to make the engine of an episode;
+* ``apply_action(action)`` — how a (sanitised) action applies, as forcing;
+* ``measure()`` — what is measured: the raw physical observables (a dict
+  of SI values); a family measures on columns (``measure_batch``);
+* ``ends(envs, nows, cols, sums, task)`` — when an episode ends: by
+  default each environment's ``_succeeded(now)`` and ``_terminated(now)``;
+* ``reward_fn`` and ``default_reward_params()`` — the reward;
+* class attributes ``extra_features`` (entries after the common ones) and
+  ``action_names``.
+
+The step itself is not the environment's: every environment's step is that
+of its batch of episodes (:class:`iceenvs.step.Episodes`), which holds the
+step count, last action, measurement, observation and sums of each
+episode. A single environment is a batch of one.
 
 Data flow of one step::
 
-    action → NaN → 0, ±inf → bound, clip → forcing → engine.advance(control interval)
-      → observables (SI dict) → reward(prev, action, now) and float32 vector
+    action → NaN → 0, ±inf → bound, clip → apply_action → engine advance (control interval)
+      → measure (SI dict) → reward(prev, action, now), ends, and the observation
 
 Conventions every environment keeps (see the environment docs):
 
@@ -41,7 +50,6 @@ Conventions every environment keeps (see the environment docs):
 from __future__ import annotations
 
 import inspect
-import math
 from dataclasses import dataclass
 from typing import Any
 from collections.abc import Callable
@@ -56,9 +64,10 @@ from physics.hertz import hertz_time_step, scaled_contact
 from physics.markdown import table_row
 
 from .observations import FLOE_FEATURES, Feature, observation_vectors
-from .snapshots import Snapshot, restore_snapshot, take_snapshot
+from .snapshots import ROW, Snapshot, restore_snapshot, take_snapshot
+from .step import PHYSICS_ERRORS, Episodes
 
-__all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "interval",
+__all__ = ["ControlEnv", "HertzEnv", "TaskParameter", "number", "interval",
            "sanitise_action", "sanitise_actions", "choice", "scaled_contact", "hertz_time_step",
            "REWARD_RANGE", "TIME_FEATURE", "task_table", "revised_task", "MAX_WIND", "PHYSICS_ERRORS"]
 
@@ -66,9 +75,6 @@ __all__ = ["ControlEnv", "FloeEnv", "HertzEnv", "TaskParameter", "number", "inte
 #: :attr:`ControlEnv.reward_bounds`; a task whose rewards leave it (the ship
 #: tasks) declares its own bounds beside its reward
 REWARD_RANGE = (0.0, 1.0)
-#: the errors of a step that are physics failures: they end the episode
-#: (``info["error"]``) instead of reaching the caller
-PHYSICS_ERRORS = (FloatingPointError, RuntimeError, ValueError)
 #: default wind speed [m/s] of a full action of the wind-driven tasks (the
 #: ``max_wind`` task parameter)
 MAX_WIND = 20.0
@@ -202,6 +208,15 @@ def task_table(params) -> str:
 
 # -- the control loop ------------------------------------------------------------------------
 
+def _check_horizon(horizon) -> int | None:
+    if horizon is None:
+        return None
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ValueError(f"horizon must be None or an integer >= 1 (the episode's "
+                         f"max_episode_steps), got {horizon!r}")
+    return int(horizon)
+
+
 class ControlEnv(gym.Env):
     """The control loop every environment of the suite shares.
 
@@ -216,9 +231,13 @@ class ControlEnv(gym.Env):
     Episodes are truncated by Gymnasium's ``TimeLimit`` (the registered
     ``max_episode_steps``), never by the environment itself.
 
-    Subclasses build their model in ``reset`` and then call
-    ``_begin_episode``; they provide the hooks named above, ``_ready`` (a
-    model exists) and ``_frame`` (an RGB array).
+    An environment over a floe engine (``self.sim``) provides
+    ``_make_sim``, ``_apply_action``, ``_measure`` and ``_frame`` (an RGB
+    array); one over another model (the thickness distribution) builds it
+    in ``reset``, then calls ``_begin_episode``, and provides ``_ready`` (a
+    model exists), ``_advance``, ``_vector`` and ``_info`` as well. The
+    environments' classes are at most three deep: this class, a family
+    (:class:`HertzEnv`, :class:`iceenvs.ship_env.ShipEnv`) and the task.
 
     The reward contract: every step's reward, a failure's included, lies in
     :attr:`reward_bounds`. A task declares both with its reward: the floe
@@ -226,6 +245,24 @@ class ControlEnv(gym.Env):
     leaves them overrides ``reward_bounds`` and ``failure_reward``
     together (:class:`iceenvs.ship_env.ShipEnv`), and
     :func:`iceenvs.checks.check_rewards` holds every registered id to it.
+
+    Arguments common to the floe environments:
+
+    * ``n_floes`` (int or None): number of floes; None for an environment
+      that draws its own field (``own_field``), whose count comes with each
+      episode's field (``n_floes`` is 0 until the first reset);
+    * ``preset`` (PaperPreset): parameter table (FSD, material, forcing);
+    * ``control_interval`` (float): model seconds per env step;
+    * ``reward_fn`` (callable, optional): ``reward(prev, action, now, **params)``;
+    * ``reward_params`` (dict, optional): overrides of the task's reward weights;
+    * ``stiffness_scale`` (float): multiplies Young's modulus (Hertz envs); < 1
+      trades contact stiffness for a longer time step (faster training);
+    * ``cluster_gap`` (float): largest gap [m] between two floes of a cluster;
+    * ``horizon`` (int, optional): adds ``time_left`` = 1 − t/horizon to the
+      observation (pass the episode's ``max_episode_steps``);
+    * ``colour_scale`` (float): speed [m/s] at the top of the frames' colour bar;
+    * ``render_mode``: None, "rgb_array" or "human";
+    * ``**task``: the task parameters of the environment (its table).
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
@@ -241,13 +278,87 @@ class ControlEnv(gym.Env):
     horizon = None
     #: what an episode changes (:mod:`iceenvs.snapshots`): the members a
     #: snapshot holds; each subclass lists the ones it adds
-    episode_members: tuple[str, ...] = ("_np_random", "_np_random_seed", "episode", "_steps",
-                                        "_last_action", "_prev", "_obs")
+    episode_members: tuple[str, ...] = ("_np_random", "_np_random_seed", "episode", "sim")
     #: what changes in an episode but is no state of it: caches that a restore
-    #: rebuilds, work buffers written whole before they are read
-    episode_caches: tuple[str, ...] = ()
+    #: rebuilds, work buffers written whole before they are read, and the
+    #: batch of episodes the environment is a row of (whose row a snapshot holds)
+    episode_caches: tuple[str, ...] = ("episodes", "row")
     #: settings of the frames, which a snapshot's configuration check ignores
     render_settings: tuple[str, ...] = ("render_mode", "colour_scale", "_renderer")
+
+    #: the observation entries every environment of the family has
+    base_features: tuple[Feature, ...] = FLOE_FEATURES
+    extra_features: tuple[Feature, ...] = ()
+    action_names: tuple[str, ...] = ()
+    reward_fn: Callable = None
+    colour_label = "speed [m/s]"
+    #: the environment draws each episode's field itself, and with it the number
+    #: of floes (it passes ``n_floes=None``)
+    own_field = False
+
+    #: the largest relative speed at impact [m/s] the time step must resolve
+    impact_speed = 1.0
+
+    # -- how the family steps in a batch (:class:`iceenvs.step.Episodes`) -------------------
+    #: the engines of a vector environment advance together, in one compiled
+    #: call (:func:`physics.hertz.advance_together`)
+    engines_together = False
+    #: ... and a single environment's engine too (else it advances on its own)
+    single_together = False
+    #: the family measures a batch on columns (``measure_batch``, ``measure_names``)
+    measures_in_batch = False
+    #: a batch measured on columns is rewarded on columns (the class's own reward)
+    rewards_on_columns = False
+    #: ... and observed on columns (``feature_columns``)
+    observes_on_columns = False
+    #: the columns of an episode's running sums (the batch's ``sums``)
+    sum_columns: tuple[str, ...] = ()
+
+    def __init__(self, *, n_floes: int | None, preset: PaperPreset, control_interval: float,
+                 reward_fn=None, reward_params: dict | None = None,
+                 stiffness_scale: float = 1.0, cluster_gap: float = 0.1,
+                 horizon: int | None = None, colour_scale: float = 0.5,
+                 render_mode: str | None = None, **task):
+        if n_floes is not None or not self.own_field:
+            if isinstance(n_floes, bool) or not isinstance(n_floes, (int, np.integer)):
+                raise ValueError(f"n_floes must be an integer >= 2, got {n_floes!r}")
+            check_range("n_floes", n_floes, 2, None)
+        check_range("control_interval", control_interval, 0.0, None, low_open=True)
+        check_range("cluster_gap", cluster_gap, 0.0, None)
+        check_range("colour_scale", colour_scale, 0.0, None, low_open=True)
+        if not isinstance(preset, PaperPreset):
+            raise TypeError(f"preset must be a PaperPreset (e.g. physics.HERMAN2013), "
+                            f"got {type(preset).__name__}")
+        self._set_render_mode(render_mode)
+        self._init_task(task)
+        self.n_floes = 0 if n_floes is None else int(n_floes)
+        self.preset = preset
+        self.control_interval = float(control_interval)
+        self.stiffness_scale = float(stiffness_scale)
+        self.contact = scaled_contact(preset.contact, stiffness_scale)
+        self.cluster_gap = float(cluster_gap)
+        self.horizon = _check_horizon(horizon)
+        self.colour_scale = float(colour_scale)
+        if reward_fn is not None:
+            if not callable(reward_fn):
+                raise TypeError("reward_fn must be callable as reward(prev, action, now, **params)")
+            self.reward_fn = reward_fn
+        else:
+            self.reward_fn = type(self).reward_fn
+        self._init_reward_params(self.default_reward_params(), reward_params,
+                                 custom=reward_fn is not None)
+
+        self.features = self.base_features + self.extra_features
+        if self.horizon is not None:
+            self.features = self.features + (TIME_FEATURE,)
+        n_act = self.action_space.shape[0]
+        low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
+        high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        #: the episode's engine (:meth:`_make_sim`); the code shared here uses only
+        #: :class:`~physics.engine.FloeEngine`, an environment may use more of its engine
+        self.sim: FloeEngine | None = None
+        Episodes([self], single=True)
 
     @property
     def reward_bounds(self) -> tuple[float, float]:
@@ -335,24 +446,24 @@ class ControlEnv(gym.Env):
                 task[name] = value
         return task
 
-    # -- hooks ------------------------------------------------------------------------------
-    def _ready(self) -> bool:
+    # -- the task ---------------------------------------------------------------------------
+    def apply_action(self, action: np.ndarray) -> None:
+        """Apply the sanitised ``action`` (as forcing, commands, ...)."""
         raise NotImplementedError
 
-    def _apply_action(self, action: np.ndarray) -> None:
+    def measure(self) -> dict:
+        """The raw physical observables now (a dict of SI values)."""
         raise NotImplementedError
 
-    def _advance(self) -> None:
-        raise NotImplementedError
-
-    def _measure(self) -> dict:
-        raise NotImplementedError
-
-    def _vector(self, now: dict) -> np.ndarray:
-        raise NotImplementedError
-
-    def _info(self, now: dict) -> dict:
-        raise NotImplementedError
+    def ends(self, envs, nows, cols, sums, task) -> tuple[np.ndarray, np.ndarray]:
+        """(succeeded, failed), boolean arrays, of the environments ``envs``
+        (of this class and configuration) that measured ``nows`` (dicts;
+        ``cols``, ``sums`` and ``task``: the columns of a family measured on
+        columns, else None): by default each one's ``_succeeded(now)`` and
+        ``_terminated(now)``."""
+        return (np.array([bool(env._succeeded(now)) for env, now in zip(envs, nows)], dtype=bool),
+                np.array([bool(env._terminated(now)) for env, now in zip(envs, nows)],
+                         dtype=bool))
 
     def _terminated(self, now: dict) -> bool:
         return False
@@ -362,17 +473,61 @@ class ControlEnv(gym.Env):
         step's own reward, unlike a failure."""
         return False
 
-    def _reward_kwargs(self) -> dict:
+    def reward_kwargs(self) -> dict:
+        """The keywords of the reward function: the reward parameters and the
+        episode's values of ``reward_task_keys``."""
         return {**self.reward_params, **{k: self.episode[k] for k in self.reward_task_keys}}
 
-    def _reward(self, action: np.ndarray, now: dict) -> float:
-        return float(self.reward_fn(self._prev, action, now, **self._reward_kwargs()))
+    def reward(self, action: np.ndarray, now: dict) -> float:
+        """The reward of a step that took ``action`` and measured ``now``."""
+        return float(self.reward_fn(self._prev, action, now, **self.reward_kwargs()))
 
     def _frame(self) -> np.ndarray:
         raise NotImplementedError
 
-    def _time_left(self) -> float:
+    def time_left(self) -> float:
+        """The remaining fraction of a ``horizon``-step episode."""
         return max(0.0, 1.0 - self._steps / self.horizon)
+
+    # -- to be provided by subclasses ------------------------------------------------
+    def default_reward_params(self) -> dict:
+        return {}
+
+    def make_sim(self, rng: np.random.Generator) -> FloeEngine:
+        raise NotImplementedError
+
+    def _ready(self) -> bool:
+        return self.sim is not None
+
+    def advance(self) -> None:
+        self.sim.advance(self.control_interval)
+
+    # -- gymnasium API ----------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.episode = self._episode_task(options)
+        self.sim = self.make_sim(self.np_random)
+        return self.episodes.begin(self.row)
+
+    def observe(self, now: dict) -> np.ndarray:
+        if self.horizon is not None:
+            now = {**now, "time_left": self.time_left()}
+        row = np.array([[float(now[f.name]) for f in self.features]])
+        return observation_vectors(row, self.features, self._last_action[None])[0]
+
+    def make_info(self, now: dict) -> dict:
+        return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps,
+                "task": dict(self.episode)}
+
+    # -- frames -----------------------------------------------------------------------
+    def _frame_text(self) -> list[str]:
+        """Lines of text on a frame: time, concentration and the task."""
+        now = self._prev
+        return [f"t = {self.sim.time:.0f} s", f"A = {now['concentration']:.3f}"]
+
+    def _frame_arrow(self):
+        """Arrows on a frame (see :func:`iceenvs.rendering.annotate`)."""
+        return None
 
     # -- the loop -----------------------------------------------------------------------------
     @property
@@ -383,74 +538,45 @@ class ControlEnv(gym.Env):
         observation use it."""
         return self._prev
 
+    # -- the episode's state: a row of its batch (:class:`iceenvs.step.Episodes`) -----------
+    def join(self, episodes: Episodes, row: int) -> None:
+        """Make this environment row ``row`` of the batch ``episodes`` (a
+        native vector environment's; at construction its own batch of one)."""
+        self.episodes = episodes
+        self.row = int(row)
+
+    @property
+    def _steps(self) -> int:
+        return int(self.episodes.steps[self.row])
+
+    @property
+    def _last_action(self) -> np.ndarray:
+        return self.episodes.last_action[self.row]
+
+    @property
+    def _prev(self) -> dict | None:
+        return self.episodes.prev[self.row]
+
+    @property
+    def _obs(self):
+        return self.episodes.obs[self.row]
+
     def _begin_episode(self):
         """Zero action, first measurement and observation of a new episode;
         returns what ``reset`` returns."""
-        self._steps = 0
-        self._last_action = np.zeros(self.action_space.shape[0])
-        self._apply_action(self._last_action)
-        now = self._measure()
-        self._prev = now
-        self._obs = self._vector(now)
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), self._info(now)
+        return self.episodes.begin(self.row)
 
     def step(self, action):
-        a, replaced = self._take_action(action)
-        try:
-            self._apply_action(a)
-            self._advance()
-            now = self._measure()
-        except PHYSICS_ERRORS as err:
-            return self._failed_step(err, replaced)
-        return self._finish_step(a, replaced, now)
-
-    # the three parts of a step, which a vector environment
-    # (:mod:`iceenvs.vector`) also calls, with its engines advanced together
-    # between the first and the last
-    def _take_action(self, action) -> tuple[np.ndarray, int]:
-        """The sanitised action of a step and the number of its non-finite
-        entries (:func:`sanitise_action`); counts the step."""
+        """One step: the step of the environment's batch of one
+        (:meth:`iceenvs.step.Episodes.step`)."""
         if not self._ready():
             raise RuntimeError("call reset() before step()")
+        if not self.episodes.single:
+            raise RuntimeError("this environment is a sub-environment of a vector environment: "
+                               "step the vector environment")
         a, replaced = sanitise_action(action, self.action_space)
-        self._took_action(a)
-        return a, replaced
-
-    def _took_action(self, a: np.ndarray) -> None:
-        """Keep the sanitised action ``a`` of a step and count the step (a
-        vector environment, which sanitises its batch at once, calls this)."""
-        self._last_action = a
-        self._steps += 1
-
-    def _failed_step(self, err: BaseException, replaced: int) -> tuple:
-        """What ``step`` returns after a physics failure: the episode ends
-        instead of the caller crashing."""
-        info = self._info(self._prev)
-        info["error"] = f"{type(err).__name__}: {err}"
-        info["nonfinite_action"] = replaced
-        return self._obs.copy(), float(self.failure_reward), True, False, info
-
-    def _finish_step(self, a: np.ndarray, replaced: int, now: dict) -> tuple:
-        """Reward, end of episode, observation and info of a step that
-        measured ``now``."""
-        reward = self._reward(a, now)
-        info = self._info(now)
-        info["nonfinite_action"] = replaced
-        succeeded = bool(self._succeeded(now))
-        failed = bool(self._terminated(now))
-        if not math.isfinite(reward):
-            info["error"] = f"non-finite reward {reward}"
-            failed = True
-        terminated = succeeded or failed
-        if failed:
-            reward = float(self.failure_reward)
-        self._prev = now
-        self._obs = self._vector(now)
-        if self.render_mode == "human":
-            self.render()
-        return self._obs.copy(), reward, terminated, False, info
+        obs, reward, terminated, info = self.episodes.step(a[None], np.array([replaced]))
+        return obs, float(reward[0]), bool(terminated[0]), False, info
 
     # -- snapshots ----------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:
@@ -485,9 +611,11 @@ class ControlEnv(gym.Env):
         self._set_members(restore_snapshot(self, snapshot))
 
     def _set_members(self, state: dict) -> None:
-        """Set the episode members ``state`` (fresh copies); a subclass
-        rebuilds its caches (:attr:`episode_caches`)."""
+        """Set the episode members ``state`` (fresh copies) and the row of
+        the batch; a subclass rebuilds its caches (:attr:`episode_caches`)."""
+        row = state.pop(ROW)
         self.__dict__.update(state)
+        self.episodes.set_row(self.row, row)
 
     # -- rendering ----------------------------------------------------------------------------
     def render(self):
@@ -514,139 +642,7 @@ class ControlEnv(gym.Env):
             self._renderer = None
 
 
-def _check_horizon(horizon) -> int | None:
-    if horizon is None:
-        return None
-    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
-        raise ValueError(f"horizon must be None or an integer >= 1 (the episode's "
-                         f"max_episode_steps), got {horizon!r}")
-    return int(horizon)
-
-
-class FloeEnv(ControlEnv):
-    """Base of the floe environments (not registered itself).
-
-    Arguments common to every floe environment
-    ------------------------------------------
-    n_floes : int or None — number of floes; None for an environment that
-        draws its own field (``own_field``), whose count comes with each
-        episode's field (``n_floes`` is 0 until the first reset)
-    preset : PaperPreset — parameter table (FSD, material, forcing)
-    control_interval : float — model seconds per env step
-    reward_fn : callable, optional — ``reward(prev, action, now, **params)``
-    reward_params : dict, optional — overrides of the task's reward weights
-    stiffness_scale : float — multiplies Young's modulus (Hertz envs); < 1
-        trades contact stiffness for a longer time step (faster training)
-    cluster_gap : float — largest gap [m] between two floes of a cluster
-    horizon : int, optional — adds ``time_left`` = 1 − t/horizon to the
-        observation (pass the episode's ``max_episode_steps``)
-    colour_scale : float — speed [m/s] at the top of the frames' colour bar
-    render_mode : None, "rgb_array" or "human"
-    **task : the task parameters of the environment (its table)
-    """
-
-    #: the observation entries every environment of the family has
-    base_features: tuple[Feature, ...] = FLOE_FEATURES
-    extra_features: tuple[Feature, ...] = ()
-    action_names: tuple[str, ...] = ()
-    reward_fn: Callable = None
-    colour_label = "speed [m/s]"
-    #: the environment draws each episode's field itself, and with it the number
-    #: of floes (it passes ``n_floes=None``)
-    own_field = False
-    episode_members = ("sim",)
-
-    def __init__(self, *, n_floes: int | None, preset: PaperPreset, control_interval: float,
-                 reward_fn=None, reward_params: dict | None = None,
-                 stiffness_scale: float = 1.0, cluster_gap: float = 0.1,
-                 horizon: int | None = None, colour_scale: float = 0.5,
-                 render_mode: str | None = None, **task):
-        if n_floes is not None or not self.own_field:
-            if isinstance(n_floes, bool) or not isinstance(n_floes, (int, np.integer)):
-                raise ValueError(f"n_floes must be an integer >= 2, got {n_floes!r}")
-            check_range("n_floes", n_floes, 2, None)
-        check_range("control_interval", control_interval, 0.0, None, low_open=True)
-        check_range("cluster_gap", cluster_gap, 0.0, None)
-        check_range("colour_scale", colour_scale, 0.0, None, low_open=True)
-        if not isinstance(preset, PaperPreset):
-            raise TypeError(f"preset must be a PaperPreset (e.g. physics.HERMAN2013), "
-                            f"got {type(preset).__name__}")
-        self._set_render_mode(render_mode)
-        self._init_task(task)
-        self.n_floes = 0 if n_floes is None else int(n_floes)
-        self.preset = preset
-        self.control_interval = float(control_interval)
-        self.stiffness_scale = float(stiffness_scale)
-        self.contact = scaled_contact(preset.contact, stiffness_scale)
-        self.cluster_gap = float(cluster_gap)
-        self.horizon = _check_horizon(horizon)
-        self.colour_scale = float(colour_scale)
-        if reward_fn is not None:
-            if not callable(reward_fn):
-                raise TypeError("reward_fn must be callable as reward(prev, action, now, **params)")
-            self.reward_fn = reward_fn
-        else:
-            self.reward_fn = type(self).reward_fn
-        self._init_reward_params(self.default_reward_params(), reward_params,
-                                 custom=reward_fn is not None)
-
-        self.features = self.base_features + self.extra_features
-        if self.horizon is not None:
-            self.features = self.features + (TIME_FEATURE,)
-        n_act = self.action_space.shape[0]
-        low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
-        high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
-        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
-        #: the episode's engine (:meth:`_make_sim`); the code shared here uses only
-        #: :class:`~physics.engine.FloeEngine`, an environment may use more of its engine
-        self.sim: FloeEngine | None = None
-        self._steps = 0
-        self._last_action = np.zeros(n_act)
-        self._prev = None
-        self._obs = None
-
-    # -- to be provided by subclasses ------------------------------------------------
-    def default_reward_params(self) -> dict:
-        return {}
-
-    def _make_sim(self, rng: np.random.Generator) -> FloeEngine:
-        raise NotImplementedError
-
-    def _ready(self) -> bool:
-        return self.sim is not None
-
-    def _advance(self) -> None:
-        self.sim.advance(self.control_interval)
-
-    # -- gymnasium API ----------------------------------------------------------------
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        self.episode = self._episode_task(options)
-        self.sim = self._make_sim(self.np_random)
-        return self._begin_episode()
-
-    def _vector(self, now: dict) -> np.ndarray:
-        if self.horizon is not None:
-            now = {**now, "time_left": self._time_left()}
-        row = np.array([[float(now[f.name]) for f in self.features]])
-        return observation_vectors(row, self.features, self._last_action[None])[0]
-
-    def _info(self, now: dict) -> dict:
-        return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps,
-                "task": dict(self.episode)}
-
-    # -- frames -----------------------------------------------------------------------
-    def _frame_text(self) -> list[str]:
-        """Lines of text on a frame: time, concentration and the task."""
-        now = self._prev
-        return [f"t = {self.sim.time:.0f} s", f"A = {now['concentration']:.3f}"]
-
-    def _frame_arrow(self):
-        """Arrows on a frame (see :func:`iceenvs.rendering.annotate`)."""
-        return None
-
-
-class HertzEnv(FloeEnv):
+class HertzEnv(ControlEnv):
     """Base of the environments over the Hertz engine
     (:class:`physics.HertzSimulation`): measurement from the engine's
     contacts and Love–Weber stress, frames with force chains.
@@ -655,11 +651,10 @@ class HertzEnv(FloeEnv):
     step must resolve (wind of 20 m/s drives floes at about 0.5 m/s).
     """
 
-    impact_speed = 1.0
     episode_members = ("_contacts",)
-    #: the class its native vector environment derives from (:func:`iceenvs.vector.vector_class`);
-    #: None: :class:`iceenvs.vector.HertzVectorEnv`
-    vector_base = None
+    #: a native vector environment advances its engines in one compiled call; a
+    #: single environment's engine advances on its own (:meth:`advance`)
+    engines_together = True
 
     def _hertz_sim(self, field, box, forcing):
         from physics import HertzSimulation
@@ -684,7 +679,7 @@ class HertzEnv(FloeEnv):
                             self._contacts, st.tensor, area, mobile,
                             cluster_gap=self.cluster_gap)
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         return self._contact_physics()
 
     def _frame(self) -> np.ndarray:

@@ -168,17 +168,17 @@ class ConvergenceEnv(HertzEnv):
     def default_reward_params(self) -> dict:
         return dict(pressure_max=1e4, concentration_scale=0.1, pressure_weight=1.0)
 
-    def _make_sim(self, rng):
+    def make_sim(self, rng):
         p = self.preset
         field, box = p.floe_field(self.n_floes, self.episode["concentration"],
                                   seed=int(rng.integers(2 ** 63)))
         self.box = DeformingPeriodicBox(box.lx, box.ly, concentration_rate=0.0)
         return self._hertz_sim(field, self.box, None)
 
-    def _apply_action(self, action):
+    def apply_action(self, action):
         self.box.set_rate(float(action[0]) * self.episode["max_rate"] / 3600.0)
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         now = self._contact_physics()
         now["target"] = self.episode["target"]
         now["error"] = (now["concentration"] - self.episode["target"]) / 0.1

@@ -6,13 +6,14 @@ import numpy as np
 
 from physics import HERMAN2011, find_clusters
 
-from .base import MAX_WIND, FloeEnv, TaskParameter, interval, number, task_table
+from .base import MAX_WIND, ControlEnv, TaskParameter, interval, number, task_table
 from .controllers import FloeController
 from .facts import EnvFacts
 from .observations import FLOE_FEATURES, Feature, feature_table, floe_physics
+from .vector import vector_class
 from .rewards import floe_clustering_reward
 
-__all__ = ["FloeClusteringEnv", "FloeClusteringController"]
+__all__ = ["FloeClusteringEnv", "FloeClusteringVectorEnv", "FloeClusteringController"]
 
 MAX_EPISODE_STEPS = 400
 
@@ -61,7 +62,7 @@ class FloeClusteringController(FloeController):
         return np.zeros(2)
 
 
-class FloeClusteringEnv(FloeEnv):
+class FloeClusteringEnv(ControlEnv):
     __doc__ = f"""Herd floes with the wind until the largest cluster holds a target
     fraction of the ice, and hold it there.
 
@@ -162,7 +163,7 @@ class FloeClusteringEnv(FloeEnv):
     def default_reward_params(self) -> dict:
         return dict(fraction_scale=0.25)
 
-    def _make_sim(self, rng):
+    def make_sim(self, rng):
         from physics import HardDiskSimulation
 
         p = self.preset
@@ -175,15 +176,15 @@ class FloeClusteringEnv(FloeEnv):
         self._window = (0.0, 0)
         return sim
 
-    def _apply_action(self, action):
+    def apply_action(self, action):
         self.forcing.wind = self.episode["max_wind"] * action
 
-    def _advance(self) -> None:
+    def advance(self) -> None:
         self.sim.reset_stress()
         self._window = (self.sim.time, self.sim.collision_count)
         self.sim.advance(self.control_interval)
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         sim = self.sim
         t0, c0 = self._window
         span = sim.time - t0
@@ -213,3 +214,7 @@ class FloeClusteringEnv(FloeEnv):
         arrow = [(wind / (self.episode["max_wind"] * np.sqrt(2.0)),
                   f"wind {np.hypot(*wind):.1f} m/s")]
         return annotate(picture, legend=CLUSTER_LEGEND[:3], arrow=arrow, text=text)
+
+
+#: N :class:`FloeClusteringEnv`, stepped as one batch (:mod:`iceenvs.vector`)
+FloeClusteringVectorEnv = vector_class(FloeClusteringEnv)

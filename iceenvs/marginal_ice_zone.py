@@ -184,7 +184,7 @@ class MarginalIceZoneEnv(HertzEnv):
     def default_reward_params(self) -> dict:
         return dict(edge_stress_max=500.0, speed_scale=0.05, stress_weight=1.0)
 
-    def _make_sim(self, rng):
+    def make_sim(self, rng):
         p = self.preset
         field, box = p.floe_field(self.n_floes, self.episode["concentration"],
                                   seed=int(rng.integers(2 ** 63)), aspect=0.5,
@@ -200,12 +200,12 @@ class MarginalIceZoneEnv(HertzEnv):
         self.forcing = p.make_forcing(wind=(0.0, 0.0))
         return self._hertz_sim(field, box, self.forcing)
 
-    def _apply_action(self, action):
+    def apply_action(self, action):
         speed = self.episode["max_wind"] * 0.5 * (float(action[0]) + 1.0)
         angle = math.pi * float(action[1])
         self.forcing.wind = (speed * math.cos(angle), speed * math.sin(angle))
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         now = self._contact_physics()
         sim = self.sim
         c = self._contacts

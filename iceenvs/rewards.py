@@ -26,7 +26,7 @@ with −``failure_penalty``, below any sum of penalties a step can carry, so
 that ending early never pays there either. :func:`ship_reward_bounds`
 gives the bounds of one step. Their functions also take columns, dicts of
 arrays with one entry per sub-environment, as the native vector
-environments pass them (:class:`iceenvs.ship_measures.ShipVectorEnv`).
+environments pass them (:class:`iceenvs.step.Episodes`).
 """
 from __future__ import annotations
 

@@ -11,7 +11,7 @@ from physics.domain import Box
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import Feature, feature_table
 from .rewards import ship_beset_reward
-from .ship_env import CONTROLS, FLOE_SIZES, SLOW_TIME, ShipEnv, ship_facts, ship_features
+from .ship_env import CONTROLS, FLOE_SIZES, ShipEnv, ship_facts, ship_features
 from .vector import vector_class
 
 __all__ = ["ShipBesetEnv", "ShipBesetVectorEnv", "MAX_EPISODE_STEPS"]
@@ -201,7 +201,7 @@ class ShipBesetEnv(ShipEnv):
 
     extra_measures = ("pressure_limit", "wall_clearance")
 
-    def _extra_measures(self, envs) -> np.ndarray:
+    def extra_values(self, envs) -> np.ndarray:
         """The episode's pressure limit and the hull's clearance [m] from the
         nearer wall."""
         out = np.empty((len(envs), 2))
@@ -210,11 +210,10 @@ class ShipBesetEnv(ShipEnv):
             out[k] = env.episode["pressure_limit"], min(y.min(), env.width - y.max())
         return out
 
-    def _ended(self, cols, sums, task):
-        # fails: beset for beset_time, or the hull within WALL_MARGIN of a wall
-        succeeded, failed = super()._ended(cols, sums, task)
-        return succeeded, (failed | (sums[:, SLOW_TIME] >= task["beset_time"])
-                           | (cols["wall_clearance"] < WALL_MARGIN))
+    def ends(self, envs, nows, cols, sums, task):
+        # fails also when the hull comes within WALL_MARGIN of a wall
+        succeeded, failed = super().ends(envs, nows, cols, sums, task)
+        return succeeded, failed | (cols["wall_clearance"] < WALL_MARGIN)
 
     def _frame_text(self):
         return super()._frame_text() + [

@@ -19,9 +19,9 @@ Subclasses say what the task is:
 
 * ``_ice(rng)`` — the floe field and the box of an episode, and the forcing;
 * ``_ship_start()`` — where the ship starts (position, heading);
-* ``_ended(cols, sums, task)`` — goal reached and failure, for a batch of
-  environments (a step is one batch, :class:`~iceenvs.ship_measures.ShipBatch`:
-  the single environment is a batch of one);
+* ``ends(envs, nows, cols, sums, task)`` — goal reached and failure, on
+  the columns of a batch of environments (a step is one batch,
+  :class:`iceenvs.step.Episodes`: the single environment is a batch of one);
 * ``controls`` (the action set-ups the task offers) and the reward.
 
 Step loads (``info["physics"]``, for the last step; forces in the ship frame):
@@ -67,13 +67,14 @@ import numpy as np
 from physics import HERMAN2013, ice_fields
 from physics.input_checks import check_range
 
-from .base import HertzEnv, sanitise_action
+from .base import ControlEnv
 from .costmap import costmap_samples, costmap_scan, costmap_shape, costmap_space
 from .facts import EnvFacts
 from .observations import Feature
 from .ship_controllers import ReactiveController, StraightLineController
-from .ship_measures import (METRICS, SUM_COLUMNS, ShipBatch, ShipVectorEnv, as_measurement,
-                            measure_names, measure_ships, metric_values)
+from .ship_measures import (INTEGER_MEASURES, METRICS, SUM_COLUMNS, info_columns,
+                            measure_names, measure_ships, metric_values, update_metrics)
+from .step import as_measurement
 from .ship_sensors import occupancy_image
 
 __all__ = ["ShipEnv", "ship_features", "ship_facts", "FLOE_SIZES", "CONTROLS", "OBS_TYPES",
@@ -117,6 +118,8 @@ CONTROLS = {
 OBS_TYPES = ("vector", "image", "dict", "costmap", "costmap_dict")
 #: the column of the time below the beset speed in a row of episode sums
 SLOW_TIME = SUM_COLUMNS.index("slow_time")
+#: the range of a drawn direction [rad]
+ANGLE = (-math.pi, math.pi)
 
 def ship_facts(*, summary: str, metrics: dict, main_metric: str, small: dict,
                **more) -> EnvFacts:
@@ -184,7 +187,7 @@ def ship_features(sectors: int, lidar_range: float) -> tuple[Feature, ...]:
     return head + lidar + tail
 
 
-class ShipEnv(HertzEnv):
+class ShipEnv(ControlEnv):
     """Base of the ship environments (not registered itself).
 
     Arguments common to the ship environments
@@ -219,23 +222,23 @@ class ShipEnv(HertzEnv):
     """
 
     controls: tuple[str, ...] = tuple(CONTROLS)
-    vector_base = ShipVectorEnv
+    # a batch of ship environments (:class:`iceenvs.step.Episodes`, a single one
+    # included) advances its engines together and measures, rewards and (for a
+    # vector observation) observes on columns (:mod:`iceenvs.ship_measures`)
+    engines_together = True
+    single_together = True
+    measures_in_batch = True
+    rewards_on_columns = True
+    sum_columns = SUM_COLUMNS
+    integer_measures = INTEGER_MEASURES
     #: each episode's field is drawn in the channel (:meth:`_floe_field`)
     own_field = True
     #: the goal line lies ahead along +x; the channel is centred on the box
     start_x = 50.0
-    episode_members = ("forcing", "n_floes", "impact_speed", "_ship", "_damping",
-                       "_hull_length", "_track", "_sums", "_floes_hit", "_field_concentration",
+    episode_members = ("forcing", "n_floes", "impact_speed", "_ship", "damping",
+                       "hull_length", "track", "floes_hit", "field_concentration",
                        "plan_overlay")
-    #: the step as a batch of one, rebuilt from the episode (:meth:`_set_members`)
-    episode_caches = ("_one", "_one_sums", "_begun")
     render_settings = ("_view", "view_behind", "view_ahead")
-
-    def _set_members(self, state: dict) -> None:
-        # the sums in place: a native vector environment's table holds them
-        self._sums[:] = state.pop("_sums")
-        super()._set_members(state)
-        self._begun = False          # the next step begins its batch from the episode
 
     def __init__(self, *, control: str = "yaw", obs_type: str = "vector", image_size: int = 64,
                  image_extent: float = 150.0, lidar_sectors: int = 9,
@@ -289,12 +292,6 @@ class ShipEnv(HertzEnv):
         self.base_features = ship_features(self.lidar_sectors, self.lidar_range)
         #: the raw measurements of a step, in the order of :func:`measure_ships`' columns
         self.measure_names = measure_names(self.lidar_sectors, self.extra_measures)
-        #: the episode's sums and metrics (:data:`~iceenvs.ship_measures.SUM_COLUMNS`);
-        #: a native vector environment makes it a row of its table
-        self._sums = np.zeros(len(SUM_COLUMNS))
-        #: the step as a batch of one (made at the first step)
-        self._one: ShipBatch | None = None
-        self._one_sums = None
         super().__init__(n_floes=None, preset=preset, control_interval=control_interval,
                          colour_scale=colour_scale, **kwargs)
         vector_space = self.observation_space
@@ -309,6 +306,10 @@ class ShipEnv(HertzEnv):
             space = costmap_space(self.costmap_size)
             self.observation_space = space if obs_type == "costmap" else gym.spaces.Dict(
                 {"costmap": space, "vector": vector_space})
+        # the vector observation's features as columns of a measurement (time_left:
+        # filled in by the batch)
+        column = {name: j for j, name in enumerate(self.measure_names)}
+        self.feature_columns = np.array([column.get(f.name, 0) for f in self.features])
 
     # -- geometry -------------------------------------------------------------------
     @property
@@ -337,7 +338,7 @@ class ShipEnv(HertzEnv):
         ship's start removed. Sets the concentration the observation reports
         (of the box or of the strip)."""
         sizes, lognormal = FLOE_SIZES[floe_sizes]
-        field, self._field_concentration = ice_fields.channel_field(
+        field, self.field_concentration = ice_fields.channel_field(
             self.preset, box, rng, concentration=concentration, sizes=sizes,
             lognormal=lognormal, band=band,
             keep=lambda positions, radii: self._clear_of_start(positions, radii, box))
@@ -381,7 +382,7 @@ class ShipEnv(HertzEnv):
     def _start_speed(self) -> float:
         return self.episode["speed"]
 
-    def _make_sim(self, rng):
+    def make_sim(self, rng):
         from physics import HertzSimulation
         from physics.hertz import ship_time_step
 
@@ -390,9 +391,9 @@ class ShipEnv(HertzEnv):
         self._ship = self._make_ship(rng)
         # constants of the ship that every step reads
         h = self._ship.hydrodynamics
-        self._damping = (tuple(float(v) for v in h.linear_damping),
+        self.damping = (tuple(float(v) for v in h.linear_damping),
                          tuple(float(v) for v in h.quadratic_damping))
-        self._hull_length = self._ship.hull.length
+        self.hull_length = self._ship.hull.length
         drift = float(np.max(np.hypot(field.velocities[:, 0], field.velocities[:, 1]))) \
             if field.n else 0.0
         impact, dt = ship_time_step(field, box, self.contact,
@@ -404,16 +405,50 @@ class ShipEnv(HertzEnv):
                               allow_overlap=self.episode["concentration"] > PLACEMENT_LIMIT)
         self.n_floes = field.n
         self.impact_speed = impact
-        self._track = [sim.ship.position]
+        self.track = [sim.ship.position]
         self._sums[:] = 0.0
-        self._sums[[SUM_COLUMNS.index("x"), SUM_COLUMNS.index("y")]] = self._track[0]
-        self._floes_hit = set()
-        self._begun = False
+        self._sums[[SUM_COLUMNS.index("x"), SUM_COLUMNS.index("y")]] = self.track[0]
+        self.floes_hit = set()
         self.plan_overlay = None
         return sim
 
+    # -- wind and current (the tasks with `wind_speed`, `wind_direction`,
+    # `current_speed` and `current_direction` parameters)
+    def _draw_episode(self, task, rng):
+        # a drawn direction is an angle, drawn over the whole circle
+        for name in self.drawn:
+            rng_range = ANGLE if name.endswith("direction") else task[f"{name}_range"]
+            value = float(rng.uniform(*rng_range))
+            if task[name] is None:
+                task[name] = value
+        return task
+
+    def _forcing(self):
+        """The episode's wind and current forcing."""
+        e = self.episode
+
+        def vector(speed, angle):
+            return (speed * math.cos(angle), speed * math.sin(angle))
+
+        return self.preset.make_forcing(wind=vector(e["wind_speed"], e["wind_direction"]),
+                                        current=vector(e["current_speed"],
+                                                       e["current_direction"]))
+
+    def _drifting(self, field, forcing):
+        """``field`` at its free drift under the episode's wind and current
+        (unchanged, at rest, without them)."""
+        from physics import FloeField
+        from physics.forcing import steady_drift
+
+        e = self.episode
+        if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
+            u = steady_drift(forcing, field.radii, field.thickness, field.masses)
+            field = FloeField(field.positions, field.radii, field.thickness, u,
+                              density=field.density)
+        return field
+
     # -- actions ---------------------------------------------------------------------
-    def _apply_action(self, action):
+    def apply_action(self, action):
         ship = self.sim.ship
         if self.control == "yaw":
             ship.command(surge=self.episode["speed"],
@@ -451,31 +486,41 @@ class ShipEnv(HertzEnv):
     #: the environment's own measurements, after those of every ship environment
     extra_measures: tuple[str, ...] = ()
 
-    def _extra_measures(self, envs) -> np.ndarray:
+    def extra_values(self, envs) -> np.ndarray:
         """(M, len(extra_measures)) values of :attr:`extra_measures` for the
         environments ``envs`` of this class (a measurement's last columns)."""
         return np.zeros((len(envs), 0))
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         # the first measurement of an episode; a step measures in its batch
         raw = measure_ships([self], self._sums[None, :], advanced=False)
-        return as_measurement(self.measure_names, raw[0])
+        return as_measurement(self.measure_names, raw[0], INTEGER_MEASURES)
 
-    def step(self, action):
-        """One step: the step of a native vector environment's
-        sub-environments (:class:`~iceenvs.ship_measures.ShipBatch`), for a
-        batch of one."""
-        if not self._ready():
-            raise RuntimeError("call reset() before step()")
-        a, replaced = sanitise_action(action, self.action_space)
-        if self._one is None or self._one_sums is not self._sums:
-            self._one, self._one_sums = ShipBatch([self], self._sums[None, :], single=True), self._sums
-        if not self._begun:
-            self._one.begin()
-            self._begun = True
-        obs, reward, terminated, info = self._one.step(a[None], np.array([replaced]))
-        obs = {key: value[0] for key, value in obs.items()} if isinstance(obs, dict) else obs[0]
-        return obs, float(reward[0]), bool(terminated[0]), False, info
+    def measure_batch(self, envs, sums: np.ndarray, lists=None) -> np.ndarray:
+        """The measurements after a step of ``envs`` (of this class and
+        configuration), a row each (:func:`~iceenvs.ship_measures.measure_ships`;
+        ``sums``: their rows of episode sums, updated in place)."""
+        return measure_ships(envs, sums, advanced=True, lists=lists)
+
+    def update_sums(self, sums: np.ndarray, cols: dict) -> None:
+        """The episode metrics of ``sums`` after a step measured ``cols``."""
+        update_metrics(sums, cols, self.goal_distance)
+
+    def info_columns(self, raw, sums, steps, task) -> dict:
+        """The info of a batch's step, on columns
+        (:func:`~iceenvs.ship_measures.info_columns`)."""
+        return info_columns(self.measure_names, raw, sums, steps, task)
+
+    @property
+    def observes_on_columns(self) -> bool:
+        """A vector observation is made on columns over a batch."""
+        return self.obs_type == "vector"
+
+    @property
+    def _sums(self) -> np.ndarray:
+        """The episode's sums and metrics (:data:`~iceenvs.ship_measures.SUM_COLUMNS`):
+        its row of the batch's ``sums``."""
+        return self.episodes.sums[self.row]
 
     @property
     def slow_time(self) -> float:
@@ -484,17 +529,17 @@ class ShipEnv(HertzEnv):
         return float(self._sums[SUM_COLUMNS.index("slow_time")])
 
     # -- observation, info, end --------------------------------------------------------
-    def _vector(self, now: dict):
+    def observe(self, now: dict):
         if self.obs_type == "vector":
-            return super()._vector(now)
+            return super().observe(now)
         if self.obs_type == "costmap":
             return self.costmap()
         if self.obs_type == "costmap_dict":
-            return {"costmap": self.costmap(), "vector": super()._vector(now)}
+            return {"costmap": self.costmap(), "vector": super().observe(now)}
         image = self._image()
         if self.obs_type == "image":
             return image
-        return {"vector": super()._vector(now), "image": image}
+        return {"vector": super().observe(now), "image": image}
 
     def _image(self) -> np.ndarray:
         sim = self.sim
@@ -527,21 +572,30 @@ class ShipEnv(HertzEnv):
         """The episode metrics so far (:data:`METRICS`)."""
         return metric_values(self._sums)
 
-    def _info(self, now: dict) -> dict:
+    def make_info(self, now: dict) -> dict:
         # the metrics as the step (its batch) left them
-        info = super()._info(now)
+        info = super().make_info(now)
         info.update(self._metrics)
         return info
 
-    def _ended(self, cols: dict, sums: np.ndarray, task: dict) -> tuple:
-        """(succeeded, failed), boolean arrays, of a batch of environments of
-        this class and configuration: ``cols`` the columns of their
+    def ends(self, envs, nows, cols: dict, sums: np.ndarray, task: dict) -> tuple:
+        """(succeeded, failed), boolean arrays, of a batch of environments
+        ``envs`` of this class and configuration: ``cols`` the columns of their
         measurements (name → array), ``sums`` their rows of episode sums
         (:data:`SUM_COLUMNS`), ``task`` the columns of their episodes'
-        tasks. Every ship task succeeds when its ship reaches the goal line;
-        a task adds its own failures."""
+        tasks. Every ship task succeeds when its ship reaches the goal line.
+        It fails when a dynamic ship stays below `beset_speed` for
+        `beset_time` (a task with that parameter), and when the ship leaves
+        the channel with `channel_exit="terminate"` (a task with that
+        parameter); a task adds its own failures."""
         succeeded = cols["reached"] > 0
-        return succeeded, np.zeros_like(succeeded)
+        failed = np.zeros_like(succeeded)
+        if self.mode == "dynamic" and "beset_time" in task:
+            failed |= sums[:, SLOW_TIME] >= task["beset_time"]
+        if "channel_exit" in task:
+            failed |= ((task["channel_exit"] == "terminate")
+                       & (np.abs(cols["channel_offset"]) > 1.0))
+        return succeeded, failed
 
     @property
     def ship(self):
@@ -566,8 +620,8 @@ class ShipEnv(HertzEnv):
 
         return ship_reward_bounds(self.reward_params)
 
-    def _reward_kwargs(self) -> dict:
-        kwargs = super()._reward_kwargs()
+    def reward_kwargs(self) -> dict:
+        kwargs = super().reward_kwargs()
         kwargs["step_length"] = self.max_speed * self.control_interval
         return kwargs
 
@@ -694,7 +748,7 @@ class ShipEnv(HertzEnv):
         picture = draw_view(box, sim.positions, sim.radii, (lx, ly), periodic=sim.box.periodic,
                             floe_colours=colours, contact_i=c.i, contact_j=c.j,
                             contact_force=c.normal_force, hull_vertices=sim.ship.vertices,
-                            track=np.array(self._track), goal_x=self.goal_x, channel=channel,
+                            track=np.array(self.track), goal_x=self.goal_x, channel=channel,
                             route=self.plan_overlay, leads=leads,
                             ice_band=getattr(sim.box, "band", None), title=title)
         if leads:
@@ -725,7 +779,7 @@ class ShipEnv(HertzEnv):
                              contact_i=c.i, contact_j=c.j, contact_force=c.normal_force,
                              speed_scale=self.colour_scale)
         y0 = self.centre_y - 0.5 * self.channel_width
-        picture = draw_ship(picture, box, sim.ship.vertices, np.array(self._track),
+        picture = draw_ship(picture, box, sim.ship.vertices, np.array(self.track),
                             goal_x=self.goal_x, channel=(y0, y0 + self.channel_width),
                             route=self.plan_overlay)
         return annotate(picture, colour_bar=(self.colour_label, 0.0, self.colour_scale),

@@ -18,22 +18,20 @@ call (:func:`measure_many`, parallel over the environments), the loads and
 sums in numpy over the environments. The result is one matrix, a row per
 environment and a column per raw measurement (:func:`measure_names`). A
 single environment is a list of one; the native vector environment
-(:class:`ShipVectorEnv`) passes its sub-environments, so a sub-environment and
+(:mod:`iceenvs.vector`) passes its sub-environments, so a sub-environment and
 the single environment seeded alike compute the same numbers with the same
 code. Per environment, Python only collects references to its engine's
 arrays and calls the compiled local-ice measure.
 
-Each environment keeps its episode's sums in one row of floats (columns
-:data:`SUM_COLUMNS`): its own array, or a row of the vector environment's
-table, so that the vector environment updates them all at once.
+Each environment's episode sums are one row of floats (columns
+:data:`SUM_COLUMNS`) of its batch of episodes (:class:`iceenvs.step.Episodes`),
+so that a batch updates them all at once.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from gymnasium.vector import VectorEnv
-from gymnasium.vector.utils import create_empty_array
 from numba import njit, prange, types
 from numba.typed import List
 
@@ -41,15 +39,11 @@ from physics.hertz import KernelLists
 from physics.hertz_batch import ICE_NEAR, ice_near_many
 from physics.hull_contact import LOG_COLUMNS, RECORD_COLUMNS
 
-from .base import PHYSICS_ERRORS
-from .observations import observation_vectors
 from .ship_sensors import LIDAR_SETTING, SCAN_BOX, box_entries, lidar_scan
-from .vector import HertzVectorEnv, batch_infos, drive, put_row, set_row
 
 __all__ = ["POSE", "LOADS", "LOCAL", "SUM_COLUMNS", "METRICS", "INTEGER_MEASURES",
            "SHIP_COLUMNS", "SCENE", "measure_names", "measure_ships", "measure_many", "step_sums",
-           "update_metrics", "metric_values", "metric_columns", "as_measurement", "ShipBatch",
-           "ShipVectorEnv"]
+           "update_metrics", "metric_values", "metric_columns", "info_columns"]
 
 #: the pose entries of a measurement (ship frame; the goal lies along +x)
 POSE = ("goal_distance", "goal_cos", "goal_sin", "channel_offset", "surge", "sway", "yaw_rate")
@@ -343,14 +337,14 @@ def measure_ships(envs, table: np.ndarray, *, advanced: bool,
     if advanced:
         for m, env in enumerate(envs):
             if env.render_mode is not None and rows[m].shape[0]:   # the path on the frames
-                env._track.append(table[m, [_SUM_X, _SUM_Y]].copy())
+                env.track.append(table[m, [_SUM_X, _SUM_Y]].copy())
         _add_collisions(envs, table, loads, logs)
     _local_ice(envs, sims, motion, lists, raw[:, loc:loc + len(LOCAL)])
     raw[:, loc + 5] = motion[:, 0] >= e0.goal_x
     if not advanced:
         table[:, _SUM_ICE_START] = raw[:, loc + 6]
     if e0.extra_measures:
-        raw[:, loc + len(LOCAL):] = e0._extra_measures(envs)
+        raw[:, loc + len(LOCAL):] = e0.extra_values(envs)
     return raw
 
 
@@ -368,10 +362,10 @@ def _local_ice(envs, sims, motion, lists, out) -> None:
                       float(box.ly), box.periodic[0], box.periodic[1], near)
     else:
         for m, sim in enumerate(sims):
-            near[m] = sim._ice_near((motion[m, 0], motion[m, 1]), e0.local_radius)
+            near[m] = sim.ice_near_row((motion[m, 0], motion[m, 1]), e0.local_radius)
     n_floes, r2, n_contacts, sxx, syy = (near[:, j] for j in (0, 1, 2, 3, 6))
     area = math.pi * float(e0.local_radius) ** 2
-    out[:, 0] = [env._field_concentration for env in envs]
+    out[:, 0] = [env.field_concentration for env in envs]
     out[:, 1] = np.minimum(1.0, math.pi * r2 / area)
     out[:, 2] = np.divide(2.0 * n_contacts, n_floes, out=np.zeros(len(sims)), where=n_floes > 0)
     out[:, 3] = np.where(n_contacts > 0, 0.5 * (-sxx / area + -syy / area), 0.0)
@@ -386,11 +380,11 @@ def _ship_rows(envs, sims, ships, commanded: bool) -> np.ndarray:
     out = np.zeros((len(envs), len(SHIP_COLUMNS)))
     for row, env, sim, ship in zip(out, envs, sims, ships):
         row[:6] = ship.motion
-        linear, quadratic = env._damping
+        linear, quadratic = env.damping
         row[_LINEAR:_LINEAR + 3] = linear
         row[_QUADRATIC:_QUADRATIC + 3] = quadratic
         row[_DT] = sim.dt
-        row[_HULL_LENGTH] = env._hull_length
+        row[_HULL_LENGTH] = env.hull_length
         if commanded:
             c = ship.commands
             row[_THRUST] = c["thrust"]
@@ -415,7 +409,7 @@ def _add_collisions(envs, table, loads, logs):
     np.maximum.at(top, owner, impulses)
     table[:, _SUM_IMPULSE_MAX] = top
     for k in np.flatnonzero(counts):
-        hit = envs[k]._floes_hit
+        hit = envs[k].floes_hit
         mine = log[owner == k]
         for floe, mass in zip(mine[:, _FLOE].astype(np.int64).tolist(),
                               mine[:, _FLOE_MASS].tolist()):
@@ -491,241 +485,15 @@ def metric_columns(table: np.ndarray) -> dict:
     return out
 
 
-def as_measurement(names, row: np.ndarray) -> dict:
-    """One row of :func:`measure_ships` as a measurement dict (counts as
-    ints)."""
-    now = dict(zip(names, row.tolist()))
+def info_columns(names, raw: np.ndarray, sums: np.ndarray, steps: np.ndarray,
+                 task: dict) -> dict:
+    """What the info of each of a batch of ship environments holds after a
+    step, as columns: ``physics`` (the measurements ``raw``, a row each, of
+    the columns ``names``), ``time``, ``steps``, ``task`` (its columns) and
+    the episode metrics of ``sums``."""
+    physics = {name: raw[:, j].copy() for j, name in enumerate(names)}
     for name in INTEGER_MEASURES:
-        now[name] = int(now[name])
-    return now
-
-
-class ShipBatch:
-    """The step of a list of ship environments (of one class and
-    configuration) as one batch: what a ship environment's step does,
-    written once, for the native vector environment's sub-environments
-    (:class:`ShipVectorEnv`) and for the single environment, a batch of one
-    (:meth:`iceenvs.ship_env.ShipEnv.step`).
-
-    A step (:meth:`step`): the actions are applied and the engines advance
-    together (:func:`iceenvs.vector.drive`); :func:`measure_ships` measures
-    every environment at once; the rewards (a built-in reward is evaluated
-    on columns), the ends of the episodes (the environment class's
-    ``_ended``, on columns), the observations (one
-    :func:`~iceenvs.observations.observation_vectors` call), the episode
-    metrics (:func:`update_metrics` on the table of sums) and the info
-    (columns) are made as arrays over the environments. Only an image
-    observation and a reward function of one's own run per environment.
-
-    Parameters
-    ----------
-    envs : list of ShipEnv
-        The environments; each keeps its episode's sums in its row of
-        ``table``.
-    table : ndarray
-        (len(envs), len(:data:`SUM_COLUMNS`)) episode sums, updated in place.
-    lists : KernelLists, optional
-        The typed lists of the engines' compiled calls, kept from step to
-        step (:class:`physics.hertz.KernelLists`).
-    single : bool
-        The batch of a single environment (not a vector environment of
-        one): its step returns the environment's own info dict.
-    """
-
-    def __init__(self, envs, table: np.ndarray, lists: KernelLists | None = None,
-                 single: bool = False):
-        self.envs = list(envs)
-        self.num_envs = len(self.envs)
-        if single and self.num_envs != 1:
-            raise ValueError(f"a single environment's batch holds one environment, "
-                             f"not {self.num_envs}")
-        self._single = single
-        self.table = table
-        self.lists = KernelLists() if lists is None else lists
-        e0 = self.envs[0]
-        self.single_observation_space = e0.observation_space
-        self._names = e0.measure_names
-        self._column = {name: j for j, name in enumerate(self._names)}
-        # the observation's features as columns of a measurement (time_left: computed)
-        self._feature_index = np.array([self._column.get(f.name, 0) for f in e0.features])
-        self._time_left = [j for j, f in enumerate(e0.features) if f.name not in self._column]
-        self._prev_raw = np.zeros((self.num_envs, len(self._names)))
-        self._reward_kw: dict[str, np.ndarray] = {}
-        self._task: dict = {}
-        self._task_keys: list[str] = []
-        self._batch_reward = all(env.reward_fn is type(env).reward_fn for env in self.envs)
-
-    @property
-    def one(self) -> bool:
-        """The batch of a single environment, whose info is its own dict
-        (the row a vector info would hold for it); a vector environment of
-        N = 1 gets a vector info, as at any N."""
-        return self._single
-
-    #: Gymnasium's builder of a vector info, which needs only ``num_envs``
-    _add_info = VectorEnv._add_info
-
-    def begin(self) -> None:
-        """After every environment began an episode (``reset``)."""
-        self._task = batch_infos([dict(env.episode) for env in self.envs])
-        self._task_keys = [key for key in self._task if not key.startswith("_")]
-        for k in range(self.num_envs):
-            self.begin_row(k)
-
-    def begin_row(self, k: int) -> None:
-        """After environment k began a new episode."""
-        env = self.envs[k]
-        self._prev_raw[k] = [env._prev[name] for name in self._names]
-        for key, value in env._reward_kwargs().items():
-            self._reward_kw.setdefault(key, np.zeros(self.num_envs))[k] = value
-        if self._task:
-            self._task = set_row(self, self._task, dict(env.episode), k)
-
-    def step(self, actions: np.ndarray, replaced: np.ndarray) -> tuple:
-        """One step of every environment with its sanitised action
-        ``actions[k]`` (``replaced[k]``: its entries that were not finite):
-        (observations, rewards, terminated, info), batched."""
-        return self.results(actions, replaced, drive(self.envs, actions, self.lists))
-
-    def results(self, actions, replaced, errors) -> tuple:
-        """(observations, rewards, terminated, info) of a step whose engines
-        ran (``errors[k]``: the physics failure of environment k, or None).
-        The info is a vector info (a dict of columns, each with its mask),
-        or for a batch of :attr:`one` the environment's info dict."""
-        n = self.num_envs
-        ok = np.array([k for k in range(n) if errors[k] is None], dtype=np.int64)
-        obs = create_empty_array(self.single_observation_space, n)
-        rewards = np.zeros(n)
-        terminated = np.zeros(n, dtype=bool)
-        infos: dict = {}
-        if ok.size:
-            table = self.table if ok.size == n else self.table[ok]
-            group = self.envs if ok.size == n else [self.envs[k] for k in ok]
-            try:
-                raw = measure_ships(group, table, advanced=True, lists=self.lists)
-            except PHYSICS_ERRORS as err:          # every measured one fails with it
-                for k in ok:
-                    errors[k] = err
-                ok = ok[:0]
-            else:
-                infos = self._measured(group, ok, raw, table, actions, replaced, obs, rewards,
-                                       terminated)
-                if ok.size < n:
-                    self.table[ok] = table
-        for k in range(n):
-            if errors[k] is not None:
-                o, rewards[k], terminated[k], _, info = self.envs[k]._failed_step(
-                    errors[k], int(replaced[k]))
-                put_row(obs, k, o)
-                infos = info if self.one else set_row(self, infos, info, k)
-        return obs, rewards, terminated, infos
-
-    def _measured(self, group, ok, raw, table, actions, replaced, obs, rewards, terminated):
-        """Rewards, ends, observations and the info of the environments
-        ``ok`` (``group``) measured ``raw``; fills their rows of ``obs``,
-        ``rewards`` and ``terminated`` and returns the info."""
-        e0 = group[0]
-        n = self.num_envs
-        full = ok.size == n
-        names = self._names
-        cols = dict(zip(names, raw.T))
-        prev_raw = self._prev_raw if full else self._prev_raw[ok]
-        task = {key: self._task[key] if full else self._task[key][ok] for key in self._task_keys}
-        nows = [as_measurement(names, row) for row in raw]
-        if self._batch_reward and not self.one:      # on columns
-            kw = self._reward_kw if full else {key: value[ok]
-                                               for key, value in self._reward_kw.items()}
-            prev = dict(zip(names, prev_raw.T))
-            reward = np.asarray(e0.reward_fn(prev, actions[ok], cols, **kw), dtype=float)
-            reward = np.broadcast_to(reward, ok.shape).copy()
-        else:                                # per environment, on its measurement
-            reward = np.array([env._reward(actions[k], now)
-                               for env, k, now in zip(group, ok, nows)])
-        bad = ~np.isfinite(reward)
-        succeeded, failed = e0._ended(cols, table, task)
-        failed = failed | bad
-        rewards[ok] = np.where(failed, e0.failure_reward, reward)
-        terminated[ok] = succeeded | failed
-        update_metrics(table, cols, e0.goal_distance)
-        self._prev_raw[ok] = raw
-        # observations
-        if e0.obs_type == "vector":
-            features = raw[:, self._feature_index]
-            for j in self._time_left:
-                features[:, j] = [env._time_left() for env in group]
-            vectors = observation_vectors(features, e0.features, actions[ok])
-            obs[ok] = vectors
-            for env, now, vector in zip(group, nows, vectors):
-                env._prev = now
-                env._obs = vector
-        else:
-            for env, k, now in zip(group, ok, nows):
-                env._prev = now
-                env._obs = env._vector(now)
-                put_row(obs, k, env._obs)
-        for env in group:
-            if env.render_mode == "human":
-                env.render()
-        if self.one:                         # a single environment: its info dict
-            info = e0._info(nows[0])
-            info["nonfinite_action"] = int(replaced[0])
-            if bad[0]:
-                info["error"] = f"non-finite reward {reward[0]}"
-            return info
-        # info: what each environment's info holds, as columns
-        physics = {name: raw[:, j].copy() for j, name in enumerate(self._names)}
-        for name in INTEGER_MEASURES:
-            physics[name] = physics[name].astype(np.int64)
-        metrics = metric_columns(table)
-        columns = {"physics": physics, "time": metrics["time"],
-                   "steps": np.array([env._steps for env in group]),
-                   "task": {key: value.copy() for key, value in task.items()}, **metrics,
-                   "nonfinite_action": replaced[ok]}
-        infos = _spread(columns, ok, n)
-        for i in np.flatnonzero(bad):
-            infos = self._add_info(infos, {"error": f"non-finite reward {reward[i]}"}, ok[i])
-        return infos
-
-
-class ShipVectorEnv(HertzVectorEnv):
-    """The native vector environment of a ship environment
-    (:class:`~iceenvs.vector.HertzVectorEnv` whose sub-environments step as
-    one :class:`ShipBatch`, the step the single environment takes as a
-    batch of one)."""
-
-    def __init__(self, num_envs: int = 1, **kwargs):
-        super().__init__(num_envs, **kwargs)
-        self._table = np.zeros((self.num_envs, len(SUM_COLUMNS)))
-        for k, env in enumerate(self.envs):
-            env._sums = self._table[k]
-        self._ship_batch = ShipBatch(self.envs, self._table, self._lists)
-
-    def reset(self, *, seed=None, options=None):
-        obs, info = super().reset(seed=seed, options=options)
-        self._ship_batch.begin()
-        return obs, info
-
-    def _reset_row(self, k: int) -> None:
-        self._ship_batch.begin_row(k)
-
-    def _results(self, actions, replaced, errors) -> tuple:
-        return self._ship_batch.results(actions, replaced, errors)
-
-
-def _spread(columns: dict, rows: np.ndarray, n: int) -> dict:
-    """A vector info of ``n`` sub-environments from the ``columns`` of the
-    sub-environments ``rows`` (each key with its mask ``_key``)."""
-    out = {}
-    full = rows.size == n
-    mask = np.zeros(n, dtype=bool)
-    mask[rows] = True
-    for key, value in columns.items():
-        if isinstance(value, dict):
-            array = _spread(value, rows, n)
-        elif full:
-            array = value
-        else:
-            array = np.zeros((n,) + value.shape[1:], dtype=value.dtype)
-            array[rows] = value
-        out[key], out["_" + key] = array, mask.copy()
-    return out
+        physics[name] = physics[name].astype(np.int64)
+    metrics = metric_columns(sums)
+    return {"physics": physics, "time": metrics["time"], "steps": np.asarray(steps),
+            "task": {key: value.copy() for key, value in task.items()}, **metrics}

@@ -4,24 +4,20 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 
-from physics import HERMAN2013, FloeField
+from physics import HERMAN2013
 from physics.domain import Box
-from physics.forcing import steady_drift
 
 from .base import TaskParameter, choice, interval, number, task_table
 from .observations import feature_table
 from .rewards import ship_navigation_reward
-from .ship_env import (CONTROLS, FLOE_SIZES, ICE_LOADS, SLOW_TIME, ShipEnv, ship_facts,
-                       ship_features)
+from .ship_env import CONTROLS, FLOE_SIZES, ICE_LOADS, ShipEnv, ship_facts, ship_features
 from .vector import vector_class
 
-__all__ = ["ShipNavigationEnv", "ShipNavigationVectorEnv", "MAX_EPISODE_STEPS"]
+__all__ = ["ShipNavigationEnv", "ShipNavigationVectorEnv", "MAX_EPISODE_STEPS",
+           "NAVIGATION_REWARD"]
 
 MAX_EPISODE_STEPS = 300
-
-_ANGLE = (-math.pi, math.pi)
 
 _TASK = (
     TaskParameter("concentration", None, "ice concentration; None: drawn uniformly from "
@@ -70,6 +66,10 @@ _TASK = (
                   "`exit_weight` every step outside) or \"terminate\" (the episode fails)",
                   choice("penalty", "terminate")),
 )
+
+#: the reward weights of ShipNavigation-v0 (:func:`iceenvs.rewards.ship_navigation_reward`)
+NAVIGATION_REWARD = dict(impulse_weight=1.0, impulse_scale=1.0e6, time_weight=0.05,
+                         exit_weight=1.0, goal_bonus=10.0, failure_penalty=10.0)
 
 _FEATURES = ship_features(9, 150.0)
 #: entries of the default vector observation: the features, then the last action
@@ -214,27 +214,7 @@ class ShipNavigationEnv(ShipEnv):
         super().__init__(preset=preset, control_interval=control_interval, **kwargs)
 
     def default_reward_params(self) -> dict:
-        return dict(impulse_weight=1.0, impulse_scale=1.0e6, time_weight=0.05,
-                    exit_weight=1.0, goal_bonus=10.0, failure_penalty=10.0)
-
-    def _draw_episode(self, task, rng):
-        for name in self.drawn:
-            rng_range = _ANGLE if name.endswith("direction") else task[f"{name}_range"]
-            value = float(rng.uniform(*rng_range))
-            if task[name] is None:
-                task[name] = value
-        return task
-
-    def _forcing(self):
-        """The episode's wind and current forcing."""
-        e = self.episode
-
-        def vector(speed, angle):
-            return (speed * math.cos(angle), speed * math.sin(angle))
-
-        return self.preset.make_forcing(wind=vector(e["wind_speed"], e["wind_direction"]),
-                                        current=vector(e["current_speed"],
-                                                       e["current_direction"]))
+        return dict(NAVIGATION_REWARD)
 
     def _ice(self, rng):
         e = self.episode
@@ -243,25 +223,6 @@ class ShipNavigationEnv(ShipEnv):
         field = self._floe_field(box, rng, concentration=e["concentration"],
                                  floe_sizes=e["floe_sizes"])
         return self._drifting(field, forcing), box, forcing
-
-    def _drifting(self, field, forcing):
-        """``field`` at its free drift under the episode's wind and current
-        (unchanged, at rest, without them)."""
-        e = self.episode
-        if e["wind_speed"] > 0.0 or e["current_speed"] > 0.0:
-            u = steady_drift(forcing, field.radii, field.thickness, field.masses)
-            field = FloeField(field.positions, field.radii, field.thickness, u,
-                              density=field.density)
-        return field
-
-    def _ended(self, cols, sums, task):
-        # fails: a dynamic ship beset for beset_time, or out of the channel
-        # when leaving it terminates
-        succeeded, failed = super()._ended(cols, sums, task)
-        if self.mode == "dynamic":
-            failed |= sums[:, SLOW_TIME] >= task["beset_time"]
-        failed |= (task["channel_exit"] == "terminate") & (np.abs(cols["channel_offset"]) > 1.0)
-        return succeeded, failed
 
 
 #: N :class:`ShipNavigationEnv` whose engines advance together (:mod:`iceenvs.vector`)

@@ -13,11 +13,12 @@ from physics.ice_fields import AUTO_ICENAV_SIZES, Lead, TransitBox, navigation_f
 
 from .base import TaskParameter, choice, interval, number, revised_task, task_table
 from .observations import Feature, feature_table
+from .rewards import ship_navigation_reward
 from .ship_controllers import SwathController
-from .ship_env import CONTROLS, ICE_LOADS, ship_features
+from .ship_env import CONTROLS, ICE_LOADS, ShipEnv, ship_features
 from .ship_sensors import (channel_room, check_bands, course_with_room, scan_box, swath_courses,
                             swath_scan)
-from .ship_navigation import ShipNavigationEnv
+from .ship_navigation import NAVIGATION_REWARD, ShipNavigationEnv
 from .vector import vector_class
 
 __all__ = ["ShipNavigationV1Env", "ShipNavigationV1VectorEnv", "MAX_EPISODE_STEPS",
@@ -120,7 +121,7 @@ _TASK = revised_task(ShipNavigationEnv.task_parameters, _CHANGED, _DEFAULTS, add
 ))
 
 
-class ShipNavigationV1Env(ShipNavigationEnv):
+class ShipNavigationV1Env(ShipEnv):
     __doc__ = f"""Cross a kilometre of pack ice, floes and gaps as in AUTO-IceNav's ice
     fields, with as little ice impact as possible.
 
@@ -264,6 +265,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
 
     task_parameters = _TASK
     drawn = ShipNavigationEnv.drawn + ("gradient",)
+    reward_fn = staticmethod(ship_navigation_reward)
     facts = replace(ShipNavigationEnv.facts,
                     summary="cross a kilometre of pack ice (AUTO-IceNav's fields)",
                     small={"concentration": 0.2, "length": 450.0, "goal_distance": 300.0},
@@ -314,11 +316,11 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         offset = float(self.sim.ship.position[1]) - self.centre_y
         return course_with_room(course, offset, 0.5 * self.channel_width, g)
 
-    def _apply_action(self, action):
+    def apply_action(self, action):
         if self.control == "course" and self.episode["course_guard"] is not None:
             turn = self.episode["max_course"]
             action = np.array([self.guarded_course(float(action[0]) * turn) / turn])
-        super()._apply_action(action)
+        super().apply_action(action)
 
     def _thickness_classes(self):
         """The episode's thickness classes [m]: the thin ice, and the thick
@@ -330,10 +332,10 @@ class ShipNavigationV1Env(ShipNavigationEnv):
         return (e["ice_thickness"],)
 
     def default_reward_params(self) -> dict:
-        return dict(super().default_reward_params(), impulse_scale=2.5e5, impulse_cap=10.0,
+        return dict(NAVIGATION_REWARD, impulse_scale=2.5e5, impulse_cap=10.0,
                     time_weight=0.2)
 
-    def _extra_measures(self, envs) -> np.ndarray:
+    def extra_values(self, envs) -> np.ndarray:
         """The swath sensor of each of ``envs``: (M, bands × rays), then with
         :attr:`swath_edge` each course's room in the channel (M, rays)."""
         out = np.empty((len(envs), len(self.extra_measures)))
@@ -376,8 +378,8 @@ class ShipNavigationV1Env(ShipNavigationEnv):
             return field
         return replace(field, radii=np.minimum(field.radii, limit))
 
-    def _make_sim(self, rng):
-        sim = super()._make_sim(rng)
+    def make_sim(self, rng):
+        sim = super().make_sim(rng)
         self._swath_weights = self.expected_impulses(sim.masses)
         return sim
 
@@ -418,7 +420,7 @@ class ShipNavigationV1Env(ShipNavigationEnv):
                 # leads whose open water the concentration cannot spare are drawn again
                 if not self.leads or attempt == LEAD_DRAWS - 1:
                     raise
-        self._field_concentration = covered
+        self.field_concentration = covered
         field = field.take(self._clear_of_start(field.positions, field.radii, box).nonzero()[0])
         field = self._fitting(field, box)
         field = self._drifting(field, forcing)

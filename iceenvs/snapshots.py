@@ -7,8 +7,9 @@ What a snapshot holds is what an episode changes: each environment class
 lists its per-episode members (``episode_members``, gathered over its
 classes by :func:`episode_attributes`): the engine (its floes, contact
 history, neighbour lists, ship, box and time), the episode's drawn task,
-step counter, last measurement and observation, the episode sums of the
-ship tasks, and the environment's random generator. They are copied
+step counter, last measurement and observation and the episode sums of the
+ship tasks (the environment's row of its batch of episodes,
+:class:`iceenvs.step.Episodes`), and the environment's random generator. They are copied
 together in one deep copy, so the objects they share stay shared, and a
 later step changes nothing in the snapshot; ``restore`` copies them again,
 so one snapshot can be restored any number of times.
@@ -33,7 +34,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Snapshot", "episode_attributes", "take_snapshot", "restore_snapshot"]
+__all__ = ["Snapshot", "episode_attributes", "take_snapshot", "restore_snapshot", "ROW"]
+
+#: the key of a snapshot's state that holds the environment's row of its batch
+#: of episodes (:meth:`iceenvs.step.Episodes.row_state`)
+ROW = "episode_row"
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,9 +121,10 @@ def take_snapshot(env) -> Snapshot:
     :meth:`iceenvs.base.ControlEnv.snapshot`)."""
     members, caches, render = episode_attributes(type(env))
     values = {name: env.__dict__[name] for name in members if name in env.__dict__}
+    values[ROW] = env.episodes.row_state(env.row)
     state = copy.deepcopy(values, _shared(env, members, caches))
     return Snapshot(type(env), _configuration(env, set(members) | set(caches) | set(render)),
-                    MappingProxyType(state), int(env.__dict__.get("_steps", 0)))
+                    MappingProxyType(state), int(state[ROW]["steps"]))
 
 
 def restore_snapshot(env, snapshot) -> dict:

@@ -13,11 +13,14 @@ from physics.itd import YEAR_DAYS, ThorndikeModel, make_kernel
 from physics.params import GODLOVITCH
 
 from .base import ControlEnv, TaskParameter
+from .step import Episodes
 from .controllers import Controller
 from .facts import EnvFacts
+from .vector import vector_class
 from .rewards import closeness, thickness_distribution_reward, wasserstein1
 
-__all__ = ["ThicknessDistributionEnv", "ThicknessDistributionController", "default_target",
+__all__ = ["ThicknessDistributionEnv", "ThicknessDistributionVectorEnv",
+           "ThicknessDistributionController", "default_target",
            "RAFT_MAX", "RAFT_CUTOFF", "COARSE_WIDTH", "N_COARSE", "MEAN_SCALE"]
 
 RAFT_MAX = 2.0 * GODLOVITCH.raft_factor   # rafting factor at action[1] = +1 (1 at −1)
@@ -360,10 +363,7 @@ class ThicknessDistributionEnv(ControlEnv):
         self._vec = np.zeros(n_obs)                     # work buffer of the observation
 
         self.model: ThorndikeModel | None = None
-        self._steps = 0
-        self._last_action = np.zeros(2)
-        self._prev = None
-        self._obs = None
+        Episodes([self], single=True)
 
     # -- helpers ----------------------------------------------------------------------
     @property
@@ -383,14 +383,14 @@ class ThicknessDistributionEnv(ControlEnv):
         """Fine fractions summed into open water and the coarse classes."""
         return np.bincount(self._coarse_idx, weights=g, minlength=N_COARSE + 1)
 
-    def _apply_action(self, a: np.ndarray) -> None:
+    def apply_action(self, a: np.ndarray) -> None:
         m = self.model
         m.kernel_scale = 10.0 ** float(a[0])
         factor = 1.0 + (RAFT_MAX - 1.0) * (float(a[1]) + 1.0) * 0.5
         if factor != m.rafting_factor:                  # rebuilding K costs O(n²)
             m.set_rafting(factor, RAFT_CUTOFF)
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         m = self.model
         g = m.g
         if not np.all(np.isfinite(g)):
@@ -400,7 +400,7 @@ class ThicknessDistributionEnv(ControlEnv):
                 "kernel_scale": float(m.kernel_scale), "rafting_factor": float(m.rafting_factor),
                 "w1": wasserstein1(g, self.target, self._h)}
 
-    def _vector(self, now: dict) -> np.ndarray:
+    def observe(self, now: dict) -> np.ndarray:
         v = self._vec
         v[:N_COARSE + 1] = self.coarse(now["g"])
         phase = 2.0 * math.pi * now["day"] / YEAR_DAYS
@@ -410,7 +410,7 @@ class ThicknessDistributionEnv(ControlEnv):
         v[N_COARSE + 4:] = self._last_action
         return np.clip(v, self._low64, self._high64).astype(np.float32)
 
-    def _info(self, now: dict) -> dict:
+    def make_info(self, now: dict) -> dict:
         # fresh arrays: what an info holds is never shared with another call's
         physics = dict(now)
         physics["g"] = now["g"].copy()
@@ -435,27 +435,27 @@ class ThicknessDistributionEnv(ControlEnv):
             task["g0"] = g0 / g0.sum()
         return task
 
-    def _reward_kwargs(self) -> dict:
+    def reward_kwargs(self) -> dict:
         return {**self.reward_params, "target": self.target, "h": self._h}
 
     # -- gymnasium API ----------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
+        gym.Env.reset(self, seed=seed)
         self.episode = self._episode_task(options)
         self.model = ThorndikeModel(self._K, n_classes=self.n_classes, dh=self.dh,
                                     g0=self.episode["g0"])
-        return self._begin_episode()
+        return self.episodes.begin(self.row)
 
     def _ready(self) -> bool:
         return self.model is not None
 
-    def _advance(self) -> None:
+    def advance(self) -> None:
         self.model.step(self.days_per_step)
 
-    def _reward(self, action: np.ndarray, now: dict) -> float:
+    def reward(self, action: np.ndarray, now: dict) -> float:
         if self._default_reward:           # thickness_distribution_reward, W1 already computed
             return closeness(now["w1"], 0.0, self.reward_params["distance_scale"])
-        return super()._reward(action, now)
+        return super().reward(action, now)
 
     # -- rendering --------------------------------------------------------------------
     def _frame(self) -> np.ndarray:
@@ -463,3 +463,7 @@ class ThicknessDistributionEnv(ControlEnv):
 
         return draw_itd(self._h_coarse, self.coarse(self.model.g),
                         target=self.coarse(self.target), day=self.model.time)
+
+
+#: N :class:`ThicknessDistributionEnv`, stepped as one batch (:mod:`iceenvs.vector`)
+ThicknessDistributionVectorEnv = vector_class(ThicknessDistributionEnv)

@@ -29,15 +29,11 @@ N dicts, one per sub-environment. ``render_env=k`` chooses the
 sub-environment that ``render()`` draws (``render_mode`` as in the single
 environment).
 
-The engine step runs in one compiled call (:func:`drive`). The end of the
-step is the environment's: :class:`HertzVectorEnv` has each sub-environment
-measure, score and observe with its own code, one after the other
-(:class:`~iceenvs.base.ControlEnv`'s step in three parts), and an
-environment whose ``vector_base`` is a subclass makes it in batch. The ship
-environments step as one :class:`iceenvs.ship_measures.ShipBatch`
-(measurements, rewards, ends of episodes, observations, metrics and info as
-arrays over the sub-environments), and their single environment steps as a
-batch of one: the step is written once.
+The sub-environments' episodes are one :class:`iceenvs.step.Episodes`, the
+batch whose step every environment takes (a single environment is a batch
+of one): the engines advance in one compiled call, and the ship
+environments measure, score and observe on columns over the
+sub-environments. The step is written once.
 
 >>> import gymnasium as gym
 >>> import iceenvs  # noqa: F401
@@ -54,13 +50,13 @@ from typing import Any
 
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
-from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
+from gymnasium.vector.utils import batch_space
 
-from physics.hertz import KernelLists, advance_together
+from .base import ControlEnv, sanitise_actions
+from .step import Episodes
+from .vector_info import batch_infos, put_row, row_info, set_row
 
-from .base import PHYSICS_ERRORS, HertzEnv, sanitise_actions
-
-__all__ = ["HertzVectorEnv", "drive", "batch_infos", "row_info", "set_row", "put_row", "vector_class"]
+__all__ = ["HertzVectorEnv", "batch_infos", "row_info", "set_row", "put_row", "vector_class"]
 
 
 class HertzVectorEnv(VectorEnv):
@@ -90,7 +86,7 @@ class HertzVectorEnv(VectorEnv):
         environment's own error for a bad argument.
     """
 
-    env_class: type[HertzEnv] = HertzEnv
+    env_class: type[ControlEnv] = ControlEnv
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": ["rgb_array", "human"]}
 
     def __init__(self, num_envs: int = 1, *, max_episode_steps: int | None = None,
@@ -105,7 +101,7 @@ class HertzVectorEnv(VectorEnv):
                 or not 0 <= render_env < num_envs):
             raise ValueError(f"render_env must be the index of a sub-environment, 0 to "
                              f"{num_envs - 1}, got {render_env!r}")
-        if self.env_class is HertzEnv:
+        if self.env_class is ControlEnv:
             raise TypeError("HertzVectorEnv is a base class; use the vector environment of an "
                             "environment (its registration's vector_entry_point)")
         self.num_envs = int(num_envs)
@@ -120,8 +116,8 @@ class HertzVectorEnv(VectorEnv):
         self.single_action_space = first.action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self._obs = create_empty_array(self.single_observation_space, self.num_envs)
-        self._lists = KernelLists()
+        #: the sub-environments' episodes and their step
+        self.episodes = Episodes(self.envs)
         self._ready = False
 
     # -- Gymnasium API -----------------------------------------------------------------
@@ -133,13 +129,10 @@ class HertzVectorEnv(VectorEnv):
         seeds = self._per_env("seed", seed, (int, np.integer), lambda s, k: s + k)
         opts = self._per_env("options", options, dict, lambda o, k: o)
         super().reset(seed=None)
-        obs, infos = [], []
-        for k, env in enumerate(self.envs):
-            o, info = env.reset(seed=seeds[k], options=opts[k])
-            obs.append(o)
-            infos.append(info)
+        infos = [env.reset(seed=seeds[k], options=opts[k])[1]
+                 for k, env in enumerate(self.envs)]
         self._ready = True
-        return self._batch(obs), batch_infos(infos)
+        return self.episodes.batched_obs(), batch_infos(infos)
 
     def step(self, actions):
         """One step of every sub-environment; the engines advance together."""
@@ -147,49 +140,19 @@ class HertzVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before step()")
         actions, replaced = sanitise_actions(self._checked_actions(actions),
                                              self.single_action_space)
-        errors = drive(self.envs, actions, self._lists)
-        obs, rewards, terminated, infos = self._results(actions, replaced, errors)
+        obs, rewards, terminated, infos = self.episodes.step(actions, replaced)
         truncated = np.zeros(self.num_envs, dtype=bool)
         if self.max_episode_steps is not None:
-            truncated[:] = [env._steps >= self.max_episode_steps for env in self.envs]
+            truncated[:] = self.episodes.steps >= self.max_episode_steps
         for k in np.flatnonzero(terminated | truncated):
             final = ({key: value[k] for key, value in obs.items()} if isinstance(obs, dict)
                      else obs[k].copy())
             final_info = row_info(infos, k)
             o, info = self.envs[k].reset()
-            self._reset_row(k)
             put_row(obs, k, o)
             infos = set_row(self, infos, info, k)
             infos = self._add_info(infos, {"final_obs": final, "final_info": final_info}, k)
         return obs, rewards, terminated, truncated, infos
-
-    def _results(self, actions, replaced, errors) -> tuple:
-        """(observations, rewards, terminated, info) of a step whose engines
-        ran (``errors[k]``: the physics failure of sub-environment k, or
-        None): each sub-environment measures, rewards and observes with its
-        own code, one after the other."""
-        obs, infos = [], []
-        rewards = np.zeros(self.num_envs)
-        terminated = np.zeros(self.num_envs, dtype=bool)
-        for k, env in enumerate(self.envs):
-            result = None
-            if errors[k] is None:
-                try:
-                    now = env._measure()
-                except PHYSICS_ERRORS as err:
-                    errors[k] = err
-                else:
-                    result = env._finish_step(actions[k], int(replaced[k]), now)
-            if result is None:
-                result = env._failed_step(errors[k], int(replaced[k]))
-            o, rewards[k], terminated[k], _, info = result
-            obs.append(o)
-            infos.append(info)
-        return self._batch(obs), rewards, terminated, batch_infos(infos)
-
-    def _reset_row(self, k: int) -> None:
-        """After sub-environment k started a new episode (a subclass that
-        keeps per-episode rows updates them)."""
 
     # -- snapshots ------------------------------------------------------------------------
     def snapshot(self, index: int | None = None):
@@ -240,9 +203,7 @@ class HertzVectorEnv(VectorEnv):
             for k, one in enumerate(snapshot):
                 self.restore(one, k)
             return
-        k = self._index(index)
-        self.envs[k].restore(snapshot)
-        self._reset_row(k)
+        self.envs[self._index(index)].restore(snapshot)
 
     def _index(self, index) -> int:
         if (isinstance(index, bool) or not isinstance(index, (int, np.integer))
@@ -289,176 +250,14 @@ class HertzVectorEnv(VectorEnv):
                              f"actions of shape {shape} (num_envs × the single action shape)")
         return a
 
-    def _batch(self, obs: list):
-        self._obs = concatenate(self.single_observation_space, obs, self._obs)
-        return self._obs.copy() if not isinstance(self._obs, dict) else {
-            key: value.copy() for key, value in self._obs.items()}
-
     def __repr__(self):
         return f"{type(self).__name__}(num_envs={self.num_envs})"
 
 
-def drive(envs: Sequence[HertzEnv], actions: np.ndarray,
-          lists: KernelLists | None = None) -> list[BaseException | None]:
-    """The first part of a step of the environments ``envs`` (of one class
-    and configuration, each with its episode running), which the native
-    vector environments and the single ship environments (a batch of one)
-    share: each counts the step and applies its sanitised action
-    ``actions[k]``, then their engines advance together by the control
-    interval (:func:`physics.hertz.advance_together`, with the typed lists
-    ``lists`` kept by the caller). Returns per environment ``None`` or the
-    physics error that ends its episode (in applying the action, or in the
-    engine)."""
-    errors: list[BaseException | None] = [None] * len(envs)
-    for k, env in enumerate(envs):
-        env._took_action(actions[k])
-        try:
-            env._apply_action(actions[k])
-        except PHYSICS_ERRORS as err:
-            errors[k] = err
-    moving = [k for k in range(len(envs)) if errors[k] is None]
-    if moving:
-        for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
-                                                   envs[0].control_interval, lists=lists)):
-            errors[k] = err
-    return errors
-
-
-def batch_infos(infos: Sequence[dict]) -> dict[str, Any]:
-    """The infos of the sub-environments as one Gymnasium vector info: what
-    :meth:`gymnasium.vector.VectorEnv._add_info` builds from them one by
-    one (a dict of arrays, each key with its mask ``_key`` of the
-    sub-environments that have it, nested dicts likewise; numbers in an
-    array of the first one's type, arrays stacked, anything else in an
-    object array), a column at a time."""
-    n = len(infos)
-    keys = list(infos[0]) if n else []
-    if not (n and all(list(info) == keys for info in infos)):
-        return _key_by_key(infos)
-    # the common case: every sub-environment has the same keys, in one order
-    out: dict[str, Any] = {}
-    for key, values in zip(keys, zip(*(info.values() for info in infos))):
-        first = values[0]
-        array = None
-        if isinstance(first, dict):
-            if all(isinstance(v, dict) for v in values):
-                array = batch_infos(values)
-        else:
-            array = _column(first, values)
-        if array is None:
-            array = _key_by_key([{key: v} for v in values])[key]
-        out[key], out["_" + key] = array, np.ones(n, dtype=np.bool_)
-    return out
-
-
-def put_row(obs, k: int, value) -> None:
-    """Sub-environment k's observation ``value`` into the batched ``obs``
-    (an array, or a dict of arrays for a Dict space)."""
-    if isinstance(obs, dict):
-        for key in obs:
-            obs[key][k] = value[key]
-    else:
-        obs[k] = value
-
-
-def row_info(infos: dict[str, Any], k: int) -> dict[str, Any]:
-    """Sub-environment k's info out of a vector info: the keys whose mask
-    is set for k, numbers as Python numbers (the inverse of
-    :func:`batch_infos` for one row)."""
-    out = {}
-    for key, value in infos.items():
-        if key.startswith("_") or not infos.get("_" + key, np.zeros(k + 1, bool))[k]:
-            continue
-        if isinstance(value, dict):
-            out[key] = row_info(value, k)
-        elif value.dtype == object:
-            out[key] = value[k]
-        elif value.ndim == 1:
-            out[key] = value[k].item()
-        else:
-            out[key] = value[k].copy()
-    return out
-
-
-def set_row(vector_env: VectorEnv, infos: dict[str, Any], info: dict[str, Any],
-            k: int) -> dict[str, Any]:
-    """``infos`` with sub-environment k's entries replaced by ``info``:
-    its keys set (Gymnasium's ``_add_info``), the others' masks cleared
-    for k."""
-    for key, value in infos.items():
-        if key.startswith("_") or key in info:
-            continue
-        infos["_" + key][k] = False
-        if isinstance(value, dict):
-            set_row(vector_env, value, {}, k)
-        elif value.dtype != object:
-            value[k] = 0
-        else:
-            value[k] = None
-    return vector_env._add_info(infos, info, k)
-
-
-def _key_by_key(infos: Sequence[dict]) -> dict[str, Any]:
-    """:func:`batch_infos` for infos whose keys differ: key by key, each
-    sub-environment's value put in its row."""
-    n = len(infos)
-    out: dict[str, Any] = {}
-    for key in dict.fromkeys(k for info in infos for k in info):
-        values = [info.get(key, _MISSING) for info in infos]
-        present = [v is not _MISSING for v in values]
-        first = next(v for v in values if v is not _MISSING)
-        if isinstance(first, dict):
-            array = batch_infos([{} if v is _MISSING else v for v in values])
-        else:
-            array = _empty_column(first, n)
-            for k, v in enumerate(values):
-                if v is not _MISSING:
-                    array[k] = v
-        out[key], out["_" + key] = array, np.array(present, dtype=np.bool_)
-    return out
-
-
-_MISSING = object()
-
-
-def _is_number(value) -> bool:
-    """Whether ``_add_info`` keeps ``value`` in an array of its own type."""
-    return _is_number_type(type(value))
-
-
-def _is_number_type(kind: type) -> bool:
-    """Whether values of type ``kind`` are numbers for :func:`_is_number`."""
-    return kind in (int, float, bool) or issubclass(kind, np.number)
-
-
-def _empty_column(first, n: int) -> np.ndarray:
-    """The array that ``_add_info`` starts a key with, from its first value."""
-    if _is_number(first):
-        return np.zeros(n, dtype=type(first))
-    if isinstance(first, np.ndarray):
-        return np.zeros((n,) + first.shape, dtype=first.dtype)
-    return np.full(n, None, dtype=object)
-
-
-def _column(first, values: Sequence) -> np.ndarray | None:
-    """The column of a key that every sub-environment has, in one call where
-    that gives what filling :func:`_empty_column` one by one gives (numbers
-    of the first one's type; arrays of one shape and dtype); else None."""
-    if _is_number(first):
-        # the distinct types, each tested once: a column is mostly of one
-        return (np.array(values, dtype=type(first))
-                if all(_is_number_type(t) for t in set(map(type, values))) else None)
-    if isinstance(first, np.ndarray) and all(
-            isinstance(v, np.ndarray) and v.shape == first.shape and v.dtype == first.dtype
-            for v in values):
-        return np.stack(values)
-    return None
-
-
-def vector_class(env_class: type[HertzEnv]) -> type[HertzVectorEnv]:
-    """The native vector environment of ``env_class``: a subclass, named after
-    it, of its ``vector_base`` (``None``: :class:`HertzVectorEnv`)."""
+def vector_class(env_class: type[ControlEnv]) -> type[HertzVectorEnv]:
+    """The native vector environment of ``env_class``: a subclass of
+    :class:`HertzVectorEnv`, named after it."""
     name = env_class.__name__.removesuffix("Env") + "VectorEnv"
-    return type(name, (env_class.vector_base or HertzVectorEnv,), {
+    return type(name, (HertzVectorEnv,), {
         "env_class": env_class, "__module__": env_class.__module__,
         "__doc__": f"N :class:`{env_class.__name__}` stepped together (:mod:`iceenvs.vector`)."})

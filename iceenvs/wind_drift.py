@@ -186,17 +186,17 @@ class WindDriftEnv(HertzEnv):
             task["heading"] = float(rng.uniform(-math.pi, math.pi))
         return task
 
-    def _make_sim(self, rng):
+    def make_sim(self, rng):
         p = self.preset
         field, box = p.floe_field(self.n_floes, self.episode["concentration"],
                                   seed=int(rng.integers(2 ** 63)))
         self.forcing = p.make_forcing(wind=(0.0, 0.0))
         return self._hertz_sim(field, box, self.forcing)
 
-    def _apply_action(self, action):
+    def apply_action(self, action):
         self.forcing.wind = self.episode["max_wind"] * action
 
-    def _measure(self) -> dict:
+    def measure(self) -> dict:
         now = self._contact_physics()
         h = self.episode["heading"]
         now["heading_cos"] = math.cos(h)

@@ -755,7 +755,7 @@ class HertzSimulation(FloeProperties):
         return LocalIce(n_floes, math.pi * r2, n_contacts,
                         np.array([[-sxx / area, -sxy / area], [-syx / area, -syy / area]]), area)
 
-    def _ice_near(self, centre, radius: float) -> np.ndarray:
+    def ice_near_row(self, centre, radius: float) -> np.ndarray:
         """The row of :data:`physics.hertz_batch.ICE_NEAR` for the disc of
         ``radius`` round ``centre``: what :func:`~physics.hertz_batch.ice_near_many`
         computes for a batch, for this simulation alone."""

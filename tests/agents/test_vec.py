@@ -82,8 +82,10 @@ def test_ppo_trains_on_it(how, env_id):
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     venv = GymnasiumVecEnv(_vector(how, env_id, 2))
-    # SB3's own checks of a sub-environment (spaces, reset and step values)
-    check_env(venv.venv.envs[0], warn=False)
+    # SB3's own checks of the environment the sub-environments are (spaces, reset
+    # and step values); a native vector environment's sub-environments step
+    # only together
+    check_env(gym.make(env_id, **SMALL[env_id]).unwrapped, warn=False)
     venv.seed(0)
     env = VecNormalize(VecMonitor(venv))
     model = PPO("MlpPolicy", env, n_steps=8, batch_size=8, n_epochs=1, seed=0, device="cpu")
@@ -144,7 +146,13 @@ def test_make_vec_env_takes_the_native_vector_env_where_there_is_one(vectorised_
 def test_native_is_refused_without_a_vector_entry_point():
     from agents.envs import make_vec_env
 
-    with pytest.raises(ValueError, match="no native vector environment"):
-        make_vec_env(ITD, n_envs=2, seed=0, env_kwargs=SMALL[ITD], vectorization="native")
+    env_id = "tests/NoVectorITD-v0"
+    gym.register(id=env_id, entry_point="iceenvs.thickness_distribution:ThicknessDistributionEnv")
+    try:
+        with pytest.raises(ValueError, match="no native vector environment"):
+            make_vec_env(env_id, n_envs=2, seed=0, env_kwargs=SMALL[ITD],
+                         vectorization="native")
+    finally:
+        del gym.registry[env_id]
     with pytest.raises(ValueError, match="unknown vectorization 'threads'"):
         make_vec_env(ITD, n_envs=2, seed=0, vectorization="threads")

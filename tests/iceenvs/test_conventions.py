@@ -2,6 +2,7 @@
 tasks, task parameters that stick (keywords, reset options, a vector
 environment's autoreset), Gymnasium's episode limits, bounded rewards and
 videos of the frames."""
+import importlib
 import math
 import re
 
@@ -293,3 +294,30 @@ def test_record_video_writes_a_file(env_id, tmp_path):
         env.close()
     videos = list(tmp_path.glob("*.mp4"))
     assert videos and videos[0].stat().st_size > 1000
+
+
+# -- class depth ------------------------------------------------------------------
+#: an environment class is at most this many project classes deep: the base
+#: (ControlEnv), a family (HertzEnv, ShipEnv) and the task
+MAX_CLASS_DEPTH = 3
+
+
+def project_classes(cls: type) -> list[str]:
+    """The project's classes of ``cls``'s chain, itself first."""
+    return [c.__name__ for c in cls.__mro__ if c.__module__.split(".")[0] == "iceenvs"]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_an_environment_class_is_at_most_three_project_classes_deep(env_id):
+    module, _, name = gym.spec(env_id).entry_point.partition(":")
+    chain = project_classes(getattr(importlib.import_module(module), name))
+    assert chain[-1] == "ControlEnv"
+    assert len(chain) <= MAX_CLASS_DEPTH, " → ".join(chain)
+
+
+def test_the_class_depth_check_finds_a_deep_class():
+    from iceenvs.ship_navigation import ShipNavigationEnv
+
+    deeper = type("DeeperEnv", (ShipNavigationEnv,), {"__module__": "iceenvs.planted"})
+    assert project_classes(deeper) == ["DeeperEnv", "ShipNavigationEnv", "ShipEnv", "ControlEnv"]
+    assert len(project_classes(deeper)) > MAX_CLASS_DEPTH

@@ -246,7 +246,7 @@ def test_convergence_failure_is_absorbing():
             assert "error" not in info
             if terminated:
                 break
-            assert reward == pytest.approx(base._reward(np.array([1.0]), info["physics"]))
+            assert reward == pytest.approx(base.reward(np.array([1.0]), info["physics"]))
             assert 0.0 <= reward <= 1.0
         assert terminated and not truncated and k < 400
         assert info["physics"]["pressure"] > 1.0

@@ -207,7 +207,7 @@ def test_collision_impulses_are_bounded_by_the_contact_impulses():
     assert impulses <= contact * (1.0 + 1e-9), (impulses, contact)
     assert resultant <= contact * (1.0 + 1e-9), (resultant, contact)
     # the mean mass of the floes hit, each once, from the engine's masses
-    hit = sorted(u._floes_hit)
+    hit = sorted(u.floes_hit)
     assert info["collided_floes"] == len(hit) > 1
     np.testing.assert_allclose(info["mean_mass_hit"], np.mean(u.sim.masses[hit]), rtol=1e-12)
 

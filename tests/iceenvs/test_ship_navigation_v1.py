@@ -136,7 +136,7 @@ class _OneFloe(ShipNavigationV1Env):
         box = TransitBox(self.length, self.width, band=self.ice_band)
         field = FloeField(np.array([[self.start_x + 100.0, self.centre_y]]), np.array([5.0]),
                           1.2, np.zeros((1, 2)), density=910.0)
-        self._field_concentration = float(field.areas.sum()) / box.band_area
+        self.field_concentration = float(field.areas.sum()) / box.band_area
         return field, box, self._forcing()
 
 
@@ -249,7 +249,7 @@ def test_swath_frame_centres_the_fan_on_the_heading_or_the_goal_direction():
                          half_beam=0.5 * env.ship.hull.beam, bands=env.swath_bands,
                          box_lengths=(env.sim.box.lx, env.sim.box.ly),
                          periodic=env.sim.box.periodic)
-        sums[frame] = got = env._extra_measures([env])[0]
+        sums[frame] = got = env.extra_values([env])[0]
         np.testing.assert_allclose(got, np.asarray(want).T.ravel(), rtol=1e-12, atol=1e-9)
         about = "the goal" if frame == "goal" else "the ship"
         assert all(f"fan about {about}" in f.meaning

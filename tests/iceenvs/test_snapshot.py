@@ -14,7 +14,8 @@ from iceenvs import ENV_IDS
 from iceenvs.base import ControlEnv
 from iceenvs.facts import env_creator, env_spec
 from iceenvs.ship_env import ShipEnv
-from iceenvs.snapshots import Snapshot, episode_attributes
+from iceenvs.snapshots import ROW, Snapshot, episode_attributes
+from iceenvs.step import ROW_STATE
 from iceenvs.vector import row_info
 from tests.small_envs import SMALL
 
@@ -98,8 +99,9 @@ def test_a_restored_episode_replays_the_same_future(played):
 
 def test_the_snapshot_is_a_copy_that_later_steps_leave_alone(played):
     env, snap, record, at, _, _ = played
-    assert snap.steps >= BEFORE and snap.state["_steps"] == snap.steps
-    assert same(snap.state["_prev"], at)
+    assert snap.steps >= BEFORE and snap.state[ROW]["steps"] == snap.steps
+    assert set(snap.state[ROW]) == set(ROW_STATE)      # the batch's arrays of the episode
+    assert same(snap.state[ROW]["prev"], at)
     sim = snap.state.get("sim")
     if sim is not None:                         # the engine's copy is its own
         assert sim is not env.sim and not np.shares_memory(sim.positions, env.sim.positions)

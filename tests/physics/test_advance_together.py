@@ -140,7 +140,7 @@ def test_the_ice_near_every_ship_in_one_call_is_each_ones_own():
     out = np.empty((3, 8))
     ice_near_many(lists[0], lists[1], centres, 30.0, 140.0, 80.0, True, True, out)
     for k, sim in enumerate(sims):
-        np.testing.assert_allclose(out[k], sim._ice_near(centres[k], 30.0), rtol=1e-12,
+        np.testing.assert_allclose(out[k], sim.ice_near_row(centres[k], 30.0), rtol=1e-12,
                                    atol=1e-9)
         ice = sim.local_ice(centres[k], 30.0)
         assert (int(out[k, 0]), int(out[k, 2])) == (ice.n_floes, ice.n_contacts)
