@@ -47,9 +47,10 @@ DEFAULT_IDS = ("iceenvs/ShipNavigation-v0", "iceenvs/ShipNavigation-v1", "iceenv
 DEFAULT_SIZES = (1, 8, 16, 32)
 #: settings of ``--quick``
 #: (each environment in its small instance, iceenvs.facts.EnvFacts.small, in
-#: this process instead of fresh ones, and no PPO run over worker processes)
-QUICK = dict(seconds=0.3, rounds=1, sizes=(2,), ppo_envs=2, ppo_steps=64, small=True,
-             fresh=False)
+#: this process instead of fresh ones, rollouts of 64 steps instead of
+#: ROLLOUT, and no PPO run over worker processes)
+QUICK = dict(seconds=0.3, rounds=1, sizes=(2,), ppo_envs=2, ppo_steps=64, ppo_rollout=64,
+             small=True, fresh=False)
 MODES = ("single", "sync", "subproc", "native")
 #: the sub-environments and steps of a PPO rollout
 ROLLOUT = 2048
@@ -144,16 +145,17 @@ def measure_stepping(mode: str, env_id: str, n: int, seconds: float, seed: int,
 
 
 def measure_training(mode: str, env_id: str, n: int, steps: int, seed: int,
-                     kwargs: dict | None = None) -> dict:
+                     kwargs: dict | None = None, rollout: int = ROLLOUT) -> dict:
     """End-to-end PPO training steps/s with ``n`` sub-environments stepped
-    ``mode``-wise (``agents.envs.make_vec_env``), in this process."""
+    ``mode``-wise (``agents.envs.make_vec_env``), in this process, with
+    rollouts of ``rollout`` steps over the sub-environments."""
     from stable_baselines3 import PPO
 
     from agents.envs import make_vec_env
 
     venv = make_vec_env(env_id, n_envs=n, seed=seed, env_kwargs=kwargs,
                         vectorization={"sync": "dummy"}.get(mode, mode))
-    n_steps = max(ROLLOUT // n, 8)
+    n_steps = max(rollout // n, 8)
     model = PPO("MlpPolicy", venv, n_steps=n_steps, batch_size=min(128, n_steps * n),
                 seed=seed, device="cpu")
     model.learn(n_steps * n)                 # one untimed rollout and update
@@ -308,11 +310,12 @@ def _summary(runs: list[dict]) -> dict:
 
 def run_benchmark(ids, sizes, seconds: float, rounds: int, seed: int, ppo_envs: int | None,
                   ppo_steps: int, small: bool = False, fresh: bool = True,
-                  quiet: bool = False) -> dict:
+                  quiet: bool = False, ppo_rollout: int = ROLLOUT) -> dict:
     """Every configuration, in turns, ``rounds`` times; then the training runs.
     ``small``: each environment in its small instance instead of its default;
     ``fresh``: each measurement in a fresh process (else all in this one,
-    without PPO over worker processes)."""
+    without PPO over worker processes); ``ppo_rollout``: the steps of a PPO
+    rollout over the sub-environments."""
     from iceenvs.facts import env_facts
 
     kwargs = {i: dict(env_facts(i).small) if small else {} for i in ids}
@@ -332,7 +335,7 @@ def run_benchmark(ids, sizes, seconds: float, rounds: int, seed: int, ppo_envs: 
                 bar.advance()
             for case in train:
                 trained[case].append(_child(measure_training, *case, ppo_steps, seed + r,
-                                            kwargs[case[1]], fresh=fresh))
+                                            kwargs[case[1]], ppo_rollout, fresh=fresh))
                 bar.advance()
     with harness.Progress(1, "where the time goes", quiet) as bar:
         phases = _child(lambda_phases, "native", ids[0], seconds, seed, max(sizes), kwargs[ids[0]],
@@ -342,7 +345,7 @@ def run_benchmark(ids, sizes, seconds: float, rounds: int, seed: int, ppo_envs: 
     training = [dict(mode=m, id=i, n=n, **_summary(trained[(m, i, n)])) for m, i, n in train]
     return dict(settings=dict(ids=list(ids), sizes=list(sizes), seconds=seconds, rounds=rounds,
                               seed=seed, ppo_envs=ppo_envs, ppo_steps=ppo_steps,
-                              small=small, fresh=fresh),
+                              ppo_rollout=ppo_rollout, small=small, fresh=fresh),
                 stepping=stepping, training=training, phases=phases)
 
 
@@ -436,7 +439,8 @@ def main(argv=None, prog: str | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="seed of the episodes and actions")
     args, argv = harness.parse(parser, argv)
     st = harness.settings(args, dict(seconds=5.0, rounds=3, sizes=DEFAULT_SIZES, ppo_envs=16,
-                                     ppo_steps=8192, small=False, fresh=True), QUICK,
+                                     ppo_steps=8192, ppo_rollout=ROLLOUT, small=False,
+                                     fresh=True), QUICK,
                           ("seconds", "rounds", "sizes", "ppo_envs", "ppo_steps"))
     if st["seconds"] <= 0 or st["rounds"] < 1 or min(st["sizes"]) < 1 or st["ppo_envs"] < 1 \
             or st["ppo_steps"] < 1:
@@ -450,7 +454,7 @@ def main(argv=None, prog: str | None = None) -> int:
     t0 = time.perf_counter()
     result = run_benchmark(ids, st["sizes"], st["seconds"], st["rounds"], args.seed,
                            None if args.no_ppo else st["ppo_envs"], st["ppo_steps"],
-                           st["small"], st["fresh"], args.quiet)
+                           st["small"], st["fresh"], args.quiet, st["ppo_rollout"])
     tables = [stepping_table(result, i) for i in ids] + [phases_table(result)]
     if result["training"]:
         tables.append(training_table(result))

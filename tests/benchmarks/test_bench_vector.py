@@ -20,6 +20,7 @@ def test_quick_run_writes_every_configuration(tmp_path, capsys):
     harness.validate_record(record)
     data = record["data"]
     assert data["settings"]["sizes"] == [2] and data["settings"]["small"]
+    assert data["settings"]["ppo_rollout"] == bench_vector.QUICK["ppo_rollout"]
     modes = {(r["mode"], r["n"]) for r in data["stepping"]}
     assert modes == {("single", 1), ("sync", 2), ("subproc", 2), ("native", 2)}
     for r in data["stepping"] + data["training"]:
