@@ -18,6 +18,8 @@ import subprocess
 import sys
 import time
 
+import pytest
+
 BUILD_LIST = """
 from physics import make_floe_field
 from physics.neighbors import choose_cell_size, pair_list, radius_rank
@@ -37,14 +39,34 @@ print("steps", sim.n_steps)
 """
 
 
-def test_kernels_compiled_in_one_process_run_when_loaded_in_the_next(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NUM_THREADS="1")
-    outputs = []
-    for script in (BUILD_LIST, HERTZ, HERTZ):
-        run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                             env=env, timeout=600)
+def _env(cache_dir, **extra) -> dict:
+    """This process's environment with Numba's cache in ``cache_dir``, Numba
+    on one thread and ``SEAICE_QUIET`` unset, then ``extra``."""
+    env = {k: v for k, v in os.environ.items() if k != "SEAICE_QUIET"}
+    env.update(NUMBA_CACHE_DIR=str(cache_dir), NUMBA_NUM_THREADS="1", **extra)
+    return env
+
+
+@pytest.fixture(scope="module")
+def three_processes(tmp_path_factory):
+    """(the cache's base directory, the three runs): the sequence of the
+    module docstring in a fresh cache. The first and the third print what
+    a user sees; the second, which compiles the Hertz step, runs with
+    ``SEAICE_QUIET=1``. The tests of the one-line notice read their stderr:
+    the first compiles (several kernels), the second compiles silenced, the
+    third loads everything from the cache."""
+    cache = tmp_path_factory.mktemp("numba-cache")
+    return cache, [subprocess.run([sys.executable, "-c", script], capture_output=True,
+                                  text=True, env=_env(cache, **extra), timeout=600)
+                   for script, extra in ((BUILD_LIST, {}), (HERTZ, {"SEAICE_QUIET": "1"}),
+                                         (HERTZ, {}))]
+
+
+def test_kernels_compiled_in_one_process_run_when_loaded_in_the_next(three_processes):
+    _, runs = three_processes
+    for run in runs:
         assert run.returncode == 0, f"exit {run.returncode}: {run.stderr[-2000:]}"
-        outputs.append(run.stdout.strip().splitlines()[-1])
+    outputs = [run.stdout.strip().splitlines()[-1] for run in runs]
     assert outputs[0].startswith("pairs ") and int(outputs[0].split()[1]) > 0
     assert outputs[1] == outputs[2] == "steps 20"
 
@@ -105,30 +127,14 @@ def test_configure_keeps_other_versions_used_recently_and_prunes_stale_ones(tmp_
 
 # -- the line printed before the first compilation ---------------------------
 
-COMPILE_SMALL_KERNELS = """
-from physics import domain
-assert domain.wrap_coordinate(1.25, 1.0, True) == 0.25
-assert domain.minimum_image(0.75, 1.0, True) == -0.25
-print("ok")
-"""
-
-
-def _run_small_kernels(cache_dir, **extra):
-    env = {k: v for k, v in os.environ.items() if k != "SEAICE_QUIET"}
-    env.update(NUMBA_CACHE_DIR=str(cache_dir), NUMBA_NUM_THREADS="1", **extra)
-    run = subprocess.run([sys.executable, "-c", COMPILE_SMALL_KERNELS], capture_output=True,
-                         text=True, env=env, timeout=300)
-    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr[-2000:]
-    return run.stderr
-
-
-def test_first_compilation_prints_one_line_and_a_warm_cache_none(tmp_path):
+def test_first_compilation_prints_one_line_and_a_warm_cache_none(three_processes):
     from physics._jit_cache import compile_notice
 
-    first = _run_small_kernels(tmp_path)
-    lines = [ln for ln in first.splitlines() if ln.startswith("seaice-gym: compiling")]
-    assert len(lines) == 1, first
-    target = tmp_path / "seaice-gym"
+    cache, (first, quiet, warm) = three_processes
+    assert first.returncode == quiet.returncode == warm.returncode == 0, first.stderr[-2000:]
+    lines = [ln for ln in first.stderr.splitlines() if ln.startswith("seaice-gym: compiling")]
+    assert len(lines) == 1, first.stderr                    # several kernels, one line
+    target = cache / "seaice-gym"
     assert lines[0] == compile_notice(next(p for p in target.iterdir() if p.is_dir()))
-    assert _run_small_kernels(tmp_path) == ""                    # loaded from the cache
-    assert _run_small_kernels(tmp_path / "quiet", SEAICE_QUIET="1") == ""
+    assert warm.stderr == ""                                 # loaded from the cache
+    assert quiet.stderr == ""                                # compiled, and silenced
