@@ -231,13 +231,13 @@ class _EngineClock:
     floes; the calls themselves are unchanged."""
 
     def __enter__(self):
-        import iceenvs.vector
+        import iceenvs.step
         from physics.hertz import HertzSimulation
 
         self.seconds = 0.0
         self.substeps = self.sims = self.floes = self.awake = 0
         self._saved = [(HertzSimulation, "advance", HertzSimulation.advance),
-                       (iceenvs.vector, "advance_together", iceenvs.vector.advance_together)]
+                       (iceenvs.step, "advance_together", iceenvs.step.advance_together)]
         advance, together = (saved[2] for saved in self._saved)
 
         inside = [False]            # advance_together of one simulation calls its advance
@@ -262,7 +262,7 @@ class _EngineClock:
             return errors
 
         HertzSimulation.advance = timed_advance
-        iceenvs.vector.advance_together = timed_together
+        iceenvs.step.advance_together = timed_together
         return self
 
     def _count(self, sims, duration):
@@ -418,7 +418,7 @@ def training_table(result: dict) -> dict:
 
 def main(argv=None, prog: str | None = None) -> int:
     from iceenvs import ENV_IDS
-    from iceenvs.facts import env_spec
+    from iceenvs.facts import env_creator
 
     from .bench_environments import resolve_ids
 
@@ -447,9 +447,10 @@ def main(argv=None, prog: str | None = None) -> int:
         parser.error("--seconds must be positive; --rounds, --sizes, --ppo-envs and "
                      "--ppo-steps at least 1")
     ids = resolve_ids(args.ids, ENV_IDS) if args.ids else list(DEFAULT_IDS)
-    plain = [i for i in ids if env_spec(i).vector_entry_point is None]
+    plain = [i for i in ids if not env_creator(i).engines_together]
     if plain:
-        parser.error(f"{', '.join(plain)} has no native vector environment")
+        parser.error(f"{', '.join(plain)}: its native vector environment advances no engines "
+                     f"together (this suite times the Hertz environments')")
     command = harness.command_line(SUITE, argv)
     t0 = time.perf_counter()
     result = run_benchmark(ids, st["sizes"], st["seconds"], st["rounds"], args.seed,
