@@ -220,24 +220,26 @@ def _check_horizon(horizon) -> int | None:
 class ControlEnv(gym.Env):
     """The control loop every environment of the suite shares.
 
-    One step: sanitise the action → ``_apply_action`` → ``_advance`` →
-    ``_measure`` (raw SI dict) → ``_reward`` → observation ``_vector`` and
-    ``_info``. A physics failure (FloatingPointError, RuntimeError,
-    ValueError), a non-finite reward or the task's failure
-    (``_terminated``) ends the episode with ``failure_reward`` and,
-    for a physics failure or a non-finite reward, ``info["error"]``; a
-    task done (``_succeeded``, a goal reached) ends it with the step's
-    reward.
+    One step, written once for every environment in its batch of episodes
+    (:class:`iceenvs.step.Episodes`; a single environment is a batch of one):
+    sanitise the action → ``apply_action`` → ``advance`` (the engines) →
+    ``measure`` (raw SI dict) → ``reward`` → ``ends`` → the observation
+    (``observe``) and the info (``make_info``). A physics failure
+    (FloatingPointError, RuntimeError, ValueError), a non-finite reward or
+    the task's failure (``_terminated``) ends the episode with
+    ``failure_reward`` and, for a physics failure or a non-finite reward,
+    ``info["error"]``; a task done (``_succeeded``, a goal reached) ends it
+    with the step's reward.
     Episodes are truncated by Gymnasium's ``TimeLimit`` (the registered
     ``max_episode_steps``), never by the environment itself.
 
-    An environment over a floe engine (``self.sim``) provides
-    ``_make_sim``, ``_apply_action``, ``_measure`` and ``_frame`` (an RGB
-    array); one over another model (the thickness distribution) builds it
-    in ``reset``, then calls ``_begin_episode``, and provides ``_ready`` (a
-    model exists), ``_advance``, ``_vector`` and ``_info`` as well. The
-    environments' classes are at most three deep: this class, a family
-    (:class:`HertzEnv`, :class:`iceenvs.ship_env.ShipEnv`) and the task.
+    An environment over a floe engine (``self.sim``) provides ``make_sim``,
+    ``apply_action``, ``measure`` and ``_frame`` (an RGB array); one over
+    another model (the thickness distribution) builds it in ``reset``, then
+    calls ``_begin_episode``, and provides ``_ready`` (a model exists),
+    ``advance``, ``observe`` and ``make_info`` as well. The environments'
+    classes are at most three deep: this class, a family (:class:`HertzEnv`,
+    :class:`iceenvs.ship_env.ShipEnv`) and the task.
 
     The reward contract: every step's reward, a failure's included, lies in
     :attr:`reward_bounds`. A task declares both with its reward: the floe
@@ -355,7 +357,7 @@ class ControlEnv(gym.Env):
         low = np.array([f.low for f in self.features] + [-1.0] * n_act, dtype=np.float32)
         high = np.array([f.high for f in self.features] + [1.0] * n_act, dtype=np.float32)
         self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
-        #: the episode's engine (:meth:`_make_sim`); the code shared here uses only
+        #: the episode's engine (:meth:`make_sim`); the code shared here uses only
         #: :class:`~physics.engine.FloeEngine`, an environment may use more of its engine
         self.sim: FloeEngine | None = None
         Episodes([self], single=True)
@@ -494,12 +496,15 @@ class ControlEnv(gym.Env):
         return {}
 
     def make_sim(self, rng: np.random.Generator) -> FloeEngine:
+        """The engine of a new episode, its floes drawn with ``rng``."""
         raise NotImplementedError
 
     def _ready(self) -> bool:
         return self.sim is not None
 
     def advance(self) -> None:
+        """Advance the engine by the control interval (a batch whose family
+        advances its engines together does it for all of them at once)."""
         self.sim.advance(self.control_interval)
 
     # -- gymnasium API ----------------------------------------------------------------
@@ -510,12 +515,14 @@ class ControlEnv(gym.Env):
         return self.episodes.begin(self.row)
 
     def observe(self, now: dict) -> np.ndarray:
+        """The observation of the measurement ``now``."""
         if self.horizon is not None:
             now = {**now, "time_left": self.time_left()}
         row = np.array([[float(now[f.name]) for f in self.features]])
         return observation_vectors(row, self.features, self._last_action[None])[0]
 
     def make_info(self, now: dict) -> dict:
+        """The info of the measurement ``now``."""
         return {"physics": dict(now), "time": float(self.sim.time), "steps": self._steps,
                 "task": dict(self.episode)}
 
