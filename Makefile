@@ -44,10 +44,11 @@ demo: setup
 	$(PY) -m seaice_gym demo
 
 # the linter and the import layers (pyproject.toml), then the tests, in
-# TEST_WORKERS processes (pytest-xdist; a test file's tests share a worker)
+# TEST_WORKERS processes (pytest-xdist; a test file's tests share a worker),
+# with the 25 slowest listed at the end
 TEST_WORKERS ?= 2
 test: setup lint
-	$(PY) -m pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadfile
+	$(PY) -m pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadfile --durations=25
 
 lint: setup
 	$(VENV)/bin/ruff check .

@@ -458,14 +458,13 @@ class ControlEnv(gym.Env):
         raise NotImplementedError
 
     def ends(self, envs, nows, cols, sums, task) -> tuple[np.ndarray, np.ndarray]:
-        """(succeeded, failed), boolean arrays, of the environments ``envs``
-        (of this class and configuration) that measured ``nows`` (dicts;
-        ``cols``, ``sums`` and ``task``: the columns of a family measured on
-        columns, else None): by default each one's ``_succeeded(now)`` and
-        ``_terminated(now)``."""
-        return (np.array([bool(env._succeeded(now)) for env, now in zip(envs, nows)], dtype=bool),
-                np.array([bool(env._terminated(now)) for env, now in zip(envs, nows)],
-                         dtype=bool))
+        """(succeeded, failed), a boolean each (arrays or lists), of the
+        environments ``envs`` (of this class and configuration) that
+        measured ``nows`` (dicts; ``cols``, ``sums`` and ``task``: the
+        columns of a family measured on columns, else None): by default each
+        one's ``_succeeded(now)`` and ``_terminated(now)``."""
+        return ([bool(env._succeeded(now)) for env, now in zip(envs, nows)],
+                [bool(env._terminated(now)) for env, now in zip(envs, nows)])
 
     def _terminated(self, now: dict) -> bool:
         return False
@@ -582,7 +581,7 @@ class ControlEnv(gym.Env):
             raise RuntimeError("this environment is a sub-environment of a vector environment: "
                                "step the vector environment")
         a, replaced = sanitise_action(action, self.action_space)
-        obs, reward, terminated, info = self.episodes.step(a[None], np.array([replaced]))
+        obs, reward, terminated, info = self.episodes.step(a[None], (replaced,))
         return obs, float(reward[0]), bool(terminated[0]), False, info
 
     # -- snapshots ----------------------------------------------------------------------------

@@ -36,6 +36,8 @@ What an environment class declares (its task) is listed in
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from gymnasium.vector import VectorEnv
 from gymnasium.vector.utils import concatenate, create_empty_array
@@ -69,7 +71,7 @@ def advance_all(envs, actions: np.ndarray, together: bool,
             env.apply_action(actions[k])
         except PHYSICS_ERRORS as err:
             errors[k] = err
-    moving = [k for k in range(len(envs)) if errors[k] is None]
+    moving = [k for k, err in enumerate(errors) if err is None]
     if together:
         if moving:
             for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
@@ -218,36 +220,16 @@ class Episodes:
         failure of environment k, or None): measurements, rewards, ends,
         sums, observations and info."""
         n = self.num_envs
-        e0 = self.envs[0]
         rewards = np.zeros(n)
         terminated = np.zeros(n, dtype=bool)
-        ok = np.array([k for k in range(n) if errors[k] is None], dtype=np.int64)
-        raw = None
-        sums = self.sums
-        nows: list = []
-        if ok.size and self._columns:
-            full = ok.size == n
-            sums = self.sums if full else self.sums[ok]
-            try:
-                raw = e0.measure_batch([self.envs[k] for k in ok], sums, self.lists)
-            except PHYSICS_ERRORS as err:          # every measured one fails with it
-                for k in ok:
-                    errors[k] = err
-                ok = ok[:0]
-            else:
-                nows = [as_measurement(self._names, row, e0.integer_measures) for row in raw]
-        elif ok.size:
-            for k in ok:
-                try:
-                    nows.append(self.envs[k].measure())
-                except PHYSICS_ERRORS as err:
-                    errors[k] = err
-            ok = np.array([k for k in ok if errors[k] is None], dtype=np.int64)
-        infos = self._measured(ok, nows, raw, sums, actions, replaced, rewards, terminated)
-        if raw is not None and ok.size < n:
-            self.sums[ok] = sums
+        ok = [k for k in range(n) if errors[k] is None]
+        if self._columns:
+            infos = self._on_columns(np.array(ok, dtype=np.int64), errors, actions, replaced,
+                                     rewards, terminated)
+        else:
+            infos = self._by_rows(ok, errors, actions, replaced, rewards, terminated)
         rows = infos if isinstance(infos, list) else None   # a dict each, or columns
-        for k in range(n):
+        for k in range(n) if errors.count(None) < n else ():
             if errors[k] is None:
                 continue
             env = self.envs[k]
@@ -266,26 +248,79 @@ class Episodes:
         obs = self.batched_obs()
         return obs, rewards, terminated, batch_infos(rows) if rows is not None else infos
 
-    def _measured(self, ok, nows, raw, sums, actions, replaced, rewards, terminated):
-        """Rewards, ends, sums, observations and the info of the environments
-        ``ok`` that measured ``nows`` (with ``raw``, their columns, for a
-        batch measured on columns; ``sums`` their rows of sums). Fills their
-        rows of ``rewards`` and ``terminated``; returns the info: a list of
-        per-environment dicts, or for a batch measured on columns its
-        columns (a dict)."""
+    def _keep(self, env, k: int, now: dict, reward: float, succeeded, failed, rewards,
+              terminated) -> None:
+        """Row k's end of a step that measured ``now``: its reward (the
+        failure reward for a failure), end and flags, and ``now`` as its last
+        measurement."""
+        rewards[k] = env.failure_reward if failed else reward
+        terminated[k] = bool(succeeded) or bool(failed)
+        self.failed[k] = failed
+        self.ended[k] = terminated[k]
+        self.prev[k] = now
+
+    def _by_rows(self, ok, errors, actions, replaced, rewards, terminated) -> list:
+        """The step's end for a family that measures each environment on its
+        own: each measures (``measure``), is rewarded (``reward``), ends
+        (the class's ``ends``), observes and makes its info dict. Fills the
+        rows ``ok`` of ``rewards`` and ``terminated`` (a physics failure of
+        a measurement goes into ``errors``); returns the infos, one per row
+        (None where the step failed)."""
+        nows = []
+        for k in ok:
+            try:
+                nows.append(self.envs[k].measure())
+            except PHYSICS_ERRORS as err:
+                errors[k] = err
+        if len(nows) < len(ok):
+            ok = [k for k in ok if errors[k] is None]
+        infos: list = [None] * self.num_envs
+        if not ok:
+            return infos
+        group = [self.envs[k] for k in ok]
+        succeeded, failed = self.envs[0].ends(group, nows, None, None, None)
+        for i, (env, k, now) in enumerate(zip(group, ok, nows)):
+            reward = env.reward(actions[k], now)
+            info = env.make_info(now)
+            info["nonfinite_action"] = int(replaced[k])
+            fail = bool(failed[i])
+            if not math.isfinite(reward):
+                info["error"] = f"non-finite reward {reward}"
+                fail = True
+            self._keep(env, k, now, reward, succeeded[i], fail, rewards, terminated)
+            self.obs[k] = env.observe(now)
+            if env.render_mode == "human":
+                env.render()
+            infos[k] = info
+        return infos
+
+    def _on_columns(self, ok, errors, actions, replaced, rewards, terminated):
+        """The step's end for a family that measures a batch on columns (the
+        ships): one ``measure_batch`` of the environments ``ok``, the rewards
+        on columns (per environment for a single environment or a reward
+        function of one's own), the ends (``ends``), the sums
+        (``update_sums``) and the vector observations on columns. Fills the
+        rows ``ok`` of ``rewards`` and ``terminated`` (a physics failure of
+        the measurement fails every one, into ``errors``); returns the
+        infos: for a single environment a list of its dict, else the
+        columns (a vector info)."""
         n = self.num_envs
         if not ok.size:
             return [None] * n
         e0 = self.envs[0]
-        group = [self.envs[k] for k in ok]
         full = ok.size == n
-        cols = task = None
-        if raw is not None:
-            cols = dict(zip(self._names, raw.T))
-            task = {key: value if full else value[ok]
-                    for key, value in self._task_columns().items()}
-        # rewards
-        if raw is not None and not self.single and e0.rewards_on_columns and all(
+        group = self.envs if full else [self.envs[k] for k in ok]
+        sums = self.sums if full else self.sums[ok]
+        try:
+            raw = e0.measure_batch(group, sums, self.lists)
+        except PHYSICS_ERRORS as err:              # every measured one fails with it
+            for k in ok:
+                errors[k] = err
+            return [None] * n
+        nows = [as_measurement(self._names, row, e0.integer_measures) for row in raw]
+        cols = dict(zip(self._names, raw.T))
+        task = {key: value if full else value[ok] for key, value in self._task_columns().items()}
+        if not self.single and e0.rewards_on_columns and all(
                 env.reward_fn is type(env).reward_fn for env in self.envs):
             kw = {key: value if full else value[ok] for key, value in self._reward_kw.items()}
             prev = dict(zip(self._names, (self._prev_raw if full else self._prev_raw[ok]).T))
@@ -297,41 +332,33 @@ class Episodes:
         bad = ~np.isfinite(reward)
         succeeded, failed = e0.ends(group, nows, cols, sums, task)
         failed = np.asarray(failed, dtype=bool) | bad
-        rewards[ok] = np.where(failed, e0.failure_reward, reward)
-        terminated[ok] = np.asarray(succeeded, dtype=bool) | failed
-        self.failed[ok] = failed
-        self.ended[ok] = terminated[ok]
-        if raw is not None:
-            e0.update_sums(sums, cols)
-            self._prev_raw[ok] = raw
-        # observations
-        if raw is not None and e0.observes_on_columns:
+        for i, (env, k, now) in enumerate(zip(group, ok, nows)):
+            self._keep(env, k, now, reward[i], succeeded[i], failed[i], rewards, terminated)
+        e0.update_sums(sums, cols)
+        if not full:
+            self.sums[ok] = sums
+        self._prev_raw[ok] = raw
+        if e0.observes_on_columns:
             features = raw[:, e0.feature_columns]
             for j, f in enumerate(e0.features):
                 if f.name == "time_left":
                     features[:, j] = [env.time_left() for env in group]
-            vectors = observation_vectors(features, e0.features, actions[ok])
-            for k, now, vector in zip(ok, nows, vectors):
-                self.prev[k] = now
+            for k, vector in zip(ok, observation_vectors(features, e0.features, actions[ok])):
                 self.obs[k] = vector
         else:
-            for env, k, now in zip(group, ok, nows):
-                self.prev[k] = now
-                self.obs[k] = env.observe(now)
+            for env, k in zip(group, ok):
+                self.obs[k] = env.observe(self.prev[k])
         for env in group:
             if env.render_mode == "human":
                 env.render()
-        if raw is None or self.single:          # each environment's info dict
-            infos: list = [None] * n
-            for env, k, now, r, b in zip(group, ok, nows, reward, bad):
-                info = env.make_info(now)
-                info["nonfinite_action"] = int(replaced[k])
-                if b:
-                    info["error"] = f"non-finite reward {r}"
-                infos[k] = info
-            return infos
+        if self.single:                      # a single environment: its info dict
+            info = e0.make_info(nows[0])
+            info["nonfinite_action"] = int(replaced[0])
+            if bad[0]:
+                info["error"] = f"non-finite reward {reward[0]}"
+            return [info]
         columns = e0.info_columns(raw, sums, self.steps[ok], task)
-        columns["nonfinite_action"] = replaced[ok]
+        columns["nonfinite_action"] = np.asarray(replaced)[ok]
         infos = spread_columns(columns, ok, n)
         for i in np.flatnonzero(bad):
             infos = self._add_info(infos, {"error": f"non-finite reward {reward[i]}"}, ok[i])
