@@ -36,6 +36,7 @@ import numpy as np
 
 __all__ = ["excess", "safety", "closeness", "wind_drift_reward", "convergence_reward",
            "marginal_ice_zone_reward", "floe_clustering_reward", "wasserstein1",
+           "cumulative_fractions", "wasserstein1_to",
            "thickness_distribution_reward", "ship_navigation_reward", "ship_beset_reward",
            "ship_progress", "ship_reward_bounds"]
 
@@ -103,11 +104,22 @@ def wasserstein1(g, g_target, h) -> float:
     """Wasserstein-1 distance [m] between two thickness distributions on the
     class thicknesses ``h`` (open water h = 0 first): ∫ |G(h) − G*(h)| dh
     with G the cumulative fractions."""
+    return wasserstein1_to(g, cumulative_fractions(g_target),
+                           np.diff(np.asarray(h, dtype=float)))
+
+
+def cumulative_fractions(g) -> np.ndarray:
+    """The cumulative fractions G of the distribution ``g`` (normalised)."""
     g = np.asarray(g, dtype=float)
-    t = np.asarray(g_target, dtype=float)
-    h = np.asarray(h, dtype=float)
-    diff = np.abs(np.cumsum(g / g.sum()) - np.cumsum(t / t.sum()))[:-1]
-    return float(np.sum(diff * np.diff(h)))
+    return np.cumsum(g / g.sum())
+
+
+def wasserstein1_to(g, target_cumulative: np.ndarray, dh: np.ndarray) -> float:
+    """:func:`wasserstein1` of ``g`` to a target given by its cumulative
+    fractions (:func:`cumulative_fractions`) on classes of widths ``dh``
+    (``np.diff(h)``): the same numbers, for a target used step after step."""
+    diff = np.abs(cumulative_fractions(g) - target_cumulative)[:-1]
+    return float(np.sum(diff * dh))
 
 
 def thickness_distribution_reward(prev, action, now, *, target, h,

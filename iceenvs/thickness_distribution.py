@@ -17,7 +17,8 @@ from .step import Episodes
 from .controllers import Controller
 from .facts import EnvFacts
 from .vector import vector_class
-from .rewards import closeness, thickness_distribution_reward, wasserstein1
+from .rewards import (closeness, cumulative_fractions, thickness_distribution_reward,
+                      wasserstein1, wasserstein1_to)
 
 __all__ = ["ThicknessDistributionEnv", "ThicknessDistributionVectorEnv",
            "ThicknessDistributionController", "default_target",
@@ -295,7 +296,7 @@ class ThicknessDistributionEnv(ControlEnv):
 
     episode_members = ("model",)
     #: the observation's work buffer, written whole before it is read
-    episode_caches = ("_vec",)
+    episode_caches = ("_vec", "_target_of", "_target_cumulative")
 
     def __init__(self, *, kernel="constant", kernel_params: dict | None = None,
                  n_classes: int = GODLOVITCH.n_classes, dh: float = GODLOVITCH.class_width,
@@ -344,6 +345,8 @@ class ThicknessDistributionEnv(ControlEnv):
         h = np.concatenate([[0.0], self.dh * np.arange(1, self.n_classes + 1)])
         h.setflags(write=False)
         self._h = h
+        self._dh = np.diff(h)                           # class widths [m]
+        self._target_of = self._target_cumulative = None
         self._coarse_idx = _coarse_index(h)
         self._h_coarse = np.concatenate(
             [[0.0], COARSE_WIDTH * (np.arange(N_COARSE) + 0.5)])      # class centres [m]
@@ -395,10 +398,13 @@ class ThicknessDistributionEnv(ControlEnv):
         g = m.g
         if not np.all(np.isfinite(g)):
             raise FloatingPointError("the thickness distribution is no longer finite")
+        target = self.target
+        if self._target_of is not target:       # the target's cumulative fractions, once
+            self._target_of, self._target_cumulative = target, cumulative_fractions(target)
         return {"g": g.copy(), "h": self._h, "open_water": float(g[0]),
                 "mean_thickness": float(np.dot(g, self._h)), "day": float(m.time),
                 "kernel_scale": float(m.kernel_scale), "rafting_factor": float(m.rafting_factor),
-                "w1": wasserstein1(g, self.target, self._h)}
+                "w1": wasserstein1_to(g, self._target_cumulative, self._dh)}
 
     def observe(self, now: dict) -> np.ndarray:
         v = self._vec
