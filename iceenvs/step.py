@@ -66,22 +66,23 @@ def advance_all(envs, actions: np.ndarray, together: bool,
     lists ``lists`` kept by the caller) or each its own. Returns per
     environment ``None`` or the physics error that ends its episode."""
     errors: list[BaseException | None] = [None] * len(envs)
+    if not together:
+        for k, env in enumerate(envs):
+            try:
+                env.apply_action(actions[k])
+                env.advance()
+            except PHYSICS_ERRORS as err:
+                errors[k] = err
+        return errors
     for k, env in enumerate(envs):
         try:
             env.apply_action(actions[k])
         except PHYSICS_ERRORS as err:
             errors[k] = err
     moving = [k for k, err in enumerate(errors) if err is None]
-    if together:
-        if moving:
-            for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
-                                                       envs[0].control_interval, lists=lists)):
-                errors[k] = err
-        return errors
-    for k in moving:
-        try:
-            envs[k].advance()
-        except PHYSICS_ERRORS as err:
+    if moving:
+        for k, err in zip(moving, advance_together([envs[k].sim for k in moving],
+                                                   envs[0].control_interval, lists=lists)):
             errors[k] = err
     return errors
 
@@ -277,9 +278,10 @@ class Episodes:
         infos: list = [None] * self.num_envs
         if not ok:
             return infos
-        group = [self.envs[k] for k in ok]
+        group = self.envs if len(ok) == self.num_envs else [self.envs[k] for k in ok]
         succeeded, failed = self.envs[0].ends(group, nows, None, None, None)
-        for i, (env, k, now) in enumerate(zip(group, ok, nows)):
+        for i, k in enumerate(ok):
+            env, now = group[i], nows[i]
             reward = env.reward(actions[k], now)
             info = env.make_info(now)
             info["nonfinite_action"] = int(replaced[k])
