@@ -54,6 +54,7 @@ import numpy as np
 from numba import njit
 
 from .domain import minimum_image
+from .neighbors import bucket_sort
 from .hertz_kernels import (KICK_FASTMATH, apart_until, first_half, floe_drag, kick_drift_pass,
                             floe_walls, floe_walls_skipping, listed_pair, max_keep_nan,
                             wall_overlap)
@@ -150,21 +151,11 @@ def pair_index(verlet):
     form: slice bounds and pairs) of the Verlet list ``verlet``."""
     start, nbr = verlet.start, verlet.nbr
     n = start.shape[0] - 1
-    m = nbr.shape[0]
-    owner = np.empty(m, dtype=np.int64)
-    partner_start = np.zeros(n + 1, dtype=np.int64)
+    owner = np.empty(nbr.shape[0], dtype=np.int64)
     for i in range(n):
         for p in range(start[i], start[i + 1]):
             owner[p] = i
-            partner_start[nbr[p] + 1] += 1
-    for i in range(n):
-        partner_start[i + 1] += partner_start[i]
-    fill = partner_start[:-1].copy()
-    as_partner = np.empty(m, dtype=np.int64)
-    for p in range(m):
-        j = nbr[p]
-        as_partner[fill[j]] = p
-        fill[j] += 1
+    partner_start, as_partner = bucket_sort(nbr, n)
     return owner, partner_start, as_partner
 
 

@@ -139,6 +139,14 @@ def _kind(movers):
     return getattr(movers, "instance_class", None)
 
 
+def _form(movers, every=None, parallel=None, awake=None, window=None):
+    """A phase's implementation for the form of ``movers`` (an overload's
+    choice, at compile time): ``every`` for :class:`EveryFloe`, ``parallel``
+    for :class:`EveryFloeParallel`, ``awake`` for :class:`AwakeFloes`,
+    ``window`` for :class:`WindowFloes`; None for a form not given."""
+    return {EveryFloe: every, EveryFloeParallel: parallel, AwakeFloes: awake,
+            WindowFloes: window}.get(_kind(movers))
+
 
 # -- the phases: each a stub whose form is compiled per movers type ----------
 # (``overload(..., inline="always")``: the chosen form becomes part of the
@@ -206,34 +214,31 @@ def _travel_phase(movers, ship, dt):
 
 @overload(kick_phase, inline="always")
 def _kick_phase(movers, work, floes, verlet, drive, kick, step):
-    kind = _kind(movers)
-    if kind is EveryFloe:
-        def impl(movers, work, floes, verlet, drive, kick, step):
-            return first_half(work, verlet.ref, drive, kick, movers.path)
-    elif kind is EveryFloeParallel:
-        def impl(movers, work, floes, verlet, drive, kick, step):
-            return first_half_parallel(movers.n_chunks, floes,
-                                       ForceBuffers(work.force, work.torque), movers.chunks,
-                                       verlet.ref, drive, kick)
-    elif kind is AwakeFloes:
-        def impl(movers, work, floes, verlet, drive, kick, step):
-            return first_half_awake(work, verlet.ref, drive, kick, movers.awake, movers.path)
-    elif kind is WindowFloes:
-        def impl(movers, work, floes, verlet, drive, kick, step):
-            counts = movers.counts
-            if counts[W_FREE] == 0:
-                worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, movers.path)
-                counts[W_BROKEN] = 0
-            else:
-                worst, mx, my, vmax2, n_broken = engaged_pass(
-                    work, verlet.ref, drive, kick, movers.awake, movers.path, movers.lines,
-                    (step + 1 - counts[W_START]) * kick.dt, movers.pairs.stack)
-                counts[W_BROKEN] = n_broken
-            counts[W_ENGAGED_STEPS] += movers.awake.count[0]
-            return worst, mx, my, vmax2
-    else:
-        return None
-    return impl
+    def every(movers, work, floes, verlet, drive, kick, step):
+        return first_half(work, verlet.ref, drive, kick, movers.path)
+
+    def parallel(movers, work, floes, verlet, drive, kick, step):
+        return first_half_parallel(movers.n_chunks, floes,
+                                   ForceBuffers(work.force, work.torque), movers.chunks,
+                                   verlet.ref, drive, kick)
+
+    def awake(movers, work, floes, verlet, drive, kick, step):
+        return first_half_awake(work, verlet.ref, drive, kick, movers.awake, movers.path)
+
+    def window(movers, work, floes, verlet, drive, kick, step):
+        counts = movers.counts
+        if counts[W_FREE] == 0:
+            worst, mx, my, vmax2 = first_half(work, verlet.ref, drive, kick, movers.path)
+            counts[W_BROKEN] = 0
+        else:
+            worst, mx, my, vmax2, n_broken = engaged_pass(
+                work, verlet.ref, drive, kick, movers.awake, movers.path, movers.lines,
+                (step + 1 - counts[W_START]) * kick.dt, movers.pairs.stack)
+            counts[W_BROKEN] = n_broken
+        counts[W_ENGAGED_STEPS] += movers.awake.count[0]
+        return worst, mx, my, vmax2
+
+    return _form(movers, every, parallel, awake, window)
 
 
 @overload(window_phase, inline="always")
@@ -288,47 +293,41 @@ def _window_phase(movers, run, work, verlet, step, dt, worst):
 
 @overload(wall_phase, inline="always")
 def _wall_phase(movers, floes, wall_law, box, dt, fbuf, tbuf):
-    kind = _kind(movers)
-    if kind is EveryFloe:
-        def impl(movers, floes, wall_law, box, dt, fbuf, tbuf):
-            if movers.skip:
-                wall_forces(0, floes.pos.shape[0], floes, wall_law, box, dt, fbuf, tbuf,
-                            movers.path, movers.wall_due)
-            else:
-                wall_forces(0, floes.pos.shape[0], floes, wall_law, box, dt, fbuf, tbuf)
-    elif kind is EveryFloeParallel:
-        def impl(movers, floes, wall_law, box, dt, fbuf, tbuf):
-            wall_forces_parallel(floes, wall_law, box, dt, fbuf, tbuf)
-    elif kind is AwakeFloes or kind is WindowFloes:
-        def impl(movers, floes, wall_law, box, dt, fbuf, tbuf):
-            awake_wall_forces(movers.awake, floes, wall_law, box, dt, movers.path,
-                              movers.wall_due, fbuf, tbuf)
-    else:
-        return None
-    return impl
+    def every(movers, floes, wall_law, box, dt, fbuf, tbuf):
+        if movers.skip:
+            wall_forces(0, floes.pos.shape[0], floes, wall_law, box, dt, fbuf, tbuf,
+                        movers.path, movers.wall_due)
+        else:
+            wall_forces(0, floes.pos.shape[0], floes, wall_law, box, dt, fbuf, tbuf)
+
+    def parallel(movers, floes, wall_law, box, dt, fbuf, tbuf):
+        wall_forces_parallel(floes, wall_law, box, dt, fbuf, tbuf)
+
+    def awake(movers, floes, wall_law, box, dt, fbuf, tbuf):
+        awake_wall_forces(movers.awake, floes, wall_law, box, dt, movers.path,
+                          movers.wall_due, fbuf, tbuf)
+
+    return _form(movers, every, parallel, awake, window=awake)
 
 
 @overload(hull_phase, inline="always")
 def _hull_phase(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
-    kind = _kind(movers)
-    if kind is EveryFloe or kind is EveryFloeParallel:
-        def impl(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
-            return hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), fbuf, tbuf)
-    elif kind is AwakeFloes:
-        def impl(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
-            logged = hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), fbuf, tbuf)
-            hull_wakes(ship, movers.awake, fbuf, tbuf)
-            return logged
-    elif kind is WindowFloes:
-        def impl(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
-            floe_speed = max(math.sqrt(vmax2), movers.bounds[1])
-            if movers.counts[W_FREE] > 0:
-                return hull_forces(ship, floes, box, time, dt, floe_speed, fbuf, tbuf,
-                                   movers.awake.flag)
-            return hull_forces(ship, floes, box, time, dt, floe_speed, fbuf, tbuf)
-    else:
-        return None
-    return impl
+    def every(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
+        return hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), fbuf, tbuf)
+
+    def awake(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
+        logged = hull_forces(ship, floes, box, time, dt, math.sqrt(vmax2), fbuf, tbuf)
+        hull_wakes(ship, movers.awake, fbuf, tbuf)
+        return logged
+
+    def window(movers, ship, floes, box, time, dt, vmax2, fbuf, tbuf):
+        floe_speed = max(math.sqrt(vmax2), movers.bounds[1])
+        if movers.counts[W_FREE] > 0:
+            return hull_forces(ship, floes, box, time, dt, floe_speed, fbuf, tbuf,
+                               movers.awake.flag)
+        return hull_forces(ship, floes, box, time, dt, floe_speed, fbuf, tbuf)
+
+    return _form(movers, every, every, awake, window)
 
 
 @overload(wide_phase, inline="always")
@@ -375,35 +374,32 @@ def _expiry_phase(movers, run, work, verlet, step, dt):
 
 @overload(pair_phase, inline="always")
 def _pair_phase(movers, floes, law, box, verlet, dt, fbuf, tbuf):
-    kind = _kind(movers)
-    if kind is EveryFloe:
-        def impl(movers, floes, law, box, verlet, dt, fbuf, tbuf):
-            owners = movers.chunks.owners
-            if movers.skip:
-                owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, fbuf, tbuf,
-                            0, 0, None, None, movers.path, movers.due)
-            else:
-                owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, fbuf, tbuf)
-    elif kind is EveryFloeParallel:
-        def impl(movers, floes, law, box, verlet, dt, fbuf, tbuf):
-            pair_forces_parallel(movers.chunks, floes, law, box, verlet, dt,
-                                 ForceBuffers(fbuf, tbuf))
-    elif kind is AwakeFloes:
-        def impl(movers, floes, law, box, verlet, dt, fbuf, tbuf):
-            live_pair_forces(movers.pairs, movers.awake, floes, law, box, verlet, dt,
-                             movers.path, fbuf, tbuf)
-            if movers.awake.count[1] > 0:
-                add_woken(movers.awake, verlet, movers.pairs)
-    elif kind is WindowFloes:
-        def impl(movers, floes, law, box, verlet, dt, fbuf, tbuf):
-            if movers.counts[W_HULL_BROKEN]:
-                # the hull's guard failed: a free floe may touch an engaged one now
-                all_pairs_live(verlet, movers.awake, movers.pairs)
-            live_pair_forces(movers.pairs, movers.awake, floes, law, box, verlet, dt,
-                             movers.path, fbuf, tbuf)
-    else:
-        return None
-    return impl
+    def every(movers, floes, law, box, verlet, dt, fbuf, tbuf):
+        owners = movers.chunks.owners
+        if movers.skip:
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, fbuf, tbuf,
+                        0, 0, None, None, movers.path, movers.due)
+        else:
+            owner_pairs(0, owners.shape[0], owners, floes, law, box, verlet, dt, fbuf, tbuf)
+
+    def parallel(movers, floes, law, box, verlet, dt, fbuf, tbuf):
+        pair_forces_parallel(movers.chunks, floes, law, box, verlet, dt,
+                             ForceBuffers(fbuf, tbuf))
+
+    def awake(movers, floes, law, box, verlet, dt, fbuf, tbuf):
+        live_pair_forces(movers.pairs, movers.awake, floes, law, box, verlet, dt,
+                         movers.path, fbuf, tbuf)
+        if movers.awake.count[1] > 0:
+            add_woken(movers.awake, verlet, movers.pairs)
+
+    def window(movers, floes, law, box, verlet, dt, fbuf, tbuf):
+        if movers.counts[W_HULL_BROKEN]:
+            # the hull's guard failed: a free floe may touch an engaged one now
+            all_pairs_live(verlet, movers.awake, movers.pairs)
+        live_pair_forces(movers.pairs, movers.awake, floes, law, box, verlet, dt,
+                         movers.path, fbuf, tbuf)
+
+    return _form(movers, every, parallel, awake, window)
 
 
 @overload(ends_window, inline="always")
@@ -520,37 +516,33 @@ def rebuilt(movers, run, verlet, lx, ly, dt):
 
 @overload(rebuilt, inline="always")
 def _rebuilt(movers, run, verlet, lx, ly, dt):
-    kind = _kind(movers)
-    if kind is EveryFloe:
-        def impl(movers, run, verlet, lx, ly, dt):
-            floes, box, ship = run[0], run[4], run[5]
-            verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, False,
-                                    ship, box.deforming, dt)
-            return verlet, EveryFloe(movers.path, np.full(verlet.nbr.shape[0], -np.inf),
-                                     movers.wall_due, pair_chunks(verlet, 1), movers.skip)
-    elif kind is EveryFloeParallel:
-        def impl(movers, run, verlet, lx, ly, dt):
-            floes, box, ship = run[0], run[4], run[5]
-            verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, True,
-                                    ship, box.deforming, dt)
-            return verlet, EveryFloeParallel(movers.n_chunks,
-                                             pair_chunks(verlet, movers.n_chunks))
-    elif kind is AwakeFloes:
-        def impl(movers, run, verlet, lx, ly, dt):
-            floes, box, ship = run[0], run[4], run[5]
-            verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, False,
-                                    ship, box.deforming, dt)
-            awake = movers.awake
-            # the new wide floes are integrated (their shadow positions must
-            # be in the kick-drift pass); the pending floes' pairs are live
-            for k in range(verlet.wide.shape[0]):
-                wake(verlet.wide[k], awake)
-            pairs = live_pairs(verlet, awake)
-            add_woken(awake, verlet, pairs)
-            return verlet, AwakeFloes(awake, pairs, movers.path, movers.wall_due)
-    else:
-        return None
-    return impl
+    def every(movers, run, verlet, lx, ly, dt):
+        floes, box, ship = run[0], run[4], run[5]
+        verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, False,
+                                ship, box.deforming, dt)
+        return verlet, EveryFloe(movers.path, np.full(verlet.nbr.shape[0], -np.inf),
+                                 movers.wall_due, pair_chunks(verlet, 1), movers.skip)
+
+    def parallel(movers, run, verlet, lx, ly, dt):
+        floes, box, ship = run[0], run[4], run[5]
+        verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, True,
+                                ship, box.deforming, dt)
+        return verlet, EveryFloeParallel(movers.n_chunks, pair_chunks(verlet, movers.n_chunks))
+
+    def awake(movers, run, verlet, lx, ly, dt):
+        floes, box, ship = run[0], run[4], run[5]
+        verlet = rebuild_in_run(floes, verlet, lx, ly, box.periodic_x, box.periodic_y, False,
+                                ship, box.deforming, dt)
+        awake = movers.awake
+        # the new wide floes are integrated (their shadow positions must
+        # be in the kick-drift pass); the pending floes' pairs are live
+        for k in range(verlet.wide.shape[0]):
+            wake(verlet.wide[k], awake)
+        pairs = live_pairs(verlet, awake)
+        add_woken(awake, verlet, pairs)
+        return verlet, AwakeFloes(awake, pairs, movers.path, movers.wall_due)
+
+    return _form(movers, every, parallel, awake)
 
 
 @njit(cache=True, error_model="numpy")
@@ -594,29 +586,31 @@ def start_run(run):
 def run_every_floe(n_steps, dt, time, run, verlet):
     """The full serial step (:class:`EveryFloe`): returns (steps done,
     status, list rebuilds, the list now)."""
-    floes, box, ship = run[0], run[4], run[5]
-    n = floes.pos.shape[0]
-    buffers, work = start_run(run)
-    movers = EveryFloe(np.zeros(n), np.full(verlet.nbr.shape[0], -np.inf), np.full(n, -np.inf),
-                       pair_chunks(verlet, 1), not box.deforming)
-    done, status, n_rebuilds, verlet, movers = run_pieces(n_steps, dt, time, run, work, verlet,
-                                                          movers)
-    gather_cut(0, n, movers.chunks, buffers.force, buffers.torque)
-    end_run(floes, buffers.force, buffers.torque, done, dt, ship)
-    return done, status, n_rebuilds, verlet
+    n, box = run[0].pos.shape[0], run[4]
+    return run_chunked(n_steps, dt, time, run, verlet,
+                       EveryFloe(np.zeros(n), np.full(verlet.nbr.shape[0], -np.inf),
+                                 np.full(n, -np.inf), pair_chunks(verlet, 1), not box.deforming))
 
 
 @njit(cache=True, error_model="numpy")
 def run_every_floe_parallel(n_steps, dt, time, run, verlet, n_chunks):
     """The full parallel step (:class:`EveryFloeParallel`, ``n_chunks``
     chunks): returns (steps done, status, list rebuilds, the list now)."""
+    return run_chunked(n_steps, dt, time, run, verlet,
+                       EveryFloeParallel(n_chunks, pair_chunks(verlet, n_chunks)))
+
+
+@njit(cache=True, error_model="numpy")
+def run_chunked(n_steps, dt, time, run, verlet, movers):
+    """A full step's run (``movers``: :class:`EveryFloe` or
+    :class:`EveryFloeParallel`, whose pairs come in chunks): the pieces,
+    then the forces each chunk cut gathered and the run ended. Returns
+    (steps done, status, list rebuilds, the list now)."""
     floes, ship = run[0], run[5]
-    n = floes.pos.shape[0]
     buffers, work = start_run(run)
-    movers = EveryFloeParallel(n_chunks, pair_chunks(verlet, n_chunks))
     done, status, n_rebuilds, verlet, movers = run_pieces(n_steps, dt, time, run, work, verlet,
                                                           movers)
-    gather_cut(0, n, movers.chunks, buffers.force, buffers.torque)
+    gather_cut(0, floes.pos.shape[0], movers.chunks, buffers.force, buffers.torque)
     end_run(floes, buffers.force, buffers.torque, done, dt, ship)
     return done, status, n_rebuilds, verlet
 

@@ -75,25 +75,33 @@ def build_cells(pos, lx, ly, cell_size):
     ncx = max(1, int(lx / cell_size))
     ncy = max(1, int(ly / cell_size))
     cell_of = np.empty(n, dtype=np.int64)
-    counts = np.zeros(ncx * ncy + 1, dtype=np.int64)
     for i in range(n):
         cx = int(pos[i, 0] / lx * ncx)
         cy = int(pos[i, 1] / ly * ncy)
         cx = min(max(cx, 0), ncx - 1)
         cy = min(max(cy, 0), ncy - 1)
-        c = cy * ncx + cx
-        cell_of[i] = c
-        counts[c + 1] += 1
-    for c in range(ncx * ncy):
-        counts[c + 1] += counts[c]
-    cell_start = counts.copy()
-    fill = counts[:-1].copy()
-    cell_floes = np.empty(n, dtype=np.int64)
-    for i in range(n):
-        c = cell_of[i]
-        cell_floes[fill[c]] = i
-        fill[c] += 1
+        cell_of[i] = cy * ncx + cx
+    cell_start, cell_floes = bucket_sort(cell_of, ncx * ncy)
     return ncx, ncy, cell_start, cell_floes, cell_of
+
+
+@njit(cache=True, error_model="numpy")
+def bucket_sort(keys, n_bins):
+    """Counting sort of the items 0..M-1 by their ``keys`` (M,) in
+    0..``n_bins``-1: (start (n_bins + 1,), order (M,)), the items of bin b
+    being ``order[start[b]:start[b + 1]]``, in their order."""
+    start = np.zeros(n_bins + 1, dtype=np.int64)
+    for k in range(keys.shape[0]):
+        start[keys[k] + 1] += 1
+    for b in range(n_bins):
+        start[b + 1] += start[b]
+    fill = start[:-1].copy()
+    order = np.empty(keys.shape[0], dtype=np.int64)
+    for k in range(keys.shape[0]):
+        b = keys[k]
+        order[fill[b]] = k
+        fill[b] += 1
+    return start, order
 
 
 N_CHUNKS = 64
