@@ -205,7 +205,8 @@ def test_time_budget_stops_training_and_saves_the_model(tmp_path, capsys):
     summary = yaml.safe_load((out / "training.yaml").read_text())
     assert summary["stopped_by"] == "its budget of 1e-09 minutes"
     assert summary["steps"] == steps and summary["planned_steps"] == 100000
-    assert summary["host"]["torch_threads"] == 1 and summary["wall_seconds"] > 0
+    # the wall time is kept to 0.1 s: a run stopped in its first rollout may keep 0.0
+    assert summary["host"]["torch_threads"] == 1 and summary["wall_seconds"] >= 0.0
     with pytest.raises(ValueError, match="minutes"):
         TimeBudgetCallback(0.0)
 
