@@ -243,8 +243,9 @@ class ControlEnv(gym.Env):
     An environment over a floe engine (``self.sim``) provides ``make_sim``,
     ``apply_action``, ``measure`` and ``_frame`` (an RGB array); one over
     another model (the thickness distribution) builds it in ``reset``, then
-    calls ``_begin_episode``, and provides ``_ready`` (a model exists),
-    ``advance``, ``observe`` and ``make_info`` as well. The environments'
+    begins the episode in its batch (``self.episodes.begin(self.row)``),
+    and provides ``_ready`` (a model exists), ``advance``, ``observe`` and
+    ``make_info`` as well. The environments'
     classes are at most three deep: this class, a family (:class:`HertzEnv`,
     :class:`iceenvs.ship_env.ShipEnv`) and the task.
 
@@ -573,11 +574,6 @@ class ControlEnv(gym.Env):
     @property
     def _obs(self):
         return self.episodes.obs[self.row]
-
-    def _begin_episode(self):
-        """Zero action, first measurement and observation of a new episode;
-        returns what ``reset`` returns."""
-        return self.episodes.begin(self.row)
 
     def step(self, action):
         """One step: the step of the environment's batch of one

@@ -138,6 +138,9 @@ class Episodes:
         self._columns = bool(e0.measures_in_batch)
         self._names = tuple(e0.measure_names) if self._columns else ()
         self._prev_raw = np.zeros((n, len(self._names)))
+        # the observation's entries that no measurement holds (``horizon``'s time_left)
+        self._time_left = [j for j, f in enumerate(e0.features)
+                           if f.name == "time_left"] if self._columns else []
         self._reward_kw: dict[str, np.ndarray] = {}
         self._task_rows: list = [None] * n
         self._task: dict | None = None
@@ -342,9 +345,8 @@ class Episodes:
         self._prev_raw[ok] = raw
         if e0.observes_on_columns:
             features = raw[:, e0.feature_columns]
-            for j, f in enumerate(e0.features):
-                if f.name == "time_left":
-                    features[:, j] = [env.time_left() for env in group]
+            for j in self._time_left:
+                features[:, j] = [env.time_left() for env in group]
             for k, vector in zip(ok, observation_vectors(features, e0.features, actions[ok])):
                 self.obs[k] = vector
         else:
