@@ -451,10 +451,15 @@ class ControlEnv(gym.Env):
         is drawn, given or not and in a fixed order, so that a seed gives
         the same episode whichever of them is given."""
         for name in self.drawn:
-            value = float(rng.uniform(*task[f"{name}_range"]))
+            value = float(rng.uniform(*self._draw_range(name, task)))
             if task[name] is None:
                 task[name] = value
         return task
+
+    def _draw_range(self, name: str, task: dict) -> tuple:
+        """The range a drawn task parameter ``name`` is drawn from: its
+        ``<name>_range``."""
+        return task[f"{name}_range"]
 
     # -- the task ---------------------------------------------------------------------------
     def apply_action(self, action: np.ndarray) -> None:

@@ -414,14 +414,9 @@ class ShipEnv(ControlEnv):
 
     # -- wind and current (the tasks with `wind_speed`, `wind_direction`,
     # `current_speed` and `current_direction` parameters)
-    def _draw_episode(self, task, rng):
+    def _draw_range(self, name, task):
         # a drawn direction is an angle, drawn over the whole circle
-        for name in self.drawn:
-            rng_range = ANGLE if name.endswith("direction") else task[f"{name}_range"]
-            value = float(rng.uniform(*rng_range))
-            if task[name] is None:
-                task[name] = value
-        return task
+        return ANGLE if name.endswith("direction") else super()._draw_range(name, task)
 
     def _forcing(self):
         """The episode's wind and current forcing."""
