@@ -26,7 +26,7 @@ tables show at most four), and ``--render`` writes it back so::
 
     python -m agents.leaderboard [--env iceenvs/ShipNavigation-v1]
         [--concentrations 0.2,0.3,0.4,0.5] [--episodes 20] [--seed 10000]
-        [--policies NAMES|module:Class] [--trained NAME=RUN_DIR[@STEPS] ...]
+        [--policies NAMES|[NAME=]module:Class] [--trained NAME=RUN_DIR[@STEPS] ...]
         [--merge [--replace NAMES]]
         [--env-kwargs key=value ...] [--processes 2] [--out DIR]
     python -m agents.leaderboard --render [--out DIR]   # the table and plot from the JSON
@@ -55,8 +55,8 @@ from physics.provenance import source_commit
 
 from .metrics import METRIC_UNITS, rounding_noise, significant
 
-__all__ = ["run_leaderboard", "summarise_board", "pooled_comparison", "board_markdown", "record_commands",
-           "grouped", "against_markdown",
+__all__ = ["run_leaderboard", "policy_label", "summarise_board", "pooled_comparison",
+           "board_markdown", "record_commands", "grouped", "against_markdown",
            "plot_board", "main",
            "NORMALISED", "SHOWN", "ROUTE_CHOICE_RATIO", "DETOUR_LIMIT"]
 
@@ -498,6 +498,23 @@ def _group_argument(item: str) -> tuple[str, list[str]]:
     return name, [m for m in members.split(",") if m]
 
 
+def policy_label(item: str) -> tuple[str, str]:
+    """(the board's name, the policy) of a ``--policies`` item: ``NAME=module:Class...``
+    names a policy of one's own NAME; any other item is its own name.
+
+    >>> policy_label("student-s1=agents.waypoints:WaypointStudent?run=runs/s1")
+    ('student-s1', 'agents.waypoints:WaypointStudent?run=runs/s1')
+    >>> policy_label("agents.baselines:ZeroPolicy?gain=1")
+    ('agents.baselines:ZeroPolicy?gain=1', 'agents.baselines:ZeroPolicy?gain=1')
+    """
+    from .policy import is_reference
+
+    label, sep, rest = item.partition("=")
+    if sep and label and not any(c in label for c in ":?/.") and is_reference(rest):
+        return label, rest
+    return item, item
+
+
 def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -510,7 +527,8 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
                    help="comma-separated baselines (default: the environment's planners, "
                         "such as straight,reactive,swath,lattice on ShipNavigation-v1) and "
                         "policies of one's own, module:Class or path/to/file.py:Class "
-                        "(?key=value&... for their arguments; agents.policy)")
+                        "(?key=value&... for their arguments; agents.policy), each "
+                        "NAME=module:Class... to show it as NAME")
     p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR[@STEPS]",
                    help="a trained policy (agents.train's run directory; @STEPS: its checkpoint "
                         "at STEPS steps), repeatable")
@@ -674,14 +692,17 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         parser.error("--env-kwargs concentration: the concentrations come from --concentrations")
     policies = ([p.strip() for p in args.policies.split(",") if p.strip()]
                 if args.policies is not None else default_policies(args.env))
+    named = dict(policy_label(p) for p in policies)
+    if len(named) < len(policies):
+        parser.error("--policies names a policy twice")
     try:
-        check_policy_names(policies, args.env)
+        check_policy_names(list(named.values()), args.env)
     except ValueError as err:
         parser.error(str(err))
-    if "straight" not in policies:
-        policies.insert(0, "straight")
+    if "straight" not in named:
+        named = {"straight": "straight", **named}
     try:
-        recipes = {name: policy_recipe(name) for name in policies}
+        recipes = {label: policy_recipe(name) for label, name in named.items()}
     except ValueError as err:
         parser.error(str(err))
     for item in args.trained:
@@ -732,7 +753,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         agent_kwargs={name: kw for name, kw in agent_kwargs.items() if kw and name in recipes},
         episodes=args.episodes, seed=args.seed,
         planners=[p for p in recipes if p != "straight" and p in planner_names],
-        own_policies=[p for p in recipes if is_reference(p)],
+        own_policies=[p for p in recipes if is_reference(named.get(p, p))
+                      or p in (old or {}).get("own_policies", ())],
         machine=f"{platform.machine()}, {platform.system()}, numba {numba.__version__}",
         host=host_signature(),
         date=datetime.date.today().isoformat(),

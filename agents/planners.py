@@ -246,10 +246,9 @@ class LatticePlanner(StraightLineController):
         x, y = (float(v) for v in ship.position)
         heading = float(ship.heading)
         cell = self.lateral_step
-        stage_cells = max(int(round(self.stage_length / cell)), 1)
+        stage_cells, max_slope = self.lattice_steps()
         reach_x = min(self.horizon, max(u.goal_x - x, 0.0) + 2.0 * self.stage_length)
         n_stages = max(int(math.ceil(reach_x / (stage_cells * cell))), 1)
-        max_slope = max(int(round(self.max_slope * stage_cells)), 1)
         half = 0.5 * u.channel_width - self.edge_margin
         low_y, high_y = u.centre_y - half, u.centre_y + half
         # grid rows: y = y0 + (b + 0.5) cell, aligned so that the ship's y is a row centre
@@ -268,8 +267,7 @@ class LatticePlanner(StraightLineController):
         rows = y0 + (np.arange(ny) + 0.5) * cell
         y_low = int(np.searchsorted(rows, min(low_y, y)))
         y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
-        slope = int(round(math.tan(max(min(heading, 1.2), -1.2)) * stage_cells))
-        slope = max(min(slope, max_slope), -max_slope)
+        slope = self.start_slope(heading)
         ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, slope, max_slope,
                                   y_low, y_high, 1.0 / self.metre_cost)
         if not math.isfinite(total):
@@ -282,6 +280,20 @@ class LatticePlanner(StraightLineController):
         if self.show:
             u.plan_overlay = (route, 0.5 * beam)
         return route
+
+    def lattice_steps(self) -> tuple[int, int]:
+        """(cells of a stage, the steepest slope in lateral cells a stage):
+        the lattice's slope steps are ``lateral_step / stage_length``."""
+        stage_cells = max(int(round(self.stage_length / self.lateral_step)), 1)
+        return stage_cells, max(int(round(self.max_slope * stage_cells)), 1)
+
+    def start_slope(self, heading: float) -> int:
+        """The slope, in lateral cells a stage, that a route starts with from
+        a ship heading ``heading`` [rad from +x]: the nearest step, within the
+        lattice's steepest."""
+        stage_cells, steepest = self.lattice_steps()
+        slope = int(round(math.tan(max(min(heading, 1.2), -1.2)) * stage_cells))
+        return max(min(slope, steepest), -steepest)
 
     def _off_route(self, position) -> float:
         xs, ys = self.route[:, 0], self.route[:, 1]

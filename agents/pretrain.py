@@ -245,6 +245,12 @@ def _action_mse(policy, obs, actions):
     return ((policy.get_distribution(obs).distribution.mean - actions) ** 2).mean()
 
 
+def _action_nll(policy, obs, actions):
+    """The mean negative log-likelihood of the discrete ``actions`` under an
+    SB3 policy's categorical distribution on ``obs`` (a torch scalar)."""
+    return -policy.get_distribution(obs).log_prob(actions).mean()
+
+
 def _fit(params, loss_of, n: int, epochs: int, batch_size: int, learning_rate: float,
          generator, deadline: float | None = None) -> int:
     """Adam on ``loss_of(batch_indices)`` over ``epochs`` passes of shuffled
@@ -278,10 +284,15 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     epochs when its part of the time left has passed (the actor's half,
     then the critic's).
 
+    A policy of a ``Discrete`` action space is fitted by the likelihood of
+    the teacher's actions (cross-entropy) instead of the squared distance.
+
     Returns
     -------
     dict
-        ``action_mse``, ``action_variance``, ``actor_epochs`` and, with
+        ``action_mse``, ``action_variance`` (for a ``Discrete`` action space:
+        ``action_nll`` and ``action_accuracy``, the share of ``actions`` that
+        are the policy's most likely), ``actor_epochs`` and, with
         values, ``value_mse``, ``value_variance`` and ``critic_epochs``, on
         the whole data after the fit.
     """
@@ -290,7 +301,12 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     generator = torch.Generator().manual_seed(int(seed))
     x = obs_rows.as_tensor(obs)
     n = obs_rows.length(x)
-    y = torch.as_tensor(actions, dtype=torch.float32).reshape(n, -1)
+    from gymnasium.spaces import Discrete
+
+    discrete = isinstance(policy.action_space, Discrete)
+    loss = _action_nll if discrete else _action_mse
+    y = (torch.as_tensor(actions, dtype=torch.long).reshape(n) if discrete else
+         torch.as_tensor(actions, dtype=torch.float32).reshape(n, -1))
     policy.set_training_mode(True)
 
     actor = [*policy.pi_features_extractor.parameters(),
@@ -302,11 +318,16 @@ def fit_policy(policy, obs: np.ndarray, actions: np.ndarray, values: np.ndarray 
     def rows(b):
         return obs_rows.take(x, b)
 
-    report = {"actor_epochs": _fit(actor, lambda b: _action_mse(policy, rows(b), y[b]), n,
+    report = {"actor_epochs": _fit(actor, lambda b: loss(policy, rows(b), y[b]), n,
                                    epochs, batch_size, learning_rate, generator, actor_deadline)}
     with torch.no_grad():
-        report["action_mse"] = float(_action_mse(policy, x, y))
-        report["action_variance"] = float(y.var(unbiased=False))
+        if discrete:
+            report["action_nll"] = float(_action_nll(policy, x, y))
+            best = policy.get_distribution(x).distribution.probs.argmax(dim=1)
+            report["action_accuracy"] = float((best == y).float().mean())
+        else:
+            report["action_mse"] = float(_action_mse(policy, x, y))
+            report["action_variance"] = float(y.var(unbiased=False))
     if values is not None:
         v = torch.as_tensor(values, dtype=torch.float32).reshape(-1, 1)
         critic = [*policy.mlp_extractor.value_net.parameters(), *policy.value_net.parameters()]

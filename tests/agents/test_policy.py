@@ -74,9 +74,13 @@ def test_own_policy_joins_the_leaderboard_in_worker_processes(steer_module, tmp_
     out = tmp_path / "board"
     ref = "steer_policy:Steer?gain=0.5"
     report = leaderboard.main(["--concentrations", "0.2", "--episodes", "2", "--processes", "2",
-                               "--out", str(out), "--policies", f"straight,{ref}"] + SHORT)
-    assert list(report["summary"]["0.2"]) == ["straight", ref]
-    assert report["own_policies"] == [ref]
+                               "--out", str(out), "--policies",
+                               f"straight,{ref},steer-half={ref}"] + SHORT)
+    assert list(report["summary"]["0.2"]) == ["straight", ref, "steer-half"]
+    assert report["own_policies"] == [ref, "steer-half"]
+    # a policy of one's own shown under a name of its own is the same policy
+    assert ([e["ret"] for e in report["episodes_detail"]["0.2"]["steer-half"]]
+            == [e["ret"] for e in report["episodes_detail"]["0.2"][ref]])
     # paired with the straight line on the same fields
     mine = report["episodes_detail"]["0.2"][ref]
     straight = report["episodes_detail"]["0.2"]["straight"]
