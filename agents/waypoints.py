@@ -1,0 +1,583 @@
+"""Waypoint decisions at the planner's pace: a navigation learner that
+decides every 10 s where to be 30 and 60 m ahead, taught by the lattice
+planner.
+
+The lattice planner (:class:`agents.planners.LatticePlanner`) plans a route
+every 5 steps (10 s of model time) and steers along it by pure pursuit in
+between. Its action at a step therefore depends on when it last planned,
+which a memoryless policy that acts every step cannot know, and a lattice
+that replans at every step sails worse than one that commits for 10 s
+(the docs' page "A navigation learner that sees what the planner sees"
+measures both). Here the learner decides at the lattice's pace and in its
+terms:
+
+* **The decision** (every ``interval`` = :data:`DECISION_STEPS` = 5
+  steps): ``points`` numbers w_k ∈ [−1, 1] (default 2), the ship's lateral
+  position at distances d_k = k × ``distance`` / ``points`` ahead along the
+  channel (default 30 and 60 m), as w_k × ``max_slope`` × d_k from where
+  it decided (``max_slope`` 0.5, the lattice's steepest: ±15 and ±30 m).
+  The route is the straight lines through those waypoints, then on along
+  the channel; each waypoint is kept ``edge_margin`` (10 m) inside the
+  channel's edges.
+* **Between decisions** the ship follows that route by the lattice's own
+  pure pursuit (30 m lookahead), with any of the environment's controls.
+* **The teacher**, :class:`LatticeWaypoints`, plans the lattice's route at
+  each decision and takes its points 30 and 60 m ahead: the ends of the
+  lattice's first two stages. Over the 20 m the ship sails until the next
+  decision the pursuit's target stays on those two stages, so the teacher
+  sails the lattice planner's own episode, step for step (tested). Its
+  decision is a function of the ship's pose and the floes at the decision
+  alone.
+* **The student**, :class:`WaypointStudent`, decides from what a ship's
+  own sensors give (:func:`decision_observation`): the environment's
+  costmap (:meth:`iceenvs.ship_env.ShipEnv.costmap`; floes within 300 m
+  ahead, 5 m cells, the channel's edges and the goal line) and its own
+  pose in the channel (lateral offset, heading, yaw rate). It reads no
+  floe itself.
+* **Imitation** (:func:`train_student`): DAgger at the decisions (Ross,
+  Gordon and Bagnell, AISTATS 2011). Round 0 is behaviour cloning on the
+  teacher's episodes; in round r the teacher's waypoints are played with
+  probability β^r and the student's otherwise, the teacher labels every
+  decision, and the student is fitted again on all labels so far, and on
+  their mirror images (:func:`mirrored`: the task is symmetric across the
+  ship's track).
+
+Train, then play the student on the leaderboard's fields::
+
+    python -m agents.waypoints train --seed 1 --out runs/waypoints/seed_1
+    python -m agents.leaderboard --out runs/board \\
+        --policies "lattice,student=agents.waypoints:WaypointStudent?run=runs/waypoints/seed_1"
+    python -m agents.waypoints report runs/waypoints/seed_1 ... --out DIR
+
+A run holds ``student.zip`` (the SB3 policy, about 0.5 MB) and
+``waypoints.json``: the settings, each round's decisions, the mean return
+of its episodes and the fit, and the imitation error on fields of no
+round (seeded ``held_out_seed`` + k). ``report`` gathers the runs' records
+into one record and a table.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .planners import LatticePlanner
+
+__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "WaypointFollower",
+           "LatticeWaypoints", "WaypointStudent", "decision_observation", "decision_space",
+           "make_student", "mirrored", "train_student", "fit_text", "report", "TRAIN_DEFAULTS",
+           "main"]
+
+#: environment steps between decisions (10 s: the lattice planner's replan)
+DECISION_STEPS = 5
+#: how far ahead [m] along the channel the waypoint lies
+WAYPOINT_DISTANCE = 60.0
+#: the forms of a decision: ``points`` lateral shifts (continuous), or one of
+#: the lattice's nine two-stage choices (:meth:`WaypointFollower.stage_waypoints`)
+FORMS = ("waypoints", "stages")
+#: the two-stage choices: the change of the route's slope at its first and at
+#: its second stage, in the lattice's slope steps; choice c is
+#: ``STAGE_CHOICES[c]`` = (c // 3 − 1, c % 3 − 1), and its mirror image 8 − c
+STAGE_CHOICES = tuple((a, b) for a in (-1, 0, 1) for b in (-1, 0, 1))
+#: scales of the pose entries of :func:`decision_observation`
+_OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
+#: the file of the student's policy, and of the run's record, in a run directory
+STUDENT, RECORD = "student.zip", "waypoints.json"
+
+
+def decision_space(env):
+    """The ``Dict`` observation space of :func:`decision_observation` for the
+    ship environment ``env``."""
+    import gymnasium as gym
+
+    from iceenvs.costmap import costmap_space
+
+    u = env.unwrapped
+    return gym.spaces.Dict({"costmap": costmap_space(u.costmap_size),
+                            "vector": gym.spaces.Box(-10.0, 10.0, (3,), np.float32)})
+
+
+def decision_observation(env) -> dict:
+    """What the student decides on: ``{"costmap": the environment's costmap
+    now, "vector": [lateral offset from the channel's centre line / 100 m,
+    heading / 0.5 rad, yaw rate / 0.04 rad/s]}`` (float32)."""
+    u = env.unwrapped
+    ship = u.sim.ship
+    pose = [(float(ship.position[1]) - u.centre_y) / _OFFSET_SCALE,
+            float(ship.heading) / _HEADING_SCALE, float(ship.yaw_rate) / _YAW_SCALE]
+    return {"costmap": np.asarray(u.costmap(), dtype=np.float32),
+            "vector": np.clip(np.asarray(pose, dtype=np.float32), -10.0, 10.0)}
+
+
+class WaypointFollower(LatticePlanner):
+    """Decide waypoints every ``interval`` steps (:meth:`decide`) and
+    follow the straight route through them by the lattice planner's pure
+    pursuit in between (see :mod:`agents.waypoints`).
+
+    Parameters
+    ----------
+    env, seed : as :class:`~agents.planners.LatticePlanner`
+    points : int
+        Waypoints of a decision, evenly spaced to ``distance``.
+    distance : float [m]
+        How far ahead the last waypoint lies.
+    interval : int
+        Environment steps between decisions.
+    form : "waypoints" or "stages"
+        A decision is ``points`` lateral shifts w_k (``"waypoints"``), or one
+        of the lattice's nine two-stage choices (``"stages"``, an integer of
+        :data:`STAGE_CHOICES`; ``points`` 2 and ``distance`` two stages).
+    **kwargs : the lattice planner's (``max_slope``: a decision w_k = 1 is a
+        slope of ``max_slope`` from the ship to waypoint k; ``edge_margin``)
+
+    Attributes
+    ----------
+    decisions : list
+        Each decision of the episode: ``points`` numbers in [−1, 1], or a
+        choice.
+    """
+
+    def __init__(self, env, seed: int = 0, *, points: int = 2,
+                 distance: float = WAYPOINT_DISTANCE, interval: int = DECISION_STEPS,
+                 form: str = "waypoints", **kwargs):
+        kwargs.setdefault("show", False)
+        super().__init__(env, seed, **kwargs)
+        for name, value in (("points", points), ("interval", interval)):
+            if isinstance(value, bool) or int(value) != value or value < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+        if not (math.isfinite(distance) and distance > 0):
+            raise ValueError(f"distance must be a positive number, got {distance!r}")
+        self.points, self.interval, self.distance = int(points), int(interval), float(distance)
+        if form not in FORMS:
+            raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+        if form == "stages" and (self.points != 2 or not math.isclose(
+                self.distance, 2.0 * self.stage_length)):
+            raise ValueError(f"form 'stages' decides the lattice's first two stages: points 2 "
+                             f"and distance {2.0 * self.stage_length:g} m, got {points} and "
+                             f"{distance:g}")
+        self.form = form
+        self.decisions: list = []
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self.decisions = []
+
+    def decide(self, obs):
+        """The decision for the episode now (``obs``: its observation):
+        ``points`` numbers w, or a choice of :data:`STAGE_CHOICES`."""
+        raise NotImplementedError
+
+    def stage_waypoints(self, choice: int) -> np.ndarray:
+        """The decision w of the two-stage choice ``choice``: from the slope
+        the lattice would start with at the ship's heading now
+        (:meth:`~agents.planners.LatticePlanner.start_slope`), the first
+        stage's slope changes by ``STAGE_CHOICES[choice][0]`` steps and the
+        second's by ``[1]`` more, within the lattice's steepest; the
+        waypoints are the two stages' ends."""
+        _, steepest = self.lattice_steps()
+        turn1, turn2 = STAGE_CHOICES[choice]
+        first = max(min(self.start_slope(float(self.unwrapped.sim.ship.heading)) + turn1,
+                        steepest), -steepest)
+        second = max(min(first + turn2, steepest), -steepest)
+        shifts = self.lateral_step * np.array([first, first + second], dtype=float)
+        return shifts / (self.max_slope * self.distances)
+
+    @property
+    def distances(self) -> np.ndarray:
+        """How far ahead [m] each waypoint of a decision lies."""
+        return self.distance * np.arange(1, self.points + 1) / self.points
+
+    def waypoint_route(self, w) -> np.ndarray:
+        """The route of decision ``w`` from the ship's position now: through
+        the waypoints, kept ``edge_margin`` inside the channel, then on
+        along +x."""
+        u = self.unwrapped
+        x, y = (float(v) for v in u.sim.ship.position)
+        half = 0.5 * u.channel_width - self.edge_margin
+        d = self.distances
+        targets = np.clip(y + np.asarray(w) * self.max_slope * d,
+                          u.centre_y - half, u.centre_y + half)
+        far = x + self.distance + 10.0 * u.channel_width
+        return np.array([[x, y], *zip(x + d, targets), [far, targets[-1]]])
+
+    def act(self, obs):
+        if self.route is None or self._age >= self.interval:
+            decision = self.decide(obs)
+            if self.form == "stages":
+                if int(decision) != decision or not 0 <= decision < len(STAGE_CHOICES):
+                    raise ValueError(f"{type(self).__name__} decided {decision!r}, not a "
+                                     f"choice 0-{len(STAGE_CHOICES) - 1}")
+                self.decisions.append(int(decision))
+                w = self.stage_waypoints(int(decision))
+            else:
+                w = np.asarray(decision, dtype=float).reshape(-1)
+                if w.shape != (self.points,) or not np.all(np.isfinite(w)):
+                    raise ValueError(f"{type(self).__name__} decided {decision!r}, not "
+                                     f"{self.points} number(s)")
+                w = np.clip(w, -1.0, 1.0)
+                self.decisions.append(w)
+            self.route = self.waypoint_route(w)
+            self._age = 0
+        self._age += 1
+        return self._pursue(self.route, obs)
+
+
+class LatticeWaypoints(WaypointFollower):
+    """The lattice planner's decision (privileged: it reads every floe
+    within 500 m): plan its route and take its points at the decision's
+    distances as the waypoints (form ``"stages"``: the choice of its first
+    two stages). With the defaults it sails the lattice planner's episode."""
+
+    reads_environment = "its floes"
+
+    def label(self):
+        """The lattice's decision from the episode now: w (unclipped), or
+        the choice of its route's first two stages (a route planned from a
+        straight heading, when none turns from the heading in time, is
+        given the nearest choice)."""
+        route = self.plan()
+        x, y = (float(v) for v in self.unwrapped.sim.ship.position)
+        d = self.distances
+        ahead = np.interp(x + d, route[:, 0], route[:, 1])
+        if self.form == "waypoints":
+            return (ahead - y) / (self.max_slope * d)
+        first = int(round((ahead[0] - y) / self.lateral_step))
+        second = int(round((ahead[1] - ahead[0]) / self.lateral_step))
+        start = self.start_slope(float(self.unwrapped.sim.ship.heading))
+        turns = (max(min(first - start, 1), -1), max(min(second - first, 1), -1))
+        return STAGE_CHOICES.index(turns)
+
+    def decide(self, obs):
+        return self.label()
+
+
+def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int = 128,
+                 net_arch=(64, 64), learning_rate: float = 3e-4, seed: int = 0):
+    """A new SB3 ``MultiInputActorCriticPolicy`` on :func:`decision_space`
+    with :class:`agents.extractors.CostmapCombined` (torch seeded by
+    ``seed``); its action is the decision: w (``points`` numbers, a ``Box``)
+    or a stage choice (``Discrete(9)``)."""
+    import gymnasium as gym
+    import torch
+    from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+
+    from .extractors import CostmapCombined
+
+    torch.manual_seed(int(seed))
+    action = gym.spaces.Discrete(len(STAGE_CHOICES)) if form == "stages" else \
+        gym.spaces.Box(-1.0, 1.0, (int(points),), np.float32)
+    return MultiInputActorCriticPolicy(
+        decision_space(env), action,
+        lambda _: learning_rate, net_arch=dict(pi=list(net_arch), vf=list(net_arch)),
+        features_extractor_class=CostmapCombined,
+        features_extractor_kwargs=dict(cnn_dim=int(cnn_dim)), log_std_init=-2.3)
+
+
+def mirrored(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tuple[dict, np.ndarray]:
+    """Decisions seen in the mirror of the channel about the ship's track:
+    the costmap's columns reversed (it is centred on the ship across), the
+    pose's lateral offset, heading and yaw rate negated, and the labels'
+    lateral shifts negated (a stage choice c becomes 8 − c, its turns
+    negated). The task is symmetric so (the floes, the
+    channel and the goal line mirror into another field of the same law),
+    and the lattice's route in the mirrored field is the mirror of its
+    route, up to ties between routes of equal cost."""
+    return ({"costmap": np.ascontiguousarray(seen["costmap"][..., ::-1]),
+             "vector": -seen["vector"]},
+            len(STAGE_CHOICES) - 1 - labels if form == "stages" else -labels)
+
+
+def _student_decision(policy, env):
+    action, _ = policy.predict(decision_observation(env), deterministic=True)
+    if _is_choice(policy):
+        return int(np.asarray(action).reshape(-1)[0])
+    return np.asarray(action, dtype=float).reshape(-1)
+
+
+def _is_choice(policy) -> bool:
+    import gymnasium as gym
+
+    return isinstance(policy.action_space, gym.spaces.Discrete)
+
+
+class WaypointStudent(WaypointFollower):
+    """The learned decision (sensor-only): an SB3 policy on
+    :func:`decision_observation`, loaded from a run of :func:`train_student`
+    (``run``: its directory, holding ``student.zip``)."""
+
+    reads_environment = "its costmap and its own pose"
+
+    def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
+        from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+
+        path = Path(run) / STUDENT
+        if not path.is_file():
+            raise FileNotFoundError(f"no student in {run!r}: {path} is missing (train one with "
+                                    f"python -m agents.waypoints train --out {run})")
+        policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
+        policy.set_training_mode(False)
+        shape = {"form": "stages"} if _is_choice(policy) else \
+            {"points": int(policy.action_space.shape[0])}
+        super().__init__(env, seed, **{**shape, **kwargs})
+        self.policy = policy
+
+    def decide(self, obs):
+        return _student_decision(self.policy, self.env)
+
+
+class _Dagger(LatticeWaypoints):
+    """The lattice labels every decision; its waypoint is played with
+    probability ``beta``, the student's (``policy``; None: never) otherwise."""
+
+    def __init__(self, env, seed: int, policy, beta: float, coin, form: str, points: int):
+        super().__init__(env, seed, form=form, points=points)
+        self.policy, self.beta, self.coin = policy, float(beta), coin
+        self.seen: list[dict] = []
+        self.labels: list = []
+        self.students: list = []
+
+    def decide(self, obs):
+        seen = decision_observation(self.env)
+        wanted = self.label()
+        self.seen.append(seen)
+        self.labels.append(wanted)
+        student = _student_decision(self.policy, self.env) if self.policy is not None \
+            else (-1 if self.form == "stages" else np.full(self.points, np.nan))
+        self.students.append(student)
+        return wanted if self.coin.random() < self.beta else student
+
+
+def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed: int,
+         label: str, progress: bool, form: str = "waypoints", points: int = 2):
+    """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`;
+    returns (observations, labels, student decisions, returns)."""
+    import gymnasium as gym
+    from tqdm.auto import tqdm
+
+    env = gym.make(env_id, **env_kwargs)
+    driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points)
+    returns = []
+    try:
+        for k in tqdm(range(episodes), desc=label, unit="episode", disable=not progress):
+            obs, _ = env.reset(seed=seed + k)
+            driver.reset(seed + k)
+            done, total = False, 0.0
+            while not done:
+                obs, reward, terminated, truncated, _ = env.step(driver.predict(obs)[0])
+                total += float(reward)
+                done = terminated or truncated
+            returns.append(total)
+    finally:
+        env.close()
+    return driver.seen, np.asarray(driver.labels), np.asarray(driver.students), returns
+
+
+#: the settings of :func:`train_student`
+TRAIN_DEFAULTS = dict(env_id="iceenvs/ShipNavigation-v1", env_kwargs={}, form="waypoints",
+                      points=2, episodes=60,
+                      rounds=4, beta=0.5, epochs=20, mirror=True, batch_size=256,
+                      learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
+                      held_out_seed=50000)
+
+
+def train_student(out: Path, seed: int, progress: bool = True, command: str | None = None,
+                  quiet: bool = False, **settings) -> dict:
+    """Train a :class:`WaypointStudent` into ``out`` by DAgger from
+    :class:`LatticeWaypoints` (see the module's text); returns the record
+    written to ``out/waypoints.json``.
+
+    Round r sails ``episodes`` fields seeded ``field_seed`` + r ×
+    ``episodes`` + k (round 0: the teacher alone); the student is fitted
+    (``epochs`` passes of Adam) after each round on every label so far,
+    from its weights before. ``seed`` seeds the network and the fits. The
+    imitation error is then measured on ``held_out_episodes`` fields seeded
+    ``held_out_seed`` + k, which the teacher sails. ``command``: the
+    command line the record names (None: none). Each round prints a line
+    unless ``quiet``.
+    """
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    from . import observations as obs_rows
+    from .pretrain import fit_policy
+
+    unknown = sorted(set(settings) - set(TRAIN_DEFAULTS))
+    if unknown:
+        raise ValueError(f"unknown settings {unknown}; valid: {', '.join(TRAIN_DEFAULTS)}")
+    s = {**TRAIN_DEFAULTS, **settings}
+    for name in ("points", "episodes", "epochs", "batch_size", "cnn_dim", "held_out_episodes"):
+        if isinstance(s[name], bool) or int(s[name]) != s[name] or s[name] < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {s[name]!r}")
+    if isinstance(s["rounds"], bool) or int(s["rounds"]) != s["rounds"] or s["rounds"] < 0:
+        raise ValueError(f"rounds must be an integer >= 0, got {s['rounds']!r}")
+    if not 0.0 <= s["beta"] <= 1.0:
+        raise ValueError(f"beta must lie in [0, 1], got {s['beta']!r}")
+    if s["form"] not in FORMS:
+        raise ValueError(f"form must be one of {FORMS}, got {s['form']!r}")
+    if s["form"] == "stages" and s["points"] != 2:
+        raise ValueError(f"form 'stages' decides two waypoints, got points {s['points']!r}")
+    choices = s["form"] == "stages"
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    probe = gym.make(s["env_id"], **s["env_kwargs"])
+    policy = make_student(probe, form=s["form"], points=s["points"], cnn_dim=s["cnn_dim"],
+                          learning_rate=s["learning_rate"], seed=seed)
+    probe.close()
+    seen: list[dict] = []
+    labels = np.empty(0, dtype=np.int64) if choices else np.empty((0, s["points"]))
+    rounds = []
+    began = time.perf_counter()
+    for r in range(s["rounds"] + 1):
+        start = time.perf_counter()
+        beta = 1.0 if r == 0 else float(s["beta"]) ** r
+        new, wanted, _, returns = sail(
+            s["env_id"], s["env_kwargs"], policy if r else None, beta, s["episodes"],
+            s["field_seed"] + r * s["episodes"], f"round {r} (beta {beta:.3g})", progress,
+            s["form"], s["points"])
+        seen += new
+        labels = np.concatenate([labels, wanted])
+        data, targets = obs_rows.stack(seen), labels if choices else np.clip(labels, -1.0, 1.0)
+        if s["mirror"]:
+            flipped, flipped_targets = mirrored(data, targets, s["form"])
+            data = {k: np.concatenate([data[k], flipped[k]]) for k in data}
+            targets = np.concatenate([targets, flipped_targets])
+        fit = fit_policy(policy, data, targets, None,
+                         epochs=s["epochs"], batch_size=s["batch_size"],
+                         learning_rate=s["learning_rate"], seed=seed * 1000 + r)
+        rounds.append({"round": r, "beta": beta, "decisions": len(wanted),
+                       "mean_return": float(np.mean(returns)),
+                       **{k: v for k, v in fit.items() if k.startswith("action_")},
+                       "seconds": round(time.perf_counter() - start, 1)})
+        if not quiet:
+            print(f"round {r} (beta {beta:.3g}): {len(wanted)} decisions, mean return "
+                  f"{np.mean(returns):.1f}, {fit_text(rounds[-1])}, "
+                  f"{rounds[-1]['seconds']:.0f} s", flush=True)
+    _, wanted, students, _ = sail(s["env_id"], s["env_kwargs"], policy, 1.0,
+                                  s["held_out_episodes"], s["held_out_seed"], "held out",
+                                  progress, s["form"], s["points"])
+    if choices:
+        held = {"action_accuracy": float(np.mean(students == wanted))}
+    else:
+        wanted = np.clip(wanted, -1.0, 1.0)
+        held = {"action_mse": float(np.mean((students - wanted) ** 2)),
+                "action_variance": float(np.var(wanted))}
+    record = {"settings": {**s, "seed": seed}, "rounds": rounds,
+              "held_out": {"decisions": len(wanted), **held},
+              "seconds": round(time.perf_counter() - began, 1),
+              "command": command}
+    policy.save(str(out / STUDENT))
+    (out / RECORD).write_text(json.dumps(record, indent=2) + "\n")
+    return record
+
+
+def fit_text(fit: dict) -> str:
+    """A fit's error in words: the share of the teacher's choices that are
+    the student's, or the squared error as a share of the labels' variance."""
+    if "action_accuracy" in fit:
+        return f"agrees on {fit['action_accuracy']:.3f} of the choices"
+    return f"error {fit['action_mse'] / max(fit['action_variance'], 1e-12):.3f} of the variance"
+
+
+def report(runs, out: Path) -> dict:
+    """Gather the records of the training runs ``runs`` (directories of
+    :func:`train_student`) into ``out``: ``waypoints.json`` (each run's
+    record, by its directory as given) and ``waypoints.md`` (a table of each
+    seed's rounds: the decisions added, the mean return of the round's
+    episodes and the fit (:func:`fit_text`); then the same on the held-out
+    fields)."""
+    records = {}
+    for run in runs:
+        path = Path(run) / RECORD
+        if not path.is_file():
+            raise FileNotFoundError(f"{run}: no {RECORD} (not a run of python -m "
+                                    f"agents.waypoints train)")
+        records[Path(run).as_posix()] = json.loads(path.read_text())
+    if not records:
+        raise ValueError("report needs at least one run")
+    lines = ["| run | round | β | decisions | mean return of the round's episodes "
+             "| fit on all labels so far |", "|---|---|---|---|---|---|"]
+    for name, record in records.items():
+        for r in record["rounds"]:
+            lines.append(f"| {name} | {r['round']} | {r['beta']:.3g} | {r['decisions']} "
+                         f"| {r['mean_return']:.1f} "
+                         f"| {fit_text(r)} |")
+    lines += ["", "| run | seed | form | held-out decisions | the student on them | fitted "
+              "on (with mirror images) | training [min] |", "|---|---|---|---|---|---|---|"]
+    for name, record in records.items():
+        held, s = record["held_out"], record["settings"]
+        fitted = sum(r["decisions"] for r in record["rounds"]) * (2 if s.get("mirror") else 1)
+        lines.append(f"| {name} | {s['seed']} | {s.get('form', 'waypoints')} "
+                     f"| {held['decisions']} "
+                     f"| {fit_text(held)} | {fitted} | {record['seconds'] / 60:.1f} |")
+    first = next(iter(records.values()))["settings"]
+    lines += ["", f"Fields: {first['episodes']} a round seeded {first['field_seed']} + k "
+              f"(round r from {first['field_seed']} + r × {first['episodes']}); held out: "
+              f"{first['held_out_episodes']} seeded {first['held_out_seed']} + k, sailed by "
+              f"the teacher. Errors of waypoints are of the decisions clipped to [−1, 1].",
+              ""]
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / RECORD).write_text(json.dumps(records, indent=1) + "\n")
+    (out / "waypoints.md").write_text("\n".join(lines))
+    return records
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m agents.waypoints", description=__doc__.split(
+        "\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    t = sub.add_parser("train", help="train a student by DAgger from the lattice's waypoints")
+    t.add_argument("--seed", type=int, default=1)
+    t.add_argument("--out", type=Path, required=True)
+    for name in ("points", "episodes", "rounds", "epochs", "field_seed", "held_out_episodes",
+                 "held_out_seed"):
+        t.add_argument("--" + name.replace("_", "-"), type=int, default=TRAIN_DEFAULTS[name])
+    t.add_argument("--form", choices=FORMS, default=TRAIN_DEFAULTS["form"],
+                   help="a decision: two lateral shifts (waypoints, default) or one of "
+                        "the lattice's nine two-stage choices (stages)")
+    t.add_argument("--beta", type=float, default=TRAIN_DEFAULTS["beta"])
+    t.add_argument("--no-mirror", dest="mirror", action="store_false",
+                   help="fit on the decisions seen only, not also on their mirror images")
+    t.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
+                   help="gymnasium.make keywords of the fields sailed (YAML values)")
+    t.add_argument("--no-progress", action="store_true")
+    r = sub.add_parser("report", help="gather runs' records into one record and a table")
+    r.add_argument("runs", nargs="+", type=Path, help="run directories of train")
+    r.add_argument("--out", type=Path, required=True)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = p.parse_args(argv)
+    if args.command == "report":
+        try:
+            report(args.runs, args.out)
+        except (ValueError, FileNotFoundError) as exc:
+            p.error(str(exc))
+        print((args.out / "waypoints.md").read_text())
+        return 0
+    settings = {k: getattr(args, k) for k in ("form", "points", "episodes", "rounds", "epochs",
+                                              "field_seed",
+                                              "held_out_episodes", "held_out_seed", "beta",
+                                              "mirror")}
+    from .envs import parse_key_values
+
+    try:
+        settings["env_kwargs"] = parse_key_values(args.env_kwargs)
+        record = train_student(args.out, args.seed, progress=not args.no_progress,
+                               command=shlex.join(["python", "-m", "agents.waypoints", *argv]),
+                               **settings)
+    except (ValueError, FileNotFoundError) as exc:
+        p.error(str(exc))
+    print(f"{args.out}: {sum(r['decisions'] for r in record['rounds'])} decisions in "
+          f"{record['seconds']:.0f} s; on the held-out fields the student "
+          f"{fit_text(record['held_out'])}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,187 @@
+"""Waypoint decisions (agents.waypoints): the lattice's two-stage waypoints
+are the lattice, the route of a decision, a DAgger run that trains and
+plays, and bad input refused."""
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from agents.planners import LatticePlanner
+from agents.rollouts import run_episode
+from agents.waypoints import (STAGE_CHOICES, WAYPOINT_DISTANCE, LatticeWaypoints, WaypointStudent,
+                              decision_observation, decision_space, main, mirrored,
+                              report, train_student)
+from small_envs import SMALL
+
+NAV = "iceenvs/ShipNavigation-v1"
+# a short transit: about 60 steps of the small field
+KWARGS = {**SMALL[NAV], "length": 300.0, "goal_distance": 150.0}
+
+
+def sail(policy_class, seed, concentration=0.2, **kwargs):
+    env = gym.make(NAV, **{**KWARGS, "concentration": concentration})
+    try:
+        policy = policy_class(env, seed=seed, **kwargs)
+        obs, _ = env.reset(seed=seed)
+        policy.reset(seed)
+        rewards, positions, done = [], [], False
+        while not done:
+            obs, reward, terminated, truncated, _ = env.step(policy.predict(obs)[0])
+            rewards.append(reward)
+            positions.append(np.array(env.unwrapped.sim.ship.position))
+            done = terminated or truncated
+        return np.array(rewards), np.array(positions), policy
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("seed, form", [(1, "waypoints"), (7, "waypoints"), (1, "stages"),
+                                        (7, "stages")])
+def test_two_waypoints_at_the_stage_ends_sail_the_lattices_episode(seed, form):
+    # the lattice's route is straight from stage to stage (30 m) and it replans
+    # every 5 steps: a decision every 5 steps of its route's points 30 and 60 m
+    # ahead is its route over the 20 m sailed until the next, so the pure
+    # pursuit steers alike (the lattice also replans when 10 m off its route,
+    # which a ship on its route is not); its first two stages are one of nine
+    # choices of their slopes
+    lattice, ship_l, _ = sail(LatticePlanner, seed, 0.4, show=False)
+    waypoints, ship_w, policy = sail(LatticeWaypoints, seed, 0.4, form=form)
+    np.testing.assert_array_equal(waypoints, lattice)
+    np.testing.assert_array_equal(ship_w, ship_l)
+    assert len(policy.decisions) == -(-len(lattice) // 5)
+    assert len({str(d) for d in policy.decisions}) > 1      # it did steer
+
+
+def test_a_decision_is_two_waypoints_along_the_channel_kept_inside_its_edges():
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=1)
+    policy = LatticeWaypoints(env)
+    u = env.unwrapped
+    x, y = (float(v) for v in u.sim.ship.position)
+    route = policy.waypoint_route(np.array([0.5, -0.25]))
+    # w_k is the slope to waypoint k as a fraction of the steepest, 0.5
+    np.testing.assert_allclose(route[:3], [[x, y], [x + 30.0, y + 0.5 * 0.5 * 30.0],
+                                           [x + WAYPOINT_DISTANCE, y - 0.25 * 0.5 * 60.0]])
+    assert route[3, 1] == route[2, 1] and route[3, 0] > route[2, 0]
+    # a waypoint past the edge margin is moved inside it (a margin that leaves
+    # 20 m either side of the centre line)
+    policy.edge_margin = 0.5 * u.channel_width - 20.0
+    assert y == pytest.approx(u.centre_y)
+    np.testing.assert_allclose(policy.waypoint_route(np.array([1.0, 1.0]))[1:, 1],
+                               [y + 15.0, y + 20.0, y + 20.0])
+    np.testing.assert_allclose(policy.waypoint_route(np.array([-1.0, -1.0]))[1:, 1],
+                               [y - 15.0, y - 20.0, y - 20.0])
+    env.close()
+
+
+def test_the_decision_observation_is_the_costmap_and_the_ships_pose():
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=2)
+    seen = decision_observation(env)
+    assert decision_space(env).contains(seen)
+    np.testing.assert_array_equal(seen["costmap"], env.unwrapped.costmap())
+    ship = env.unwrapped.sim.ship
+    assert seen["vector"][0] == pytest.approx((ship.position[1] - env.unwrapped.centre_y) / 100)
+    env.close()
+
+
+@pytest.mark.parametrize("form", ["stages", "waypoints"])
+def test_a_dagger_run_trains_a_student_that_plays(tmp_path, form):
+    record = train_student(tmp_path / "run", 0, progress=False, quiet=True, env_kwargs=KWARGS,
+                           form=form, episodes=1, rounds=1, epochs=2, held_out_episodes=1)
+    assert [r["beta"] for r in record["rounds"]] == [1.0, 0.5]
+    assert all(r["decisions"] > 5 for r in record["rounds"])
+    held = record["held_out"]
+    assert held["decisions"] > 5
+    if form == "stages":
+        assert 0.0 <= held["action_accuracy"] <= 1.0
+    else:
+        assert held["action_mse"] >= 0.0 and held["action_variance"] >= 0.0
+    assert json.loads((tmp_path / "run" / "waypoints.json").read_text()) == record
+    env = gym.make(NAV, **KWARGS)
+    student = WaypointStudent(env, run=str(tmp_path / "run"))
+    assert student.form == form
+    episode = run_episode(env, student, seed=4, main_metric=None)
+    env.close()
+    assert episode["length"] > 5 and np.isfinite(episode["ret"])
+    if form == "stages":
+        assert all(d in range(9) for d in student.decisions)
+    else:
+        assert all(np.all(np.abs(w) <= 1.0) for w in student.decisions)
+    # the runs' records gathered: one record and a table
+    gathered = report([tmp_path / "run"], tmp_path / "report")
+    assert gathered == {(tmp_path / "run").as_posix(): record}
+    assert "| 1 | 0.5 |" in (tmp_path / "report" / "waypoints.md").read_text()
+
+
+def test_bad_input_is_refused(tmp_path, capsys):
+    with pytest.raises(ValueError, match="unknown settings"):
+        train_student(tmp_path, 0, progress=False, epocs=3)
+    with pytest.raises(ValueError, match="beta"):
+        train_student(tmp_path, 0, progress=False, beta=1.5)
+    with pytest.raises(ValueError, match="rounds"):
+        train_student(tmp_path, 0, progress=False, rounds=-1)
+    with pytest.raises(ValueError, match="form"):
+        train_student(tmp_path, 0, progress=False, form="route")
+    with pytest.raises(ValueError, match="decides two waypoints"):
+        train_student(tmp_path, 0, progress=False, form="stages", points=3)
+    env = gym.make(NAV, **KWARGS)
+    with pytest.raises(FileNotFoundError, match="agents.waypoints train"):
+        WaypointStudent(env, run=str(tmp_path / "none"))
+    with pytest.raises(ValueError, match="points"):
+        LatticeWaypoints(env, points=0)
+    with pytest.raises(ValueError, match="distance"):
+        LatticeWaypoints(env, distance=-5.0)
+    with pytest.raises(ValueError, match="first two stages"):
+        LatticeWaypoints(env, form="stages", distance=90.0)
+    with pytest.raises(FileNotFoundError, match="not a run"):
+        report([tmp_path], tmp_path / "out")
+    with pytest.raises(SystemExit):
+        main(["train", "--out", str(tmp_path), "--episodes", "0"])
+    assert "episodes must be an integer >= 1" in capsys.readouterr().err
+    env.close()
+
+
+def test_the_mirror_of_a_field_is_seen_and_planned_as_its_mirror_image(monkeypatch):
+    # the ship starts on the centre line: reflect every floe across it and the
+    # costmap is the same with its columns reversed, and the lattice's waypoints
+    # are the same with their shifts negated
+    env = gym.make(NAV, **{**KWARGS, "concentration": 0.4})
+    env.reset(seed=5)
+    u = env.unwrapped
+    teacher = LatticeWaypoints(env)
+    seen, label = decision_observation(env), teacher.label()
+    centre = u.centre_y
+    assert u.sim.ship.position[1] == pytest.approx(centre)
+    reflected = u.sim.positions.copy()
+    reflected[:, 1] = np.mod(2.0 * centre - reflected[:, 1], u.sim.box.ly)
+    # the engine's floes as the sensors and the planner read them, reflected
+    monkeypatch.setattr(type(u.sim), "positions", property(lambda self: reflected))
+    seen_m, label_m = decision_observation(env), teacher.label()
+    env.close()
+    flipped, flipped_label = mirrored(seen, label)
+    assert seen["costmap"][0].max() > 0.5         # there is ice to see
+    np.testing.assert_allclose(seen_m["costmap"], flipped["costmap"], rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(seen_m["vector"], flipped["vector"], atol=1e-7)
+    assert np.abs(label).max() > 0.05             # the lattice turns ...
+    np.testing.assert_allclose(label_m, flipped_label, atol=1e-12)   # ... the other way
+    # off the centre line, turned and turning: the pose is mirrored too
+    pose = {"costmap": np.arange(6.0).reshape(1, 1, 2, 3), "vector": np.array([[0.1, -0.2, 0.3]])}
+    image, shifts = mirrored(pose, np.array([[0.4, -0.5]]))
+    np.testing.assert_array_equal(image["vector"], [[-0.1, 0.2, -0.3]])
+    np.testing.assert_array_equal(image["costmap"][0, 0], [[2.0, 1.0, 0.0], [5.0, 4.0, 3.0]])
+    np.testing.assert_array_equal(shifts, [[-0.4, 0.5]])
+
+
+def test_a_stage_choice_turns_each_stage_by_at_most_one_slope_step():
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=1)
+    policy = LatticeWaypoints(env, form="stages")
+    # heading +x: slope 0; choice c turns the first stage by c // 3 - 1 steps of
+    # 1.5 m per 30 m and the second by c % 3 - 1 more
+    for c, (a, b) in enumerate(STAGE_CHOICES):
+        w = policy.stage_waypoints(c)
+        np.testing.assert_allclose(w * 0.5 * np.array([30.0, 60.0]), [1.5 * a, 1.5 * (2 * a + b)])
+    assert STAGE_CHOICES[8 - 3] == tuple(-t for t in STAGE_CHOICES[3])
+    env.close()
