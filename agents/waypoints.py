@@ -67,6 +67,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .leaderboard import DEFAULT_ENV
 from .planners import LatticePlanner
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "WaypointFollower",
@@ -379,7 +380,8 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
 
 
 #: the settings of :func:`train_student`
-TRAIN_DEFAULTS = dict(env_id="iceenvs/ShipNavigation-v1", env_kwargs={}, form="waypoints",
+#: (the environment is the leaderboard's, on whose fields a student is judged)
+TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints",
                       points=2, episodes=60,
                       rounds=4, beta=0.5, epochs=20, mirror=True, batch_size=256,
                       learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
