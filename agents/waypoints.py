@@ -294,8 +294,9 @@ def mirrored(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tuple[d
             len(STAGE_CHOICES) - 1 - labels if form == "stages" else -labels)
 
 
-def _student_decision(policy, env):
-    action, _ = policy.predict(decision_observation(env), deterministic=True)
+def _student_decision(policy, seen: dict):
+    """The decision of the SB3 ``policy`` on ``seen`` (:func:`decision_observation`)."""
+    action, _ = policy.predict(seen, deterministic=True)
     if _is_choice(policy):
         return int(np.asarray(action).reshape(-1)[0])
     return np.asarray(action, dtype=float).reshape(-1)
@@ -329,7 +330,7 @@ class WaypointStudent(WaypointFollower):
         self.policy = policy
 
     def decide(self, obs):
-        return _student_decision(self.policy, self.env)
+        return _student_decision(self.policy, decision_observation(self.env))
 
 
 class _Dagger(LatticeWaypoints):
@@ -348,7 +349,7 @@ class _Dagger(LatticeWaypoints):
         wanted = self.label()
         self.seen.append(seen)
         self.labels.append(wanted)
-        student = _student_decision(self.policy, self.env) if self.policy is not None \
+        student = _student_decision(self.policy, seen) if self.policy is not None \
             else (-1 if self.form == "stages" else np.full(self.points, np.nan))
         self.students.append(student)
         return wanted if self.coin.random() < self.beta else student
