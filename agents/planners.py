@@ -88,7 +88,8 @@ from numba import njit
 from iceenvs.costmap import impulse_costmap
 from iceenvs.ship_controllers import StraightLineController
 
-__all__ = ["LatticePlanner", "RolloutPlanner", "ON_REQUEST", "impulse_costmap", "lattice_route", "PLANNERS"]
+__all__ = ["LatticePlanner", "CostmapLatticePlanner", "RolloutPlanner", "ON_REQUEST",
+           "costmap_cost_grid", "impulse_costmap", "lattice_route", "PLANNERS"]
 
 
 @njit(cache=True)
@@ -258,12 +259,7 @@ class LatticePlanner(StraightLineController):
         y0 = y - (below + 0.5) * cell
         ny = below + max(int(math.ceil((high_y - y) / cell)), 0) + 2
         nx = n_stages * stage_cells
-        ice = u.ice_near(math.hypot(reach_x, max(y - low_y, high_y - y)) + 60.0)
-        beam = float(u.ship.hull.beam)
-        reach = ice["radii"] + 0.5 * beam
-        cost = impulse_costmap(x, y0, nx, ny, cell, ice["positions"][:, 0],
-                               ice["positions"][:, 1], reach, u.expected_impulses(ice["masses"]),
-                               self.cone)
+        cost = self.cost_grid(x, y0, nx, ny, math.hypot(reach_x, max(y - low_y, high_y - y)))
         rows = y0 + (np.arange(ny) + 0.5) * cell
         y_low = int(np.searchsorted(rows, min(low_y, y)))
         y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
@@ -278,8 +274,19 @@ class LatticePlanner(StraightLineController):
         route = np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]])
         self.decision_times.append(time.perf_counter() - t0)
         if self.show:
-            u.plan_overlay = (route, 0.5 * beam)
+            u.plan_overlay = (route, 0.5 * float(u.ship.hull.beam))
         return route
+
+    def cost_grid(self, x: float, y0: float, nx: int, ny: int, reach: float) -> np.ndarray:
+        """The ice's cost density [N s/m] on the lattice's grid: ``nx`` ×
+        ``ny`` cells of side ``lateral_step`` from the corner (``x``,
+        ``y0``), from the floes within ``reach`` [m] (and 60 m more) of the
+        ship (:func:`~iceenvs.costmap.impulse_costmap`)."""
+        u = self.unwrapped
+        ice = u.ice_near(reach + 60.0)
+        return impulse_costmap(x, y0, nx, ny, self.lateral_step, ice["positions"][:, 0],
+                               ice["positions"][:, 1], ice["radii"] + 0.5 * float(u.ship.hull.beam),
+                               u.expected_impulses(ice["masses"]), self.cone)
 
     def lattice_steps(self) -> tuple[int, int]:
         """(cells of a stage, the steepest slope in lateral cells a stage):
@@ -321,6 +328,53 @@ class LatticePlanner(StraightLineController):
         bearing = math.atan2(target_y - position[1], target_x - position[0]) - float(ship.heading)
         bearing = math.atan2(math.sin(bearing), math.cos(bearing))
         return self._steer(bearing, self._reader(obs))
+
+
+class CostmapLatticePlanner(LatticePlanner):
+    """The lattice planner on what the ship's own costmap shows
+    (``costmap-lattice``; not privileged): the same lattice, cost and
+    tracking as :class:`LatticePlanner`, but the ice's cost density on the
+    lattice's grid is read from the environment's costmap observation
+    (:meth:`iceenvs.ship_env.ShipEnv.costmap`: the cone-spread impulse
+    averaged over cells of ``costmap_cell``, 5 m, to ``costmap_ahead``,
+    300 m, ahead, and the channel's width across, centred on the ship)
+    instead of from the floes. Each lattice cell takes the density of the
+    costmap cell its centre lies in, undoing the map's scaling
+    (c = :data:`~iceenvs.costmap.COSTMAP_SCALE` · (e^v − 1)); where the map
+    does not reach, the ice costs nothing.
+
+    It plans on exactly what a costmap learner sees (the costmap and its
+    own pose), so its score against the lattice's is what the costmap's
+    coarser cells and shorter reach cost a planner: what a learner that
+    imitates the lattice from the costmap can at best recover."""
+
+    reads_environment = "its costmap"
+
+    def cost_grid(self, x: float, y0: float, nx: int, ny: int, reach: float) -> np.ndarray:
+        return costmap_cost_grid(self.unwrapped, y0, nx, ny, self.lateral_step)
+
+
+def costmap_cost_grid(env, y0: float, nx: int, ny: int, cell: float) -> np.ndarray:
+    """The cost density [N s/m] of the ship environment ``env``'s costmap
+    (:meth:`iceenvs.ship_env.ShipEnv.costmap`) on a lattice's grid: ``nx``
+    × ``ny`` cells of side ``cell`` [m] from the corner (the ship's x,
+    ``y0``); each cell takes the density of the costmap cell its centre
+    lies in, 0 where the map does not reach
+    (:class:`CostmapLatticePlanner`)."""
+    from iceenvs.costmap import COSTMAP_SCALE
+
+    seen = np.expm1(np.asarray(env.costmap()[0], dtype=float)) * COSTMAP_SCALE
+    rows, cols = seen.shape
+    side, ahead = env.costmap_cell, env.costmap_ahead
+    ship_y = float(env.sim.ship.position[1])
+    # the costmap's row of each grid column (along x) and its column of each grid row (across)
+    i = np.floor((ahead - (np.arange(nx) + 0.5) * cell) / side).astype(np.int64)
+    j = np.floor((0.5 * cols * side - (y0 + (np.arange(ny) + 0.5) * cell - ship_y))
+                 / side).astype(np.int64)
+    inside_i, inside_j = (i >= 0) & (i < rows), (j >= 0) & (j < cols)
+    cost = np.zeros((nx, ny))
+    cost[np.ix_(inside_i, inside_j)] = seen[np.ix_(i[inside_i], j[inside_j])]
+    return cost
 
 
 class RolloutPlanner(LatticePlanner):

@@ -68,9 +68,9 @@ from pathlib import Path
 import numpy as np
 
 from .leaderboard import DEFAULT_ENV
-from .planners import LatticePlanner
+from .planners import LatticePlanner, costmap_cost_grid
 
-__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "WaypointFollower",
+__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "STAGE_CHOICES", "WaypointFollower",
            "LatticeWaypoints", "WaypointStudent", "decision_observation", "decision_space",
            "make_student", "mirrored", "train_student", "fit_text", "report", "TRAIN_DEFAULTS",
            "main"]
@@ -82,6 +82,9 @@ WAYPOINT_DISTANCE = 60.0
 #: the forms of a decision: ``points`` lateral shifts (continuous), or one of
 #: the lattice's nine two-stage choices (:meth:`WaypointFollower.stage_waypoints`)
 FORMS = ("waypoints", "stages")
+#: the teachers of :class:`LatticeWaypoints`: the lattice on the floes
+#: (privileged), or on the environment's costmap (what the student sees)
+TEACHERS = ("lattice", "costmap-lattice")
 #: the two-stage choices: the change of the route's slope at its first and at
 #: its second stage, in the lattice's slope steps; choice c is
 #: ``STAGE_CHOICES[c]`` = (c // 3 − 1, c % 3 − 1), and its mirror image 8 − c
@@ -233,9 +236,27 @@ class LatticeWaypoints(WaypointFollower):
     """The lattice planner's decision (privileged: it reads every floe
     within 500 m): plan its route and take its points at the decision's
     distances as the waypoints (form ``"stages"``: the choice of its first
-    two stages). With the defaults it sails the lattice planner's episode."""
+    two stages). With the defaults it sails the lattice planner's episode.
+
+    ``teacher="costmap-lattice"``: the lattice plans on the environment's
+    costmap instead (:class:`agents.planners.CostmapLatticePlanner`; not
+    privileged), whose episode it then sails: a decision that is a function
+    of what the student sees."""
 
     reads_environment = "its floes"
+
+    def __init__(self, env, seed: int = 0, *, teacher: str = "lattice", **kwargs):
+        super().__init__(env, seed, **kwargs)
+        if teacher not in TEACHERS:
+            raise ValueError(f"teacher must be one of {TEACHERS}, got {teacher!r}")
+        self.teacher = teacher
+        if teacher == "costmap-lattice":
+            self.reads_environment = "its costmap"
+
+    def cost_grid(self, x, y0, nx, ny, reach):
+        if self.teacher == "costmap-lattice":
+            return costmap_cost_grid(self.unwrapped, y0, nx, ny, self.lateral_step)
+        return super().cost_grid(x, y0, nx, ny, reach)
 
     def label(self):
         """The lattice's decision from the episode now: w (unclipped), or
@@ -337,8 +358,9 @@ class _Dagger(LatticeWaypoints):
     """The lattice labels every decision; its waypoint is played with
     probability ``beta``, the student's (``policy``; None: never) otherwise."""
 
-    def __init__(self, env, seed: int, policy, beta: float, coin, form: str, points: int):
-        super().__init__(env, seed, form=form, points=points)
+    def __init__(self, env, seed: int, policy, beta: float, coin, form: str, points: int,
+                 teacher: str = "lattice"):
+        super().__init__(env, seed, form=form, points=points, teacher=teacher)
         self.policy, self.beta, self.coin = policy, float(beta), coin
         self.seen: list[dict] = []
         self.labels: list = []
@@ -356,14 +378,16 @@ class _Dagger(LatticeWaypoints):
 
 
 def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed: int,
-         label: str, progress: bool, form: str = "waypoints", points: int = 2):
+         label: str, progress: bool, form: str = "waypoints", points: int = 2,
+         teacher: str = "lattice"):
     """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`;
     returns (observations, labels, student decisions, returns)."""
     import gymnasium as gym
     from tqdm.auto import tqdm
 
     env = gym.make(env_id, **env_kwargs)
-    driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points)
+    driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points,
+                     teacher)
     returns = []
     try:
         for k in tqdm(range(episodes), desc=label, unit="episode", disable=not progress):
@@ -382,7 +406,7 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
 
 #: the settings of :func:`train_student`
 #: (the environment is the leaderboard's, on whose fields a student is judged)
-TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints",
+TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints", teacher="lattice",
                       points=2, episodes=60,
                       rounds=4, beta=0.5, epochs=20, mirror=True, batch_size=256,
                       learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
@@ -424,6 +448,8 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         raise ValueError(f"beta must lie in [0, 1], got {s['beta']!r}")
     if s["form"] not in FORMS:
         raise ValueError(f"form must be one of {FORMS}, got {s['form']!r}")
+    if s["teacher"] not in TEACHERS:
+        raise ValueError(f"teacher must be one of {TEACHERS}, got {s['teacher']!r}")
     if s["form"] == "stages" and s["points"] != 2:
         raise ValueError(f"form 'stages' decides two waypoints, got points {s['points']!r}")
     choices = s["form"] == "stages"
@@ -443,7 +469,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         new, wanted, _, returns = sail(
             s["env_id"], s["env_kwargs"], policy if r else None, beta, s["episodes"],
             s["field_seed"] + r * s["episodes"], f"round {r} (beta {beta:.3g})", progress,
-            s["form"], s["points"])
+            s["form"], s["points"], s["teacher"])
         seen += new
         labels = np.concatenate([labels, wanted])
         data, targets = obs_rows.stack(seen), labels if choices else np.clip(labels, -1.0, 1.0)
@@ -464,7 +490,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
                   f"{rounds[-1]['seconds']:.0f} s", flush=True)
     _, wanted, students, _ = sail(s["env_id"], s["env_kwargs"], policy, 1.0,
                                   s["held_out_episodes"], s["held_out_seed"], "held out",
-                                  progress, s["form"], s["points"])
+                                  progress, s["form"], s["points"], s["teacher"])
     if choices:
         held = {"action_accuracy": float(np.mean(students == wanted))}
     else:
@@ -545,6 +571,9 @@ def main(argv=None) -> int:
     t.add_argument("--form", choices=FORMS, default=TRAIN_DEFAULTS["form"],
                    help="a decision: two lateral shifts (waypoints, default) or one of "
                         "the lattice's nine two-stage choices (stages)")
+    t.add_argument("--teacher", choices=TEACHERS, default=TRAIN_DEFAULTS["teacher"],
+                   help="the lattice on the floes (lattice, default; privileged) or on the "
+                        "environment's costmap (costmap-lattice; what the student sees)")
     t.add_argument("--beta", type=float, default=TRAIN_DEFAULTS["beta"])
     t.add_argument("--no-mirror", dest="mirror", action="store_false",
                    help="fit on the decisions seen only, not also on their mirror images")
@@ -563,7 +592,7 @@ def main(argv=None) -> int:
             p.error(str(exc))
         print((args.out / "waypoints.md").read_text())
         return 0
-    settings = {k: getattr(args, k) for k in ("form", "points", "episodes", "rounds", "epochs",
+    settings = {k: getattr(args, k) for k in ("form", "teacher", "points", "episodes", "rounds", "epochs",
                                               "field_seed",
                                               "held_out_episodes", "held_out_seed", "beta",
                                               "mirror")}

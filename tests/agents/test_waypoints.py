@@ -7,7 +7,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from agents.planners import LatticePlanner
+from agents.planners import CostmapLatticePlanner, LatticePlanner
 from agents.rollouts import run_episode
 from agents.waypoints import (STAGE_CHOICES, WAYPOINT_DISTANCE, LatticeWaypoints, WaypointStudent,
                               decision_observation, decision_space, main, mirrored,
@@ -51,6 +51,20 @@ def test_two_waypoints_at_the_stage_ends_sail_the_lattices_episode(seed, form):
     np.testing.assert_array_equal(ship_w, ship_l)
     assert len(policy.decisions) == -(-len(lattice) // 5)
     assert len({str(d) for d in policy.decisions}) > 1      # it did steer
+
+
+@pytest.mark.parametrize("form", ["waypoints", "stages"])
+def test_the_costmap_teacher_sails_the_costmap_lattices_episode(form):
+    """Taught by the lattice on the costmap, the decisions sail the episode
+    of :class:`CostmapLatticePlanner`, as the lattice's sail the lattice's."""
+    planner, ship_p, _ = sail(CostmapLatticePlanner, 1, 0.4, show=False)
+    waypoints, ship_w, policy = sail(LatticeWaypoints, 1, 0.4, form=form,
+                                     teacher="costmap-lattice")
+    np.testing.assert_array_equal(waypoints, planner)
+    np.testing.assert_array_equal(ship_w, ship_p)
+    assert policy.reads_environment == "its costmap"
+    with pytest.raises(ValueError, match="teacher must be one of"):
+        sail(LatticeWaypoints, 1, 0.4, teacher="oracle")
 
 
 def test_a_decision_is_two_waypoints_along_the_channel_kept_inside_its_edges():
