@@ -29,7 +29,11 @@ name            controller or planner                                       read
 ==============  ==========================================================  ================
 
 The first three are the environments' own controllers
-(:mod:`iceenvs.ship_controllers`); the planners build on them. The
+(:mod:`iceenvs.ship_controllers`); the planners build on them. A third
+planner, :class:`CostmapLatticePlanner`, is the lattice planner on the
+environment's costmap observation instead of the floes (not privileged);
+it is no baseline of the boards, and is played by name
+(``costmap-lattice=agents.planners:CostmapLatticePlanner``). The
 lattice planner follows the lattice planner of AUTO-IceNav (de Schaetzen
 et al., IEEE Transactions on Robotics, 2025) in its parts: a lattice of
 motion primitives the ship can follow, a cost of path length plus a
