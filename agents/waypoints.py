@@ -70,7 +70,8 @@ import numpy as np
 from .leaderboard import DEFAULT_ENV
 from .planners import LatticePlanner, costmap_cost_grid
 
-__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "STAGE_CHOICES", "WaypointFollower",
+__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
+           "WaypointFollower",
            "LatticeWaypoints", "WaypointStudent", "decision_observation", "decision_space",
            "make_student", "mirrored", "train_student", "fit_text", "report", "TRAIN_DEFAULTS",
            "main"]
@@ -91,6 +92,9 @@ TEACHERS = ("lattice", "costmap-lattice")
 STAGE_CHOICES = tuple((a, b) for a in (-1, 0, 1) for b in (-1, 0, 1))
 #: scales of the pose entries of :func:`decision_observation`
 _OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
+#: how a DAgger round fits the student on all labels so far: from its weights
+#: after the round before (``warm``), or a new network seeded alike (``fresh``)
+REFITS = ("warm", "fresh")
 #: the file of the student's policy, and of the run's record, in a run directory
 STUDENT, RECORD = "student.zip", "waypoints.json"
 
@@ -408,7 +412,7 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
 #: (the environment is the leaderboard's, on whose fields a student is judged)
 TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints", teacher="lattice",
                       points=2, episodes=60,
-                      rounds=4, beta=0.5, epochs=20, mirror=True, batch_size=256,
+                      rounds=4, beta=0.5, epochs=20, refit="warm", mirror=True, batch_size=256,
                       learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
                       held_out_seed=50000)
 
@@ -422,7 +426,9 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     Round r sails ``episodes`` fields seeded ``field_seed`` + r ×
     ``episodes`` + k (round 0: the teacher alone); the student is fitted
     (``epochs`` passes of Adam) after each round on every label so far,
-    from its weights before. ``seed`` seeds the network and the fits. The
+    from its weights before (``refit="warm"``) or from a new network
+    seeded alike (``"fresh"``), so that the first rounds' labels are not
+    passed over again in every round. ``seed`` seeds the network and the fits. The
     imitation error is then measured on ``held_out_episodes`` fields seeded
     ``held_out_seed`` + k, which the teacher sails. ``command``: the
     command line the record names (None: none). Each round prints a line
@@ -448,6 +454,8 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         raise ValueError(f"beta must lie in [0, 1], got {s['beta']!r}")
     if s["form"] not in FORMS:
         raise ValueError(f"form must be one of {FORMS}, got {s['form']!r}")
+    if s["refit"] not in REFITS:
+        raise ValueError(f"refit must be one of {REFITS}, got {s['refit']!r}")
     if s["teacher"] not in TEACHERS:
         raise ValueError(f"teacher must be one of {TEACHERS}, got {s['teacher']!r}")
     if s["form"] == "stages" and s["points"] != 2:
@@ -458,7 +466,6 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     probe = gym.make(s["env_id"], **s["env_kwargs"])
     policy = make_student(probe, form=s["form"], points=s["points"], cnn_dim=s["cnn_dim"],
                           learning_rate=s["learning_rate"], seed=seed)
-    probe.close()
     seen: list[dict] = []
     labels = np.empty(0, dtype=np.int64) if choices else np.empty((0, s["points"]))
     rounds = []
@@ -472,6 +479,10 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
             s["form"], s["points"], s["teacher"])
         seen += new
         labels = np.concatenate([labels, wanted])
+        if r and s["refit"] == "fresh":
+            policy = make_student(probe, form=s["form"], points=s["points"],
+                                  cnn_dim=s["cnn_dim"], learning_rate=s["learning_rate"],
+                                  seed=seed)
         data, targets = obs_rows.stack(seen), labels if choices else np.clip(labels, -1.0, 1.0)
         if s["mirror"]:
             flipped, flipped_targets = mirrored(data, targets, s["form"])
@@ -488,6 +499,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
             print(f"round {r} (beta {beta:.3g}): {len(wanted)} decisions, mean return "
                   f"{np.mean(returns):.1f}, {fit_text(rounds[-1])}, "
                   f"{rounds[-1]['seconds']:.0f} s", flush=True)
+    probe.close()
     _, wanted, students, _ = sail(s["env_id"], s["env_kwargs"], policy, 1.0,
                                   s["held_out_episodes"], s["held_out_seed"], "held out",
                                   progress, s["form"], s["points"], s["teacher"])
@@ -575,6 +587,9 @@ def main(argv=None) -> int:
     t.add_argument("--teacher", choices=TEACHERS, default=TRAIN_DEFAULTS["teacher"],
                    help="the lattice on the floes (lattice, default; privileged) or on the "
                         "environment's costmap (costmap-lattice; what the student sees)")
+    t.add_argument("--refit", choices=REFITS, default=TRAIN_DEFAULTS["refit"],
+                   help="fit each round's student from the last round's weights (warm, "
+                        "default) or from a new network (fresh)")
     t.add_argument("--beta", type=float, default=TRAIN_DEFAULTS["beta"])
     t.add_argument("--no-mirror", dest="mirror", action="store_false",
                    help="fit on the decisions seen only, not also on their mirror images")
@@ -593,7 +608,8 @@ def main(argv=None) -> int:
             p.error(str(exc))
         print((args.out / "waypoints.md").read_text())
         return 0
-    settings = {k: getattr(args, k) for k in ("form", "teacher", "points", "episodes", "rounds", "epochs",
+    settings = {k: getattr(args, k) for k in ("form", "teacher", "refit", "points", "episodes",
+                                              "rounds", "epochs",
                                               "field_seed",
                                               "held_out_episodes", "held_out_seed", "beta",
                                               "mirror")}
