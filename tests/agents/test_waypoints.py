@@ -10,8 +10,8 @@ import pytest
 from agents.planners import CostmapLatticePlanner, LatticePlanner
 from agents.rollouts import run_episode
 from agents.waypoints import (STAGE_CHOICES, WAYPOINT_DISTANCE, LatticeWaypoints, WaypointStudent,
-                              decision_observation, decision_space, main, mirrored,
-                              report, train_student)
+                              decision_observation, decision_space, main, make_student,
+                              mirrored, report, train_student)
 from small_envs import SMALL
 
 NAV = "iceenvs/ShipNavigation-v1"
@@ -127,6 +127,29 @@ def test_a_dagger_run_trains_a_student_that_plays(tmp_path, form):
     gathered = report([tmp_path / "run"], tmp_path / "report")
     assert gathered == {(tmp_path / "run").as_posix(): record}
     assert "| 1 | 0.5 |" in (tmp_path / "report" / "waypoints.md").read_text()
+
+
+@pytest.mark.parametrize("refit, networks", [("warm", 1), ("fresh", 3)])
+def test_a_fresh_refit_fits_a_new_network_each_round(tmp_path, monkeypatch, refit, networks):
+    """``refit="fresh"``: each round after the first fits a network made anew
+    (seeded alike) on all labels so far; ``"warm"`` goes on with one."""
+    import agents.waypoints as waypoints
+
+    made = []
+
+    def counted(*args, **kwargs):
+        made.append(kwargs.get("seed"))
+        return make_student(*args, **kwargs)
+
+    monkeypatch.setattr(waypoints, "make_student", counted)
+    record = train_student(tmp_path / "run", 7, progress=False, quiet=True,
+                           env_kwargs=KWARGS, episodes=1, rounds=2, epochs=1,
+                           held_out_episodes=1, refit=refit, teacher="costmap-lattice")
+    assert made == [7] * networks
+    assert record["settings"]["refit"] == refit
+    assert record["settings"]["teacher"] == "costmap-lattice"
+    with pytest.raises(ValueError, match="refit must be one of"):
+        train_student(tmp_path / "bad", 7, progress=False, refit="cold")
 
 
 def test_bad_input_is_refused(tmp_path, capsys):
