@@ -549,14 +549,15 @@ def report(runs, out: Path) -> dict:
             lines.append(f"| {name} | {r['round']} | {r['beta']:.3g} | {r['decisions']} "
                          f"| {r['mean_return']:.1f} "
                          f"| {fit_text(r)} |")
-    lines += ["", "| run | seed | form | teacher | held-out decisions | the student on them "
-              "| fitted on (with mirror images) | training [min] |",
-              "|---|---|---|---|---|---|---|---|"]
+    lines += ["", "| run | seed | form | teacher | fits | held-out decisions "
+              "| the student on them | fitted on (with mirror images) | training [min] |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for name, record in records.items():
         held, s = record["held_out"], record["settings"]
         fitted = sum(r["decisions"] for r in record["rounds"]) * (2 if s.get("mirror") else 1)
         lines.append(f"| {name} | {s['seed']} | {s.get('form', 'waypoints')} "
-                     f"| {s.get('teacher', 'lattice')} | {held['decisions']} "
+                     f"| {s.get('teacher', 'lattice')} "
+                     f"| {s.get('refit', 'warm')}, {s['epochs']} epochs | {held['decisions']} "
                      f"| {fit_text(held)} | {fitted} | {record['seconds'] / 60:.1f} |")
     first = next(iter(records.values()))["settings"]
     lines += ["", f"Fields: {first['episodes']} a round seeded {first['field_seed']} + k "
