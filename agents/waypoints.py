@@ -349,6 +349,13 @@ class WaypointStudent(WaypointFollower):
                                     f"python -m agents.waypoints train --out {run})")
         policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
         policy.set_training_mode(False)
+        trained = policy.observation_space["costmap"].shape
+        here = decision_space(env)["costmap"].shape
+        if trained != here:
+            raise ValueError(f"the student of {run!r} was trained on costmaps of shape "
+                             f"{trained}, and this environment's are {here}: make it with the "
+                             f"training's costmap settings (costmap_ahead, costmap_behind, "
+                             f"costmap_cell; see {RECORD} in the run)")
         shape = {"form": "stages"} if _is_choice(policy) else \
             {"points": int(policy.action_space.shape[0])}
         super().__init__(env, seed, **{**shape, **kwargs})

@@ -127,6 +127,12 @@ def test_a_dagger_run_trains_a_student_that_plays(tmp_path, form):
     gathered = report([tmp_path / "run"], tmp_path / "report")
     assert gathered == {(tmp_path / "run").as_posix(): record}
     assert "| 1 | 0.5 |" in (tmp_path / "report" / "waypoints.md").read_text()
+    # played where the costmap differs from the training's, it says so
+    if form == "waypoints":
+        longer = gym.make(NAV, **{**KWARGS, "costmap_ahead": 400.0})
+        with pytest.raises(ValueError, match="trained on costmaps of shape"):
+            WaypointStudent(longer, run=str(tmp_path / "run"))
+        longer.close()
 
 
 @pytest.mark.parametrize("refit, networks", [("warm", 1), ("fresh", 3)])
