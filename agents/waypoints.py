@@ -435,8 +435,8 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     (``epochs`` passes of Adam) after each round on every label so far,
     from its weights before (``refit="warm"``) or from a new network
     seeded alike (``"fresh"``), so that the first rounds' labels are not
-    passed over again in every round. ``seed`` seeds the network and the fits. The
-    imitation error is then measured on ``held_out_episodes`` fields seeded
+    passed over again in every round. ``seed`` seeds the network and the
+    fits. The imitation error is then measured on ``held_out_episodes`` fields seeded
     ``held_out_seed`` + k, which the teacher sails. ``command``: the
     command line the record names (None: none). Each round prints a line
     unless ``quiet``.
@@ -471,8 +471,12 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     probe = gym.make(s["env_id"], **s["env_kwargs"])
-    policy = make_student(probe, form=s["form"], points=s["points"], cnn_dim=s["cnn_dim"],
-                          learning_rate=s["learning_rate"], seed=seed)
+
+    def new_student():
+        return make_student(probe, form=s["form"], points=s["points"], cnn_dim=s["cnn_dim"],
+                            learning_rate=s["learning_rate"], seed=seed)
+
+    policy = new_student()
     seen: list[dict] = []
     labels = np.empty(0, dtype=np.int64) if choices else np.empty((0, s["points"]))
     rounds = []
@@ -487,9 +491,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         seen += new
         labels = np.concatenate([labels, wanted])
         if r and s["refit"] == "fresh":
-            policy = make_student(probe, form=s["form"], points=s["points"],
-                                  cnn_dim=s["cnn_dim"], learning_rate=s["learning_rate"],
-                                  seed=seed)
+            policy = new_student()
         data, targets = obs_rows.stack(seen), labels if choices else np.clip(labels, -1.0, 1.0)
         if s["mirror"]:
             flipped, flipped_targets = mirrored(data, targets, s["form"])
