@@ -73,7 +73,7 @@ from .planners import LatticePlanner, costmap_cost_grid
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
            "WaypointFollower",
            "LatticeWaypoints", "WaypointStudent", "decision_observation", "decision_space",
-           "make_student", "mirrored", "train_student", "fit_text", "report", "TRAIN_DEFAULTS",
+           "make_student", "mirrored", "with_mirror", "train_student", "fit_text", "report", "TRAIN_DEFAULTS",
            "main"]
 
 #: environment steps between decisions (10 s: the lattice planner's replan)
@@ -305,7 +305,8 @@ def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int 
         features_extractor_kwargs=dict(cnn_dim=int(cnn_dim)), log_std_init=-2.3)
 
 
-def mirrored(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tuple[dict, np.ndarray]:
+def mirrored(seen: dict, labels: np.ndarray, form: str = "waypoints",
+             out: dict | None = None) -> tuple[dict, np.ndarray]:
     """Decisions seen in the mirror of the channel about the ship's track:
     the costmap's columns reversed (it is centred on the ship across), the
     pose's lateral offset, heading and yaw rate negated, and the labels'
@@ -313,10 +314,28 @@ def mirrored(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tuple[d
     negated). The task is symmetric so (the floes, the
     channel and the goal line mirror into another field of the same law),
     and the lattice's route in the mirrored field is the mirror of its
-    route, up to ties between routes of equal cost."""
-    return ({"costmap": np.ascontiguousarray(seen["costmap"][..., ::-1]),
-             "vector": -seen["vector"]},
-            len(STAGE_CHOICES) - 1 - labels if form == "stages" else -labels)
+    route, up to ties between routes of equal cost.
+
+    ``out``: arrays (by key, of ``seen``'s shapes) the images are written
+    into instead of new ones."""
+    if out is None:
+        out = {k: np.empty_like(seen[k]) for k in ("costmap", "vector")}
+    np.copyto(out["costmap"], seen["costmap"][..., ::-1])
+    np.negative(seen["vector"], out=out["vector"])
+    return out, len(STAGE_CHOICES) - 1 - labels if form == "stages" else -labels
+
+
+def with_mirror(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tuple[dict, np.ndarray]:
+    """``seen`` and ``labels`` followed by their :func:`mirrored` images, in
+    one new array per key: the decisions and their images are held twice
+    over in all, not four times as stacking them apart and concatenating
+    would (a 500 m costmap is about 100 kB a decision)."""
+    n = len(labels)
+    both = {k: np.empty((2 * n, *v.shape[1:]), dtype=v.dtype) for k, v in seen.items()}
+    for k, v in seen.items():
+        both[k][:n] = v
+    _, flipped = mirrored(seen, labels, form, out={k: both[k][n:] for k in both})
+    return both, np.concatenate([labels, flipped])
 
 
 def _student_decision(policy, seen: dict):
@@ -477,7 +496,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
                             learning_rate=s["learning_rate"], seed=seed)
 
     policy = new_student()
-    seen: list[dict] = []
+    seen: dict | None = None  # every decision so far, one float32 array per key
     labels = np.empty(0, dtype=np.int64) if choices else np.empty((0, s["points"]))
     rounds = []
     began = time.perf_counter()
@@ -488,18 +507,19 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
             s["env_id"], s["env_kwargs"], policy if r else None, beta, s["episodes"],
             s["field_seed"] + r * s["episodes"], f"round {r} (beta {beta:.3g})", progress,
             s["form"], s["points"], s["teacher"])
-        seen += new
+        new = obs_rows.stack(new)
+        seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
+        del new
         labels = np.concatenate([labels, wanted])
         if r and s["refit"] == "fresh":
             policy = new_student()
-        data, targets = obs_rows.stack(seen), labels if choices else np.clip(labels, -1.0, 1.0)
+        data, targets = seen, labels if choices else np.clip(labels, -1.0, 1.0)
         if s["mirror"]:
-            flipped, flipped_targets = mirrored(data, targets, s["form"])
-            data = {k: np.concatenate([data[k], flipped[k]]) for k in data}
-            targets = np.concatenate([targets, flipped_targets])
+            data, targets = with_mirror(data, targets, s["form"])
         fit = fit_policy(policy, data, targets, None,
                          epochs=s["epochs"], batch_size=s["batch_size"],
                          learning_rate=s["learning_rate"], seed=seed * 1000 + r)
+        del data  # the mirrored copy, until the next round's fit
         rounds.append({"round": r, "beta": beta, "decisions": len(wanted),
                        "mean_return": float(np.mean(returns)),
                        **{k: v for k, v in fit.items() if k.startswith("action_")},

@@ -11,7 +11,7 @@ from agents.planners import CostmapLatticePlanner, LatticePlanner
 from agents.rollouts import run_episode
 from agents.waypoints import (STAGE_CHOICES, WAYPOINT_DISTANCE, LatticeWaypoints, WaypointStudent,
                               decision_observation, decision_space, main, make_student,
-                              mirrored, report, train_student)
+                              mirrored, report, train_student, with_mirror)
 from small_envs import SMALL
 
 NAV = "iceenvs/ShipNavigation-v1"
@@ -215,6 +215,13 @@ def test_the_mirror_of_a_field_is_seen_and_planned_as_its_mirror_image(monkeypat
     np.testing.assert_array_equal(image["vector"], [[-0.1, 0.2, -0.3]])
     np.testing.assert_array_equal(image["costmap"][0, 0], [[2.0, 1.0, 0.0], [5.0, 4.0, 3.0]])
     np.testing.assert_array_equal(shifts, [[-0.4, 0.5]])
+    # the training's one array of the decisions and their images
+    both, labels = with_mirror(pose, np.array([[0.4, -0.5]]))
+    np.testing.assert_array_equal(both["costmap"], np.concatenate([pose["costmap"], image["costmap"]]))
+    np.testing.assert_array_equal(both["vector"], [[0.1, -0.2, 0.3], [-0.1, 0.2, -0.3]])
+    np.testing.assert_array_equal(labels, [[0.4, -0.5], [-0.4, 0.5]])
+    _, choices = with_mirror(pose, np.array([0]), "stages")
+    np.testing.assert_array_equal(choices, [0, len(STAGE_CHOICES) - 1])
 
 
 def test_a_stage_choice_turns_each_stage_by_at_most_one_slope_step():
