@@ -626,6 +626,16 @@ def main(argv=None) -> int:
     t.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make keywords of the fields sailed (YAML values)")
     t.add_argument("--no-progress", action="store_true")
+    from .waypoint_rl import FINETUNE_DEFAULTS
+
+    f = sub.add_parser("finetune", help="train a student further by PPO on the reward, one "
+                                         "action a decision (agents.waypoint_rl)")
+    f.add_argument("--run", type=Path, required=True, help="the student's run directory")
+    f.add_argument("--seed", type=int, default=1)
+    f.add_argument("--out", type=Path, required=True)
+    for name, value in FINETUNE_DEFAULTS.items():
+        f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value)
+    f.add_argument("--no-progress", action="store_true")
     r = sub.add_parser("report", help="gather runs' records into one record and a table")
     r.add_argument("runs", nargs="+", type=Path, help="run directories of train")
     r.add_argument("--out", type=Path, required=True)
@@ -637,6 +647,19 @@ def main(argv=None) -> int:
         except (ValueError, FileNotFoundError) as exc:
             p.error(str(exc))
         print((args.out / "waypoints.md").read_text())
+        return 0
+    if args.command == "finetune":
+        from .waypoint_rl import finetune
+
+        try:
+            record = finetune(args.run, args.out, args.seed, progress=not args.no_progress,
+                              command=shlex.join(["python", "-m", "agents.waypoints", *argv]),
+                              **{k: getattr(args, k) for k in FINETUNE_DEFAULTS})
+        except (ValueError, FileNotFoundError) as exc:
+            p.error(str(exc))
+        print(f"{args.out}: {record['decisions']} decisions, {record['episodes']} episodes in "
+              f"{record['seconds']:.0f} s; mean return by {record['window']} episodes: "
+              f"{record['mean_return_by_window']}")
         return 0
     settings = {k: getattr(args, k) for k in ("form", "teacher", "refit", "points", "episodes",
                                               "rounds", "epochs",

@@ -1,0 +1,300 @@
+"""Fine-tuning a waypoint student by reinforcement learning, at its own
+pace: one action is one decision of :mod:`agents.waypoints`.
+
+Imitation can at best sail as well as its teacher. To do better, the
+student of :func:`agents.waypoints.train_student` is trained further by
+PPO (Schulman et al. 2017) on the environment's own reward, in the terms
+it decides in:
+
+* **The environment** (:class:`WaypointDecisionEnv`): an action is a
+  decision w (the waypoints' lateral shifts); the ship follows the route
+  through them by pure pursuit for :data:`~agents.waypoints.DECISION_STEPS`
+  steps (10 s, the lattice planner's replan), and the reward is the sum of
+  the environment's rewards over those steps. The observation is
+  :func:`agents.waypoints.decision_observation`: the costmap and the
+  ship's pose, what the student saw while it imitated. Exploration noise
+  is drawn once per decision, so it is held for 10 s: correlated in time
+  at the pace the task is decided.
+* **Starting from the student**: the policy's actor is the student's
+  network, weights and all. The critic has a network of its own (its
+  costmap CNN starts as a copy of the student's), so that fitting the
+  value does not move the features the actor imitated with.
+* **Keeping near the teacher at first**: the critic is fitted alone for
+  ``critic_steps`` decisions (learning rate ``critic_learning_rate``),
+  with the actor frozen; then both are trained with a smaller learning
+  rate, a clip range of 0.1 and PPO's early stop on the approximate KL
+  divergence. The exploration starts at the student's (a standard
+  deviation of 0.1 on each shift). The rewards are divided by a running
+  estimate of the discounted return's spread (SB3's ``VecNormalize``),
+  so that the critic's targets are of order one.
+
+The fields sailed are seeded ``field_seed`` + k, episode by episode, apart
+from the leaderboard's and the tuning fields. Run::
+
+    python -m agents.waypoints finetune --run runs/cm-fresh/seed_1 --seed 1 \\
+        --out runs/cm-rl/seed_1
+
+The output is a run directory like the student's (``student.zip``, the
+student's network with the fine-tuned actor, so
+:class:`agents.waypoints.WaypointStudent` plays it), with ``ppo.zip`` (the
+whole PPO model) and ``finetune.json``: the settings, the mean return of
+the training episodes in windows, and the wall time.
+"""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+from .waypoints import (RECORD, STUDENT, WaypointFollower, decision_observation,
+                        decision_space)
+
+__all__ = ["WaypointDecisionEnv", "finetune", "FINETUNE_DEFAULTS", "FINETUNE_RECORD", "PPO_MODEL"]
+
+#: the record of a fine-tuning run, and its whole PPO model (actor, critic and
+#: optimiser, for ``PPO.load``), in its directory
+FINETUNE_RECORD, PPO_MODEL = "finetune.json", "ppo.zip"
+#: the settings of :func:`finetune`
+FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
+                         n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,
+                         clip_range=0.1, target_kl=0.02, gamma=0.99, gae_lambda=0.95,
+                         field_seed=80_000)
+
+
+class _Commanded(WaypointFollower):
+    """Follows the decision it is given (:attr:`command`)."""
+
+    def __init__(self, env, seed: int = 0, **kwargs):
+        super().__init__(env, seed, **kwargs)
+        self.command = None
+
+    def decide(self, obs):
+        return self.command
+
+
+class WaypointDecisionEnv(gym.Env):
+    """A ship environment seen at the decisions of a waypoint follower: an
+    action is a decision w ∈ [−1, 1]^points, a step sails ``interval``
+    environment steps (fewer when the episode ends) along its route, and
+    the reward is their rewards' sum.
+
+    Parameters
+    ----------
+    env : gymnasium.Env
+        A ship environment (e.g. ``gymnasium.make("iceenvs/ShipNavigation-v1")``);
+        closed with this one.
+    field_seed : int or None
+        A reset without a seed seeds episode k of this environment's life
+        ``field_seed`` + k (None: the environment's own sequence).
+    **follower : :class:`agents.waypoints.WaypointFollower`'s settings
+        (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
+        ``"waypoints"`` only).
+
+    ``info`` of a step holds ``env_steps`` (the environment steps it sailed)
+    and the last environment step's info.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, env, field_seed: int | None = None, **follower):
+        if follower.get("form", "waypoints") != "waypoints":
+            raise ValueError("WaypointDecisionEnv decides lateral shifts (form 'waypoints'), "
+                             f"got form {follower['form']!r}")
+        self.env = env
+        self.follower = _Commanded(env, **follower)
+        self.observation_space = decision_space(env)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (self.follower.points,), np.float32)
+        self.field_seed = field_seed
+        self._episodes = 0
+        self._obs = None
+
+    def reset(self, *, seed: int | None = None, options=None):
+        super().reset(seed=seed)
+        if seed is None and self.field_seed is not None:
+            seed = self.field_seed + self._episodes
+        self._episodes += 1
+        self._obs, info = self.env.reset(seed=seed, options=options)
+        self.follower.reset(seed)
+        return decision_observation(self.env), info
+
+    def step(self, action):
+        if self._obs is None:
+            raise RuntimeError("WaypointDecisionEnv.step before reset")
+        w = np.asarray(action, dtype=float).reshape(-1)
+        if w.shape != self.action_space.shape or not np.all(np.isfinite(w)):
+            raise ValueError(f"a decision is {self.action_space.shape[0]} finite number(s) "
+                             f"in [-1, 1], got {action!r}")
+        self.follower.command = w
+        self.follower._age = self.follower.interval        # decide now
+        total, steps = 0.0, 0
+        terminated = truncated = False
+        info: dict = {}
+        while steps < self.follower.interval and not (terminated or truncated):
+            self._obs, reward, terminated, truncated, info = self.env.step(
+                self.follower.predict(self._obs)[0])
+            total += float(reward)
+            steps += 1
+        return (decision_observation(self.env), total, terminated, truncated,
+                {**info, "env_steps": steps})
+
+    def close(self):
+        self.env.close()
+
+
+def _actor_parameters(policy):
+    return [*policy.pi_features_extractor.parameters(),
+            *policy.mlp_extractor.policy_net.parameters(),
+            *policy.action_net.parameters(), policy.log_std]
+
+
+def _from_student(policy, student) -> None:
+    """Load the student's weights into ``policy`` (a PPO policy of the same
+    network but a critic CNN of its own, which starts as the student's)."""
+    import torch
+
+    source = student.state_dict()
+    target = policy.state_dict()
+    loaded = {}
+    for key in target:
+        origin = ("features_extractor." + key.split(".", 1)[1]
+                  if key.startswith(("pi_features_extractor.", "vf_features_extractor."))
+                  else key)
+        if origin not in source or source[origin].shape != target[key].shape:
+            raise ValueError(f"the student has no weights for {key!r} of this network")
+        loaded[key] = source[origin]
+    with torch.no_grad():
+        policy.load_state_dict(loaded)
+
+
+def _to_student(policy, student):
+    """``student`` (the student's own network, one costmap CNN shared by its
+    actor and critic) with the actor of the fine-tuned ``policy``: what
+    :class:`agents.waypoints.WaypointStudent` plays. (SB3 saves a policy
+    without its ``share_features_extractor``, so a policy of two CNNs is
+    loaded back as one, and with the critic's.)"""
+    import torch
+
+    tuned = policy.state_dict()
+    mine = student.state_dict()
+    for key in mine:
+        if key.startswith(("features_extractor.", "pi_features_extractor.",
+                           "vf_features_extractor.")):
+            mine[key] = tuned["pi_features_extractor." + key.split(".", 1)[1]]
+        elif key.startswith(("mlp_extractor.policy_net.", "action_net.", "log_std")):
+            mine[key] = tuned[key]
+    with torch.no_grad():
+        student.load_state_dict(mine)
+    return student
+
+
+def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
+             command: str | None = None, **settings) -> dict:
+    """Fine-tune the student of ``run`` (a directory of
+    :func:`agents.waypoints.train_student`) by PPO on
+    :class:`WaypointDecisionEnv` of its training's environment, and save
+    the policy as ``out/student.zip`` with the record ``out/finetune.json``.
+
+    ``settings``: :data:`FINETUNE_DEFAULTS` (``steps`` and
+    ``critic_steps``: decisions in all and of the critic's fit alone).
+    """
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.monitor import Monitor
+    from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+    from stable_baselines3.common.utils import set_random_seed
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    from .callbacks import TqdmCallback
+
+    unknown = sorted(set(settings) - set(FINETUNE_DEFAULTS))
+    if unknown:
+        raise ValueError(f"unknown settings {unknown}; valid: {', '.join(FINETUNE_DEFAULTS)}")
+    s = {**FINETUNE_DEFAULTS, **settings}
+    for name in ("steps", "n_steps", "batch_size", "n_epochs"):
+        if isinstance(s[name], bool) or int(s[name]) != s[name] or s[name] < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {s[name]!r}")
+    if isinstance(s["critic_steps"], bool) or int(s["critic_steps"]) != s["critic_steps"] \
+            or not 0 <= s["critic_steps"] < s["steps"]:
+        raise ValueError(f"critic_steps must be an integer in [0, steps), got "
+                         f"{s['critic_steps']!r}")
+    run, out = Path(run), Path(out)
+    for name in (STUDENT, RECORD):
+        if not (run / name).is_file():
+            raise FileNotFoundError(f"{run} is not a run of python -m agents.waypoints train: "
+                                    f"{run / name} is missing")
+    trained = json.loads((run / RECORD).read_text())["settings"]
+    student = MultiInputActorCriticPolicy.load(str(run / STUDENT), device="cpu")
+    if isinstance(student.action_space, gym.spaces.Discrete):
+        raise ValueError(f"{run} decides stage choices; fine-tuning takes a student of "
+                         f"form 'waypoints'")
+    made = gym.make(trained["env_id"], **trained["env_kwargs"])
+    env = WaypointDecisionEnv(made, field_seed=s["field_seed"],
+                              points=int(student.action_space.shape[0]))
+    if env.observation_space["costmap"].shape != student.observation_space["costmap"].shape:
+        env.close()
+        raise ValueError(f"the student of {run} was trained on other costmaps than its "
+                         f"environment makes now")
+    kept = student._get_constructor_parameters()
+    policy_kwargs = {k: kept[k] for k in ("net_arch", "activation_fn", "ortho_init",
+                                          "log_std_init", "features_extractor_class",
+                                          "features_extractor_kwargs", "normalize_images")}
+    policy_kwargs["share_features_extractor"] = False
+    out.mkdir(parents=True, exist_ok=True)
+    monitored = Monitor(env)
+    # the rewards scaled by a running estimate of the return's spread (the
+    # environment's own are kept in the record)
+    vec = VecNormalize(DummyVecEnv([lambda: monitored]), norm_obs=False, norm_reward=True,
+                       gamma=s["gamma"])
+    # torch and numpy seeded here, not by PPO's ``seed``, which would also
+    # seed the first field (it is field_seed)
+    set_random_seed(seed)
+    model = PPO("MultiInputPolicy", vec, learning_rate=s["critic_learning_rate"],
+                n_steps=s["n_steps"], batch_size=s["batch_size"], n_epochs=s["n_epochs"],
+                gamma=s["gamma"], gae_lambda=s["gae_lambda"], clip_range=s["clip_range"],
+                target_kl=s["target_kl"], policy_kwargs=policy_kwargs,
+                device="cpu", verbose=0)
+    _from_student(model.policy, student)
+    began = time.perf_counter()
+    actor = _actor_parameters(model.policy)
+    if s["critic_steps"]:
+        for p in actor:
+            p.requires_grad_(False)
+        model.learn(s["critic_steps"], reset_num_timesteps=True,
+                    callback=TqdmCallback(s["critic_steps"], disable=not progress))
+        for p in actor:
+            p.requires_grad_(True)
+    model.learning_rate = s["learning_rate"]
+    model._setup_lr_schedule()
+    rest = s["steps"] - s["critic_steps"]
+    model.learn(rest, reset_num_timesteps=not s["critic_steps"],
+                callback=TqdmCallback(rest, disable=not progress))
+    returns = [float(r) for r in monitored.get_episode_rewards()]
+    lengths = [int(n) for n in monitored.get_episode_lengths()]
+    window = 10
+    record = {"settings": {**s, "seed": seed, "run": str(run), "env_id": trained["env_id"],
+                           "env_kwargs": trained["env_kwargs"]},
+              "episodes": len(returns),
+              "mean_return_by_window": [round(float(np.mean(returns[i:i + window])), 3)
+                                        for i in range(0, len(returns), window)],
+              "window": window,
+              "decisions": int(sum(lengths)),
+              "critic_episodes": _episodes_within(lengths, s["critic_steps"]),
+              "seconds": round(time.perf_counter() - began, 1),
+              "torch_threads": torch.get_num_threads(),
+              "command": command}
+    _to_student(model.policy, student).save(str(out / STUDENT))
+    model.save(str(out / PPO_MODEL))
+    (out / FINETUNE_RECORD).write_text(json.dumps(record, indent=2) + "\n")
+    vec.close()
+    return record
+
+
+def _episodes_within(lengths, decisions: int) -> int:
+    """How many whole episodes of ``lengths`` (decisions each) end within
+    the first ``decisions``."""
+    return int(np.searchsorted(np.cumsum(lengths), decisions, side="right"))

@@ -1,0 +1,143 @@
+"""Fine-tuning a waypoint student by PPO (agents.waypoint_rl): one action is
+one decision and sails the follower's steps, the fine-tuning starts from the
+student and fits the critic alone first, and bad input is refused."""
+import gymnasium as gym
+import numpy as np
+import pytest
+from stable_baselines3 import PPO
+from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+
+from agents.waypoint_rl import FINETUNE_RECORD, PPO_MODEL, WaypointDecisionEnv, finetune
+from agents.waypoints import LatticeWaypoints, main, train_student
+from small_envs import SMALL
+
+NAV = "iceenvs/ShipNavigation-v1"
+KWARGS = {**SMALL[NAV], "length": 300.0, "goal_distance": 150.0}
+
+
+def test_a_decision_sails_five_steps_of_the_followers_episode():
+    # the lattice's waypoints played through the decision environment: its
+    # steps are the teacher's episode five steps at a time, with their rewards
+    def direct():
+        env = gym.make(NAV, **{**KWARGS, "concentration": 0.4})
+        teacher = LatticeWaypoints(env)
+        obs, _ = env.reset(seed=3)
+        teacher.reset(3)
+        rewards, ships, done = [], [], False
+        while not done:
+            obs, reward, terminated, truncated, _ = env.step(teacher.predict(obs)[0])
+            rewards.append(reward)
+            ships.append(np.array(env.unwrapped.sim.ship.position))
+            done = terminated or truncated
+        env.close()
+        return np.array(rewards), np.array(ships)
+
+    rewards, ships = direct()
+    env = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.4}))
+    teacher = LatticeWaypoints(env.env)
+    obs, _ = env.reset(seed=3)
+    assert env.observation_space.contains(obs)
+    sums, at, steps, done = [], [], 0, False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(teacher.label())
+        steps += info["env_steps"]
+        sums.append(reward)
+        at.append(np.array(env.env.unwrapped.sim.ship.position))
+        done = terminated or truncated
+    env.close()
+    assert steps == len(rewards) and len(sums) == -(-len(rewards) // 5)
+    np.testing.assert_array_equal(np.array(at), ships[np.minimum(np.arange(5, 5 * len(sums) + 1, 5),
+                                                                 len(ships)) - 1])
+    np.testing.assert_allclose(sums, [rewards[k:k + 5].sum() for k in range(0, len(rewards), 5)],
+                               rtol=1e-12, atol=1e-12)
+
+
+def test_unseeded_resets_sail_the_fields_in_order():
+    env = WaypointDecisionEnv(gym.make(NAV, **KWARGS), field_seed=123)
+    first, _ = env.reset()
+    second, _ = env.reset()
+    env.close()
+    again = WaypointDecisionEnv(gym.make(NAV, **KWARGS))
+    np.testing.assert_array_equal(again.reset(seed=123)[0]["costmap"], first["costmap"])
+    np.testing.assert_array_equal(again.reset(seed=124)[0]["costmap"], second["costmap"])
+    again.close()
+
+
+@pytest.fixture(scope="module")
+def student(tmp_path_factory):
+    run = tmp_path_factory.mktemp("student")
+    train_student(run, 0, progress=False, quiet=True, env_kwargs=KWARGS, episodes=1,
+                  rounds=0, epochs=2, held_out_episodes=1, teacher="costmap-lattice")
+    return run
+
+
+def test_the_critic_is_fitted_alone_from_the_students_actor(student, tmp_path):
+    # a learning rate of 0 after the critic's phase: the actor must still be
+    # the student's, weight for weight, and the critic must have moved
+    record = finetune(student, tmp_path / "ft", 1, progress=False, steps=48, critic_steps=24,
+                      n_steps=24, batch_size=8, n_epochs=2, learning_rate=0.0,
+                      critic_learning_rate=1e-3)
+    assert record["decisions"] <= 48 and record["episodes"] >= 1
+    assert (tmp_path / "ft" / FINETUNE_RECORD).is_file()
+    old = MultiInputActorCriticPolicy.load(str(student / "student.zip"), device="cpu")
+    tuned = PPO.load(str(tmp_path / "ft" / PPO_MODEL), device="cpu").policy
+    before, after = old.state_dict(), tuned.state_dict()
+    for key in after:
+        if key.startswith(("pi_features_extractor.", "mlp_extractor.policy_net.", "action_net.",
+                           "log_std")):
+            origin = key.replace("pi_features_extractor.", "features_extractor.")
+            np.testing.assert_array_equal(after[key].numpy(), before[origin].numpy(),
+                                          err_msg=key)
+    assert not np.array_equal(after["value_net.weight"].numpy(), before["value_net.weight"].numpy())
+    # the critic has a costmap network of its own, which started as the
+    # student's and was fitted apart from it
+    own = [k for k in after if k.startswith("vf_features_extractor.")]
+    assert own
+    assert any(not np.array_equal(after[k].numpy(),
+                                  after["pi_features_extractor." + k.split(".", 1)[1]].numpy())
+               for k in own)
+    # it plays as the student it was
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=9)
+    from agents.waypoints import WaypointStudent, decision_observation
+
+    seen = decision_observation(env)
+    a = WaypointStudent(env, run=str(student)).policy.predict(seen, deterministic=True)[0]
+    b = WaypointStudent(env, run=str(tmp_path / "ft")).policy.predict(seen, deterministic=True)[0]
+    env.close()
+    np.testing.assert_array_equal(a, b)
+
+
+def test_a_finetuning_run_learns(student, tmp_path):
+    finetune(student, tmp_path / "ft", 2, progress=False, steps=48, critic_steps=24,
+             n_steps=24, batch_size=8, n_epochs=2)
+    # and its student is the fine-tuned actor, as the whole model has it
+    old = MultiInputActorCriticPolicy.load(str(student / "student.zip"), device="cpu").state_dict()
+    new = MultiInputActorCriticPolicy.load(str(tmp_path / "ft" / "student.zip"),
+                                           device="cpu").state_dict()
+    tuned = PPO.load(str(tmp_path / "ft" / PPO_MODEL), device="cpu").policy.state_dict()
+    for key in ("action_net.weight", "features_extractor.extractors.costmap.cnn.0.weight"):
+        assert not np.array_equal(new[key].numpy(), old[key].numpy())
+        np.testing.assert_array_equal(new[key].numpy(), tuned[key.replace(
+            "features_extractor.", "pi_features_extractor.")].numpy())
+
+
+def test_bad_input_is_refused(student, tmp_path, capsys):
+    with pytest.raises(FileNotFoundError, match="not a run"):
+        finetune(tmp_path, tmp_path / "ft", 1, progress=False)
+    with pytest.raises(ValueError, match="critic_steps must be"):
+        finetune(student, tmp_path / "ft", 1, progress=False, steps=10, critic_steps=10)
+    with pytest.raises(ValueError, match="unknown settings"):
+        finetune(student, tmp_path / "ft", 1, progress=False, epochs=3)
+    with pytest.raises(ValueError, match="form 'waypoints'"):
+        WaypointDecisionEnv(gym.make(NAV, **KWARGS), form="stages")
+    env = WaypointDecisionEnv(gym.make(NAV, **KWARGS))
+    with pytest.raises(RuntimeError, match="before reset"):
+        env.step(np.zeros(2))
+    env.reset(seed=1)
+    with pytest.raises(ValueError, match="finite number"):
+        env.step(np.array([np.nan, 0.0]))
+    env.close()
+    with pytest.raises(SystemExit):
+        main(["finetune", "--run", str(tmp_path), "--out", str(tmp_path / "ft")])
+    assert "not a run" in capsys.readouterr().err
