@@ -52,7 +52,8 @@ import numpy as np
 from .waypoints import (RECORD, STUDENT, WaypointFollower, decision_observation,
                         decision_space)
 
-__all__ = ["WaypointDecisionEnv", "finetune", "FINETUNE_DEFAULTS", "FINETUNE_RECORD", "PPO_MODEL"]
+__all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
+           "FINETUNE_RECORD", "PPO_MODEL"]
 
 #: the record of a fine-tuning run, and its whole PPO model (actor, critic and
 #: optimiser, for ``PPO.load``), in its directory
@@ -298,3 +299,55 @@ def _episodes_within(lengths, decisions: int) -> int:
     """How many whole episodes of ``lengths`` (decisions each) end within
     the first ``decisions``."""
     return int(np.searchsorted(np.cumsum(lengths), decisions, side="right"))
+
+
+def finetune_report(runs, out: str | Path) -> dict:
+    """Gather the records of the fine-tuning runs ``runs`` (directories of
+    :func:`finetune`) into ``out``: ``finetune.json`` (each run's record, by
+    its directory as given), ``finetune.md`` (a table of the runs) and
+    ``finetune.png`` (each run's mean return of the training episodes, by
+    windows of 10 episodes)."""
+    from physics.scenarios import plots
+
+    records = {}
+    for run in runs:
+        path = Path(run) / FINETUNE_RECORD
+        if not path.is_file():
+            raise FileNotFoundError(f"{run}: no {FINETUNE_RECORD} (not a run of python -m "
+                                    f"agents.waypoints finetune)")
+        records[Path(run).as_posix()] = json.loads(path.read_text())
+    if not records:
+        raise ValueError("a report needs at least one run")
+    lines = ["| run | seed | from the student | decisions (critic alone) | episodes "
+             "| mean return, first and last 10 episodes | training [min] |",
+             "|---|---|---|---|---|---|---|"]
+    for name, record in records.items():
+        s, windows = record["settings"], record["mean_return_by_window"]
+        lines.append(f"| {name} | {s['seed']} | {s['run']} | {record['decisions']} "
+                     f"({s['critic_steps']}) | {record['episodes']} "
+                     f"| {windows[0]:.1f} → {windows[-1]:.1f} | {record['seconds'] / 60:.1f} |")
+    first = next(iter(records.values()))["settings"]
+    lines += ["", f"Fields: seeded {first['field_seed']} + k, one per episode; learning rate "
+              f"{first['critic_learning_rate']:g} for the critic alone, then {first['learning_rate']:g}; "
+              f"{first['n_steps']} decisions a rollout, {first['n_epochs']} epochs of "
+              f"{first['batch_size']}, clip {first['clip_range']:g}, target KL "
+              f"{first['target_kl']:g}. The training episodes' returns are of the "
+              f"stochastic policy, on fields of every concentration: the leaderboard judges.",
+              ""]
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / FINETUNE_RECORD).write_text(json.dumps(records, indent=1) + "\n")
+    (out / "finetune.md").write_text("\n".join(lines))
+    plt = plots.pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for name, record in records.items():
+        windows = record["mean_return_by_window"]
+        x = record["window"] * (np.arange(len(windows)) + 1)
+        ax.plot(x, windows, lw=1.2, label=name)
+        ax.axvline(record["critic_episodes"], color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel("training episodes (dotted: the critic's fit alone ends)")
+    ax.set_ylabel(f"mean return of {next(iter(records.values()))['window']} episodes")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    plots.savefig(fig, out / "finetune.png", dpi=110, palette=True)
+    return records

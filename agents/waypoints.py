@@ -637,16 +637,25 @@ def main(argv=None) -> int:
         f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value)
     f.add_argument("--no-progress", action="store_true")
     r = sub.add_parser("report", help="gather runs' records into one record and a table")
-    r.add_argument("runs", nargs="+", type=Path, help="run directories of train")
+    r.add_argument("runs", nargs="+", type=Path, help="run directories of train or finetune "
+                                                       "(gathered apart)")
     r.add_argument("--out", type=Path, required=True)
     argv = sys.argv[1:] if argv is None else list(argv)
     args = p.parse_args(argv)
     if args.command == "report":
+        from .waypoint_rl import FINETUNE_RECORD, finetune_report
+
+        tuned = [run for run in args.runs if (run / FINETUNE_RECORD).is_file()]
+        trained = [run for run in args.runs if run not in tuned]
         try:
-            report(args.runs, args.out)
+            if trained:
+                report(trained, args.out)
+                print((args.out / "waypoints.md").read_text())
+            if tuned:
+                finetune_report(tuned, args.out)
+                print((args.out / "finetune.md").read_text())
         except (ValueError, FileNotFoundError) as exc:
             p.error(str(exc))
-        print((args.out / "waypoints.md").read_text())
         return 0
     if args.command == "finetune":
         from .waypoint_rl import finetune

@@ -1,6 +1,8 @@
 """Fine-tuning a waypoint student by PPO (agents.waypoint_rl): one action is
 one decision and sails the follower's steps, the fine-tuning starts from the
 student and fits the critic alone first, and bad input is refused."""
+import json
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -108,9 +110,15 @@ def test_the_critic_is_fitted_alone_from_the_students_actor(student, tmp_path):
     np.testing.assert_array_equal(a, b)
 
 
-def test_a_finetuning_run_learns(student, tmp_path):
-    finetune(student, tmp_path / "ft", 2, progress=False, steps=48, critic_steps=24,
-             n_steps=24, batch_size=8, n_epochs=2)
+def test_a_finetuning_run_learns(student, tmp_path, capsys):
+    record = finetune(student, tmp_path / "ft", 2, progress=False, steps=48, critic_steps=24,
+                      n_steps=24, batch_size=8, n_epochs=2)
+    # the report gathers it apart from the training run
+    assert main(["report", str(student), str(tmp_path / "ft"), "--out", str(tmp_path / "r")]) == 0
+    assert (tmp_path / "r" / "waypoints.md").is_file() and (tmp_path / "r" / "finetune.png").is_file()
+    gathered = json.loads((tmp_path / "r" / FINETUNE_RECORD).read_text())
+    assert list(gathered.values()) == [record]
+    assert f"| {record['decisions']} (24) |" in capsys.readouterr().out
     # and its student is the fine-tuned actor, as the whole model has it
     old = MultiInputActorCriticPolicy.load(str(student / "student.zip"), device="cpu").state_dict()
     new = MultiInputActorCriticPolicy.load(str(tmp_path / "ft" / "student.zip"),
