@@ -345,6 +345,8 @@ def finetune_report(runs, out: str | Path) -> dict:
         x = record["window"] * (np.arange(len(windows)) + 1)
         ax.plot(x, windows, lw=1.2, label=name)
         ax.axvline(record["critic_episodes"], color="0.6", lw=0.8, ls=":")
+    ax.set_title("runs with the same field_seed sail the same fields in turn: "
+                 "their common swings are the fields'", fontsize=9)
     ax.set_xlabel("training episodes (dotted: the critic's fit alone ends)")
     ax.set_ylabel(f"mean return of {next(iter(records.values()))['window']} episodes")
     ax.legend(fontsize=8)

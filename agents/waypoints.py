@@ -329,7 +329,7 @@ def with_mirror(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tupl
     """``seen`` and ``labels`` followed by their :func:`mirrored` images, in
     one new array per key: the decisions and their images are held twice
     over in all, not four times as stacking them apart and concatenating
-    would (a 500 m costmap is about 100 kB a decision)."""
+    would (a 500 m costmap is 50 kB a decision)."""
     n = len(labels)
     both = {k: np.empty((2 * n, *v.shape[1:]), dtype=v.dtype) for k, v in seen.items()}
     for k, v in seen.items():
