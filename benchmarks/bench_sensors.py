@@ -28,16 +28,24 @@ each called as the environment calls it: the sector lidar (the compiled
 image (the environment's `occupancy_image`, 64 × 64 pixels of 150 m, with
 its argument checks). Each is timed as the best of
 five loops of `--calls` calls after a warm-up loop (compilation excluded;
-the kernels are serial). Beside them, the mean wall time of the next 30
-environment steps (a zero action) of the same field, and the lidar's and
-the swath's share of it: v1's vector observation computes both once a
-step, the image only with `obs_type="image"` or `"dict"`.
+the kernels are serial). The costmap (`ShipEnv.costmap`, the compiled
+`costmap_scan` of `iceenvs.costmap`: 5 m cells from 20 m behind the ship
+to 300 m ahead, the channel's width across) is timed likewise, and again
+reaching 500 m ahead (`costmap_ahead=500`, an environment of its own on
+the same field sailed alike). Beside them, the mean wall time of the next 30
+environment steps (a zero action) of the same field, the lidar's and
+the swath's share of it (v1's vector observation computes both once a
+step, the image only with `obs_type="image"` or `"dict"`), and the
+costmap's (once a step with `obs_type="costmap"` or `"costmap_dict"`,
+once a decision for the waypoint learner).
 """
 
 #: sizes of ``--quick``
 QUICK = dict(concentrations=[0.2], calls=50, steps=3)
 #: straight-line steps before the timing: the ship 120 m on, its bow in the ice
 SAIL_IN = 60
+#: the reach [m] ahead of the second costmap timed (the lattice planner's horizon)
+FAR_AHEAD = 500.0
 
 
 def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int = 2000,
@@ -48,17 +56,21 @@ def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int
     import iceenvs  # noqa: F401  (registers the ids)
 
     rows = []
-    bar = harness.Progress(len(concentrations) * 4, "sensors", quiet)
+    bar = harness.Progress(len(concentrations) * 6, "sensors", quiet)
     with bar:
         for a in concentrations:
             env = gym.make("iceenvs/ShipNavigation-v1", concentration=float(a))
+            far = gym.make("iceenvs/ShipNavigation-v1", concentration=float(a),
+                           costmap_ahead=FAR_AHEAD)
             try:
-                env.reset(seed=seed)
-                zero = np.zeros(env.action_space.shape, env.action_space.dtype)
-                for _ in range(SAIL_IN):
-                    env.step(zero)
+                for e in (env, far):
+                    e.reset(seed=seed)
+                    zero = np.zeros(e.action_space.shape, e.action_space.dtype)
+                    for _ in range(SAIL_IN):
+                        e.step(zero)
                 row = dict(concentration=float(a), floes=int(env.unwrapped.sim.radii.size))
-                for name, call in _sensor_calls(env.unwrapped).items():
+                calls_of = {**_sensor_calls(env.unwrapped), "costmap_far": far.unwrapped.costmap}
+                for name, call in calls_of.items():
                     def loop(call=call):
                         for _ in range(calls):
                             call()
@@ -71,9 +83,12 @@ def bench_sensors(concentrations=(0.2, 0.3, 0.4, 0.5), seed: int = 1, calls: int
                 bar.advance()
             finally:
                 env.close()
+                far.close()
             rows.append(row)
             bar.log(f"  A = {a:g}: lidar {row['lidar'] * 1e6:.3g} µs, swath "
-                    f"{row['swath'] * 1e6:.3g} µs, image {row['image'] * 1e6:.3g} µs, "
+                    f"{row['swath'] * 1e6:.3g} µs, image {row['image'] * 1e6:.3g} µs, costmap "
+                    f"{row['costmap'] * 1e6:.3g} µs ({row['costmap_far'] * 1e6:.3g} µs to "
+                    f"{FAR_AHEAD:g} m), "
                     f"step {row['step'] * 1e3:.3g} ms")
     return rows
 
@@ -94,6 +109,7 @@ def _sensor_calls(u) -> dict:
         "lidar": lambda: lidar_scan(pose, sim.positions, sim.radii, setting, packed_box),
         "swath": lambda: u.extra_values([u]),
         "image": u._image,
+        "costmap": u.costmap,
     }
 
 
@@ -101,10 +117,13 @@ def sensors_table(rows: list[dict]) -> dict:
     """The table of a :func:`bench_sensors` result."""
     return harness.table(
         "Ship sensors on the fields of ShipNavigation-v1, one call",
-        ["A", "floes", "lidar [µs]", "swath [µs]", "image [µs]", "env step [ms]",
-         "lidar + swath / step"],
+        ["A", "floes", "lidar [µs]", "swath [µs]", "image [µs]", "costmap [µs]",
+         f"costmap to {FAR_AHEAD:g} m [µs]", "env step [ms]", "lidar + swath / step",
+         "costmap / step", f"costmap to {FAR_AHEAD:g} m / step"],
         [[r["concentration"], r["floes"], r["lidar"] * 1e6, r["swath"] * 1e6,
-          r["image"] * 1e6, r["step"] * 1e3, (r["lidar"] + r["swath"]) / r["step"]]
+          r["image"] * 1e6, r["costmap"] * 1e6, r["costmap_far"] * 1e6, r["step"] * 1e3,
+          (r["lidar"] + r["swath"]) / r["step"], r["costmap"] / r["step"],
+          r["costmap_far"] / r["step"]]
          for r in rows])
 
 

@@ -97,8 +97,7 @@ approximates the impulse that a straight route there would meet. The map is
 a sensor: only floes whose enlarged disc reaches into it count. ShipNavigation-v1's
 channel is periodic across, so the map shows the ice beyond its edges
 through the floes' periodic images, as the swath sensor sees it, and channel
-1 says where the channel ends. Making the map costs about a twentieth of a
-step of ShipNavigation-v1.
+1 says where the channel ends. {costmap_cost}
 
 ```python
 import gymnasium as gym
@@ -122,6 +121,40 @@ python -m iceenvs.costmap --out docs/figures/costmap
 """
 
 
+#: the sensors benchmark's record (``seaice bench sensors``), from which the
+#: page states what the costmap costs
+SENSORS_RECORD = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "sensors.json"
+
+
+def costmap_cost(record: Path = SENSORS_RECORD) -> str:
+    """The page's sentence on what making the costmap costs, from the
+    sensors benchmark's record (a pointer to the command where there is
+    none)."""
+    import json
+
+    if not record.is_file():
+        return ("What making the map costs, beside a step, is timed by "
+                "`seaice bench sensors`.")
+    data = json.loads(record.read_text(encoding="utf-8"))
+    rows = data["data"]["rows"]
+    if not all("costmap" in r and "costmap_far" in r for r in rows):
+        return ("What making the map costs, beside a step, is timed by "
+                "`seaice bench sensors`.")
+    near = [r["costmap"] / r["step"] for r in rows]
+    far = [r["costmap_far"] / r["step"] for r in rows]
+    spread = [r["concentration"] for r in rows]
+    cpu = data["machine"].get("cpu", "this machine")
+
+    def span(values):
+        lo, hi = min(values), max(values)
+        return f"{lo:.2f}" if f"{lo:.2f}" == f"{hi:.2f}" else f"{lo:.2f}–{hi:.2f}"
+
+    return (f"Making the map costs {span(near)} of a step of ShipNavigation-v1 "
+            f"(A = {min(spread):g}–{max(spread):g}), and {span(far)} with it reaching 500 m "
+            f"ahead (`seaice bench sensors`, on the Benchmarks page; {cpu}, "
+            f"{data['date'][:10]}).")
+
+
 def observations_page() -> str:
     """The page: the head, then a section per environment with a feature
     list (its table, :func:`iceenvs.observations.feature_table`), in the
@@ -131,7 +164,7 @@ def observations_page() -> str:
     from . import ENV_IDS
     from .observations import feature_table
 
-    parts = [_HEAD]
+    parts = [_HEAD.replace("{costmap_cost}", costmap_cost())]
     for env_id in ENV_IDS:
         env = gym.make(env_id)
         try:
