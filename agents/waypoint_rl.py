@@ -49,8 +49,8 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoints import (RECORD, STUDENT, WaypointFollower, decision_observation,
-                        decision_space)
+from .waypoint_follower import (RECORD, STUDENT, WaypointFollower, decision_observation,
+                                decision_space)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
            "FINETUNE_RECORD", "PPO_MODEL"]
@@ -129,7 +129,7 @@ class WaypointDecisionEnv(gym.Env):
             raise ValueError(f"a decision is {self.action_space.shape[0]} finite number(s) "
                              f"in [-1, 1], got {action!r}")
         self.follower.command = w
-        self.follower._age = self.follower.interval        # decide now
+        self.follower.decide_next_step()
         total, steps = 0.0, 0
         terminated = truncated = False
         info: dict = {}

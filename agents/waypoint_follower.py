@@ -1,0 +1,182 @@
+"""The waypoint decision and its follower: what the waypoint learner
+(:mod:`agents.waypoints`) decides every 10 s, what it decides on, and the
+pure pursuit that sails a decision until the next.
+
+* :func:`decision_observation` (space :func:`decision_space`): the
+  environment's costmap beside the ship's pose in the channel;
+* :class:`WaypointFollower`: decides every ``interval`` steps
+  (:meth:`~WaypointFollower.decide`, for a subclass to give) and follows the
+  route through the decision's waypoints by the lattice planner's pure
+  pursuit in between.
+
+The teacher, the student and their training are in :mod:`agents.waypoints`;
+fine-tuning by reinforcement learning in :mod:`agents.waypoint_rl`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .planners import LatticePlanner
+
+__all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
+           "WaypointFollower", "decision_observation", "decision_space"]
+
+#: environment steps between decisions (10 s: the lattice planner's replan)
+DECISION_STEPS = 5
+#: how far ahead [m] along the channel the waypoint lies
+WAYPOINT_DISTANCE = 60.0
+#: the forms of a decision: ``points`` lateral shifts (continuous), or one of
+#: the lattice's nine two-stage choices (:meth:`WaypointFollower.stage_waypoints`)
+FORMS = ("waypoints", "stages")
+#: the two-stage choices: the change of the route's slope at its first and at
+#: its second stage, in the lattice's slope steps; choice c is
+#: ``STAGE_CHOICES[c]`` = (c // 3 − 1, c % 3 − 1), and its mirror image 8 − c
+STAGE_CHOICES = tuple((a, b) for a in (-1, 0, 1) for b in (-1, 0, 1))
+#: scales of the pose entries of :func:`decision_observation`
+_OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
+#: the file of the student's policy, and of the run's record, in a run directory
+STUDENT, RECORD = "student.zip", "waypoints.json"
+
+
+def decision_space(env):
+    """The ``Dict`` observation space of :func:`decision_observation` for the
+    ship environment ``env``."""
+    import gymnasium as gym
+
+    from iceenvs.costmap import costmap_space
+
+    u = env.unwrapped
+    return gym.spaces.Dict({"costmap": costmap_space(u.costmap_size),
+                            "vector": gym.spaces.Box(-10.0, 10.0, (3,), np.float32)})
+
+
+def decision_observation(env) -> dict:
+    """What the student decides on: ``{"costmap": the environment's costmap
+    now, "vector": [lateral offset from the channel's centre line / 100 m,
+    heading / 0.5 rad, yaw rate / 0.04 rad/s]}`` (float32)."""
+    u = env.unwrapped
+    ship = u.sim.ship
+    pose = [(float(ship.position[1]) - u.centre_y) / _OFFSET_SCALE,
+            float(ship.heading) / _HEADING_SCALE, float(ship.yaw_rate) / _YAW_SCALE]
+    return {"costmap": np.asarray(u.costmap(), dtype=np.float32),
+            "vector": np.clip(np.asarray(pose, dtype=np.float32), -10.0, 10.0)}
+
+
+class WaypointFollower(LatticePlanner):
+    """Decide waypoints every ``interval`` steps (:meth:`decide`) and
+    follow the straight route through them by the lattice planner's pure
+    pursuit in between (see :mod:`agents.waypoints`).
+
+    Parameters
+    ----------
+    env, seed : as :class:`~agents.planners.LatticePlanner`
+    points : int
+        Waypoints of a decision, evenly spaced to ``distance``.
+    distance : float [m]
+        How far ahead the last waypoint lies.
+    interval : int
+        Environment steps between decisions.
+    form : "waypoints" or "stages"
+        A decision is ``points`` lateral shifts w_k (``"waypoints"``), or one
+        of the lattice's nine two-stage choices (``"stages"``, an integer of
+        :data:`STAGE_CHOICES`; ``points`` 2 and ``distance`` two stages).
+    **kwargs : the lattice planner's (``max_slope``: a decision w_k = 1 is a
+        slope of ``max_slope`` from the ship to waypoint k; ``edge_margin``)
+
+    Attributes
+    ----------
+    decisions : list
+        Each decision of the episode: ``points`` numbers in [−1, 1], or a
+        choice.
+    """
+
+    def __init__(self, env, seed: int = 0, *, points: int = 2,
+                 distance: float = WAYPOINT_DISTANCE, interval: int = DECISION_STEPS,
+                 form: str = "waypoints", **kwargs):
+        kwargs.setdefault("show", False)
+        super().__init__(env, seed, **kwargs)
+        for name, value in (("points", points), ("interval", interval)):
+            if isinstance(value, bool) or int(value) != value or value < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+        if not (math.isfinite(distance) and distance > 0):
+            raise ValueError(f"distance must be a positive number, got {distance!r}")
+        self.points, self.interval, self.distance = int(points), int(interval), float(distance)
+        if form not in FORMS:
+            raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+        if form == "stages" and (self.points != 2 or not math.isclose(
+                self.distance, 2.0 * self.stage_length)):
+            raise ValueError(f"form 'stages' decides the lattice's first two stages: points 2 "
+                             f"and distance {2.0 * self.stage_length:g} m, got {points} and "
+                             f"{distance:g}")
+        self.form = form
+        self.decisions: list = []
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self.decisions = []
+
+    def decide(self, obs):
+        """The decision for the episode now (``obs``: its observation):
+        ``points`` numbers w, or a choice of :data:`STAGE_CHOICES`."""
+        raise NotImplementedError
+
+    def decide_next_step(self) -> None:
+        """Make the next step decide anew, however long ago the last
+        decision was (a driver that sets the decisions' pace itself)."""
+        self._age = self.interval
+
+    def stage_waypoints(self, choice: int) -> np.ndarray:
+        """The decision w of the two-stage choice ``choice``: from the slope
+        the lattice would start with at the ship's heading now
+        (:meth:`~agents.planners.LatticePlanner.start_slope`), the first
+        stage's slope changes by ``STAGE_CHOICES[choice][0]`` steps and the
+        second's by ``[1]`` more, within the lattice's steepest; the
+        waypoints are the two stages' ends."""
+        _, steepest = self.lattice_steps()
+        turn1, turn2 = STAGE_CHOICES[choice]
+        first = max(min(self.start_slope(float(self.unwrapped.sim.ship.heading)) + turn1,
+                        steepest), -steepest)
+        second = max(min(first + turn2, steepest), -steepest)
+        shifts = self.lateral_step * np.array([first, first + second], dtype=float)
+        return shifts / (self.max_slope * self.distances)
+
+    @property
+    def distances(self) -> np.ndarray:
+        """How far ahead [m] each waypoint of a decision lies."""
+        return self.distance * np.arange(1, self.points + 1) / self.points
+
+    def waypoint_route(self, w) -> np.ndarray:
+        """The route of decision ``w`` from the ship's position now: through
+        the waypoints, kept ``edge_margin`` inside the channel, then on
+        along +x."""
+        u = self.unwrapped
+        x, y = (float(v) for v in u.sim.ship.position)
+        half = 0.5 * u.channel_width - self.edge_margin
+        d = self.distances
+        targets = np.clip(y + np.asarray(w) * self.max_slope * d,
+                          u.centre_y - half, u.centre_y + half)
+        far = x + self.distance + 10.0 * u.channel_width
+        return np.array([[x, y], *zip(x + d, targets), [far, targets[-1]]])
+
+    def act(self, obs):
+        if self.route is None or self._age >= self.interval:
+            decision = self.decide(obs)
+            if self.form == "stages":
+                if int(decision) != decision or not 0 <= decision < len(STAGE_CHOICES):
+                    raise ValueError(f"{type(self).__name__} decided {decision!r}, not a "
+                                     f"choice 0-{len(STAGE_CHOICES) - 1}")
+                self.decisions.append(int(decision))
+                w = self.stage_waypoints(int(decision))
+            else:
+                w = np.asarray(decision, dtype=float).reshape(-1)
+                if w.shape != (self.points,) or not np.all(np.isfinite(w)):
+                    raise ValueError(f"{type(self).__name__} decided {decision!r}, not "
+                                     f"{self.points} number(s)")
+                w = np.clip(w, -1.0, 1.0)
+                self.decisions.append(w)
+            self.route = self.waypoint_route(w)
+            self._age = 0
+        self._age += 1
+        return self._pursue(self.route, obs)
