@@ -240,10 +240,9 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
         env.close()
         raise ValueError(f"the student of {run} was trained on other costmaps than its "
                          f"environment makes now")
-    kept = student._get_constructor_parameters()
-    policy_kwargs = {k: kept[k] for k in ("net_arch", "activation_fn", "ortho_init",
-                                          "log_std_init", "features_extractor_class",
-                                          "features_extractor_kwargs", "normalize_images")}
+    policy_kwargs = {k: getattr(student, k) for k in (
+        "net_arch", "activation_fn", "ortho_init", "log_std_init", "features_extractor_class",
+        "features_extractor_kwargs", "normalize_images")}
     policy_kwargs["share_features_extractor"] = False
     out.mkdir(parents=True, exist_ok=True)
     monitored = Monitor(env)
@@ -254,7 +253,9 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     # torch and numpy seeded here, not by PPO's ``seed``, which would also
     # seed the first field (it is field_seed)
     set_random_seed(seed)
-    model = PPO("MultiInputPolicy", vec, learning_rate=s["critic_learning_rate"],
+    # the learning rate of each phase, read by PPO at every update
+    rate = {"now": s["critic_learning_rate"]}
+    model = PPO("MultiInputPolicy", vec, learning_rate=lambda _: rate["now"],
                 n_steps=s["n_steps"], batch_size=s["batch_size"], n_epochs=s["n_epochs"],
                 gamma=s["gamma"], gae_lambda=s["gae_lambda"], clip_range=s["clip_range"],
                 target_kl=s["target_kl"], policy_kwargs=policy_kwargs,
@@ -269,8 +270,7 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
                     callback=TqdmCallback(s["critic_steps"], disable=not progress))
         for p in actor:
             p.requires_grad_(True)
-    model.learning_rate = s["learning_rate"]
-    model._setup_lr_schedule()
+    rate["now"] = s["learning_rate"]
     rest = s["steps"] - s["critic_steps"]
     model.learn(rest, reset_num_timesteps=not s["critic_steps"],
                 callback=TqdmCallback(rest, disable=not progress))
