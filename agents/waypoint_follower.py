@@ -14,14 +14,17 @@ fine-tuning by reinforcement learning in :mod:`agents.waypoint_rl`.
 """
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
 from .planners import LatticePlanner
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "WaypointFollower", "decision_observation", "decision_space"]
+           "WaypointFollower", "decision_observation", "decision_space", "gather_records",
+           "write_gathered"]
 
 #: environment steps between decisions (10 s: the lattice planner's replan)
 DECISION_STEPS = 5
@@ -180,3 +183,28 @@ class WaypointFollower(LatticePlanner):
             self._age = 0
         self._age += 1
         return self._pursue(self.route, obs)
+
+
+def gather_records(runs, record: str, command: str) -> dict:
+    """The JSON file ``record`` of each run directory of ``runs``, by the
+    directory as given (``FileNotFoundError`` naming ``command``, which
+    makes such runs, for one without it; ``ValueError`` for no run)."""
+    records = {}
+    for run in runs:
+        path = Path(run) / record
+        if not path.is_file():
+            raise FileNotFoundError(f"{run}: no {record} (not a run of python -m {command})")
+        records[Path(run).as_posix()] = json.loads(path.read_text())
+    if not records:
+        raise ValueError("a report needs at least one run")
+    return records
+
+
+def write_gathered(out, record: str, records: dict, table: str, lines: list) -> Path:
+    """Write gathered ``records`` to ``out/record`` and the table ``lines``
+    to ``out/table``; returns ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / record).write_text(json.dumps(records, indent=1) + "\n")
+    (out / table).write_text("\n".join(lines))
+    return out

@@ -50,7 +50,7 @@ import gymnasium as gym
 import numpy as np
 
 from .waypoint_follower import (RECORD, STUDENT, WaypointFollower, decision_observation,
-                                decision_space)
+                                decision_space, gather_records, write_gathered)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
            "FINETUNE_RECORD", "PPO_MODEL"]
@@ -309,15 +309,7 @@ def finetune_report(runs, out: str | Path) -> dict:
     windows of 10 episodes)."""
     from physics.scenarios import plots
 
-    records = {}
-    for run in runs:
-        path = Path(run) / FINETUNE_RECORD
-        if not path.is_file():
-            raise FileNotFoundError(f"{run}: no {FINETUNE_RECORD} (not a run of python -m "
-                                    f"agents.waypoints finetune)")
-        records[Path(run).as_posix()] = json.loads(path.read_text())
-    if not records:
-        raise ValueError("a report needs at least one run")
+    records = gather_records(runs, FINETUNE_RECORD, "agents.waypoints finetune")
     lines = ["| run | seed | from the student | decisions (critic alone) | episodes "
              "| mean return, first and last 10 episodes | training [min] |",
              "|---|---|---|---|---|---|---|"]
@@ -334,10 +326,7 @@ def finetune_report(runs, out: str | Path) -> dict:
               f"{first['target_kl']:g}. The training episodes' returns are of the "
               f"stochastic policy, on fields of every concentration: the leaderboard judges.",
               ""]
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / FINETUNE_RECORD).write_text(json.dumps(records, indent=1) + "\n")
-    (out / "finetune.md").write_text("\n".join(lines))
+    out = write_gathered(out, FINETUNE_RECORD, records, "finetune.md", lines)
     plt = plots.pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, record in records.items():

@@ -70,7 +70,7 @@ from .leaderboard import DEFAULT_ENV
 from .planners import costmap_cost_grid
 from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, STUDENT,
                                 WAYPOINT_DISTANCE, WaypointFollower, decision_observation,
-                                decision_space)
+                                decision_space, gather_records, write_gathered)
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
@@ -413,15 +413,7 @@ def report(runs, out: Path) -> dict:
     seed's rounds: the decisions added, the mean return of the round's
     episodes and the fit (:func:`fit_text`); then the same on the held-out
     fields)."""
-    records = {}
-    for run in runs:
-        path = Path(run) / RECORD
-        if not path.is_file():
-            raise FileNotFoundError(f"{run}: no {RECORD} (not a run of python -m "
-                                    f"agents.waypoints train)")
-        records[Path(run).as_posix()] = json.loads(path.read_text())
-    if not records:
-        raise ValueError("report needs at least one run")
+    records = gather_records(runs, RECORD, "agents.waypoints train")
     lines = ["| run | round | β | decisions | mean return of the round's episodes "
              "| fit on all labels so far |", "|---|---|---|---|---|---|"]
     for name, record in records.items():
@@ -445,10 +437,7 @@ def report(runs, out: Path) -> dict:
               f"{first['held_out_episodes']} seeded {first['held_out_seed']} + k, sailed by "
               f"the teacher. Errors of waypoints are of the decisions clipped to [−1, 1].",
               ""]
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / RECORD).write_text(json.dumps(records, indent=1) + "\n")
-    (out / "waypoints.md").write_text("\n".join(lines))
+    write_gathered(out, RECORD, records, "waypoints.md", lines)
     return records
 
 

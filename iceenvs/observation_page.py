@@ -132,12 +132,9 @@ def costmap_cost(record: Path = SENSORS_RECORD) -> str:
     none)."""
     import json
 
-    if not record.is_file():
-        return ("What making the map costs, beside a step, is timed by "
-                "`seaice bench sensors`.")
-    data = json.loads(record.read_text(encoding="utf-8"))
-    rows = data["data"]["rows"]
-    if not all("costmap" in r and "costmap_far" in r for r in rows):
+    data = json.loads(record.read_text(encoding="utf-8")) if record.is_file() else None
+    rows = data["data"]["rows"] if data else []
+    if not rows or not all("costmap" in r and "costmap_far" in r for r in rows):
         return ("What making the map costs, beside a step, is timed by "
                 "`seaice bench sensors`.")
     near = [r["costmap"] / r["step"] for r in rows]

@@ -10,31 +10,15 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.policies import MultiInputActorCriticPolicy
 
 from agents.waypoint_rl import FINETUNE_RECORD, PPO_MODEL, WaypointDecisionEnv, finetune
-from agents.waypoints import LatticeWaypoints, main, train_student
-from small_envs import SMALL
-
-NAV = "iceenvs/ShipNavigation-v1"
-KWARGS = {**SMALL[NAV], "length": 300.0, "goal_distance": 150.0}
+from agents.waypoints import (LatticeWaypoints, WaypointStudent, decision_observation, main,
+                              train_student)
+from test_waypoints import KWARGS, NAV, sail
 
 
 def test_a_decision_sails_five_steps_of_the_followers_episode():
     # the lattice's waypoints played through the decision environment: its
     # steps are the teacher's episode five steps at a time, with their rewards
-    def direct():
-        env = gym.make(NAV, **{**KWARGS, "concentration": 0.4})
-        teacher = LatticeWaypoints(env)
-        obs, _ = env.reset(seed=3)
-        teacher.reset(3)
-        rewards, ships, done = [], [], False
-        while not done:
-            obs, reward, terminated, truncated, _ = env.step(teacher.predict(obs)[0])
-            rewards.append(reward)
-            ships.append(np.array(env.unwrapped.sim.ship.position))
-            done = terminated or truncated
-        env.close()
-        return np.array(rewards), np.array(ships)
-
-    rewards, ships = direct()
+    rewards, ships, _ = sail(LatticeWaypoints, 3, 0.4)
     env = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.4}))
     teacher = LatticeWaypoints(env.env)
     obs, _ = env.reset(seed=3)
@@ -101,8 +85,6 @@ def test_the_critic_is_fitted_alone_from_the_students_actor(student, tmp_path):
     # it plays as the student it was
     env = gym.make(NAV, **KWARGS)
     env.reset(seed=9)
-    from agents.waypoints import WaypointStudent, decision_observation
-
     seen = decision_observation(env)
     a = WaypointStudent(env, run=str(student)).policy.predict(seen, deterministic=True)[0]
     b = WaypointStudent(env, run=str(tmp_path / "ft")).policy.predict(seen, deterministic=True)[0]
