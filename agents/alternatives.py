@@ -13,6 +13,9 @@ benchmark's (40000 + k). ``REFERENCE`` is usually the id's reference agent
 the same with other hyperparameters, shipped elsewhere (``ship --out DIR``).
 Nothing is played again: every set was scored on the same episodes.
 
+The table gives each set's kept seed on the selection episodes too: the
+score that chose it, and that may choose among the sets.
+
 Each candidate is compared with the reference twice. Its kept seed against
 the reference's kept seed, paired by benchmark episode; and its training
 seeds against the reference's, paired by training seed (the difference of
@@ -29,7 +32,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from .diagnostics import stamped, write_record
 
@@ -39,14 +41,25 @@ __all__ = ["read_set", "compare_sets", "markdown", "main"]
 def read_set(directory: Path, label: str | None = None) -> dict:
     """A shipped set of seeds: its ``seeds.json``, the kept run's algorithm
     and a label (default the algorithm, upper case)."""
+    import yaml
+
+    from .benchmark import run_summary
+    from .waypoint_follower import STUDENT
+
     directory = Path(directory)
     path = directory / "seeds.json"
-    if not path.is_file() or not (directory / "args.yaml").is_file():
+    if (directory / "args.yaml").is_file():
+        algo = yaml.safe_load((directory / "args.yaml").read_text())["algo"]
+    elif (directory / STUDENT).is_file():
+        algo = run_summary(directory)["algo"]
+    else:
+        algo = None
+    if not path.is_file() or algo is None:
         raise ValueError(f"{directory} is not a directory written by agents.benchmark ship "
-                         f"(no seeds.json or args.yaml)")
+                         f"(no seeds.json, or neither args.yaml nor {STUDENT})")
     seeds = json.loads(path.read_text())
-    algo = yaml.safe_load((directory / "args.yaml").read_text())["algo"]
-    return dict(label=label or algo.upper(), algo=algo, directory=str(directory), **seeds)
+    return dict(label=label or (algo.upper() if algo.islower() else algo), algo=algo,
+                directory=str(directory), **seeds)
 
 
 def _paired(a: list[float], b: list[float]) -> dict:
@@ -76,6 +89,7 @@ def compare_sets(reference: dict, candidates: list[dict]) -> dict:
         wall = [x["training"].get("wall_seconds", np.nan) for x in s["seeds"]]
         row = dict(label=s["label"], algo=s["algo"], seeds=[x["seed"] for x in s["seeds"]],
                    steps=float(np.mean(steps)), minutes=float(np.mean(wall)) / 60.0,
+                   unit=s["seeds"][0]["training"].get("unit", "steps"),
                    selection=k["selection"], evaluation=k["evaluation"],
                    across_seeds=s["across_seeds"], command=s["command"])
         if s is not reference:
@@ -100,15 +114,18 @@ def markdown(record: dict) -> str:
              f"returns are on the benchmark's {record['evaluation_episodes']}. \"Kept\" pairs "
              f"the kept seeds by episode; \"by seed\" pairs each training seed's mean with "
              f"the seed of the same number of the reference, {ref}. Mean ± standard error.",
-             "", "| training | seeds | steps a seed | minutes a seed | kept seed | across seeds | "
-             "kept − reference | by seed − reference |", "|---|---|---|---|---|---|---|---|"]
+             "", "| training | seeds | steps a seed | minutes a seed | kept seed: selection "
+             "| kept seed: benchmark | across seeds | kept − reference | by seed − reference |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for row in record["rows"]:
         a = row["across_seeds"]
         kept = row.get("kept_vs_reference")
         by_seed = row.get("seeds_vs_reference")
         lines.append(
-            f"| {row['label']} | {len(row['seeds'])} | {row['steps']:.0f} | "
-            f"{row['minutes']:.0f} | {format_pm(row['evaluation']['mean'], row['evaluation']['sem'])}"
+            f"| {row['label']} | {len(row['seeds'])} | {row['steps']:.0f}"
+            f"{' decisions (5 steps each)' if row.get('unit') == 'decisions' else ''} | "
+            f"{row['minutes']:.0f} | {format_pm(row['selection']['mean'], row['selection']['sem'])}"
+            f" | {format_pm(row['evaluation']['mean'], row['evaluation']['sem'])}"
             f" | {a['mean']:.4g} ({a['min']:.4g}–{a['max']:.4g}) | "
             f"{format_pm(kept['diff'], kept['sem']) if kept else '–'} | "
             f"{format_pm(by_seed['diff'], by_seed['sem']) if by_seed else '–'} |")

@@ -7,13 +7,16 @@ reference agent (:mod:`agents.reference`)::
 
     python -m agents.benchmark ship runs/reference/WindDrift-v0/seed_* [--episodes 20]
 
+A run is one of :mod:`agents.train` or a waypoint student's
+(:mod:`agents.waypoints`; ShipNavigation-v1's reference agent is one).
 Every seed's final model plays the same selection episodes (seeded
 :data:`agents.reference.TUNE_EVAL_SEED` + k: not the benchmark's) and the
 benchmark's episodes (:data:`agents.reference.EVAL_SEED` + k), on the
 environment's default configuration but for the run's own way of acting
 and observing (:data:`agents.rollouts.AGENT_KWARGS`); the seed of the best
 selection score is copied to ``docs/agents/reference/<env-name>/``
-(:data:`agents.reference.KEPT_FILES`) with ``seeds.json``: each seed's
+(:data:`agents.reference.KEPT_FILES`, replacing the agent kept there
+before; other files and folders there stay) with ``seeds.json``: each seed's
 scores, returns on the benchmark's episodes, training summary and learning
 curve. Choosing on other episodes than those reported keeps the choice
 from flattering the benchmark.
@@ -51,11 +54,16 @@ import yaml
 
 from .diagnostics import DIAGNOSTICS_DIR  # the ceiling, chaos and oracle records the rows note
 
-__all__ = ["ship", "benchmark_id", "markdown", "details_markdown", "main", "DEFAULT_OUT", "AGENT"]
+__all__ = ["ship", "run_summary", "benchmark_id", "markdown", "details_markdown", "main",
+           "DEFAULT_OUT", "AGENT", "STUDENT_ALGO", "FINETUNED_ALGO"]
 
 DEFAULT_OUT = Path("docs") / "agents" / "benchmark"
 #: the name of the reference agent among the policies of a row
 AGENT = "agent"
+#: how the table names a waypoint student (agents.waypoints) kept as a reference agent
+STUDENT_ALGO = "DAgger waypoint student"
+#: ... and one fine-tuned by PPO on its decisions (agents.waypoint_rl)
+FINETUNED_ALGO = "PPO-tuned waypoint student"
 #: where the best constant action of each id is kept (agents.tasks)
 TASKS_DIR = Path("docs") / "agents" / "tasks"
 
@@ -90,27 +98,114 @@ def play(env_id: str, recipes: dict, *, episodes: int, seed: int, processes: int
     :data:`AGENT_KWARGS`); in this process for one."""
     import gymnasium as gym
 
-    from .rollouts import evaluate, evaluate_in_processes, policy_from_recipe
+    from .rollouts import evaluate, evaluate_in_processes, policy_from_recipe, run_agent_kwargs
 
     if processes > 1:
         return evaluate_in_processes(env_id, {}, recipes, episodes=episodes, seed=seed,
                                      processes=processes, progress=progress)
-    env = gym.make(env_id)
+    envs = {}   # one environment per way of acting and observing
     try:
-        policies = {name: policy_from_recipe(recipe, env, seed)
-                    for name, recipe in recipes.items()}
-        return evaluate(env, policies, episodes=episodes, seed=seed, progress=progress)
+        policies = {}
+        for name, recipe in recipes.items():
+            agent = run_agent_kwargs(recipe[1]) if recipe[0] == "trained" else {}
+            key = repr(sorted(agent.items()))
+            if key not in envs:
+                envs[key] = gym.make(env_id, **agent)
+            policies[name] = (envs[key], policy_from_recipe(recipe, envs[key], seed))
+        out = {}
+        for name, (env, policy) in policies.items():
+            out.update(evaluate(env, {name: policy}, episodes=episodes, seed=seed,
+                                progress=progress))
+        return out
     finally:
-        env.close()
+        for env in envs.values():
+            env.close()
 
 
 def _play(run_dir: Path, episodes: int, seed: int, processes: int, progress: bool) -> list[float]:
     """The returns of a run's final model on episodes seeded ``seed`` + k."""
-    with open(run_dir / "args.yaml") as fh:
-        env_id = yaml.safe_load(fh)["env"]
+    from .rollouts import run_env_id
+
+    env_id = run_env_id(run_dir)
     runs = play(env_id, {"run": ("trained", str(run_dir), {})}, episodes=episodes, seed=seed,
                 processes=processes, progress=progress)
     return [e["ret"] for e in runs["run"]]
+
+
+def _student_training(record: dict) -> dict:
+    """A waypoint student's training in the terms of ``training.yaml``:
+    the decisions it learnt from (``steps``, ``unit``) and its wall time;
+    for imitation its rounds and its imitation error on held-out fields,
+    for fine-tuning the run it started from (whose own time is not
+    counted)."""
+    from .waypoint_follower import student_record
+
+    if "rounds" in record:
+        return dict(steps=int(sum(r["decisions"] for r in record["rounds"])),
+                    unit="decisions", wall_seconds=record.get("seconds"),
+                    rounds=len(record["rounds"]), held_out=record.get("held_out"))
+    out = dict(steps=int(record["decisions"]), unit="decisions",
+               wall_seconds=record.get("seconds"), started_from=record["settings"].get("run"),
+               finetune_decisions=int(record["decisions"]),
+               finetune_seconds=record.get("seconds"))
+    try:
+        start = student_record(out["started_from"]) if out["started_from"] else None
+    except FileNotFoundError:
+        start = None
+    if start is not None and "rounds" in start:     # the imitation it started from, counted in
+        imitation = _student_training(start)
+        out.update(steps=out["steps"] + imitation["steps"],
+                   wall_seconds=(out["wall_seconds"] or 0.0) + (imitation["wall_seconds"] or 0.0),
+                   imitation_decisions=imitation["steps"],
+                   imitation_seconds=imitation["wall_seconds"], held_out=imitation["held_out"])
+    return out
+
+
+def _student_curve(record: dict) -> dict:
+    """A waypoint student's training as a learning curve (no evaluation
+    callback): each DAgger round's mean return (the teacher's and the
+    student's decisions mixed) against the decisions taught so far (none
+    for a fine-tuning: its record has the return by window of episodes)."""
+    taught, train = 0, []
+    for r in record.get("rounds", []):
+        taught += r["decisions"]
+        train.append([taught, float(r["mean_return"])])
+    return {"eval": [], "train": train}
+
+
+def run_summary(run: Path) -> dict:
+    """What a run directory (of :mod:`agents.train`, or a waypoint student's)
+    says of its training: ``seed``, ``training`` (``training.yaml``'s
+    entries: ``steps``, ``wall_seconds``, ...), ``curve``, ``algo`` (the
+    algorithm as the table names it), ``env_kwargs`` and ``command``."""
+    from .waypoint_follower import student_record
+
+    run = Path(run)
+    student = student_record(run)
+    if student is not None:
+        # a kept agent's training.yaml (written by ship) holds what its record alone cannot
+        # say: the imitation a fine-tuning started from
+        kept = yaml.safe_load((run / "training.yaml").read_text()) \
+            if (run / "training.yaml").is_file() else None
+        return dict(seed=int(student["settings"]["seed"]),
+                    training=kept or _student_training(student),
+                    curve=_student_curve(student),
+                    algo=STUDENT_ALGO if "rounds" in student else FINETUNED_ALGO,
+                    env_kwargs=student["settings"].get("env_kwargs") or {},
+                    command=student.get("command") or "")
+    if not (run / "model.zip").is_file() or not (run / "args.yaml").is_file():
+        raise ValueError(f"{run} is not a finished run of agents.train (no model.zip or "
+                         f"args.yaml) nor of agents.waypoints train (no student.zip)")
+    args = yaml.safe_load((run / "args.yaml").read_text())
+    training = yaml.safe_load((run / "training.yaml").read_text()) \
+        if (run / "training.yaml").is_file() else {}
+    hp = yaml.safe_load((run / "hyperparams.yaml").read_text()) \
+        if (run / "hyperparams.yaml").is_file() else {}
+    command = (run / "command.txt").read_text().strip() if (run / "command.txt").is_file() \
+        else ""
+    return dict(seed=int(args["seed"]), training=training or {}, curve=_learning_curve(run),
+                algo=args["algo"], env_kwargs=hp.get("env_kwargs") or {},
+                command=command)
 
 
 def portable_command(text: str) -> str:
@@ -132,42 +227,46 @@ def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
     ``seeds.json`` beside it; returns the reference directory."""
     from .reference import (EVAL_EPISODES, EVAL_SEED, KEPT_FILES, MAX_BYTES, TUNE_EVAL_SEED,
                             drop_optimizer_states, reference_dir)
-    from .rollouts import stats
+    from .rollouts import run_env_id, stats
 
     evaluation_episodes = evaluation_episodes or EVAL_EPISODES
     runs = [Path(r) for r in run_dirs]
-    envs = set()
-    for run in runs:
-        if not (run / "model.zip").is_file() or not (run / "args.yaml").is_file():
-            raise ValueError(f"{run} is not a finished run of agents.train (no model.zip or "
-                             f"args.yaml)")
-        envs.add(yaml.safe_load((run / "args.yaml").read_text())["env"])
+    if not runs:
+        raise ValueError("ship needs at least one run directory")
+    summaries = [run_summary(run) for run in runs]   # refuses what is not a finished run
+    kinds = {s["algo"] in (STUDENT_ALGO, FINETUNED_ALGO) for s in summaries}
+    if len(kinds) != 1:
+        raise ValueError("the runs mix waypoint students and runs of agents.train: ship one "
+                         "kind at a time")
+    envs = {run_env_id(run) for run in runs}
     if len(envs) != 1:
         raise ValueError(f"the runs are of several environments: {sorted(envs)}")
     env_id = envs.pop()
     seeds = []
-    for run in runs:
-        args = yaml.safe_load((run / "args.yaml").read_text())
+    for run, summary in zip(runs, summaries):
         print(f"{run}: {episodes} selection episodes, then {evaluation_episodes} benchmark "
               f"episodes", flush=True)
         selection = _play(run, episodes, TUNE_EVAL_SEED, processes, progress)
         evaluation = _play(run, evaluation_episodes, EVAL_SEED, processes, progress)
-        training = yaml.safe_load((run / "training.yaml").read_text()) \
-            if (run / "training.yaml").is_file() else {}
-        seeds.append(dict(seed=int(args["seed"]), run=run.name,
+        seeds.append(dict(seed=summary["seed"], run=run.name,
                           selection=stats(np.array(selection)),
                           evaluation=stats(np.array(evaluation)), returns=evaluation,
-                          training=training, curve=_learning_curve(run)))
+                          training=summary["training"], curve=summary["curve"]))
     best = max(seeds, key=lambda s: s["selection"]["mean"])
     target = Path(out) if out is not None else reference_dir(env_id)
-    if target.exists():
-        shutil.rmtree(target)
-    target.mkdir(parents=True)
+    target.mkdir(parents=True, exist_ok=True)
+    for name in (*KEPT_FILES, "seeds.json"):   # the agent kept before; anything else stays
+        (target / name).unlink(missing_ok=True)
     source = runs[seeds.index(best)]
     for name in KEPT_FILES:
         if (source / name).is_file():
             shutil.copy2(source / name, target / name)
-    (target / "command.txt").write_text(portable_command((target / "command.txt").read_text()))
+    chosen = summaries[seeds.index(best)]
+    if not (target / "training.yaml").is_file():      # a waypoint student's, from its record
+        (target / "training.yaml").write_text(yaml.safe_dump(chosen["training"], sort_keys=False))
+    (target / "command.txt").write_text(portable_command(
+        (target / "command.txt").read_text() if (target / "command.txt").is_file()
+        else chosen["command"]))
     means = [s["evaluation"]["mean"] for s in seeds]
     record = dict(env=env_id, chosen_seed=best["seed"],
                   chosen_by=f"the best mean return on {episodes} selection episodes seeded "
@@ -179,8 +278,8 @@ def ship(run_dirs: list[Path], *, episodes: int = 20, processes: int = 1,
                   seeds=seeds, command=shlex.join(["python", "-m", "agents.benchmark", "ship",
                                                    *map(str, run_dirs)]))
     (target / "seeds.json").write_text(json.dumps(record, indent=1) + "\n")
-    size = sum(p.stat().st_size for p in target.rglob("*") if p.is_file())
-    if size > MAX_BYTES:
+    size = sum(p.stat().st_size for p in target.rglob("*") if p.is_file())   # all it holds
+    if size > MAX_BYTES and (target / "model.zip").is_file():
         saved = drop_optimizer_states(target / "model.zip",
                                       yaml.safe_load((target / "args.yaml").read_text())["algo"])
         size -= saved
@@ -225,12 +324,12 @@ def benchmark_id(env_id: str, *, episodes: int, processes: int, progress: bool =
     """One row: every policy's returns on the benchmark's episodes, and the
     reference agent's paired differences with each baseline (the agents
     under ``root``, default ``docs/agents/reference``)."""
-    from .reference import EVAL_SEED, reference_dir
+    from .reference import EVAL_SEED, is_reference, reference_dir
     from .rollouts import compare, stats
 
     recipes = _baseline_recipes(env_id)
     agent_dir = reference_dir(env_id, root)
-    has_agent = (agent_dir / "model.zip").is_file()
+    has_agent = is_reference(agent_dir)
     if has_agent:
         recipes = {AGENT: ("trained", str(agent_dir), {}), **recipes}
     t0 = time.perf_counter()
@@ -244,14 +343,13 @@ def benchmark_id(env_id: str, *, episodes: int, processes: int, progress: bool =
     if has_agent:
         seeds = json.loads((agent_dir / "seeds.json").read_text()) \
             if (agent_dir / "seeds.json").is_file() else {}
-        hp = yaml.safe_load((agent_dir / "hyperparams.yaml").read_text())
-        args = yaml.safe_load((agent_dir / "args.yaml").read_text())
-        training = yaml.safe_load((agent_dir / "training.yaml").read_text()) \
-            if (agent_dir / "training.yaml").is_file() else {}
+        summary = run_summary(agent_dir)
+        training = summary["training"]
         row["agent"] = dict(
-            algo=args["algo"], seed=args["seed"], steps=training.get("steps"),
+            algo=summary["algo"], seed=summary["seed"], steps=training.get("steps"),
+            unit=training.get("unit", "steps"),
             wall_seconds=training.get("wall_seconds"), host=training.get("host"),
-            env_kwargs=hp.get("env_kwargs") or {}, across_seeds=seeds.get("across_seeds"),
+            env_kwargs=summary["env_kwargs"], across_seeds=seeds.get("across_seeds"),
             seeds=[dict(seed=s["seed"], mean=s["evaluation"]["mean"],
                         sem=s["evaluation"]["sem"], steps=s["training"].get("steps"),
                         wall_seconds=s["training"].get("wall_seconds"))
@@ -354,8 +452,8 @@ def markdown(record: dict) -> str:
         d = row["differences"][best]
         solved = task_table_note(row["id"]) + ceiling_note(row["id"]) + oracle_note(row["id"])
         lines.append(f"| [`{row['id']}`](/reference-agents.md#{name.lower()}) | "
-                     f"{a['algo'].upper()}, seed "
-                     f"{a['seed']} | {a['steps']} steps{soft}, {hours} | "
+                     f"{a['algo'].upper() if a['algo'].islower() else a['algo']}, seed "
+                     f"{a['seed']} | {a['steps']} {a.get('unit', 'steps')}{soft}, {hours} | "
                      f"{_pm(returns[AGENT])} | {across} | {best} {_pm(baselines[best])} | "
                      f"{d['diff']:+.3g} ± {d['sem']:.2g} | {verdict(d)}{solved} |")
     return "\n".join(lines) + "\n"
@@ -373,10 +471,12 @@ def details_markdown(record: dict) -> str:
         name = row["id"].split("/")[-1]
         a = row["agent"]
         lines += ["", f"### {name}", "",
-                  f"`{a['command']}`; trained on {a['host']['cpu'] if a.get('host') else '?'} "
-                  f"({a['host']['logical_cpus'] if a.get('host') else '?'} logical CPUs). "
-                  f"Seeds: " + ", ".join(
-                      f"{s['seed']}: {s['mean']:.4g} ± {s['sem']:.2g} ({s['steps']} steps, "
+                  f"`{a['command']}`; " + (
+                      f"trained on {a['host']['cpu']} ({a['host']['logical_cpus']} logical "
+                      f"CPUs). " if a.get("host") else "its training did not record its host. ") +
+                  "Seeds: " + ", ".join(
+                      f"{s['seed']}: {s['mean']:.4g} ± {s['sem']:.2g} ({s['steps']} "
+                      f"{a.get('unit', 'steps')}, "
                       f"{(s['wall_seconds'] or 0) / 60:.0f} min)" for s in a["seeds"]) + ".", "",
                   "| baseline | its return | agent − baseline (paired) | the agent (by > 2 SE) |",
                   "|---|---|---|---|"]
@@ -403,17 +503,29 @@ def plot_curves(record: dict, path: Path, root: Path | None = None) -> None:
     for ax, row in zip(axes.flat, rows):
         seeds_file = reference_dir(row["id"], root) / "seeds.json"
         seeds = json.loads(seeds_file.read_text())["seeds"] if seeds_file.is_file() else []
+        student = (row["agent"] or {}).get("unit") == "decisions"
+        if student and not any(s["curve"]["eval"] or s["curve"]["train"] for s in seeds):
+            ax.text(0.5, 0.5, "a waypoint student: no evaluation callback\n(its training's "
+                    "record is in its directory)", ha="center", va="center",
+                    transform=ax.transAxes, fontsize=8)
         for k, s in enumerate(seeds):
             curve = s["curve"]["eval"]
             if curve:
                 x, y, sd = map(np.array, zip(*curve))
                 ax.plot(x, y, color=f"C{k}", lw=1.2, label=f"seed {s['seed']}")
                 ax.fill_between(x, y - sd, y + sd, color=f"C{k}", alpha=0.15)
+            elif student and s["curve"]["train"]:
+                # a waypoint student has no evaluation callback: each DAgger round's
+                # episodes (teacher and student mixed) against the decisions taught
+                x, y = map(np.array, zip(*s["curve"]["train"]))
+                ax.plot(x, y, "o-", color=f"C{k}", lw=1.2, ms=3,
+                        label=f"seed {s['seed']} (DAgger rounds)")
         best = max((n for n in row["returns"] if n != AGENT),
                    key=lambda n: row["returns"][n]["mean"])
         ax.axhline(row["returns"][best]["mean"], color="k", ls="--", lw=0.9,
                    label=f"{best} (benchmark)")
-        ax.set(title=row["id"].split("/")[-1], xlabel="steps", ylabel="evaluation return")
+        ax.set(title=row["id"].split("/")[-1], xlabel="decisions taught" if student else "steps",
+               ylabel="evaluation return")
         ax.legend(fontsize=7)
     for ax in list(axes.flat)[len(rows):]:
         ax.set_axis_off()

@@ -11,6 +11,14 @@ directory takes one (``agents.evaluate``, ``agents.leaderboard --trained
 NAME=DIR``, ``agents.frames``, ``agents.tasks``, ``agents.train
 --init-from``).
 
+ShipNavigation-v1's is a waypoint student's run instead
+(:mod:`agents.waypoints`: ``student.zip``, ``waypoints.json``,
+``command.txt``, ``training.yaml``): it decides every 10 s from the
+environment's costmap and follows its waypoints by pure pursuit, so it
+reads the environment it plays (:func:`load_reference` with
+``environment=``, made by :func:`reference_env`), and the leaderboard
+plays it as ``agents.waypoints:WaypointStudent?run=DIR``.
+
 Seeds, fixed before any agent was trained or tuned:
 
 - the benchmark plays :data:`EVAL_EPISODES` episodes seeded
@@ -26,8 +34,8 @@ from __future__ import annotations
 from pathlib import Path
 
 __all__ = ["EVAL_SEED", "EVAL_EPISODES", "TUNE_TRAIN_SEED", "TUNE_EVAL_SEED", "TRAIN_SEEDS",
-           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir", "load_reference",
-           "drop_optimizer_states"]
+           "REFERENCE_DIR", "MAX_BYTES", "KEPT_FILES", "reference_dir", "is_reference",
+           "reference_env", "load_reference", "drop_optimizer_states"]
 
 #: the benchmark's episodes are seeded EVAL_SEED + k, k < EVAL_EPISODES
 EVAL_SEED = 40_000
@@ -44,7 +52,7 @@ REFERENCE_DIR = Path(__file__).resolve().parent.parent / "docs" / "agents" / "re
 MAX_BYTES = 2 * 1024 * 1024
 #: the files of a run directory that a reference agent keeps
 KEPT_FILES = ("model.zip", "vecnormalize.pkl", "hyperparams.yaml", "args.yaml", "command.txt",
-              "training.yaml", "pretrain.yaml")
+              "training.yaml", "pretrain.yaml", "student.zip", "waypoints.json", "finetune.json")
 
 
 def reference_dir(env_id: str, root: str | Path | None = None) -> Path:
@@ -53,27 +61,68 @@ def reference_dir(env_id: str, root: str | Path | None = None) -> Path:
     return Path(REFERENCE_DIR if root is None else root) / env_id.split("/")[-1]
 
 
-def load_reference(env: str, root: str | Path | None = None):
+def is_reference(folder: str | Path) -> bool:
+    """Whether ``folder`` holds an agent: a model of :mod:`agents.train`
+    (``model.zip``) or a waypoint student (``student.zip``)."""
+    folder = Path(folder)
+    return (folder / "model.zip").is_file() or (folder / "student.zip").is_file()
+
+
+def _folder(env: str, root: str | Path | None) -> Path:
+    folder = reference_dir(env, root)
+    if not is_reference(folder):
+        base = Path(REFERENCE_DIR if root is None else root)
+        have = sorted(p.name for p in base.glob("*") if is_reference(p))
+        raise FileNotFoundError(f"no reference agent for {env}; the reference agents: "
+                                f"{', '.join(have) or 'none'}")
+    return folder
+
+
+def reference_env(env: str, root: str | Path | None = None, **env_kwargs):
+    """The environment the reference agent of ``env`` plays: its id, made
+    with the agent's own way of acting and observing
+    (:data:`agents.rollouts.AGENT_KWARGS`) over ``env_kwargs``."""
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    from .rollouts import run_agent_kwargs, run_env_id
+
+    folder = _folder(env, root)
+    return gym.make(run_env_id(folder), **{**env_kwargs, **run_agent_kwargs(folder)})
+
+
+def load_reference(env: str, root: str | Path | None = None, *, environment=None):
     """The reference agent of an environment (``"iceenvs/WindDrift-v0"`` or
-    ``"WindDrift-v0"``) as a :class:`agents.rollouts.TrainedPolicy`: its
-    ``predict(obs)`` acts on raw observations, ``env_id`` and
-    ``agent_kwargs`` say which environment it plays and how it acts and
-    observes there.
+    ``"WindDrift-v0"``) as a policy with the baselines' ``predict(obs)``;
+    ``env_id`` and ``agent_kwargs`` say which environment it plays and how
+    it acts and observes there.
+
+    Most are an :class:`agents.rollouts.TrainedPolicy`, which acts on raw
+    observations alone. ShipNavigation-v1's is a waypoint student
+    (:class:`agents.waypoint_follower.WaypointStudent`), which reads the
+    environment it plays: pass it as ``environment`` (made by
+    :func:`reference_env`) and call ``reset(seed)`` with each episode's
+    reset, as for the planners.
 
     Raises
     ------
     FileNotFoundError
         When the id has no reference agent; the message lists those that do.
+    ValueError
+        When the agent needs ``environment`` and was not given one, or one
+        made with other settings than its own.
     """
-    from .rollouts import TrainedPolicy
+    from .rollouts import TrainedPolicy, trained_policy
+    from .waypoint_follower import student_record
 
-    folder = reference_dir(env, root)
-    if not (folder / "model.zip").is_file():
-        base = Path(REFERENCE_DIR if root is None else root)
-        have = sorted(p.name for p in base.glob("*") if (p / "model.zip").is_file())
-        raise FileNotFoundError(f"no reference agent for {env}; the reference agents: "
-                                f"{', '.join(have) or 'none'}")
-    return TrainedPolicy(folder)
+    folder = _folder(env, root)
+    if student_record(folder) is None:
+        return TrainedPolicy(folder)
+    if environment is None:
+        raise ValueError(f"the reference agent of {env} is a waypoint student: it reads the "
+                         f"environment it plays; pass environment=reference_env({env!r})")
+    return trained_policy(folder, environment)
 
 
 def drop_optimizer_states(model_zip: Path, algo: str) -> int:

@@ -30,7 +30,7 @@ from .runs import checkpoint_paths_checked, trained_argument  # noqa: F401  (re-
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
            "evaluate_in_processes", "policy_from_recipe", "rounded", "stats", "summarise", "compare",
            "verdict",
-           "AGENT_KWARGS", "run_agent_kwargs"]
+           "AGENT_KWARGS", "run_agent_kwargs", "run_env_id", "trained_policy"]
 
 #: environment arguments that set how an agent acts and what it sees rather
 #: than the task (the action, the observation and the sensors' settings): a
@@ -42,9 +42,53 @@ AGENT_KWARGS = ("control", "obs_type", "lidar_sectors", "lidar_range", "image_si
 
 def run_agent_kwargs(run_dir: str | Path) -> dict:
     """The :data:`AGENT_KWARGS` a run of :mod:`agents.train` was trained
-    with (from its ``hyperparams.yaml``; empty when it kept the defaults)."""
+    with (from its ``hyperparams.yaml``; empty when it kept the defaults),
+    or a waypoint student's run (from its ``waypoints.json``)."""
+    from .waypoint_follower import student_record
+
+    student = student_record(run_dir)
+    if student is not None:
+        return _agent_part(student["settings"].get("env_kwargs") or {})
     with open(Path(run_dir) / "hyperparams.yaml") as fh:
         return _agent_part(yaml.safe_load(fh).get("env_kwargs") or {})
+
+
+def run_env_id(run_dir: str | Path) -> str:
+    """The environment id a run of :mod:`agents.train` (``args.yaml``) or a
+    waypoint student's run (``waypoints.json``) was trained on."""
+    from .waypoint_follower import student_record
+
+    student = student_record(run_dir)
+    if student is not None:
+        return student["settings"]["env_id"]
+    with open(Path(run_dir) / "args.yaml") as fh:
+        return yaml.safe_load(fh)["env"]
+
+
+def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | str | None = None):
+    """The policy of a run directory for ``env``: a :class:`TrainedPolicy`
+    for a run of :mod:`agents.train` (``env`` unused), a
+    :class:`agents.waypoint_follower.WaypointStudent` for a waypoint
+    student's run, which reads ``env`` (made with the run's
+    :func:`run_agent_kwargs`). Either has ``env_id`` and ``agent_kwargs``."""
+    from .waypoint_follower import WaypointStudent, student_record
+
+    student = student_record(run_dir)
+    if student is None:
+        return TrainedPolicy(run_dir, checkpoint)
+    if checkpoint is not None:
+        raise ValueError(f"{run_dir} is a waypoint student's run: it keeps no checkpoints "
+                         f"(asked for {checkpoint!r})")
+    agent = run_agent_kwargs(run_dir)
+    made = dict(env.spec.kwargs)
+    differ = {k: v for k, v in agent.items()
+              if made.get(k, getattr(env.unwrapped, k, None)) != v}
+    if differ:
+        raise ValueError(f"the waypoint student of {run_dir} was trained with {differ}: make "
+                         f"the environment with them (gymnasium.make(..., **agent_kwargs))")
+    policy = WaypointStudent(env, seed, run=str(run_dir))
+    policy.env_id, policy.agent_kwargs = student["settings"]["env_id"], agent
+    return policy
 
 
 def _agent_part(env_kwargs: dict) -> dict:
@@ -258,7 +302,7 @@ def policy_from_recipe(recipe: tuple, env, seed: int):
 
     kind, target, kwargs = recipe
     if kind == "trained":
-        return TrainedPolicy(target, **kwargs)
+        return trained_policy(target, env, seed, **kwargs)
     if kind == "policy":
         return make_policy(target, env, seed=seed, **kwargs)
     return make_baseline(target, env, seed=seed, **kwargs)

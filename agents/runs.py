@@ -61,7 +61,8 @@ def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, in
     """``(name, run_dir, checkpoint or None)`` of a ``--trained`` argument
     ``NAME=RUN_DIR``, ``NAME=RUN_DIR@STEPS`` or ``NAME=RUN_DIR@best``: the
     run directory of :mod:`agents.train` (it must hold ``args.yaml``; a
-    reference agent's directory is one) and, with ``@STEPS``, its
+    reference agent's directory is one) or of a waypoint student
+    (``student.zip``, :mod:`agents.waypoints`) and, with ``@STEPS``, its
     checkpoint at STEPS steps, with ``@best`` its evaluation callback's
     best model.
 
@@ -75,12 +76,21 @@ def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, in
     if not sep or not name or (at and not (steps.isdigit() or steps == BEST)):
         raise ValueError(f"--trained takes NAME=RUN_DIR, NAME=RUN_DIR@STEPS or "
                          f"NAME=RUN_DIR@best, got {item!r}")
-    if not (Path(run_dir) / "args.yaml").is_file():
+    from .waypoint_follower import student_record
+
+    student = student_record(run_dir)
+    if student is not None and at:
+        raise ValueError(f"--trained {item}: {run_dir} is a waypoint student's run, which keeps "
+                         f"no checkpoints")
+    if student is None and not (Path(run_dir) / "args.yaml").is_file():
         raise ValueError(f"--trained {item}: {run_dir} is not an existing run directory of "
-                         f"agents.train (no args.yaml)")
+                         f"agents.train (no args.yaml) nor a waypoint student's (no student.zip)")
     if env_id is not None:
-        with open(Path(run_dir) / "args.yaml") as fh:
-            trained_on = yaml.safe_load(fh).get("env")
+        if student is not None:
+            trained_on = student["settings"]["env_id"]
+        else:
+            with open(Path(run_dir) / "args.yaml") as fh:
+                trained_on = yaml.safe_load(fh).get("env")
         if trained_on != env_id:
             raise ValueError(f"--trained {item}: the run was trained on {trained_on}, "
                              f"not {env_id}")

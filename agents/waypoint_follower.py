@@ -7,7 +7,10 @@ pure pursuit that sails a decision until the next.
 * :class:`WaypointFollower`: decides every ``interval`` steps
   (:meth:`~WaypointFollower.decide`, for a subclass to give) and follows the
   route through the decision's waypoints by the lattice planner's pure
-  pursuit in between.
+  pursuit in between;
+* :class:`WaypointStudent`: the learned decision, played from a run
+  directory (``student.zip``); :func:`student_record` tells such a run
+  from a run of :mod:`agents.train`.
 
 The teacher, the student and their training are in :mod:`agents.waypoints`;
 fine-tuning by reinforcement learning in :mod:`agents.waypoint_rl`.
@@ -23,8 +26,9 @@ import numpy as np
 from .planners import LatticePlanner
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "WaypointFollower", "decision_observation", "decision_space", "gather_records",
-           "write_gathered"]
+           "FINETUNE_RECORD",
+           "WaypointFollower", "WaypointStudent", "decision_observation", "decision_space",
+           "student_decision", "student_record", "gather_records", "write_gathered"]
 
 #: environment steps between decisions (10 s: the lattice planner's replan)
 DECISION_STEPS = 5
@@ -41,6 +45,8 @@ STAGE_CHOICES = tuple((a, b) for a in (-1, 0, 1) for b in (-1, 0, 1))
 _OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
 #: the file of the student's policy, and of the run's record, in a run directory
 STUDENT, RECORD = "student.zip", "waypoints.json"
+#: the record of a fine-tuned student's run (:mod:`agents.waypoint_rl`), in place of RECORD
+FINETUNE_RECORD = "finetune.json"
 
 
 def decision_space(env):
@@ -183,6 +189,76 @@ class WaypointFollower(LatticePlanner):
             self._age = 0
         self._age += 1
         return self._pursue(self.route, obs)
+
+
+def student_decision(policy, seen: dict):
+    """The decision of the SB3 ``policy`` on ``seen`` (:func:`decision_observation`)."""
+    action, _ = policy.predict(seen, deterministic=True)
+    if _is_choice(policy):
+        return int(np.asarray(action).reshape(-1)[0])
+    return np.asarray(action, dtype=float).reshape(-1)
+
+
+def _is_choice(policy) -> bool:
+    import gymnasium as gym
+
+    return isinstance(policy.action_space, gym.spaces.Discrete)
+
+
+class WaypointStudent(WaypointFollower):
+    """The learned decision (sensor-only): an SB3 policy on
+    :func:`decision_observation`, loaded from a run of :func:`agents.waypoints.train_student`
+    (``run``: its directory, holding ``student.zip``)."""
+
+    reads_environment = "its costmap and its own pose"
+
+    def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
+        from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+
+        path = Path(run) / STUDENT
+        if not path.is_file():
+            raise FileNotFoundError(f"no student in {run!r}: {path} is missing (train one with "
+                                    f"python -m agents.waypoints train --out {run})")
+        policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
+        policy.set_training_mode(False)
+        trained = policy.observation_space["costmap"].shape
+        here = decision_space(env)["costmap"].shape
+        if trained != here:
+            raise ValueError(f"the student of {run!r} was trained on costmaps of shape "
+                             f"{trained}, and this environment's are {here}: make it with the "
+                             f"training's costmap settings (costmap_ahead, costmap_behind, "
+                             f"costmap_cell; see {RECORD} in the run)")
+        shape = {"form": "stages"} if _is_choice(policy) else \
+            {"points": int(policy.action_space.shape[0])}
+        super().__init__(env, seed, **{**shape, **kwargs})
+        self.policy = policy
+
+    def decide(self, obs):
+        return student_decision(self.policy, decision_observation(self.env))
+
+
+def student_record(run) -> dict | None:
+    """The record of a run directory that holds a waypoint student
+    (``student.zip``): ``waypoints.json`` of a run of imitation, or
+    ``finetune.json`` of a fine-tuned one (:mod:`agents.waypoint_rl`). Both
+    hold ``settings`` (``env_id``, ``env_kwargs``, ``seed``), ``seconds`` and
+    ``command``; imitation's ``rounds``, fine-tuning's ``decisions``. None
+    for any other directory.
+
+    Raises
+    ------
+    FileNotFoundError
+        When the directory holds a student but neither record, which says
+        the environment and the costmap it was trained on."""
+    run = Path(run)
+    if not (run / STUDENT).is_file():
+        return None
+    for name in (RECORD, FINETUNE_RECORD):
+        if (run / name).is_file():
+            return json.loads((run / name).read_text())
+    raise FileNotFoundError(f"{run} holds a waypoint student ({STUDENT}) but not its record "
+                            f"({RECORD} or {FINETUNE_RECORD}), which names its environment and "
+                            f"costmap")
 
 
 def gather_records(runs, record: str, command: str) -> dict:

@@ -49,7 +49,7 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoint_follower import (RECORD, STUDENT, WaypointFollower, decision_observation,
+from .waypoint_follower import (FINETUNE_RECORD, RECORD, STUDENT, WaypointFollower, decision_observation,
                                 decision_space, gather_records, write_gathered)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
@@ -57,7 +57,7 @@ __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAU
 
 #: the record of a fine-tuning run, and its whole PPO model (actor, critic and
 #: optimiser, for ``PPO.load``), in its directory
-FINETUNE_RECORD, PPO_MODEL = "finetune.json", "ppo.zip"
+PPO_MODEL = "ppo.zip"
 #: the settings of :func:`finetune`
 FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
                          n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,

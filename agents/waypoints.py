@@ -69,8 +69,9 @@ import numpy as np
 from .leaderboard import DEFAULT_ENV
 from .planners import costmap_cost_grid
 from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, STUDENT,
-                                WAYPOINT_DISTANCE, WaypointFollower, decision_observation,
-                                decision_space, gather_records, write_gathered)
+                                WAYPOINT_DISTANCE, WaypointFollower, WaypointStudent,
+                                decision_observation, decision_space, gather_records,
+                                student_decision, write_gathered)
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
@@ -189,52 +190,6 @@ def with_mirror(seen: dict, labels: np.ndarray, form: str = "waypoints") -> tupl
     return both, np.concatenate([labels, flipped])
 
 
-def _student_decision(policy, seen: dict):
-    """The decision of the SB3 ``policy`` on ``seen`` (:func:`decision_observation`)."""
-    action, _ = policy.predict(seen, deterministic=True)
-    if _is_choice(policy):
-        return int(np.asarray(action).reshape(-1)[0])
-    return np.asarray(action, dtype=float).reshape(-1)
-
-
-def _is_choice(policy) -> bool:
-    import gymnasium as gym
-
-    return isinstance(policy.action_space, gym.spaces.Discrete)
-
-
-class WaypointStudent(WaypointFollower):
-    """The learned decision (sensor-only): an SB3 policy on
-    :func:`decision_observation`, loaded from a run of :func:`train_student`
-    (``run``: its directory, holding ``student.zip``)."""
-
-    reads_environment = "its costmap and its own pose"
-
-    def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
-        from stable_baselines3.common.policies import MultiInputActorCriticPolicy
-
-        path = Path(run) / STUDENT
-        if not path.is_file():
-            raise FileNotFoundError(f"no student in {run!r}: {path} is missing (train one with "
-                                    f"python -m agents.waypoints train --out {run})")
-        policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
-        policy.set_training_mode(False)
-        trained = policy.observation_space["costmap"].shape
-        here = decision_space(env)["costmap"].shape
-        if trained != here:
-            raise ValueError(f"the student of {run!r} was trained on costmaps of shape "
-                             f"{trained}, and this environment's are {here}: make it with the "
-                             f"training's costmap settings (costmap_ahead, costmap_behind, "
-                             f"costmap_cell; see {RECORD} in the run)")
-        shape = {"form": "stages"} if _is_choice(policy) else \
-            {"points": int(policy.action_space.shape[0])}
-        super().__init__(env, seed, **{**shape, **kwargs})
-        self.policy = policy
-
-    def decide(self, obs):
-        return _student_decision(self.policy, decision_observation(self.env))
-
-
 class _Dagger(LatticeWaypoints):
     """The lattice labels every decision; its waypoint is played with
     probability ``beta``, the student's (``policy``; None: never) otherwise."""
@@ -252,7 +207,7 @@ class _Dagger(LatticeWaypoints):
         wanted = self.label()
         self.seen.append(seen)
         self.labels.append(wanted)
-        student = _student_decision(self.policy, seen) if self.policy is not None \
+        student = student_decision(self.policy, seen) if self.policy is not None \
             else (-1 if self.form == "stages" else np.full(self.points, np.nan))
         self.students.append(student)
         return wanted if self.coin.random() < self.beta else student

@@ -14,13 +14,19 @@ from agents import reference
 from agents.benchmark import AGENT, DEFAULT_OUT
 
 ROOT = Path(__file__).resolve().parents[2]
-AGENTS = sorted(p.name for p in reference.REFERENCE_DIR.glob("*") if (p / "model.zip").is_file())
+AGENTS = sorted(p.name for p in reference.REFERENCE_DIR.glob("*") if reference.is_reference(p))
 RECORD = ROOT / DEFAULT_OUT / "benchmark.json"
 
 
-def _episode(agent, seed):
-    env = gym.make(agent.env_id, **agent.agent_kwargs)
+def _load(name):
+    """The reference agent of ``name`` and the environment it plays."""
+    env = reference.reference_env(name)
+    return reference.load_reference(name, environment=env), env
+
+
+def _episode(agent, env, seed):
     obs, _ = env.reset(seed=seed)
+    agent.reset(seed)
     total, actions, done = 0.0, [], False
     while not done:
         action, _ = agent.predict(obs, deterministic=True)
@@ -38,14 +44,54 @@ def test_there_are_reference_agents():
 
 @pytest.mark.parametrize("name", AGENTS)
 def test_a_reference_agent_loads_and_plays_a_seeded_episode_deterministically(name):
-    agent = reference.load_reference(name)
+    agent, env = _load(name)
     assert agent.env_id == f"iceenvs/{name}"
-    first = _episode(agent, reference.EVAL_SEED)
-    again = _episode(reference.load_reference(f"iceenvs/{name}"), reference.EVAL_SEED)
+    first = _episode(agent, env, reference.EVAL_SEED)
+    again = _episode(*_load(f"iceenvs/{name}"), reference.EVAL_SEED)
     assert first[1] == again[1] and first[0] == again[0]
     # it names the command that made it and how long that took
-    assert "agents.train" in (reference.reference_dir(name) / "command.txt").read_text()
+    command = (reference.reference_dir(name) / "command.txt").read_text()
+    assert any(f"python -m agents.{c}" in command for c in ("train", "waypoints train",
+                                                             "waypoints finetune"))
     assert (reference.reference_dir(name) / "training.yaml").is_file()
+
+
+def test_a_waypoint_student_is_kept_played_and_refused_without_its_environment(tmp_path):
+    """A waypoint student's run ships as a reference agent (student.zip, its
+    record, command.txt, training.yaml); load_reference needs the
+    environment it reads, made with its costmap, and reference_env makes it."""
+    from agents.benchmark import run_summary, ship
+    from agents.waypoints import train_student
+
+    run = tmp_path / "run"
+    short = dict(length=300.0, goal_distance=150.0, concentration=0.2, costmap_ahead=200.0)
+    train_student(run, seed=1, progress=False, quiet=True, env_kwargs=short, episodes=1,
+                  rounds=0, epochs=1, held_out_episodes=1, command="python -m agents.waypoints "
+                  "train --seed 1 --out run")
+    summary = run_summary(run)
+    assert summary["seed"] == 1 and summary["training"]["unit"] == "decisions"
+    assert summary["training"]["steps"] > 0 and summary["curve"]["eval"] == []
+    root = tmp_path / "reference"
+    folder = reference.reference_dir("ShipNavigation-v1", root)
+    ship([run], episodes=1, evaluation_episodes=1, progress=False, out=folder)
+    assert reference.is_reference(folder)
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "command.txt", "seeds.json", "student.zip", "training.yaml", "waypoints.json"]
+    assert (folder / "command.txt").read_text().startswith("python -m agents.waypoints train")
+    kept = json.loads((folder / "seeds.json").read_text())
+    assert kept["chosen_seed"] == 1 and kept["seeds"][0]["training"]["unit"] == "decisions"
+    with pytest.raises(ValueError, match="waypoint student.*reference_env"):
+        reference.load_reference("ShipNavigation-v1", root=root)
+    with pytest.raises(ValueError, match="costmap_ahead"):
+        reference.load_reference("ShipNavigation-v1", root=root,
+                                 environment=gym.make("iceenvs/ShipNavigation-v1"))
+    env = reference.reference_env("ShipNavigation-v1", root=root, length=300.0,
+                                  goal_distance=150.0, concentration=0.2)
+    agent = reference.load_reference("ShipNavigation-v1", root=root, environment=env)
+    assert agent.env_id == "iceenvs/ShipNavigation-v1"
+    assert agent.agent_kwargs == {"costmap_ahead": 200.0}
+    first, again = _episode(agent, env, 7), _episode(agent, env, 7)
+    assert first == again and len(first[1]) > 5
 
 
 def test_an_id_without_an_agent_is_refused_with_those_that_have_one(tmp_path):
@@ -63,6 +109,18 @@ def test_evaluating_a_reference_agent_gives_the_records_first_episodes(name, tmp
         pytest.skip("the record was made on another host: a DEM trajectory depends on how "
                     "its sums are rounded")
     row = next(r for r in record["rows"] if r["id"] == f"iceenvs/{name}")
+    if reference.is_reference(reference.reference_dir(name)) and not (
+            reference.reference_dir(name) / "model.zip").is_file():
+        # a waypoint student: agents.evaluate takes runs of agents.train; the benchmark's
+        # own player gives its episodes
+        from agents.benchmark import play
+
+        episodes = play(f"iceenvs/{name}", {AGENT: ("trained", str(
+            reference.reference_dir(name)), {})}, episodes=2, seed=record["seed"],
+            processes=1, progress=False)
+        returns = [e["ret"] for e in episodes[AGENT]]
+        assert returns == pytest.approx(row["first_returns"][AGENT], rel=1e-9, abs=1e-9)
+        return
     evaluate_main([str(reference.reference_dir(name)), "--seed", str(record["seed"]),
                    "--episodes", "2", "--baselines", "zero", "--out", str(tmp_path),
                    "--default-config", "--no-progress"])
