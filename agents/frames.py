@@ -335,7 +335,8 @@ def build_parser(prog: str = "python -m agents.frames") -> argparse.ArgumentPars
     p.add_argument("policy", metavar="POLICY",
                    help="a baseline (straight, swath, lattice, ...), a policy of one's own "
                         "(module:Class or path/to/file.py:Class, ?key=value&... for its "
-                        "arguments) or a run of agents.train (RUN_DIR or RUN_DIR@STEPS)")
+                        "arguments), a run of agents.train (RUN_DIR or RUN_DIR@STEPS) or a "
+                        "waypoint student's run (RUN_DIR; agents.waypoints)")
     p.add_argument("--env", default=None,
                    help=f"environment id (default: a trained run's own, else {DEFAULT_ENV})")
     p.add_argument("--seed", type=int, default=10_000,
@@ -379,7 +380,8 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
     from .metrics import env_name
     from .policy import is_reference
     from .rollouts import (TrainedPolicy, policy_from_recipe, policy_recipe, run_agent_kwargs,
-                           trained_argument)
+                           run_env_id, trained_argument, trained_policy)
+    from .waypoint_follower import student_record
 
     if args.every is not None and args.every < 1:
         parser.error(f"--every must be at least 1, got {args.every}")
@@ -408,11 +410,13 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
     if not is_reference(policy) and _is_run(policy):
         try:
             _, run_dir, steps = trained_argument(f"run={policy}", args.env)
-            run = TrainedPolicy(run_dir, checkpoint=steps)
+            if student_record(run_dir) is None:   # a waypoint student is made with its env
+                TrainedPolicy(run_dir, checkpoint=steps)          # refuses a missing model
+            run = (run_dir, steps)
         except (ValueError, FileNotFoundError) as err:
             parser.error(str(err).replace(f"--trained run={policy}", f"policy {policy}"))
         env_kwargs.update(run_agent_kwargs(run_dir))     # it acts and sees as it was trained
-    env_id = args.env or (run.env_id if run is not None else DEFAULT_ENV)
+    env_id = args.env or (run_env_id(run[0]) if run is not None else DEFAULT_ENV)
     try:
         env_spec(env_id)
         baseline_names(env_id)      # an id without facts is refused here
@@ -443,7 +447,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
             except ValueError as err:
                 parser.error(str(err))
         else:
-            agent = run
+            agent = trained_policy(run[0], env, args.seed, checkpoint=run[1])
         out = args.out or default_out(env_id, policy, args.seed, args.concentration)
         try:
             episode = play_frames(env, agent, args.seed, out, every=args.every, times=times,

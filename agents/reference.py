@@ -16,8 +16,9 @@ ShipNavigation-v1's is a waypoint student's run instead
 ``command.txt``, ``training.yaml``): it decides every 10 s from the
 environment's costmap and follows its waypoints by pure pursuit, so it
 reads the environment it plays (:func:`load_reference` with
-``environment=``, made by :func:`reference_env`), and the leaderboard
-plays it as ``agents.waypoints:WaypointStudent?run=DIR``.
+``environment=``, made by :func:`reference_env`); ``agents.leaderboard
+--trained``, ``agents.benchmark`` and ``agents.frames`` take its folder,
+``agents.evaluate`` and ``agents.train --init-from`` do not.
 
 Seeds, fixed before any agent was trained or tuned:
 

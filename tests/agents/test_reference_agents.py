@@ -92,6 +92,13 @@ def test_a_waypoint_student_is_kept_played_and_refused_without_its_environment(t
     assert agent.agent_kwargs == {"costmap_ahead": 200.0}
     first, again = _episode(agent, env, 7), _episode(agent, env, 7)
     assert first == again and len(first[1]) > 5
+    # agents.frames takes its folder as it takes a run of agents.train
+    from agents.frames import main as frames_main
+
+    episode = frames_main([str(folder), "--seed", "7", "--env-kwargs", "length=300.0",
+                           "goal_distance=150.0", "--concentration", "0.2", "--every", "20",
+                           "--out", str(tmp_path / "frames"), "--no-progress"])
+    assert episode["summary"] and (tmp_path / "frames" / "contact_sheet.png").is_file()
 
 
 def test_an_id_without_an_agent_is_refused_with_those_that_have_one(tmp_path):
