@@ -28,6 +28,19 @@ it decides in:
   estimate of the discounted return's spread (SB3's ``VecNormalize``),
   so that the critic's targets are of order one.
 
+* **A paired reward** (``paired_horizon`` H > 0, with ``gamma`` 0): the
+  field's own difficulty dwarfs what one decision changes, so the
+  environment's reward makes a noisy policy gradient. Instead each
+  decision is scored against the costmap lattice on the same episode:
+  from a snapshot, the decision's H-step return (the decision, then the
+  costmap lattice) minus the costmap lattice's own; the field cancels.
+  Each decision is then a problem of its own, whose best answer is one
+  step of policy improvement over the costmap lattice (as the rollout
+  planner takes at every replan; a learner that reached it would decide
+  as that rollout does, from its sensors alone). Training is privileged
+  (it steps copies of the episode); the student still decides from its
+  costmap and pose.
+
 The fields sailed are seeded ``field_seed`` + k, episode by episode, apart
 from the leaderboard's and the tuning fields. Run::
 
@@ -37,8 +50,9 @@ from the leaderboard's and the tuning fields. Run::
 The output is a run directory like the student's (``student.zip``, the
 student's network with the fine-tuned actor, so
 :class:`agents.waypoints.WaypointStudent` plays it), with ``ppo.zip`` (the
-whole PPO model) and ``finetune.json``: the settings, the mean return of
-the training episodes in windows, and the wall time.
+whole PPO model) and ``finetune.json``: the settings, the reward, the mean
+return of the training episodes in windows (the environment's, and with a
+paired reward its sums too), and the wall time.
 """
 from __future__ import annotations
 
@@ -62,7 +76,7 @@ PPO_MODEL = "ppo.zip"
 FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
                          n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,
                          clip_range=0.1, target_kl=0.02, gamma=0.99, gae_lambda=0.95,
-                         field_seed=80_000)
+                         field_seed=80_000, paired_horizon=0)
 
 
 class _Commanded(WaypointFollower):
@@ -94,18 +108,44 @@ class WaypointDecisionEnv(gym.Env):
         (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
         ``"waypoints"`` only).
 
-    ``info`` of a step holds ``env_steps`` (the environment steps it sailed)
-    and the last environment step's info.
+    paired_horizon : int
+        0 (default): the reward is the environment's. H > 0: the reward is
+        the decision's advantage over the costmap lattice, paired on the
+        same episode (privileged: it steps copies of the episode). From a
+        snapshot (:meth:`iceenvs.base.ControlEnv.snapshot`) the costmap
+        lattice (:class:`agents.planners.CostmapLatticePlanner`) sails H
+        steps; from the same snapshot the decision is sailed for
+        ``interval`` steps and the costmap lattice sails on to H; the
+        reward is the second sum minus the first. Field, ice and weather
+        are the same in both, so what the field gives every policy cancels,
+        and what is left is what the decision changed (for the lattice's
+        own decision, about zero). The episode then goes on from the
+        decision's own ``interval`` steps. Each decision costs 2 H + ``interval``
+        steps.
+
+    ``info`` of a step holds ``env_steps`` (the environment steps it sailed),
+    ``env_reward`` (their rewards' sum), with ``paired_horizon`` the two
+    rollouts' returns (``decision_return``, ``lattice_return``), and the
+    last environment step's info.
     """
 
     metadata = {"render_modes": []}
 
-    def __init__(self, env, field_seed: int | None = None, **follower):
+    def __init__(self, env, field_seed: int | None = None, paired_horizon: int = 0,
+                 **follower):
         if follower.get("form", "waypoints") != "waypoints":
             raise ValueError("WaypointDecisionEnv decides lateral shifts (form 'waypoints'), "
                              f"got form {follower['form']!r}")
         self.env = env
         self.follower = _Commanded(env, **follower)
+        if isinstance(paired_horizon, bool) or int(paired_horizon) != paired_horizon or not (
+                paired_horizon == 0 or paired_horizon >= self.follower.interval):
+            raise ValueError(f"paired_horizon must be 0 (off) or an integer of at least the "
+                             f"decision's {self.follower.interval} steps, got {paired_horizon!r}")
+        if paired_horizon and not hasattr(env.unwrapped, "snapshot"):
+            raise ValueError(f"paired_horizon needs an environment with snapshot and restore, "
+                             f"got {type(env.unwrapped).__name__}")
+        self.paired_horizon = int(paired_horizon)
         self.observation_space = decision_space(env)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (self.follower.points,), np.float32)
         self.field_seed = field_seed
@@ -128,6 +168,17 @@ class WaypointDecisionEnv(gym.Env):
         if w.shape != self.action_space.shape or not np.all(np.isfinite(w)):
             raise ValueError(f"a decision is {self.action_space.shape[0]} finite number(s) "
                              f"in [-1, 1], got {action!r}")
+        paired = {}
+        if self.paired_horizon:
+            u = self.env.unwrapped
+            snap = u.snapshot()
+            # restore before each rollout: a restore puts copies in the episode, so the
+            # rollouts step those and leave alone the objects this environment holds
+            u.restore(snap)
+            paired["lattice_return"] = self._rollout(None)
+            u.restore(snap)
+            paired["decision_return"] = self._rollout(w)
+            u.restore(snap)
         self.follower.command = w
         self.follower.decide_next_step()
         total, steps = 0.0, 0
@@ -138,11 +189,59 @@ class WaypointDecisionEnv(gym.Env):
                 self.follower.predict(self._obs)[0])
             total += float(reward)
             steps += 1
-        return (decision_observation(self.env), total, terminated, truncated,
-                {**info, "env_steps": steps})
+        reward = paired["decision_return"] - paired["lattice_return"] if paired else total
+        return (decision_observation(self.env), reward, terminated, truncated,
+                {**info, "env_steps": steps, "env_reward": total, **paired})
+
+    def _rollout(self, w) -> float:
+        """The summed reward of ``paired_horizon`` steps of the episode as it
+        is now (the caller restores it): decision ``w`` for ``interval``
+        steps, then the costmap lattice; None: the costmap lattice
+        throughout. Stepped below any wrapper, whose counters stay as they
+        are."""
+        from .planners import CostmapLatticePlanner
+
+        u = self.env.unwrapped
+        lattice = CostmapLatticePlanner(self.env, 0, show=False)
+        follower = _Commanded(self.env, points=self.follower.points,
+                              distance=self.follower.distance,
+                              interval=self.follower.interval)
+        follower.command = w
+        space = self.env.action_space
+        obs, total = self._obs, 0.0
+        for k in range(self.paired_horizon):
+            mine = w is not None and k < self.follower.interval
+            action = (follower if mine else lattice).predict(obs)[0]
+            obs, reward, terminated, truncated, _ = u.step(
+                np.clip(action, space.low, space.high).astype(space.dtype))
+            total += float(reward)
+            if terminated or truncated:
+                break
+        return total
 
     def close(self):
         self.env.close()
+
+
+class _EnvReturns(gym.Wrapper):
+    """Keeps each episode's sum of the environment's own rewards
+    (``info["env_reward"]``), whatever reward the learner is given."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.returns: list[float] = []
+        self._sum = 0.0
+
+    def reset(self, **kwargs):
+        self._sum = 0.0
+        return self.env.reset(**kwargs)
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self._sum += float(info["env_reward"])
+        if terminated or truncated:
+            self.returns.append(self._sum)
+        return obs, reward, terminated, truncated, info
 
 
 def _actor_parameters(policy):
@@ -233,8 +332,13 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     if isinstance(student.action_space, gym.spaces.Discrete):
         raise ValueError(f"{run} decides stage choices; fine-tuning takes a student of "
                          f"form 'waypoints'")
+    if s["paired_horizon"] and s["gamma"] != 0.0:
+        raise ValueError(f"with paired_horizon the reward of a decision is its advantage over "
+                         f"the costmap lattice over the horizon: each decision is its own "
+                         f"problem, so gamma must be 0 (got {s['gamma']})")
     made = gym.make(trained["env_id"], **trained["env_kwargs"])
     env = WaypointDecisionEnv(made, field_seed=s["field_seed"],
+                              paired_horizon=s["paired_horizon"],
                               points=int(student.action_space.shape[0]))
     if env.observation_space["costmap"].shape != student.observation_space["costmap"].shape:
         env.close()
@@ -245,7 +349,8 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
         "features_extractor_kwargs", "normalize_images")}
     policy_kwargs["share_features_extractor"] = False
     out.mkdir(parents=True, exist_ok=True)
-    monitored = Monitor(env)
+    own = _EnvReturns(env)
+    monitored = Monitor(own)
     # the rewards scaled by a running estimate of the return's spread (the
     # environment's own are kept in the record)
     vec = VecNormalize(DummyVecEnv([lambda: monitored]), norm_obs=False, norm_reward=True,
@@ -277,11 +382,18 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     returns = [float(r) for r in monitored.get_episode_rewards()]
     lengths = [int(n) for n in monitored.get_episode_lengths()]
     window = 10
+
+    def by_window(values):
+        return [round(float(np.mean(values[i:i + window])), 3)
+                for i in range(0, len(values), window)]
+
     record = {"settings": {**s, "seed": seed, "run": str(run), "env_id": trained["env_id"],
                            "env_kwargs": trained["env_kwargs"]},
+              "reward": (f"paired: advantage over the costmap lattice in {s['paired_horizon']} "
+                         f"steps" if s["paired_horizon"] else "the environment's"),
               "episodes": len(returns),
-              "mean_return_by_window": [round(float(np.mean(returns[i:i + window])), 3)
-                                        for i in range(0, len(returns), window)],
+              "mean_return_by_window": by_window(returns),
+              "mean_env_return_by_window": by_window(own.returns[:len(returns)]),
               "window": window,
               "decisions": int(sum(lengths)),
               "critic_episodes": _episodes_within(lengths, s["critic_steps"]),
@@ -301,6 +413,13 @@ def _episodes_within(lengths, decisions: int) -> int:
     return int(np.searchsorted(np.cumsum(lengths), decisions, side="right"))
 
 
+def _env_windows(record: dict) -> list:
+    """A fine-tuning's mean return (the environment's reward) by window of
+    episodes; a record before paired rewards has only its own sums, which
+    are the same."""
+    return record.get("mean_env_return_by_window", record["mean_return_by_window"])
+
+
 def finetune_report(runs, out: str | Path) -> dict:
     """Gather the records of the fine-tuning runs ``runs`` (directories of
     :func:`finetune`) into ``out``: ``finetune.json`` (each run's record, by
@@ -310,14 +429,18 @@ def finetune_report(runs, out: str | Path) -> dict:
     from physics.scenarios import plots
 
     records = gather_records(runs, FINETUNE_RECORD, "agents.waypoints finetune")
-    lines = ["| run | seed | from the student | decisions (critic alone) | episodes "
-             "| mean return, first and last 10 episodes | training [min] |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["| run | seed | from the student | reward | decisions (critic alone) | episodes "
+             "| mean reward sum, first and last 10 episodes | mean return, the same "
+             "| training [min] |", "|---|---|---|---|---|---|---|---|---|"]
     for name, record in records.items():
         s, windows = record["settings"], record["mean_return_by_window"]
-        lines.append(f"| {name} | {s['seed']} | {s['run']} | {record['decisions']} "
-                     f"({s['critic_steps']}) | {record['episodes']} "
-                     f"| {windows[0]:.1f} → {windows[-1]:.1f} | {record['seconds'] / 60:.1f} |")
+        env_windows = _env_windows(record)
+        lines.append(f"| {name} | {s['seed']} | {s['run']} | "
+                     f"{record.get('reward', 'the environment' + chr(39) + 's')} | "
+                     f"{record['decisions']} ({s['critic_steps']}) | {record['episodes']} "
+                     f"| {windows[0]:.1f} → {windows[-1]:.1f} "
+                     f"| {env_windows[0]:.1f} → {env_windows[-1]:.1f} "
+                     f"| {record['seconds'] / 60:.1f} |")
     first = next(iter(records.values()))["settings"]
     lines += ["", f"Fields: seeded {first['field_seed']} + k, one per episode; learning rate "
               f"{first['critic_learning_rate']:g} for the critic alone, then {first['learning_rate']:g}; "
@@ -330,7 +453,7 @@ def finetune_report(runs, out: str | Path) -> dict:
     plt = plots.pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, record in records.items():
-        windows = record["mean_return_by_window"]
+        windows = _env_windows(record)
         x = record["window"] * (np.arange(len(windows)) + 1)
         ax.plot(x, windows, lw=1.2, label=name)
         ax.axvline(record["critic_episodes"], color="0.6", lw=0.8, ls=":")

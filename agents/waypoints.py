@@ -428,8 +428,12 @@ def main(argv=None) -> int:
     f.add_argument("--run", type=Path, required=True, help="the student's run directory")
     f.add_argument("--seed", type=int, default=1)
     f.add_argument("--out", type=Path, required=True)
+    helps = {"paired_horizon": "0: the environment's reward (default); H: each decision's "
+                               "advantage over the costmap lattice in H steps, paired on the "
+                               "same episode from a snapshot (privileged; with --gamma 0)"}
     for name, value in FINETUNE_DEFAULTS.items():
-        f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value)
+        f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value,
+                       help=helps.get(name))
     f.add_argument("--no-progress", action="store_true")
     r = sub.add_parser("report", help="gather runs' records into one record and a table")
     r.add_argument("runs", nargs="+", type=Path, help="run directories of train or finetune "
@@ -463,7 +467,9 @@ def main(argv=None) -> int:
             p.error(str(exc))
         print(f"{args.out}: {record['decisions']} decisions, {record['episodes']} episodes in "
               f"{record['seconds']:.0f} s; mean return by {record['window']} episodes: "
-              f"{record['mean_return_by_window']}")
+              f"{record['mean_env_return_by_window']}" + (
+                  f"; reward {record['reward']}, its sums {record['mean_return_by_window']}"
+                  if record["settings"]["paired_horizon"] else ""))
         return 0
     settings = {k: getattr(args, k) for k in ("form", "teacher", "refit", "points", "episodes",
                                               "rounds", "epochs",

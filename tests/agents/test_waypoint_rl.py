@@ -38,6 +38,47 @@ def test_a_decision_sails_five_steps_of_the_followers_episode():
                                rtol=1e-12, atol=1e-12)
 
 
+def test_a_paired_reward_is_the_decisions_advantage_over_the_costmap_lattice():
+    """With paired_horizon the costmap lattice's own decision earns exactly
+    nothing (the two rollouts are the same steps), any decision earns its
+    rollout's return minus the lattice's, and the episode goes on as it does
+    unpaired: the rollouts leave it, and the time limit's count, as they
+    were."""
+    from agents.waypoints import LatticeWaypoints as Teacher
+
+    def play(horizon, decide):
+        env = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.3}),
+                                  paired_horizon=horizon)
+        obs, _ = env.reset(seed=4)
+        out, done = [], False
+        while not done:
+            obs, reward, terminated, truncated, info = env.step(decide(env, len(out)))
+            out.append((reward, info, obs["costmap"].copy()))
+            done = terminated or truncated
+        env.close()
+        return out
+
+    def teacher(env, k):
+        if k == 0:
+            teacher.planner = Teacher(env.env, teacher="costmap-lattice")
+        return teacher.planner.label()
+
+    own = play(15, teacher)
+    assert len(own) > 3
+    assert all(abs(r) < 1e-12 and abs(i["decision_return"] - i["lattice_return"]) < 1e-12
+               for r, i, _ in own)
+    shifts = np.random.default_rng(5).uniform(-1.0, 1.0, (200, 2))
+    paired, plain = play(15, lambda env, k: shifts[k]), play(0, lambda env, k: shifts[k])
+    assert len(paired) == len(plain)
+    assert any(abs(r) > 1e-3 for r, _, _ in paired)      # a decision changes what follows
+    for (r, info, costmap), (r0, info0, costmap0) in zip(paired, plain):
+        assert r == info["decision_return"] - info["lattice_return"]
+        assert info["env_reward"] == r0 == info0["env_reward"]
+        np.testing.assert_array_equal(costmap, costmap0)
+    with pytest.raises(ValueError, match="paired_horizon must be"):
+        WaypointDecisionEnv(gym.make(NAV, **KWARGS), paired_horizon=3)
+
+
 def test_unseeded_resets_sail_the_fields_in_order():
     env = WaypointDecisionEnv(gym.make(NAV, **KWARGS), field_seed=123)
     first, _ = env.reset()
@@ -112,6 +153,18 @@ def test_a_finetuning_run_learns(student, tmp_path, capsys):
             "features_extractor.", "pi_features_extractor.")].numpy())
 
 
+def test_a_paired_finetuning_keeps_the_environments_returns_apart(student, tmp_path, capsys):
+    record = finetune(student, tmp_path / "ft", 2, progress=False, steps=24, critic_steps=12,
+                      n_steps=12, batch_size=6, n_epochs=1, gamma=0.0, paired_horizon=10)
+    assert record["reward"].startswith("paired") and record["episodes"] >= 2
+    assert len(record["mean_env_return_by_window"]) == len(record["mean_return_by_window"])
+    # the environment's returns are those of a ship sailing a short field; the paired sums
+    # are not (an advantage per decision of order one)
+    assert record["mean_env_return_by_window"] != record["mean_return_by_window"]
+    assert main(["report", str(tmp_path / "ft"), "--out", str(tmp_path / "r")]) == 0
+    assert "| paired: advantage over the costmap lattice in 10 steps |" in capsys.readouterr().out
+
+
 def test_bad_input_is_refused(student, tmp_path, capsys):
     with pytest.raises(FileNotFoundError, match="not a run"):
         finetune(tmp_path, tmp_path / "ft", 1, progress=False)
@@ -119,6 +172,8 @@ def test_bad_input_is_refused(student, tmp_path, capsys):
         finetune(student, tmp_path / "ft", 1, progress=False, steps=10, critic_steps=10)
     with pytest.raises(ValueError, match="unknown settings"):
         finetune(student, tmp_path / "ft", 1, progress=False, epochs=3)
+    with pytest.raises(ValueError, match="gamma must be 0"):
+        finetune(student, tmp_path / "ft", 1, progress=False, paired_horizon=15)
     with pytest.raises(ValueError, match="form 'waypoints'"):
         WaypointDecisionEnv(gym.make(NAV, **KWARGS), form="stages")
     env = WaypointDecisionEnv(gym.make(NAV, **KWARGS))
