@@ -96,6 +96,11 @@ class WaypointDecisionEnv(gym.Env):
     environment steps (fewer when the episode ends) along its route, and
     the reward is their rewards' sum.
 
+    ``info`` of a step holds ``env_steps`` (the environment steps it sailed),
+    ``env_reward`` (their rewards' sum), with ``paired_horizon`` the two
+    rollouts' returns (``decision_return``, ``lattice_return``), and the
+    last environment step's info.
+
     Parameters
     ----------
     env : gymnasium.Env
@@ -104,10 +109,6 @@ class WaypointDecisionEnv(gym.Env):
     field_seed : int or None
         A reset without a seed seeds episode k of this environment's life
         ``field_seed`` + k (None: the environment's own sequence).
-    **follower : :class:`agents.waypoints.WaypointFollower`'s settings
-        (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
-        ``"waypoints"`` only).
-
     paired_horizon : int
         0 (default): the reward is the environment's. H > 0: the reward is
         the decision's advantage over the costmap lattice, paired on the
@@ -119,14 +120,13 @@ class WaypointDecisionEnv(gym.Env):
         reward is the second sum minus the first. Field, ice and weather
         are the same in both, so what the field gives every policy cancels,
         and what is left is what the decision changed (for the lattice's
-        own decision, about zero). The episode then goes on from the
+        own decision, exactly zero). The episode then goes on from the
         decision's own ``interval`` steps. Each decision costs 2 H + ``interval``
         steps.
+    **follower : :class:`agents.waypoints.WaypointFollower`'s settings
+        (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
+        ``"waypoints"`` only).
 
-    ``info`` of a step holds ``env_steps`` (the environment steps it sailed),
-    ``env_reward`` (their rewards' sum), with ``paired_horizon`` the two
-    rollouts' returns (``decision_return``, ``lattice_return``), and the
-    last environment step's info.
     """
 
     metadata = {"render_modes": []}
@@ -430,7 +430,8 @@ def finetune_report(runs, out: str | Path) -> dict:
 
     records = gather_records(runs, FINETUNE_RECORD, "agents.waypoints finetune")
     lines = ["| run | seed | from the student | reward | decisions (critic alone) | episodes "
-             "| mean reward sum, first and last 10 episodes | mean return, the same "
+             "| mean reward sum, first and last 10 episodes | mean return (the environment's "
+             "reward), the same "
              "| training [min] |", "|---|---|---|---|---|---|---|---|---|"]
     for name, record in records.items():
         s, windows = record["settings"], record["mean_return_by_window"]
