@@ -539,7 +539,9 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     else:
         if args.run_dir is None:
             parser.error("give a RUN_DIR, or --baseline NAME --env ID")
-        if (Path(args.run_dir) / "student.zip").is_file():   # agents.waypoints
+        from .waypoint_follower import STUDENT
+
+        if (Path(args.run_dir) / STUDENT).is_file():
             parser.error(f"{args.run_dir} holds a waypoint student, which reads the environment "
                          f"it plays: play it with python -m agents.leaderboard --policies "
                          f"'student=agents.waypoints:WaypointStudent?run={args.run_dir}'")

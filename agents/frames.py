@@ -379,7 +379,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
     from .envs import make_checked_env, parse_key_values
     from .metrics import env_name
     from .policy import is_reference
-    from .rollouts import (TrainedPolicy, policy_from_recipe, policy_recipe, run_agent_kwargs,
+    from .rollouts import (checkpoint_files, policy_from_recipe, policy_recipe, run_agent_kwargs,
                            run_env_id, trained_argument, trained_policy)
     from .waypoint_follower import student_record
 
@@ -411,7 +411,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.frames") -
         try:
             _, run_dir, steps = trained_argument(f"run={policy}", args.env)
             if student_record(run_dir) is None:   # a waypoint student is made with its env
-                TrainedPolicy(run_dir, checkpoint=steps)          # refuses a missing model
+                checkpoint_files(run_dir, steps)                  # refuses a missing model
             run = (run_dir, steps)
         except (ValueError, FileNotFoundError) as err:
             parser.error(str(err).replace(f"--trained run={policy}", f"policy {policy}"))

@@ -65,8 +65,10 @@ def reference_dir(env_id: str, root: str | Path | None = None) -> Path:
 def is_reference(folder: str | Path) -> bool:
     """Whether ``folder`` holds an agent: a model of :mod:`agents.train`
     (``model.zip``) or a waypoint student (``student.zip``)."""
+    from .waypoint_follower import STUDENT
+
     folder = Path(folder)
-    return (folder / "model.zip").is_file() or (folder / "student.zip").is_file()
+    return (folder / "model.zip").is_file() or (folder / STUDENT).is_file()
 
 
 def _folder(env: str, root: str | Path | None) -> Path:

@@ -25,7 +25,8 @@ import yaml
 from iceenvs.facts import env_facts
 
 from .observations import as_float32
-from .runs import checkpoint_paths_checked, trained_argument  # noqa: F401  (re-exported)
+from .runs import (checkpoint_paths_checked, run_env_id,  # noqa: F401  (re-exported)
+                   trained_argument)
 
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
            "evaluate_in_processes", "policy_from_recipe", "rounded", "stats", "summarise", "compare",
@@ -51,18 +52,6 @@ def run_agent_kwargs(run_dir: str | Path) -> dict:
         return _agent_part(student["settings"].get("env_kwargs") or {})
     with open(Path(run_dir) / "hyperparams.yaml") as fh:
         return _agent_part(yaml.safe_load(fh).get("env_kwargs") or {})
-
-
-def run_env_id(run_dir: str | Path) -> str:
-    """The environment id a run of :mod:`agents.train` (``args.yaml``) or a
-    waypoint student's run (``waypoints.json``) was trained on."""
-    from .waypoint_follower import student_record
-
-    student = student_record(run_dir)
-    if student is not None:
-        return student["settings"]["env_id"]
-    with open(Path(run_dir) / "args.yaml") as fh:
-        return yaml.safe_load(fh)["env"]
 
 
 def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | str | None = None):

@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 __all__ = ["BEST", "BEST_STATS", "checkpoint_paths", "checkpoint_paths_checked",
-           "trained_argument"]
+           "run_env_id", "trained_argument"]
 
 #: the checkpoint name of the evaluation callback's best model (``RUN_DIR@best``)
 BEST = "best"
@@ -57,6 +57,19 @@ def checkpoint_paths_checked(run_dir: Path, steps: int | str | None = None) -> t
     return model, stats
 
 
+def run_env_id(run_dir: str | Path) -> str | None:
+    """The environment id a run of :mod:`agents.train` (``args.yaml``; None
+    when it names none) or a waypoint student's run (its record,
+    :func:`agents.waypoint_follower.student_record`) was trained on."""
+    from .waypoint_follower import student_record
+
+    student = student_record(run_dir)
+    if student is not None:
+        return student["settings"]["env_id"]
+    with open(Path(run_dir) / "args.yaml") as fh:
+        return yaml.safe_load(fh).get("env")
+
+
 def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, int | str | None]:
     """``(name, run_dir, checkpoint or None)`` of a ``--trained`` argument
     ``NAME=RUN_DIR``, ``NAME=RUN_DIR@STEPS`` or ``NAME=RUN_DIR@best``: the
@@ -86,11 +99,7 @@ def trained_argument(item: str, env_id: str | None = None) -> tuple[str, str, in
         raise ValueError(f"--trained {item}: {run_dir} is not an existing run directory of "
                          f"agents.train (no args.yaml) nor a waypoint student's (no student.zip)")
     if env_id is not None:
-        if student is not None:
-            trained_on = student["settings"]["env_id"]
-        else:
-            with open(Path(run_dir) / "args.yaml") as fh:
-                trained_on = yaml.safe_load(fh).get("env")
+        trained_on = run_env_id(run_dir)
         if trained_on != env_id:
             raise ValueError(f"--trained {item}: the run was trained on {trained_on}, "
                              f"not {env_id}")

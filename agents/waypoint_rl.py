@@ -63,8 +63,9 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoint_follower import (FINETUNE_RECORD, RECORD, STUDENT, WaypointFollower, decision_observation,
-                                decision_space, gather_records, write_gathered)
+from .waypoint_follower import (FINETUNE_RECORD, RECORD, STUDENT, WaypointFollower,
+                                decision_observation, decision_space, gather_records,
+                                write_gathered)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
            "FINETUNE_RECORD", "PPO_MODEL"]
@@ -72,6 +73,8 @@ __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAU
 #: the record of a fine-tuning run, and its whole PPO model (actor, critic and
 #: optimiser, for ``PPO.load``), in its directory
 PPO_MODEL = "ppo.zip"
+#: what a record's ``reward`` says of a fine-tuning on the environment's own reward
+ENV_REWARD = "the environment's"
 #: the settings of :func:`finetune`
 FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
                          n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,
@@ -390,7 +393,7 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     record = {"settings": {**s, "seed": seed, "run": str(run), "env_id": trained["env_id"],
                            "env_kwargs": trained["env_kwargs"]},
               "reward": (f"paired: advantage over the costmap lattice in {s['paired_horizon']} "
-                         f"steps" if s["paired_horizon"] else "the environment's"),
+                         f"steps" if s["paired_horizon"] else ENV_REWARD),
               "episodes": len(returns),
               "mean_return_by_window": by_window(returns),
               "mean_env_return_by_window": by_window(own.returns[:len(returns)]),
@@ -437,7 +440,7 @@ def finetune_report(runs, out: str | Path) -> dict:
         s, windows = record["settings"], record["mean_return_by_window"]
         env_windows = _env_windows(record)
         lines.append(f"| {name} | {s['seed']} | {s['run']} | "
-                     f"{record.get('reward', 'the environment' + chr(39) + 's')} | "
+                     f"{record.get('reward', ENV_REWARD)} | "
                      f"{record['decisions']} ({s['critic_steps']}) | {record['episodes']} "
                      f"| {windows[0]:.1f} → {windows[-1]:.1f} "
                      f"| {env_windows[0]:.1f} → {env_windows[-1]:.1f} "
