@@ -527,7 +527,8 @@ def build_parser(prog: str = "python -m agents.leaderboard") -> argparse.Argumen
                    help="comma-separated baselines (default: the environment's planners, "
                         "such as straight,reactive,swath,lattice on ShipNavigation-v1) and "
                         "policies of one's own, module:Class or path/to/file.py:Class "
-                        "(?key=value&... for their arguments; agents.policy), each "
+                        "(?key=value&... for their arguments, YAML values; a comma inside "
+                        "brackets, as in ?offsets=[-4,4], is the value's; agents.policy), each "
                         "NAME=module:Class... to show it as NAME")
     p.add_argument("--trained", action="append", default=[], metavar="NAME=RUN_DIR[@STEPS]",
                    help="a trained policy (agents.train's run directory; @STEPS: its checkpoint "
@@ -674,7 +675,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
     from .baselines import check_policy_names
     from .envs import make_checked_env, parse_key_values
     from .planners import PLANNERS
-    from .policy import is_reference
+    from .policy import is_reference, split_policies
     from .rollouts import policy_recipe, run_agent_kwargs, trained_argument
 
     if args.episodes < 2:
@@ -690,8 +691,11 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
         parser.error("--concentrations is empty")
     if "concentration" in env_kwargs:
         parser.error("--env-kwargs concentration: the concentrations come from --concentrations")
-    policies = ([p.strip() for p in args.policies.split(",") if p.strip()]
-                if args.policies is not None else default_policies(args.env))
+    try:
+        policies = (split_policies(args.policies) if args.policies is not None
+                    else default_policies(args.env))
+    except ValueError as err:
+        parser.error(f"--policies: {err}")
     named = dict(policy_label(p) for p in policies)
     if len(named) < len(policies):
         parser.error("--policies names a policy twice")

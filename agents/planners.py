@@ -246,6 +246,15 @@ class LatticePlanner(StraightLineController):
         """Plan a route from the ship's pose now: (K, 2) points [m], one a
         stage."""
         t0 = time.perf_counter()
+        route = self.lattice_plan(self.metre_cost)
+        self.decision_times.append(time.perf_counter() - t0)
+        if self.show:
+            self.unwrapped.plan_overlay = (route, 0.5 * float(self.unwrapped.ship.hull.beam))
+        return route
+
+    def lattice_plan(self, metre_cost: float) -> np.ndarray:
+        """The lattice's route from the ship's pose now, pricing a metre
+        sailed at ``metre_cost`` [N s/m]: (K, 2) points [m], one a stage."""
         u = self.unwrapped
         ship = u.sim.ship
         x, y = (float(v) for v in ship.position)
@@ -269,17 +278,13 @@ class LatticePlanner(StraightLineController):
         y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
         slope = self.start_slope(heading)
         ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, slope, max_slope,
-                                  y_low, y_high, 1.0 / self.metre_cost)
+                                  y_low, y_high, 1.0 / metre_cost)
         if not math.isfinite(total):
             # heading for an edge too steeply to turn within the lattice's slope steps
             # (a ship another controller steered there): plan from a straight heading
             ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, 0, max_slope,
-                                      y_low, y_high, 1.0 / self.metre_cost)
-        route = np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]])
-        self.decision_times.append(time.perf_counter() - t0)
-        if self.show:
-            u.plan_overlay = (route, 0.5 * float(u.ship.hull.beam))
-        return route
+                                      y_low, y_high, 1.0 / metre_cost)
+        return np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]])
 
     def cost_grid(self, x: float, y0: float, nx: int, ny: int, reach: float) -> np.ndarray:
         """The ice's cost density [N s/m] on the lattice's grid: ``nx`` ×
@@ -411,8 +416,9 @@ class RolloutPlanner(LatticePlanner):
 
     It reads what the lattice reads (every floe within its range) and steps
     the episode forward: a planner with a perfect model, listed as
-    privileged beside the lattice. Each plan costs ``1 + len(offsets)``
-    rollouts of ``rollout_steps`` steps.
+    privileged beside the lattice. Each plan costs
+    ``1 + len(offsets) + len(cost_factors)`` rollouts of ``rollout_steps``
+    steps.
 
     The defaults were chosen on fields apart from the leaderboard's (seeded
     40000 + k, A = 0.3 and 0.4) among ±6 m with 30 or 50 steps and ±4 and
@@ -425,6 +431,11 @@ class RolloutPlanner(LatticePlanner):
     offsets : sequence of float [m]
         Lateral shifts of the lattice's route tried beside it (0, the
         lattice's own, is always tried).
+    cost_factors : sequence of float
+        Also tried, unshifted: the lattice's route planned with its price
+        of a metre sailed (``metre_cost``) times each factor. Below 1 the
+        route detours more for the ice, above 1 it runs straighter, so a
+        candidate may pass a floe on the other side, which a shift cannot.
     rollout_steps : int
         Steps of each rollout (at least ``replan_steps``).
     **kwargs : the lattice planner's
@@ -433,7 +444,7 @@ class RolloutPlanner(LatticePlanner):
     reads_environment = "its floes, and steps copies of the episode forward"
 
     def __init__(self, env, seed: int = 0, *, offsets=(-10.0, -4.0, 4.0, 10.0),
-                 rollout_steps: int = 30,
+                 cost_factors=(), rollout_steps: int = 30,
                  **kwargs):
         super().__init__(env, seed, **kwargs)
         if not hasattr(self.unwrapped, "snapshot"):
@@ -443,13 +454,21 @@ class RolloutPlanner(LatticePlanner):
         if not all(math.isfinite(o) for o in shifts):
             raise ValueError(f"offsets must be finite numbers, got {offsets!r}")
         self.offsets = (0.0, *sorted({o for o in shifts if o != 0.0}))
+        factors = [float(f) for f in cost_factors]
+        if not all(math.isfinite(f) and f > 0.0 for f in factors):
+            raise ValueError(f"cost_factors must be positive numbers, got {cost_factors!r}")
+        self.cost_factors = tuple(sorted({f for f in factors if f != 1.0}))
+        #: every candidate's label, in the order tried: an offset [m] of the
+        #: lattice's route, then ``"metre cost × f"`` for each cost factor
+        self.candidates = (*self.offsets, *(f"metre cost × {f:g}" for f in self.cost_factors))
         if isinstance(rollout_steps, bool) or int(rollout_steps) != rollout_steps \
                 or rollout_steps < self.replan_steps:
             raise ValueError(f"rollout_steps must be an integer >= replan_steps "
                              f"({self.replan_steps}), got {rollout_steps!r}")
         self.rollout_steps = int(rollout_steps)
         self._base_kwargs = dict(kwargs, show=False)
-        #: per plan: the offset kept [m] and every candidate's rollout return
+        #: per plan: the candidate kept (its label in ``candidates``) and every
+    #: candidate's rollout return
         self.choices: list[tuple[float, tuple[float, ...]]] = []
         self._seen = None
 
@@ -484,20 +503,23 @@ class RolloutPlanner(LatticePlanner):
         u = self.unwrapped
         half = 0.5 * u.channel_width - self.edge_margin
         low, high = u.centre_y - half, u.centre_y + half
+        routes = []
+        for offset in self.offsets:
+            shifted = route.copy()
+            shifted[1:, 1] = np.clip(route[1:, 1] + offset, low, high)
+            routes.append(shifted)
+        routes += [self.lattice_plan(self.metre_cost * f) for f in self.cost_factors]
         snap = u.snapshot()
         returns = []
-        for offset in self.offsets:
+        for candidate in routes:
             # restore first: a restore puts copies in the episode, so the rollouts step
             # those and leave alone the objects the caller holds (act's ship)
             u.restore(snap)
-            shifted = route.copy()
-            shifted[1:, 1] = np.clip(route[1:, 1] + offset, low, high)
-            returns.append(self._rollout(shifted))
+            returns.append(self._rollout(candidate))
         u.restore(snap)
         best = int(np.argmax(returns))
-        self.choices.append((self.offsets[best], tuple(returns)))
-        route = route.copy()
-        route[1:, 1] = np.clip(route[1:, 1] + self.offsets[best], low, high)
+        self.choices.append((self.candidates[best], tuple(returns)))
+        route = routes[best]
         self.decision_times[-1] += time.perf_counter() - t0
         if self.show:
             u.plan_overlay = (route, u.plan_overlay[1])

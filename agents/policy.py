@@ -63,6 +63,33 @@ def is_reference(name: str) -> bool:
     return ":" in name
 
 
+def split_policies(text: str) -> list[str]:
+    """The policies of a comma-separated list such as ``--policies``: a comma
+    inside brackets belongs to an argument's value
+    (``rollout-wide=agents.planners:RolloutPlanner?offsets=[-16,-4,4,16]``).
+
+    Raises
+    ------
+    ValueError
+        For brackets that do not close, or close before they open.
+    """
+    names, depth, start = [], 0, 0
+    for i, char in enumerate(text):
+        if char in "[{(":
+            depth += 1
+        elif char in "]})":
+            depth -= 1
+            if depth < 0:
+                raise ValueError(f"policies {text!r}: {char!r} closes a bracket never opened")
+        elif char == "," and depth == 0:
+            names.append(text[start:i])
+            start = i + 1
+    if depth:
+        raise ValueError(f"policies {text!r}: a bracket is not closed")
+    names.append(text[start:])
+    return [n.strip() for n in names if n.strip()]
+
+
 def parse_reference(reference: str) -> tuple[str, str, dict]:
     """(module or file, class name, keyword arguments) of ``reference``.
 

@@ -276,9 +276,12 @@ def _own_policies(parser, text: str, ids) -> list[str]:
     ``ids`` or a reference whose class imports; a bad one exits with the
     reason."""
     from .baselines import check_policy_names
-    from .policy import check_reference, is_reference
+    from .policy import check_reference, is_reference, split_policies
 
-    names = [n.strip() for n in text.split(",") if n.strip()]
+    try:
+        names = split_policies(text)
+    except ValueError as err:
+        parser.error(f"--policies: {err}")
     for name in names:
         if is_reference(name):
             try:

@@ -39,13 +39,35 @@ def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
 def test_each_plan_keeps_the_candidate_of_the_best_rollout():
     planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=8)
     assert planner.offsets == (0.0, -6.0, 6.0)  # the offsets asked for, 0 first
+    assert planner.candidates == planner.offsets
     for offset, returns in planner.choices:
         assert len(returns) == 3 and returns[planner.offsets.index(offset)] == max(returns)
     assert len(planner.choices) == len(planner.decision_times)
 
 
+def test_a_cost_factor_tries_the_lattices_route_at_another_price_of_a_metre():
+    """A factor of 1 is the lattice's own route, so it is not tried twice;
+    another is the lattice planned at that price, a route the planner may
+    keep; with a price that makes every metre dear the route runs straight
+    down the ship's row."""
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=3)
+    planner = RolloutPlanner(env, 0, offsets=(), cost_factors=(1.0, 1e9, 0.5), rollout_steps=8)
+    assert planner.candidates == (0.0, "metre cost × 0.5", "metre cost × 1e+09")
+    np.testing.assert_array_equal(planner.lattice_plan(planner.metre_cost),
+                                  LatticePlanner(env, 0).plan())
+    straight = planner.lattice_plan(planner.metre_cost * 1e9)
+    np.testing.assert_allclose(straight[:, 1], straight[0, 1], atol=planner.lateral_step)
+    env.close()
+    planner, _, _ = _sail(RolloutPlanner, offsets=(), cost_factors=(0.5, 2.0), rollout_steps=8)
+    for label, returns in planner.choices:
+        assert len(returns) == 3 and returns[planner.candidates.index(label)] == max(returns)
+
+
 @pytest.mark.parametrize("kwargs, message", [
     ({"offsets": (float("nan"),)}, "offsets must be finite"),
+    ({"cost_factors": (0.0,)}, "cost_factors must be positive"),
+    ({"cost_factors": (float("inf"),)}, "cost_factors must be positive"),
     ({"rollout_steps": 4}, "rollout_steps must be an integer >= replan_steps"),
     ({"rollout_steps": 7.5}, "rollout_steps must be an integer >= replan_steps"),
 ])

@@ -10,7 +10,7 @@ import pytest
 import iceenvs  # noqa: F401
 from agents import evaluate, leaderboard
 from agents.baselines import make_baseline
-from agents.policy import Policy, make_policy, parse_reference, policy_class
+from agents.policy import Policy, make_policy, parse_reference, policy_class, split_policies
 from cli_checks import assert_refused
 
 SHORT = ["--env-kwargs", "goal_distance=200.0", "length=500.0"]
@@ -57,6 +57,18 @@ def test_a_reference_is_a_module_or_a_file_and_its_arguments():
     assert parse_reference("pkg.mod:Steer") == ("pkg.mod", "Steer", {})
     assert parse_reference("a/b/steer.py:Steer?gain=0.5&name=x&on=true") == (
         "a/b/steer.py", "Steer", {"gain": 0.5, "name": "x", "on": True})
+
+
+def test_a_list_value_keeps_its_commas_in_a_list_of_policies(tmp_path, capsys):
+    text = "lattice, wide=agents.planners:RolloutPlanner?offsets=[-16,4]&x={a: 1, b: 2},swath"
+    assert split_policies(text) == [
+        "lattice", "wide=agents.planners:RolloutPlanner?offsets=[-16,4]&x={a: 1, b: 2}", "swath"]
+    assert parse_reference(split_policies(text)[1].partition("=")[2])[2] == {
+        "offsets": [-16, 4], "x": {"a": 1, "b": 2}}
+    for bad, words in (("a?x=[1,2", ["not closed"]), ("a?x=1],b", ["never opened"])):
+        with pytest.raises(ValueError, match=words[0]):
+            split_policies(bad)
+        assert_refused(leaderboard.main, ["--policies", bad], words, tmp_path / "none", capsys)
 
 
 def test_own_policy_is_made_for_its_environment(steer_module):
