@@ -503,6 +503,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
     from .baselines import ConstantPolicy, check_policy_names, make_baseline
     from .constant import format_action
     from .envs import make_checked_env, parse_key_values
+    from .policy import split_policies
     from .rollouts import policy_recipe
 
     parser = build_parser(prog)
@@ -516,7 +517,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.evaluate")
         parser.error("--episodes must be >= 1")
     if args.processes < 1:
         parser.error(f"--processes must be >= 1, got {args.processes}")
-    names = [n.strip() for n in args.baselines.split(",") if n.strip()]
+    try:
+        names = split_policies(args.baselines)
+    except ValueError as err:
+        parser.error(f"--baselines: {err}")
     if args.baseline is not None:
         names = [args.baseline]
     elif args.constant is not None and "constant" not in names:

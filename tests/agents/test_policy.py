@@ -69,6 +69,8 @@ def test_a_list_value_keeps_its_commas_in_a_list_of_policies(tmp_path, capsys):
         with pytest.raises(ValueError, match=words[0]):
             split_policies(bad)
         assert_refused(leaderboard.main, ["--policies", bad], words, tmp_path / "none", capsys)
+        assert_refused(evaluate.main, ["--baselines", bad, "--env", "iceenvs/ShipNavigation-v0"],
+                       words, tmp_path / "none", capsys)
 
 
 def test_own_policy_is_made_for_its_environment(steer_module):
