@@ -472,8 +472,8 @@ class RolloutPlanner(LatticePlanner):
         self.rollout_steps = int(rollout_steps)
         self._base_kwargs = dict(kwargs, show=False)
         #: per plan: the candidate kept (its label in ``candidates``) and every
-    #: candidate's rollout return
-        self.choices: list[tuple[float, tuple[float, ...]]] = []
+        #: candidate's rollout return
+        self.choices: list[tuple[float | str, tuple[float, ...]]] = []
         self._seen = None
 
     def reset(self, seed: int | None = None) -> None:
