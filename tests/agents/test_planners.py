@@ -36,6 +36,17 @@ def test_without_offsets_the_rollouts_leave_the_lattices_episode_as_it_was():
     assert planner.choices and all(offset == 0.0 for offset, _ in planner.choices)
 
 
+def test_with_a_margin_no_rollout_beats_the_lattice_keeps_the_lattices_route():
+    """A margin larger than any window's return keeps the lattice's own
+    route at every plan: the episode is the lattice planner's, bit for bit,
+    though other candidates were rolled out."""
+    planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=8,
+                                margin=1e9)
+    _, lattice_rewards, _ = _sail(LatticePlanner)
+    np.testing.assert_array_equal(rewards, lattice_rewards)
+    assert all(label == 0.0 and len(returns) == 3 for label, returns in planner.choices)
+
+
 def test_each_plan_keeps_the_candidate_of_the_best_rollout():
     planner, rewards, _ = _sail(RolloutPlanner, offsets=(-6.0, 6.0), rollout_steps=8)
     assert planner.offsets == (0.0, -6.0, 6.0)  # the offsets asked for, 0 first
@@ -64,10 +75,58 @@ def test_a_cost_factor_tries_the_lattices_route_at_another_price_of_a_metre():
         assert len(returns) == 3 and returns[planner.candidates.index(label)] == max(returns)
 
 
+class _UniformIce(RolloutPlanner):
+    """The rollout planner on a grid of one ice cost density everywhere."""
+    density = 0.0
+
+    def cost_grid(self, x, y0, nx, ny, reach):
+        return np.full((nx, ny), self.density)
+
+
+@pytest.mark.parametrize("density", [0.0, 2_000.0])
+def test_the_value_to_go_of_a_uniform_ice_is_the_progress_left_less_its_time_and_ice(density):
+    """With one ice cost density c [N s/m] everywhere, the lattice's route
+    runs straight (a detour adds length and ice), so the value to go from d
+    metres before the goal line is (1 − w) d / ℓ − (w / ℓ) c L₀ / metre cost,
+    L₀ the route's extent: the progress left less the ice the reward charges
+    for it (its time is the progress's w)."""
+    env = gym.make(NAV, **KWARGS)
+    env.reset(seed=3)
+    u = env.unwrapped
+    planner = _UniformIce(env, 0, cost_to_go=True)
+    planner.density = density
+    route = planner.lattice_plan(u.metre_cost)
+    np.testing.assert_allclose(route[:, 1], route[0, 1], atol=1e-9)
+    extent = route[-1, 0] - route[0, 0]
+    step, w = u.max_speed * u.control_interval, u.reward_params["time_weight"]
+    left = u.goal_x - float(u.sim.ship.position[0])
+    expected = (1 - w) * left / step - w / step * density * extent / u.metre_cost
+    assert planner.value_to_go() == pytest.approx(expected, rel=1e-9)
+    env.close()
+
+
+def test_with_cost_to_go_a_rollout_adds_the_value_to_go_from_where_it_ends():
+    env = gym.make(NAV, **KWARGS)
+    obs, _ = env.reset(seed=3)
+    u = env.unwrapped
+    plain = RolloutPlanner(env, 0, rollout_steps=8)
+    togo = RolloutPlanner(env, 0, rollout_steps=8, cost_to_go=True)
+    for planner in (plain, togo):
+        planner.predict(obs)              # the first plan, and its rollouts restored
+    route, snap = plain.route, u.snapshot()
+    window = plain._rollout(route)
+    tail = plain.value_to_go()           # from where the window left the ship
+    u.restore(snap)
+    assert togo._rollout(route) == pytest.approx(window + tail, rel=1e-12)
+    env.close()
+
+
 @pytest.mark.parametrize("kwargs, message", [
     ({"offsets": (float("nan"),)}, "offsets must be finite"),
     ({"cost_factors": (0.0,)}, "cost_factors must be positive"),
     ({"cost_factors": (float("inf"),)}, "cost_factors must be positive"),
+    ({"margin": -1.0}, "margin must be a number >= 0"),
+    ({"margin": float("nan")}, "margin must be a number >= 0"),
     ({"rollout_steps": 4}, "rollout_steps must be an integer >= replan_steps"),
     ({"rollout_steps": 7.5}, "rollout_steps must be an integer >= replan_steps"),
 ])
@@ -75,6 +134,15 @@ def test_refused_arguments(kwargs, message):
     env = gym.make(NAV, **KWARGS)
     with pytest.raises(ValueError, match=message):
         RolloutPlanner(env, 0, **kwargs)
+
+
+def test_cost_to_go_needs_a_flag_and_a_reward_that_prices_time_and_ice():
+    env = gym.make(NAV, **KWARGS)
+    with pytest.raises(TypeError, match="cost_to_go must be True or False"):
+        RolloutPlanner(env, 0, cost_to_go="yes")
+    env = gym.make(NAV, **KWARGS, reward_params={"time_weight": 0.0})
+    with pytest.raises(ValueError, match="cost_to_go needs a reward that prices"):
+        RolloutPlanner(env, 0, cost_to_go=True)
 
 
 def test_the_lattice_plans_for_a_ship_heading_steeply_for_the_edge():
