@@ -535,9 +535,9 @@ class RolloutPlanner(LatticePlanner):
             total += float(reward)
             if terminated or truncated:
                 return total
-        return total + self.value_to_go(base) if self.cost_to_go else total
+        return total + self.value_to_go() if self.cost_to_go else total
 
-    def value_to_go(self, base: LatticePlanner | None = None) -> float:
+    def value_to_go(self) -> float:
         """The reward the lattice expects from the ship's pose now to the
         goal line: the progress left, less the time and the ice its route
         costs.
@@ -550,24 +550,24 @@ class RolloutPlanner(LatticePlanner):
         worth, with d the distance left to the goal line,
 
             d / ℓ − (w / ℓ) (L + I / metre_cost)
-            = (1 − w) d / ℓ − (w / ℓ) (C − L₀),
+            ≈ (1 − w) d / ℓ − (w / ℓ) (C − L₀),
 
         with C = L + I / metre_cost the lattice's cost [m] of its route
         (:meth:`LatticePlanner.lattice_search`) and L₀ its straight extent
-        along x (so that C − L₀ is the detour and the ice, each in metres).
+        along x (so that C − L₀ is the detour and the ice, each in metres,
+        and the straight part's time is taken as that of the d metres left;
+        no ice is charged where no route fits).
         The progress left and the window's own progress sum to the same for
         every candidate, so a candidate slowed by the ice is charged only
         for the time it lost, as the episode's return charges it.
         """
         u = self.unwrapped
-        base = base if base is not None else self
-        route, cost = base.lattice_search(u.metre_cost)
+        route, cost = self.lattice_search(u.metre_cost)
+        excess = cost - (route[-1, 0] - route[0, 0]) if math.isfinite(cost) else 0.0
         step = u.max_speed * u.control_interval
         w = u.reward_params["time_weight"]
         left = max(u.goal_x - float(u.sim.ship.position[0]), 0.0)
-        if not math.isfinite(cost):
-            cost = route[-1, 0] - route[0, 0]
-        return (1.0 - w) * left / step - w / step * (cost - (route[-1, 0] - route[0, 0]))
+        return (1.0 - w) * left / step - w / step * excess
 
     def plan(self) -> np.ndarray:
         route = super().plan()
