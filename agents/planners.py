@@ -188,6 +188,13 @@ class LatticePlanner(StraightLineController):
     max_slope : float — steepest slope dy/dx of the route
     replan_steps : int — env steps between plans
     show : bool — draw the route and its swath on the environment's frames
+    noise : float — σ ≥ 0 (default 0): a planner that errs as an imperfect
+        student of it would. Each route it plans is followed with its first
+        stage's end shifted across the channel by e₁ · ``max_slope`` · 1
+        stage and the points beyond by e₂ · ``max_slope`` · 2 stages, e_k
+        normal of σ (kept ``edge_margin`` inside the channel): the error of
+        a waypoint decision (:mod:`agents.waypoints`) of σ on each w_k. The
+        errors are drawn from a generator seeded by the episode's seed.
     """
 
     reads_environment = "its floes"
@@ -203,7 +210,7 @@ class LatticePlanner(StraightLineController):
 
     def __init__(self, env, seed: int = 0, *, metre_cost: float | None = None, cone: bool = True,
                  horizon: float | None = None, replan_steps: int | None = None,
-                 show: bool = True, **geometry):
+                 show: bool = True, noise: float = 0.0, **geometry):
         super().__init__(env, seed)
         u = self.unwrapped
         if not hasattr(u, "ice_near"):
@@ -232,6 +239,10 @@ class LatticePlanner(StraightLineController):
         self.metre_cost = float(metre_cost)
         self.show = bool(show)
         self.cone = bool(cone)
+        if isinstance(noise, bool) or not (math.isfinite(float(noise)) and noise >= 0.0):
+            raise ValueError(f"noise must be a standard deviation >= 0, got {noise!r}")
+        self.noise = float(noise)
+        self._errors = np.random.default_rng(seed)
         self.decision_times: list[float] = []
         self.route = None
         self._age = 0
@@ -240,6 +251,8 @@ class LatticePlanner(StraightLineController):
         self.route = None
         self._age = 0
         self.decision_times = []
+        if seed is not None:
+            self._errors = np.random.default_rng(seed)
 
     # -- planning --------------------------------------------------------------------
     def plan(self) -> np.ndarray:
@@ -327,10 +340,24 @@ class LatticePlanner(StraightLineController):
         if (self.route is None or self._age >= self.replan_steps
                 or position[0] >= self.route[-1, 0] - self.lookahead
                 or self._off_route(position) > self.max_off_route):
-            self.route = self.plan()
+            self.route = self._erred(self.plan())
             self._age = 0
         self._age += 1
         return self._pursue(self.route, obs)
+
+    def _erred(self, route: np.ndarray) -> np.ndarray:
+        """``route`` as followed with the ``noise`` of the class's text (the
+        route itself without noise)."""
+        if not self.noise:
+            return route
+        u = self.unwrapped
+        e = self._errors.normal(0.0, self.noise, 2) * self.max_slope * self.stage_length
+        erred = route.copy()
+        erred[1:2, 1] += e[0]
+        erred[2:, 1] += 2.0 * e[1]
+        half = 0.5 * u.channel_width - self.edge_margin
+        erred[1:, 1] = np.clip(erred[1:, 1], u.centre_y - half, u.centre_y + half)
+        return erred
 
     def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
         """The action that steers for the point ``lookahead`` ahead on
@@ -506,7 +533,8 @@ class RolloutPlanner(LatticePlanner):
             raise ValueError(f"rollout_steps must be an integer >= replan_steps "
                              f"({self.replan_steps}), got {rollout_steps!r}")
         self.rollout_steps = int(rollout_steps)
-        self._base_kwargs = dict(kwargs, show=False)
+        # the rollouts' lattice after the window plans without the noise
+        self._base_kwargs = dict(kwargs, show=False, noise=0.0)
         #: per plan: the candidate kept (its label in ``candidates``) and every
         #: candidate's rollout return
         self.choices: list[tuple[float | str, tuple[float, ...]]] = []

@@ -92,7 +92,11 @@ class WaypointFollower(LatticePlanner):
         of the lattice's nine two-stage choices (``"stages"``, an integer of
         :data:`STAGE_CHOICES`; ``points`` 2 and ``distance`` two stages).
     **kwargs : the lattice planner's (``max_slope``: a decision w_k = 1 is a
-        slope of ``max_slope`` from the ship to waypoint k; ``edge_margin``)
+        slope of ``max_slope`` from the ship to waypoint k; ``edge_margin``;
+        ``noise`` σ: each decision w is sailed as w + e, e normal of σ on
+        each w_k, drawn from a generator seeded by the episode's seed, then
+        clipped: a decider that errs as an imperfect student of it would;
+        form ``"waypoints"`` only)
 
     Attributes
     ----------
@@ -120,6 +124,9 @@ class WaypointFollower(LatticePlanner):
                              f"and distance {2.0 * self.stage_length:g} m, got {points} and "
                              f"{distance:g}")
         self.form = form
+        if self.noise and form != "waypoints":
+            raise ValueError(f"noise errs on lateral shifts: form 'waypoints' only, got form "
+                             f"{form!r}")
         self.decisions: list = []
 
     def reset(self, seed: int | None = None) -> None:
@@ -183,6 +190,8 @@ class WaypointFollower(LatticePlanner):
                 if w.shape != (self.points,) or not np.all(np.isfinite(w)):
                     raise ValueError(f"{type(self).__name__} decided {decision!r}, not "
                                      f"{self.points} number(s)")
+                if self.noise:
+                    w = w + self._errors.normal(0.0, self.noise, self.points)
                 w = np.clip(w, -1.0, 1.0)
                 self.decisions.append(w)
             self.route = self.waypoint_route(w)

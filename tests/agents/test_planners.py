@@ -129,6 +129,9 @@ def test_with_cost_to_go_a_rollout_adds_the_value_to_go_from_where_it_ends():
     ({"margin": float("nan")}, "margin must be a number >= 0"),
     ({"rollout_steps": 4}, "rollout_steps must be an integer >= replan_steps"),
     ({"rollout_steps": 7.5}, "rollout_steps must be an integer >= replan_steps"),
+    ({"noise": -0.1}, "noise must be a standard deviation"),
+    ({"noise": float("nan")}, "noise must be a standard deviation"),
+    ({"noise": True}, "noise must be a standard deviation"),
 ])
 def test_refused_arguments(kwargs, message):
     env = gym.make(NAV, **KWARGS)
@@ -143,6 +146,53 @@ def test_cost_to_go_needs_a_flag_and_a_reward_that_prices_time_and_ice():
     env = gym.make(NAV, **KWARGS, reward_params={"time_weight": 0.0})
     with pytest.raises(ValueError, match="cost_to_go needs a reward that prices"):
         RolloutPlanner(env, 0, cost_to_go=True)
+
+
+@pytest.mark.parametrize("planner", [CostmapLatticePlanner, RolloutPlanner])
+def test_a_noisy_planner_follows_its_routes_shifted_by_seeded_errors(monkeypatch, planner):
+    """``noise`` σ: each route planned is followed with its first stage's
+    end shifted by e₁ · max_slope · 30 m and the points beyond by
+    e₂ · max_slope · 60 m, e normal of σ from a generator seeded by the
+    episode (a waypoint decision's error of σ); the rollouts' lattice
+    after the window plans without it; the same seed sails the same
+    episode."""
+    planned, followed = [], []
+    plan = planner.plan
+    erred = LatticePlanner._erred
+
+    def kept_plan(self):
+        planned.append(plan(self))
+        return planned[-1]
+
+    def kept_erred(self, route):
+        out = erred(self, route)
+        if self.noise:          # the planner's, not its rollouts' lattice's
+            followed.append(out)
+        return out
+
+    monkeypatch.setattr(planner, "plan", kept_plan)
+    monkeypatch.setattr(LatticePlanner, "_erred", kept_erred)
+    sigma = 0.1
+    kwargs = {"noise": sigma, "offsets": (-5.0, 5.0)} if planner is RolloutPlanner \
+        else {"noise": sigma}
+    policy, rewards, _ = _sail(planner, seed=3, **kwargs)
+    rng = np.random.default_rng(3)
+    half = 0.5 * policy.unwrapped.channel_width - policy.edge_margin
+    low, high = policy.unwrapped.centre_y - half, policy.unwrapped.centre_y + half
+    assert len(planned) == len(followed) > 3
+    for route, sailed in zip(planned, followed):
+        e = rng.normal(0.0, sigma, 2) * 0.5 * 30.0
+        expected = route.copy()
+        expected[1:2, 1] += e[0]
+        expected[2:, 1] += 2.0 * e[1]
+        expected[1:, 1] = np.clip(expected[1:, 1], low, high)
+        np.testing.assert_allclose(sailed, expected, rtol=0, atol=1e-9)
+    if planner is RolloutPlanner:
+        assert policy._base_kwargs["noise"] == 0.0
+    planned.clear()
+    followed.clear()
+    _, again, _ = _sail(planner, seed=3, **kwargs)
+    np.testing.assert_array_equal(again, rewards)
 
 
 def test_the_lattice_plans_for_a_ship_heading_steeply_for_the_edge():

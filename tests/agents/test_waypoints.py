@@ -67,6 +67,40 @@ def test_the_costmap_teacher_sails_the_costmap_lattices_episode(form):
         sail(LatticeWaypoints, 1, 0.4, teacher="oracle")
 
 
+def test_a_noisy_teacher_sails_its_labels_plus_seeded_normal_errors(monkeypatch):
+    """``noise`` σ: each decision sailed is the teacher's label plus normal
+    errors of σ drawn from a generator seeded by the episode, then clipped;
+    the same seed sails the same episode, another seed other decisions."""
+    labels = []
+    label = LatticeWaypoints.label
+
+    def kept(self):
+        labels.append(label(self))
+        return labels[-1]
+
+    monkeypatch.setattr(LatticeWaypoints, "label", kept)
+    sigma = 0.2
+    rewards, _, policy = sail(LatticeWaypoints, 3, 0.4, teacher="costmap-lattice",
+                              noise=sigma)
+    errors = np.random.default_rng(3).normal(0.0, sigma, (len(labels), 2))
+    np.testing.assert_allclose(np.array(policy.decisions),
+                               np.clip(np.array(labels) + errors, -1.0, 1.0), rtol=0, atol=1e-12)
+    again, _, _ = sail(LatticeWaypoints, 3, 0.4, teacher="costmap-lattice", noise=sigma)
+    np.testing.assert_array_equal(again, rewards)
+    labels.clear()
+    _, _, other = sail(LatticeWaypoints, 4, 0.4, teacher="costmap-lattice", noise=sigma)
+    errors = np.random.default_rng(4).normal(0.0, sigma, (len(labels), 2))
+    np.testing.assert_allclose(np.array(other.decisions),
+                               np.clip(np.array(labels) + errors, -1.0, 1.0), rtol=0, atol=1e-12)
+    env = gym.make(NAV, **KWARGS)
+    for bad in (-0.1, float("nan"), True):
+        with pytest.raises(ValueError, match="noise must be"):
+            LatticeWaypoints(env, noise=bad)
+    with pytest.raises(ValueError, match="form 'waypoints' only"):
+        LatticeWaypoints(env, form="stages", noise=0.1)
+    env.close()
+
+
 def test_a_decision_is_two_waypoints_along_the_channel_kept_inside_its_edges():
     env = gym.make(NAV, **KWARGS)
     env.reset(seed=1)
