@@ -510,7 +510,11 @@ def policy_label(item: str) -> tuple[str, str]:
     from .policy import is_reference
 
     label, sep, rest = item.partition("=")
-    if sep and label and not any(c in label for c in ":?/.") and is_reference(rest):
+    if sep and label and not any(c in label for c in ":?/") and is_reference(rest):
+        if "." in label:
+            raise ValueError(f"the name {label!r} of {item!r} holds a '.', which would read "
+                             f"as a module's path: name it without one (e.g. "
+                             f"{label.replace('.', '')!r})")
         return label, rest
     return item, item
 
@@ -696,7 +700,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m agents.leaderboar
                     else default_policies(args.env))
     except ValueError as err:
         parser.error(f"--policies: {err}")
-    named = dict(policy_label(p) for p in policies)
+    try:
+        named = dict(policy_label(p) for p in policies)
+    except ValueError as err:
+        parser.error(f"--policies: {err}")
     if len(named) < len(policies):
         parser.error("--policies names a policy twice")
     try:

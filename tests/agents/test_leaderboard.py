@@ -122,6 +122,7 @@ def test_all_concentrations_are_paired_field_by_field():
     (["--merge"], "does not exist"),
     (["--render"], "does not exist"),
     (["--replace", "straight"], "needs --merge"),
+    (["--policies", "noise-0.1=agents.baselines:ZeroPolicy"], "holds a '.'"),
 ])
 def test_leaderboard_refuses_bad_arguments(tmp_path, capsys, args, message):
     assert_refused(leaderboard.main, args, [message], tmp_path / "none", capsys)
