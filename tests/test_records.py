@@ -5,6 +5,7 @@ under docs/ is left out of the manifest."""
 import importlib
 import importlib.util
 import json
+import re
 import shlex
 import tomllib
 from pathlib import Path
@@ -34,13 +35,32 @@ AGENTS_LIMIT = 5 * 2**20
 RUN_RECORD_LIMIT = 1_000_000
 #: the reference agents (each under agents.reference.MAX_BYTES) and their limit together
 REFERENCE = DOCS / "agents" / "reference"
+#: the leaderboard's variant boards
+VARIANTS = DOCS / "agents" / "leaderboard" / "variants"
 REFERENCE_LIMIT = 6 * 2**20
 SCRIPTS = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
 
 
+def not_kept(path: Path) -> bool:
+    """Written by a record's command beside it but not kept (``.gitignore``):
+    the episodes behind a board, and a variant board's figure, which no page
+    shows (its tables are kept)."""
+    return path.name == "episodes.json" or (
+        path.name == "leaderboard.png" and path.parent.parent == VARIANTS)
+
+
 def generated_files() -> list[Path]:
     return sorted(p for folder in GENERATED for p in (DOCS / folder).rglob("*")
-                  if p.is_file() and not p.name.startswith(".") and p.name != "episodes.json")
+                  if p.is_file() and not p.name.startswith(".") and not not_kept(p))
+
+
+def test_no_page_shows_a_variant_boards_figure():
+    """A variant board's figure is not kept, so no page may show one."""
+    for page in DOCS.rglob("*.md"):
+        if "_build" in page.parts or "_generated" in page.parts:
+            continue
+        shown = re.findall(r"variants/[^/\s)]+/leaderboard\.png", page.read_text(encoding="utf-8"))
+        assert not shown, f"{page.relative_to(ROOT)} shows {shown}"
 
 
 def page_text(page: str) -> str:
