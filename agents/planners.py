@@ -195,6 +195,12 @@ class LatticePlanner(StraightLineController):
         normal of σ (kept ``edge_margin`` inside the channel): the error of
         a waypoint decision (:mod:`agents.waypoints`) of σ on each w_k. The
         errors are drawn from a generator seeded by the episode's seed.
+    blur : float [m] — b ≥ 0 (default 0): the ice's cost on the lattice's
+        grid is smoothed across the channel by a normal kernel of standard
+        deviation b before the search (the grid's edges repeated beyond
+        it), so that a route is priced for a ship that strays from it by
+        about b: a plan that keeps a margin an imperfect follower's errors
+        do not cross.
     """
 
     reads_environment = "its floes"
@@ -210,7 +216,7 @@ class LatticePlanner(StraightLineController):
 
     def __init__(self, env, seed: int = 0, *, metre_cost: float | None = None, cone: bool = True,
                  horizon: float | None = None, replan_steps: int | None = None,
-                 show: bool = True, noise: float = 0.0, **geometry):
+                 show: bool = True, noise: float = 0.0, blur: float = 0.0, **geometry):
         super().__init__(env, seed)
         u = self.unwrapped
         if not hasattr(u, "ice_near"):
@@ -243,6 +249,9 @@ class LatticePlanner(StraightLineController):
             raise ValueError(f"noise must be a standard deviation >= 0, got {noise!r}")
         self.noise = float(noise)
         self._errors = np.random.default_rng(seed)
+        if isinstance(blur, bool) or not (math.isfinite(float(blur)) and blur >= 0.0):
+            raise ValueError(f"blur must be a distance >= 0 [m], got {blur!r}")
+        self.blur = float(blur)
         self.decision_times: list[float] = []
         self.route = None
         self._age = 0
@@ -290,7 +299,8 @@ class LatticePlanner(StraightLineController):
         y0 = y - (below + 0.5) * cell
         ny = below + max(int(math.ceil((high_y - y) / cell)), 0) + 2
         nx = n_stages * stage_cells
-        cost = self.cost_grid(x, y0, nx, ny, math.hypot(reach_x, max(y - low_y, high_y - y)))
+        cost = self.blurred(self.cost_grid(x, y0, nx, ny,
+                                           math.hypot(reach_x, max(y - low_y, high_y - y))))
         rows = y0 + (np.arange(ny) + 0.5) * cell
         y_low = int(np.searchsorted(rows, min(low_y, y)))
         y_high = int(np.searchsorted(rows, max(high_y, y), side="right")) - 1
@@ -303,6 +313,16 @@ class LatticePlanner(StraightLineController):
             ys, total = lattice_route(cost, cell, stage_cells, n_stages, below, 0, max_slope,
                                       y_low, y_high, 1.0 / metre_cost)
         return np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]]), total
+
+    def blurred(self, cost: np.ndarray) -> np.ndarray:
+        """The cost grid ``cost`` (x index, y index) smoothed across the
+        channel by the ``blur`` of the class's text (itself when 0)."""
+        if not self.blur:
+            return cost
+        from scipy.ndimage import gaussian_filter1d
+
+        return gaussian_filter1d(cost, self.blur / self.lateral_step, axis=1, mode="nearest",
+                                 truncate=4.0)
 
     def cost_grid(self, x: float, y0: float, nx: int, ny: int, reach: float) -> np.ndarray:
         """The ice's cost density [N s/m] on the lattice's grid: ``nx`` ×

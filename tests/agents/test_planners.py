@@ -132,6 +132,8 @@ def test_with_cost_to_go_a_rollout_adds_the_value_to_go_from_where_it_ends():
     ({"noise": -0.1}, "noise must be a standard deviation"),
     ({"noise": float("nan")}, "noise must be a standard deviation"),
     ({"noise": True}, "noise must be a standard deviation"),
+    ({"blur": -1.0}, "blur must be a distance"),
+    ({"blur": float("inf")}, "blur must be a distance"),
 ])
 def test_refused_arguments(kwargs, message):
     env = gym.make(NAV, **KWARGS)
@@ -193,6 +195,31 @@ def test_a_noisy_planner_follows_its_routes_shifted_by_seeded_errors(monkeypatch
     followed.clear()
     _, again, _ = _sail(planner, seed=3, **kwargs)
     np.testing.assert_array_equal(again, rewards)
+
+
+def test_a_blur_spreads_the_cost_across_the_channel_by_its_variance():
+    """``blur`` b: each column of the cost grid is convolved across the
+    channel with a normal kernel of b: away from the edges its total is
+    kept, its centre stays and its variance grows by (b / cell)² cells²
+    (the moments of a convolution); without a blur the grid is itself."""
+    env = gym.make(NAV, **KWARGS)
+    planner = LatticePlanner(env, 0, blur=3.0)
+    cost = np.zeros((4, 101))
+    cost[:, 50] = 1.0
+    cost[1, 40:61] = np.linspace(0.0, 2.0, 21)
+    smooth = planner.blurred(cost)
+    y = np.arange(101.0)
+    for before, after in zip(cost, smooth):
+        assert after.sum() == pytest.approx(before.sum(), rel=1e-9)
+        mean_b, mean_a = (y @ before) / before.sum(), (y @ after) / after.sum()
+        assert mean_a == pytest.approx(mean_b, abs=1e-9)
+        var_b = ((y - mean_b) ** 2 @ before) / before.sum()
+        var_a = ((y - mean_a) ** 2 @ after) / after.sum()
+        # the kernel is cut at 4 standard deviations and sampled on cells: its variance
+        # is (b / cell)² to within 0.5 % at b / cell = 2
+        assert var_a - var_b == pytest.approx((3.0 / 1.5) ** 2, rel=5e-3)
+    assert LatticePlanner(env, 0).blurred(cost) is cost
+    env.close()
 
 
 def test_the_lattice_plans_for_a_ship_heading_steeply_for_the_edge():

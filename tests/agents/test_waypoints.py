@@ -53,13 +53,15 @@ def test_two_waypoints_at_the_stage_ends_sail_the_lattices_episode(seed, form):
     assert len({str(d) for d in policy.decisions}) > 1      # it did steer
 
 
-@pytest.mark.parametrize("form", ["waypoints", "stages"])
-def test_the_costmap_teacher_sails_the_costmap_lattices_episode(form):
+@pytest.mark.parametrize("form, blur", [("waypoints", 0.0), ("stages", 0.0),
+                                        ("waypoints", 2.0)])
+def test_the_costmap_teacher_sails_the_costmap_lattices_episode(form, blur):
     """Taught by the lattice on the costmap, the decisions sail the episode
-    of :class:`CostmapLatticePlanner`, as the lattice's sail the lattice's."""
-    planner, ship_p, _ = sail(CostmapLatticePlanner, 1, 0.4, show=False)
+    of :class:`CostmapLatticePlanner`, as the lattice's sail the lattice's
+    (and with a blur of the cost, that of the planner with the same blur)."""
+    planner, ship_p, _ = sail(CostmapLatticePlanner, 1, 0.4, show=False, blur=blur)
     waypoints, ship_w, policy = sail(LatticeWaypoints, 1, 0.4, form=form,
-                                     teacher="costmap-lattice")
+                                     teacher="costmap-lattice", blur=blur)
     np.testing.assert_array_equal(waypoints, planner)
     np.testing.assert_array_equal(ship_w, ship_p)
     assert policy.reads_environment == "its costmap"
