@@ -23,8 +23,8 @@ decisions, their variance and each σ's share) and ``DIR/imitation-error.md``
 (the table). ``plot`` draws what the noisy teachers of a leaderboard run
 lost to their teacher against σ, from the episodes that run wrote::
 
-    python -m agents.imitation_error plot --board BOARD \
-        --reference costmap-lattice-500 --noisy noise-1=0.01,noise-3=0.03 \
+    python -m agents.imitation_error plot --board BOARD \\
+        --reference costmap-lattice-500 --noisy noise-1=0.01,noise-3=0.03 \\
         --out FIGURE.png
 """
 from __future__ import annotations
@@ -163,7 +163,7 @@ def plot_losses(lost: dict, noisy: dict, reference: str, path: Path) -> None:
 
 
 def _plot_main(argv) -> int:
-    from .leaderboard import read_board
+    from .leaderboard import RECORD as BOARD_RECORD, read_board
 
     p = argparse.ArgumentParser(prog="python -m agents.imitation_error plot",
                                 description=plot_losses.__doc__.split("\n\n")[0])
@@ -181,10 +181,7 @@ def _plot_main(argv) -> int:
             if not sep or not name:
                 raise ValueError(f"--noisy takes NAME=SIGMA items, got {item!r}")
             noisy[name] = float(value)
-        if (args.board / "leaderboard.json").is_file():
-            _, board = read_board(args.board)
-        else:
-            board = None
+        board = read_board(args.board)[1] if (args.board / BOARD_RECORD).is_file() else None
         if board is None:
             raise ValueError(f"{args.board} holds no episodes.json: run the leaderboard's "
                              f"command there first")

@@ -290,8 +290,7 @@ class LatticePlanner(StraightLineController):
         stage_cells, max_slope = self.lattice_steps()
         reach_x = min(self.horizon, max(u.goal_x - x, 0.0) + 2.0 * self.stage_length)
         n_stages = max(int(math.ceil(reach_x / (stage_cells * cell))), 1)
-        half = 0.5 * u.channel_width - self.edge_margin
-        low_y, high_y = u.centre_y - half, u.centre_y + half
+        low_y, high_y = self.route_bounds()
         # grid rows: y = y0 + (b + 0.5) cell, aligned so that the ship's y is a row centre
         # (a ship within the edge margin, where another controller took it, has no
         # rows on that side of it but its own and the next)
@@ -370,14 +369,19 @@ class LatticePlanner(StraightLineController):
         route itself without noise)."""
         if not self.noise:
             return route
-        u = self.unwrapped
         e = self._errors.normal(0.0, self.noise, 2) * self.max_slope * self.stage_length
         erred = route.copy()
         erred[1:2, 1] += e[0]
         erred[2:, 1] += 2.0 * e[1]
-        half = 0.5 * u.channel_width - self.edge_margin
-        erred[1:, 1] = np.clip(erred[1:, 1], u.centre_y - half, u.centre_y + half)
+        erred[1:, 1] = np.clip(erred[1:, 1], *self.route_bounds())
         return erred
+
+    def route_bounds(self) -> tuple[float, float]:
+        """The lowest and highest y [m] a route may take: ``edge_margin``
+        inside the channel's edges."""
+        u = self.unwrapped
+        half = 0.5 * u.channel_width - self.edge_margin
+        return u.centre_y - half, u.centre_y + half
 
     def _pursue(self, route: np.ndarray, obs) -> np.ndarray:
         """The action that steers for the point ``lookahead`` ahead on
@@ -621,8 +625,7 @@ class RolloutPlanner(LatticePlanner):
         route = super().plan()
         t0 = time.perf_counter()
         u = self.unwrapped
-        half = 0.5 * u.channel_width - self.edge_margin
-        low, high = u.centre_y - half, u.centre_y + half
+        low, high = self.route_bounds()
         routes = []
         for offset in self.offsets:
             shifted = route.copy()

@@ -169,10 +169,8 @@ class WaypointFollower(LatticePlanner):
         along +x."""
         u = self.unwrapped
         x, y = (float(v) for v in u.sim.ship.position)
-        half = 0.5 * u.channel_width - self.edge_margin
         d = self.distances
-        targets = np.clip(y + np.asarray(w) * self.max_slope * d,
-                          u.centre_y - half, u.centre_y + half)
+        targets = np.clip(y + np.asarray(w) * self.max_slope * d, *self.route_bounds())
         far = x + self.distance + 10.0 * u.channel_width
         return np.array([[x, y], *zip(x + d, targets), [far, targets[-1]]])
 
