@@ -15,7 +15,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from iceenvs.facts import env_facts
 
 __all__ = ["PhysicsMetricsCallback", "TqdmCallback", "TimeBudgetCallback",
-           "SaveNormalizationOnBest"]
+           "SaveNormalizationOnBest", "UpdateLog"]
 
 
 class PhysicsMetricsCallback(BaseCallback):
@@ -146,6 +146,41 @@ class TqdmCallback(BaseCallback):
     def _on_training_end(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+class UpdateLog(BaseCallback):
+    """Keeps what each update of an on-policy algorithm logged under
+    ``keys`` (e.g. ``"train/explained_variance"``, the share of the
+    returns' variance the critic's values explained before the update), in
+    :attr:`values`, one list per key, update by update.
+
+    An update's values are read when the next rollout ends, or when the
+    training ends, before SB3's logger writes and clears them; each update
+    (by SB3's ``train/n_updates``) is kept once, so one instance may follow
+    several ``learn`` calls of one model."""
+
+    def __init__(self, keys=("train/explained_variance",)):
+        super().__init__(0)
+        self.keys = tuple(keys)
+        self.values: dict[str, list[float]] = {k: [] for k in self.keys}
+        self._last = None
+
+    def _keep(self) -> None:
+        logged = self.model.logger.name_to_value
+        update = logged.get("train/n_updates")
+        if self.keys[0] in logged and update is not None and update != self._last:
+            self._last = update
+            for key in self.keys:
+                self.values[key].append(float(logged.get(key, math.nan)))
+
+    def _on_rollout_end(self) -> None:
+        self._keep()
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_training_end(self) -> None:
+        self._keep()
 
 
 class TimeBudgetCallback(BaseCallback):

@@ -313,6 +313,41 @@ class LatticePlanner(StraightLineController):
                                       y_low, y_high, 1.0 / metre_cost)
         return np.column_stack([x + np.arange(n_stages + 1) * stage_cells * cell, rows[ys]]), total
 
+    def value_to_go(self) -> float:
+        """The reward the lattice expects from the ship's pose now to the
+        goal line: the progress left, less the time and the ice its route
+        costs.
+
+        A v1 step pays the progress d / ℓ and charges the time w and the ice
+        impulse J × (impulse weight / impulse scale), with ℓ the step's
+        length at full speed. At full speed the time is w / ℓ a metre, and
+        the reward prices the ice at the environment's ``metre_cost`` N s a
+        metre, so a route of length L and ice cost I [N s] left to sail is
+        worth, with d the distance left to the goal line,
+
+            d / ℓ − (w / ℓ) (L + I / metre_cost)
+            ≈ (1 − w) d / ℓ − (w / ℓ) (C − L₀),
+
+        with C = L + I / metre_cost the lattice's cost [m] of its route
+        (:meth:`LatticePlanner.lattice_search`) and L₀ its straight extent
+        along x (so that C − L₀ is the detour and the ice, each in metres,
+        and the straight part's time is taken as that of the d metres left;
+        no ice is charged where no route fits).
+        The progress left and the window's own progress sum to the same for
+        every candidate, so a candidate slowed by the ice is charged only
+        for the time it lost, as the episode's return charges it.
+        """
+        u = self.unwrapped
+        if getattr(u, "metre_cost", None) is None:
+            raise ValueError("value_to_go needs a reward that prices both the ice and the time "
+                             f"(its metre_cost), and {type(u).__name__}'s has none")
+        route, cost = self.lattice_search(u.metre_cost)
+        excess = cost - (route[-1, 0] - route[0, 0]) if math.isfinite(cost) else 0.0
+        step = u.max_speed * u.control_interval
+        w = u.reward_params["time_weight"]
+        left = max(u.goal_x - float(u.sim.ship.position[0]), 0.0)
+        return (1.0 - w) * left / step - w / step * excess
+
     def blurred(self, cost: np.ndarray) -> np.ndarray:
         """The cost grid ``cost`` (x index, y index) smoothed across the
         channel by the ``blur`` of the class's text (itself when 0)."""
@@ -588,38 +623,6 @@ class RolloutPlanner(LatticePlanner):
             if terminated or truncated:
                 return total
         return total + self.value_to_go() if self.cost_to_go else total
-
-    def value_to_go(self) -> float:
-        """The reward the lattice expects from the ship's pose now to the
-        goal line: the progress left, less the time and the ice its route
-        costs.
-
-        A v1 step pays the progress d / ℓ and charges the time w and the ice
-        impulse J × (impulse weight / impulse scale), with ℓ the step's
-        length at full speed. At full speed the time is w / ℓ a metre, and
-        the reward prices the ice at the environment's ``metre_cost`` N s a
-        metre, so a route of length L and ice cost I [N s] left to sail is
-        worth, with d the distance left to the goal line,
-
-            d / ℓ − (w / ℓ) (L + I / metre_cost)
-            ≈ (1 − w) d / ℓ − (w / ℓ) (C − L₀),
-
-        with C = L + I / metre_cost the lattice's cost [m] of its route
-        (:meth:`LatticePlanner.lattice_search`) and L₀ its straight extent
-        along x (so that C − L₀ is the detour and the ice, each in metres,
-        and the straight part's time is taken as that of the d metres left;
-        no ice is charged where no route fits).
-        The progress left and the window's own progress sum to the same for
-        every candidate, so a candidate slowed by the ice is charged only
-        for the time it lost, as the episode's return charges it.
-        """
-        u = self.unwrapped
-        route, cost = self.lattice_search(u.metre_cost)
-        excess = cost - (route[-1, 0] - route[0, 0]) if math.isfinite(cost) else 0.0
-        step = u.max_speed * u.control_interval
-        w = u.reward_params["time_weight"]
-        left = max(u.goal_x - float(u.sim.ship.position[0]), 0.0)
-        return (1.0 - w) * left / step - w / step * excess
 
     def plan(self) -> np.ndarray:
         route = super().plan()

@@ -26,7 +26,7 @@ import numpy as np
 from .planners import LatticePlanner
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "FINETUNE_RECORD",
+           "FINETUNE_RECORD", "PRIVILEGED",
            "WaypointFollower", "WaypointStudent", "decision_observation", "decision_space",
            "student_decision", "student_record", "gather_records", "write_gathered"]
 
@@ -47,6 +47,11 @@ _OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
 STUDENT, RECORD = "student.zip", "waypoints.json"
 #: the record of a fine-tuned student's run (:mod:`agents.waypoint_rl`), in place of RECORD
 FINETUNE_RECORD = "finetune.json"
+
+
+#: the key of a privileged critic's signals beside a decision's observation
+#: (:mod:`agents.waypoint_rl`, :mod:`agents.privileged`)
+PRIVILEGED = "privileged"
 
 
 def decision_space(env):

@@ -41,6 +41,14 @@ it decides in:
   (it steps copies of the episode); the student still decides from its
   costmap and pose.
 
+* **A privileged critic** (``privileged_critic``): the critic also reads
+  the lattice planner's price of the ice ahead (its expected reward to the
+  goal line, from every floe within 500 m) and the field's concentration
+  (:func:`privileged_observation`, :class:`agents.privileged.PrivilegedCriticPolicy`),
+  so that its value follows the field as the returns do and the
+  advantages carry less of the field's luck. The actor, the policy
+  played, still reads the costmap and its pose alone.
+
 The fields sailed are seeded ``field_seed`` + k, episode by episode, apart
 from the leaderboard's and the tuning fields. Run::
 
@@ -52,7 +60,9 @@ student's network with the fine-tuned actor, so
 :class:`agents.waypoints.WaypointStudent` plays it), with ``ppo.zip`` (the
 whole PPO model) and ``finetune.json``: the settings, the reward, the mean
 return of the training episodes in windows (the environment's, and with a
-paired reward its sums too), and the wall time.
+paired reward its sums too), the critic's explained variance update by
+update (SB3's, of the returns of each rollout before the update), and the
+wall time.
 """
 from __future__ import annotations
 
@@ -63,12 +73,12 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoint_follower import (FINETUNE_RECORD, RECORD, STUDENT, WaypointFollower,
+from .waypoint_follower import (FINETUNE_RECORD, PRIVILEGED, RECORD, STUDENT, WaypointFollower,
                                 decision_observation, decision_space, gather_records,
                                 write_gathered)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
-           "FINETUNE_RECORD", "PPO_MODEL"]
+           "FINETUNE_RECORD", "PPO_MODEL", "PRIVILEGED", "privileged_observation"]
 
 #: the record of a fine-tuning run, and its whole PPO model (actor, critic and
 #: optimiser, for ``PPO.load``), in its directory
@@ -79,7 +89,25 @@ ENV_REWARD = "the environment's"
 FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
                          n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,
                          clip_range=0.1, target_kl=0.02, gamma=0.99, gae_lambda=0.95,
-                         field_seed=80_000, paired_horizon=0)
+                         field_seed=80_000, paired_horizon=0, privileged_critic=False)
+
+
+def privileged_observation(env, lattice) -> np.ndarray:
+    """What a privileged critic sees beside the student's observation, two
+    numbers of order one (float32):
+
+    * the reward the lattice planner expects from the ship's pose to the
+      goal line (:meth:`agents.planners.LatticePlanner.value_to_go`, which
+      reads every floe within the lattice's 500 m), over the progress
+      reward of the whole channel (``goal_distance`` / the step's length at
+      full speed): the field ahead, priced;
+    * the field's concentration (``field_concentration``).
+
+    ``lattice``: a :class:`~agents.planners.LatticePlanner` on ``env``."""
+    u = env.unwrapped
+    whole = u.goal_distance / (u.max_speed * u.control_interval)
+    return np.clip(np.array([lattice.value_to_go() / whole, u.field_concentration],
+                            dtype=np.float32), -10.0, 10.0)
 
 
 class _Commanded(WaypointFollower):
@@ -126,6 +154,10 @@ class WaypointDecisionEnv(gym.Env):
         own decision, exactly zero). The episode then goes on from the
         decision's own ``interval`` steps. Each decision costs 2 H + ``interval``
         steps.
+    privileged : bool
+        Add :func:`privileged_observation` to the observation under
+        :data:`PRIVILEGED`, for a privileged critic (:mod:`agents.privileged`);
+        the student's own observation is unchanged beside it.
     **follower : :class:`agents.waypoints.WaypointFollower`'s settings
         (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
         ``"waypoints"`` only).
@@ -135,7 +167,7 @@ class WaypointDecisionEnv(gym.Env):
     metadata = {"render_modes": []}
 
     def __init__(self, env, field_seed: int | None = None, paired_horizon: int = 0,
-                 **follower):
+                 privileged: bool = False, **follower):
         if follower.get("form", "waypoints") != "waypoints":
             raise ValueError("WaypointDecisionEnv decides lateral shifts (form 'waypoints'), "
                              f"got form {follower['form']!r}")
@@ -149,7 +181,20 @@ class WaypointDecisionEnv(gym.Env):
             raise ValueError(f"paired_horizon needs an environment with snapshot and restore, "
                              f"got {type(env.unwrapped).__name__}")
         self.paired_horizon = int(paired_horizon)
+        if not isinstance(privileged, (bool, np.bool_)):
+            raise TypeError(f"privileged must be True or False, got {privileged!r}")
         self.observation_space = decision_space(env)
+        self._lattice = None
+        if privileged:
+            from .planners import LatticePlanner
+
+            if getattr(env.unwrapped, "metre_cost", None) is None:
+                raise ValueError(f"privileged needs a reward that prices both the ice and the "
+                                 f"time, and {type(env.unwrapped).__name__}'s has none")
+            self._lattice = LatticePlanner(env, 0, show=False)
+            self.observation_space = gym.spaces.Dict({
+                **self.observation_space.spaces,
+                PRIVILEGED: gym.spaces.Box(-10.0, 10.0, (2,), np.float32)})
         self.action_space = gym.spaces.Box(-1.0, 1.0, (self.follower.points,), np.float32)
         self.field_seed = field_seed
         self._episodes = 0
@@ -162,7 +207,13 @@ class WaypointDecisionEnv(gym.Env):
         self._episodes += 1
         self._obs, info = self.env.reset(seed=seed, options=options)
         self.follower.reset(seed)
-        return decision_observation(self.env), info
+        return self._observation(), info
+
+    def _observation(self) -> dict:
+        obs = decision_observation(self.env)
+        if self._lattice is not None:
+            obs[PRIVILEGED] = privileged_observation(self.env, self._lattice)
+        return obs
 
     def step(self, action):
         if self._obs is None:
@@ -193,7 +244,7 @@ class WaypointDecisionEnv(gym.Env):
             total += float(reward)
             steps += 1
         reward = paired["decision_return"] - paired["lattice_return"] if paired else total
-        return (decision_observation(self.env), reward, terminated, truncated,
+        return (self._observation(), reward, terminated, truncated,
                 {**info, "env_steps": steps, "env_reward": total, **paired})
 
     def _rollout(self, w) -> float:
@@ -255,16 +306,21 @@ def _actor_parameters(policy):
 
 def _from_student(policy, student) -> None:
     """Load the student's weights into ``policy`` (a PPO policy of the same
-    network but a critic CNN of its own, which starts as the student's)."""
+    network but a critic CNN of its own, which starts as the student's; a
+    privileged critic's map of its privileged signals starts at zero)."""
     import torch
 
     source = student.state_dict()
     target = policy.state_dict()
     loaded = {}
     for key in target:
+        if key.startswith("vf_features_extractor.inject."):
+            loaded[key] = torch.zeros_like(target[key])
+            continue
         origin = ("features_extractor." + key.split(".", 1)[1]
                   if key.startswith(("pi_features_extractor.", "vf_features_extractor."))
                   else key)
+        origin = origin.replace("features_extractor.base.", "features_extractor.", 1)
         if origin not in source or source[origin].shape != target[key].shape:
             raise ValueError(f"the student has no weights for {key!r} of this network")
         loaded[key] = source[origin]
@@ -312,7 +368,7 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
 
     import iceenvs  # noqa: F401  (registers the ids)
 
-    from .callbacks import TqdmCallback
+    from .callbacks import TqdmCallback, UpdateLog
 
     unknown = sorted(set(settings) - set(FINETUNE_DEFAULTS))
     if unknown:
@@ -340,8 +396,13 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
                          f"the costmap lattice over the horizon: each decision is its own "
                          f"problem, so gamma must be 0 (got {s['gamma']})")
     made = gym.make(trained["env_id"], **trained["env_kwargs"])
+    if not isinstance(s["privileged_critic"], (bool, np.bool_)):
+        made.close()
+        raise ValueError(f"privileged_critic must be True or False, got "
+                         f"{s['privileged_critic']!r}")
     env = WaypointDecisionEnv(made, field_seed=s["field_seed"],
                               paired_horizon=s["paired_horizon"],
+                              privileged=s["privileged_critic"],
                               points=int(student.action_space.shape[0]))
     if env.observation_space["costmap"].shape != student.observation_space["costmap"].shape:
         env.close()
@@ -363,7 +424,10 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     set_random_seed(seed)
     # the learning rate of each phase, read by PPO at every update
     rate = {"now": s["critic_learning_rate"]}
-    model = PPO("MultiInputPolicy", vec, learning_rate=lambda _: rate["now"],
+    policy_class = "MultiInputPolicy"
+    if s["privileged_critic"]:
+        from .privileged import PrivilegedCriticPolicy as policy_class
+    model = PPO(policy_class, vec, learning_rate=lambda _: rate["now"],
                 n_steps=s["n_steps"], batch_size=s["batch_size"], n_epochs=s["n_epochs"],
                 gamma=s["gamma"], gae_lambda=s["gae_lambda"], clip_range=s["clip_range"],
                 target_kl=s["target_kl"], policy_kwargs=policy_kwargs,
@@ -371,17 +435,19 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     _from_student(model.policy, student)
     began = time.perf_counter()
     actor = _actor_parameters(model.policy)
+    # the critic's explained variance, update by update
+    updates = UpdateLog(("train/explained_variance",))
     if s["critic_steps"]:
         for p in actor:
             p.requires_grad_(False)
         model.learn(s["critic_steps"], reset_num_timesteps=True,
-                    callback=TqdmCallback(s["critic_steps"], disable=not progress))
+                    callback=[TqdmCallback(s["critic_steps"], disable=not progress), updates])
         for p in actor:
             p.requires_grad_(True)
     rate["now"] = s["learning_rate"]
     rest = s["steps"] - s["critic_steps"]
     model.learn(rest, reset_num_timesteps=not s["critic_steps"],
-                callback=TqdmCallback(rest, disable=not progress))
+                callback=[TqdmCallback(rest, disable=not progress), updates])
     returns = [float(r) for r in monitored.get_episode_rewards()]
     lengths = [int(n) for n in monitored.get_episode_lengths()]
     window = 10
@@ -400,6 +466,8 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
               "window": window,
               "decisions": int(sum(lengths)),
               "critic_episodes": _episodes_within(lengths, s["critic_steps"]),
+              "explained_variance": [round(v, 4) if np.isfinite(v) else None
+                                     for v in updates.values["train/explained_variance"]],
               "seconds": round(time.perf_counter() - began, 1),
               "torch_threads": torch.get_num_threads(),
               "command": command}
@@ -423,6 +491,15 @@ def _env_windows(record: dict) -> list:
     return record.get("mean_env_return_by_window", record["mean_return_by_window"])
 
 
+def _explained(record: dict, n: int = 5) -> str:
+    """The mean explained variance of a fine-tuning's first and last ``n``
+    updates ("–" for a record without them)."""
+    values = [v for v in record.get("explained_variance", []) if v is not None]
+    if not values:
+        return "–"
+    return f"{np.mean(values[:n]):.2f} → {np.mean(values[-n:]):.2f}"
+
+
 def finetune_report(runs, out: str | Path) -> dict:
     """Gather the records of the fine-tuning runs ``runs`` (directories of
     :func:`finetune`) into ``out``: ``finetune.json`` (each run's record, by
@@ -434,8 +511,8 @@ def finetune_report(runs, out: str | Path) -> dict:
     records = gather_records(runs, FINETUNE_RECORD, "agents.waypoints finetune")
     lines = ["| run | seed | from the student | reward | decisions (critic alone) | episodes "
              "| mean reward sum, first and last 10 episodes | mean return (the environment's "
-             "reward), the same "
-             "| training [min] |", "|---|---|---|---|---|---|---|---|---|"]
+             "reward), the same | critic's explained variance, first and last 5 updates "
+             "| training [min] |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name, record in records.items():
         s, windows = record["settings"], record["mean_return_by_window"]
         env_windows = _env_windows(record)
@@ -444,13 +521,16 @@ def finetune_report(runs, out: str | Path) -> dict:
                      f"{record['decisions']} ({s['critic_steps']}) | {record['episodes']} "
                      f"| {windows[0]:.1f} → {windows[-1]:.1f} "
                      f"| {env_windows[0]:.1f} → {env_windows[-1]:.1f} "
+                     f"| {_explained(record)} "
                      f"| {record['seconds'] / 60:.1f} |")
     first = next(iter(records.values()))["settings"]
     lines += ["", f"Fields: seeded {first['field_seed']} + k, one per episode; learning rate "
               f"{first['critic_learning_rate']:g} for the critic alone, then {first['learning_rate']:g}; "
               f"{first['n_steps']} decisions a rollout, {first['n_epochs']} epochs of "
               f"{first['batch_size']}, clip {first['clip_range']:g}, target KL "
-              f"{first['target_kl']:g}. The training episodes' returns are of the "
+              f"{first['target_kl']:g}. The explained variance is SB3's, of each "
+              f"rollout's returns by the critic's values before the update (1: the critic "
+              f"foresees them; 0: no better than their mean). The training episodes' returns are of the "
               f"stochastic policy, on fields of every concentration: the leaderboard judges.",
               ""]
     out = write_gathered(out, FINETUNE_RECORD, records, "finetune.md", lines)

@@ -431,9 +431,15 @@ def main(argv=None) -> int:
     helps = {"paired_horizon": "0: the environment's reward (default); H: each decision's "
                                "advantage over the costmap lattice in H steps, paired on the "
                                "same episode from a snapshot (privileged; with --gamma 0)"}
+    helps["privileged_critic"] = ("the critic also reads the lattice's price of the ice ahead "
+                                  "and the field's concentration (privileged; agents.privileged)")
     for name, value in FINETUNE_DEFAULTS.items():
-        f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value,
-                       help=helps.get(name))
+        if isinstance(value, bool):
+            f.add_argument("--" + name.replace("_", "-"), action="store_true",
+                           help=helps.get(name))
+        else:
+            f.add_argument("--" + name.replace("_", "-"), type=type(value), default=value,
+                           help=helps.get(name))
     f.add_argument("--no-progress", action="store_true")
     r = sub.add_parser("report", help="gather runs' records into one record and a table")
     r.add_argument("runs", nargs="+", type=Path, help="run directories of train or finetune "

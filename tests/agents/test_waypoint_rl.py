@@ -90,6 +90,17 @@ def test_unseeded_resets_sail_the_fields_in_order():
     again.close()
 
 
+def assert_actor_is_students(after, before):
+    """The fine-tuned policy's actor (state dict ``after``) is the student's
+    (``before``), weight for weight."""
+    for key in after:
+        if key.startswith(("pi_features_extractor.", "mlp_extractor.policy_net.", "action_net.",
+                           "log_std")):
+            origin = key.replace("pi_features_extractor.", "features_extractor.")
+            np.testing.assert_array_equal(after[key].numpy(), before[origin].numpy(),
+                                          err_msg=key)
+
+
 @pytest.fixture(scope="module")
 def student(tmp_path_factory):
     run = tmp_path_factory.mktemp("student")
@@ -109,12 +120,7 @@ def test_the_critic_is_fitted_alone_from_the_students_actor(student, tmp_path):
     old = MultiInputActorCriticPolicy.load(str(student / "student.zip"), device="cpu")
     tuned = PPO.load(str(tmp_path / "ft" / PPO_MODEL), device="cpu").policy
     before, after = old.state_dict(), tuned.state_dict()
-    for key in after:
-        if key.startswith(("pi_features_extractor.", "mlp_extractor.policy_net.", "action_net.",
-                           "log_std")):
-            origin = key.replace("pi_features_extractor.", "features_extractor.")
-            np.testing.assert_array_equal(after[key].numpy(), before[origin].numpy(),
-                                          err_msg=key)
+    assert_actor_is_students(after, before)
     assert not np.array_equal(after["value_net.weight"].numpy(), before["value_net.weight"].numpy())
     # the critic has a costmap network of its own, which started as the
     # student's and was fitted apart from it
@@ -186,3 +192,85 @@ def test_bad_input_is_refused(student, tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["finetune", "--run", str(tmp_path), "--out", str(tmp_path / "ft")])
     assert "not a run" in capsys.readouterr().err
+
+
+def test_the_privileged_signals_price_the_field_ahead():
+    """The critic's privileged vector: the lattice's expected reward to the
+    goal line over the whole channel's progress (at most the progress left,
+    less its time, since a route is no shorter than its extent along the
+    channel), and the field's concentration; the student's part of the
+    observation is as without it."""
+    from agents.planners import LatticePlanner
+    from agents.waypoint_follower import PRIVILEGED
+    from agents.waypoint_rl import privileged_observation
+
+    env = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.4}), privileged=True)
+    plain = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.4}))
+    obs, _ = env.reset(seed=5)
+    seen, _ = plain.reset(seed=5)
+    assert env.observation_space.contains(obs) and set(obs) == {*seen, PRIVILEGED}
+    np.testing.assert_array_equal(obs["costmap"], seen["costmap"])
+    u = env.env.unwrapped
+    step = u.max_speed * u.control_interval
+    w = u.reward_params["time_weight"]
+    for _ in range(3):
+        left = u.goal_x - float(u.sim.ship.position[0])
+        assert obs[PRIVILEGED][0] <= (1.0 - w) * left / step / (u.goal_distance / step) + 1e-6
+        assert obs[PRIVILEGED][1] == np.float32(u.field_concentration)
+        obs, *_ = env.step(np.zeros(2))
+    np.testing.assert_array_equal(
+        obs[PRIVILEGED], privileged_observation(env.env, LatticePlanner(env.env, 0, show=False)))
+    env.close()
+    plain.close()
+    with pytest.raises(TypeError, match="privileged must be True or False"):
+        WaypointDecisionEnv(gym.make(NAV, **KWARGS), privileged=1)
+
+
+def test_a_privileged_critic_reads_what_the_actor_does_not(student, tmp_path):
+    """With privileged_critic the actor is the student's, weight for weight,
+    and reads no privileged key; the critic's map of the privileged signals
+    starts at zero (the critic starts as the plain one) and is fitted."""
+    import torch
+
+    from agents.privileged import PrivilegedCriticPolicy, PrivilegedFeatures, public_space
+    from agents.waypoint_follower import PRIVILEGED
+
+    assert main(["finetune", "--run", str(student), "--out", str(tmp_path / "ft"),
+                 "--seed", "1", "--steps", "48", "--critic-steps", "24", "--n-steps", "24",
+                 "--batch-size", "8", "--n-epochs", "2", "--learning-rate", "0",
+                 "--privileged-critic", "--no-progress"]) == 0
+    record = json.loads((tmp_path / "ft" / FINETUNE_RECORD).read_text())
+    assert record["settings"]["privileged_critic"] is True
+    # one explained variance per update: one of the critic alone, one after
+    assert len(record["explained_variance"]) == 2
+    assert all(v is None or v <= 1.0 for v in record["explained_variance"])
+    model = PPO.load(str(tmp_path / "ft" / PPO_MODEL), device="cpu")
+    policy = model.policy
+    assert isinstance(policy, PrivilegedCriticPolicy)
+    assert isinstance(policy.vf_features_extractor, PrivilegedFeatures)
+    assert PRIVILEGED not in policy.pi_features_extractor.extractors
+    inject = policy.vf_features_extractor.inject
+    assert torch.count_nonzero(inject.weight) > 0
+    before = MultiInputActorCriticPolicy.load(str(student / "student.zip"),
+                                              device="cpu").state_dict()
+    assert_actor_is_students(policy.state_dict(), before)
+    # a zero map adds nothing: the critic's features are its base's
+    space = model.observation_space
+    obs = {k: torch.as_tensor(v[None]) for k, v in space.sample().items()}
+    features = PrivilegedFeatures(space, policy.features_extractor_class,
+                                  policy.features_extractor_kwargs)
+    with torch.no_grad():
+        features.inject.weight.zero_()
+        features.inject.bias.zero_()
+        torch.testing.assert_close(features(obs), features.base(obs))
+    with pytest.raises(ValueError, match="privileged"):
+        public_space(decision_space_of(NAV))
+
+
+def decision_space_of(env_id):
+    from agents.waypoint_follower import decision_space
+
+    env = gym.make(env_id, **KWARGS)
+    space = decision_space(env)
+    env.close()
+    return space
