@@ -491,7 +491,7 @@ def _env_windows(record: dict) -> list:
     return record.get("mean_env_return_by_window", record["mean_return_by_window"])
 
 
-def _explained(record: dict, n: int = 5) -> str:
+def _explained(record: dict, n: int = 3) -> str:
     """The mean explained variance of a fine-tuning's first and last ``n``
     updates ("–" for a record without them)."""
     values = [v for v in record.get("explained_variance", []) if v is not None]
@@ -511,7 +511,7 @@ def finetune_report(runs, out: str | Path) -> dict:
     records = gather_records(runs, FINETUNE_RECORD, "agents.waypoints finetune")
     lines = ["| run | seed | from the student | reward | decisions (critic alone) | episodes "
              "| mean reward sum, first and last 10 episodes | mean return (the environment's "
-             "reward), the same | critic's explained variance, first and last 5 updates "
+             "reward), the same | critic's explained variance, first and last 3 updates "
              "| training [min] |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name, record in records.items():
         s, windows = record["settings"], record["mean_return_by_window"]
@@ -535,7 +535,10 @@ def finetune_report(runs, out: str | Path) -> dict:
               ""]
     out = write_gathered(out, FINETUNE_RECORD, records, "finetune.md", lines)
     plt = plots.pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.2))
+    explained = any(record.get("explained_variance") for record in records.values())
+    fig, axes = plt.subplots(1, 2 if explained else 1, figsize=(12 if explained else 7, 4.2),
+                             squeeze=False)
+    ax = axes[0, 0]
     for name, record in records.items():
         windows = _env_windows(record)
         x = record["window"] * (np.arange(len(windows)) + 1)
@@ -547,5 +550,18 @@ def finetune_report(runs, out: str | Path) -> dict:
     ax.set_ylabel(f"mean return of {next(iter(records.values()))['window']} episodes")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
+    if explained:
+        ax = axes[0, 1]
+        for name, record in records.items():
+            values = [np.nan if v is None else v for v in record.get("explained_variance", [])]
+            ax.plot(np.arange(1, len(values) + 1), values, lw=1.2, marker=".", label=name)
+            ax.axvline(record["settings"]["critic_steps"] / record["settings"]["n_steps"] + 0.5,
+                       color="0.6", lw=0.8, ls=":")
+        ax.set_title("the critic's explained variance of each rollout's returns, before "
+                     "its update", fontsize=9)
+        ax.set_xlabel("update (dotted: the critic's fit alone ends)")
+        ax.set_ylabel("explained variance")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
     plots.savefig(fig, out / "finetune.png", dpi=110, palette=True)
     return records
