@@ -338,15 +338,22 @@ class LatticePlanner(StraightLineController):
         for the time it lost, as the episode's return charges it.
         """
         u = self.unwrapped
-        if getattr(u, "metre_cost", None) is None:
-            raise ValueError("value_to_go needs a reward that prices both the ice and the time "
-                             f"(its metre_cost), and {type(u).__name__}'s has none")
+        self.require_value_to_go("value_to_go")
         route, cost = self.lattice_search(u.metre_cost)
         excess = cost - (route[-1, 0] - route[0, 0]) if math.isfinite(cost) else 0.0
         step = u.max_speed * u.control_interval
         w = u.reward_params["time_weight"]
         left = max(u.goal_x - float(u.sim.ship.position[0]), 0.0)
         return (1.0 - w) * left / step - w / step * excess
+
+    def require_value_to_go(self, who: str) -> None:
+        """Raise ValueError, naming ``who``, unless the environment's reward
+        prices both the ice and the time (its ``metre_cost``), as
+        :meth:`value_to_go` needs."""
+        u = self.unwrapped
+        if getattr(u, "metre_cost", None) is None:
+            raise ValueError(f"{who} needs a reward that prices both the ice and the time "
+                             f"(its metre_cost), and {type(u).__name__}'s has none")
 
     def blurred(self, cost: np.ndarray) -> np.ndarray:
         """The cost grid ``cost`` (x index, y index) smoothed across the
@@ -573,9 +580,8 @@ class RolloutPlanner(LatticePlanner):
         if isinstance(margin, bool) or not (math.isfinite(float(margin)) and margin >= 0):
             raise ValueError(f"margin must be a number >= 0, got {margin!r}")
         self.margin = float(margin)
-        if self.cost_to_go and self.unwrapped.metre_cost is None:
-            raise ValueError("cost_to_go needs a reward that prices both the ice and the time "
-                             f"(its metre_cost), and {type(self.unwrapped).__name__}'s has none")
+        if self.cost_to_go:
+            self.require_value_to_go("cost_to_go")
         shifts = [float(o) for o in offsets]
         if not all(math.isfinite(o) for o in shifts):
             raise ValueError(f"offsets must be finite numbers, got {offsets!r}")

@@ -188,10 +188,8 @@ class WaypointDecisionEnv(gym.Env):
         if privileged:
             from .planners import LatticePlanner
 
-            if getattr(env.unwrapped, "metre_cost", None) is None:
-                raise ValueError(f"privileged needs a reward that prices both the ice and the "
-                                 f"time, and {type(env.unwrapped).__name__}'s has none")
             self._lattice = LatticePlanner(env, 0, show=False)
+            self._lattice.require_value_to_go("privileged")
             self.observation_space = gym.spaces.Dict({
                 **self.observation_space.spaces,
                 PRIVILEGED: gym.spaces.Box(-10.0, 10.0, (2,), np.float32)})

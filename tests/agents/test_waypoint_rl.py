@@ -224,6 +224,9 @@ def test_the_privileged_signals_price_the_field_ahead():
     plain.close()
     with pytest.raises(TypeError, match="privileged must be True or False"):
         WaypointDecisionEnv(gym.make(NAV, **KWARGS), privileged=1)
+    with pytest.raises(ValueError, match="privileged needs a reward that prices"):
+        WaypointDecisionEnv(gym.make(NAV, **KWARGS, reward_params={"time_weight": 0.0}),
+                            privileged=True)
 
 
 def test_a_privileged_critic_reads_what_the_actor_does_not(student, tmp_path):
