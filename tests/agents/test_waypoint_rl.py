@@ -257,6 +257,14 @@ def test_a_privileged_critic_reads_what_the_actor_does_not(student, tmp_path):
     before = MultiInputActorCriticPolicy.load(str(student / "student.zip"),
                                               device="cpu").state_dict()
     assert_actor_is_students(policy.state_dict(), before)
+    # the map starts at zero: with both learning rates 0 it is zero still
+    idle = finetune(student, tmp_path / "idle", 1, progress=False, steps=16, critic_steps=8,
+                    n_steps=8, batch_size=8, n_epochs=1, learning_rate=0.0,
+                    critic_learning_rate=0.0, privileged_critic=True)
+    assert idle["settings"]["privileged_critic"] is True
+    start = PPO.load(str(tmp_path / "idle" / PPO_MODEL), device="cpu").policy
+    assert torch.count_nonzero(start.vf_features_extractor.inject.weight) == 0
+    assert torch.count_nonzero(start.vf_features_extractor.inject.bias) == 0
     # a zero map adds nothing: the critic's features are its base's
     space = model.observation_space
     obs = {k: torch.as_tensor(v[None]) for k, v in space.sample().items()}
