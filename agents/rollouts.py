@@ -58,9 +58,10 @@ def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | st
     """The policy of a run directory for ``env``: a :class:`TrainedPolicy`
     for a run of :mod:`agents.train` (``env`` unused), a
     :class:`agents.waypoint_follower.WaypointStudent` for a waypoint
-    student's run, which reads ``env`` (made with the run's
-    :func:`run_agent_kwargs`). Either has ``env_id`` and ``agent_kwargs``."""
-    from .waypoint_follower import WaypointStudent, student_record
+    student's run (a :class:`agents.waypoints.WaypointResidual` for a
+    residual on the costmap lattice), which reads ``env`` (made with the
+    run's :func:`run_agent_kwargs`). Either has ``env_id`` and ``agent_kwargs``."""
+    from .waypoint_follower import WaypointStudent, is_residual, student_record
 
     student = student_record(run_dir)
     if student is None:
@@ -75,6 +76,8 @@ def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | st
     if differ:
         raise ValueError(f"the waypoint student of {run_dir} was trained with {differ}: make "
                          f"the environment with them (gymnasium.make(..., **agent_kwargs))")
+    if is_residual(run_dir):
+        from .waypoint_follower import WaypointResidual as WaypointStudent
     policy = WaypointStudent(env, seed, run=str(run_dir))
     policy.env_id, policy.agent_kwargs = student["settings"]["env_id"], agent
     return policy

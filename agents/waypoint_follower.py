@@ -8,11 +8,14 @@ pure pursuit that sails a decision until the next.
   (:meth:`~WaypointFollower.decide`, for a subclass to give) and follows the
   route through the decision's waypoints by the lattice planner's pure
   pursuit in between;
+* :class:`LatticeWaypoints`: the lattice planner's decision, the teacher;
 * :class:`WaypointStudent`: the learned decision, played from a run
   directory (``student.zip``); :func:`student_record` tells such a run
-  from a run of :mod:`agents.train`.
+  from a run of :mod:`agents.train`;
+* :class:`WaypointResidual`: the costmap lattice's decision corrected by a
+  learned one (a fine-tuning with ``residual``).
 
-The teacher, the student and their training are in :mod:`agents.waypoints`;
+The student's training is in :mod:`agents.waypoints`, which names all of these too;
 fine-tuning by reinforcement learning in :mod:`agents.waypoint_rl`.
 """
 from __future__ import annotations
@@ -23,12 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .planners import LatticePlanner
+from .planners import LatticePlanner, costmap_cost_grid
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "FINETUNE_RECORD", "PRIVILEGED",
-           "WaypointFollower", "WaypointStudent", "decision_observation", "decision_space",
-           "student_decision", "student_record", "gather_records", "write_gathered"]
+           "FINETUNE_RECORD", "PRIVILEGED", "TEACHERS", "WaypointFollower", "WaypointStudent",
+           "LatticeWaypoints", "WaypointResidual", "decision_observation", "decision_space",
+           "load_student", "is_residual", "student_decision", "student_record",
+           "gather_records", "write_gathered"]
 
 #: environment steps between decisions (10 s: the lattice planner's replan)
 DECISION_STEPS = 5
@@ -217,6 +221,44 @@ def _is_choice(policy) -> bool:
     return isinstance(policy.action_space, gym.spaces.Discrete)
 
 
+def load_student(run, env):
+    """The SB3 policy of the run directory ``run`` (its ``student.zip``), in
+    evaluation mode, checked against the costmaps of ``env``.
+
+    Raises
+    ------
+    FileNotFoundError
+        For a directory without ``student.zip``.
+    ValueError
+        When the student was trained on costmaps of another shape."""
+    from stable_baselines3.common.policies import MultiInputActorCriticPolicy
+
+    path = Path(run) / STUDENT
+    if not path.is_file():
+        raise FileNotFoundError(f"no student in {run!r}: {path} is missing (train one with "
+                                f"python -m agents.waypoints train --out {run})")
+    policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
+    policy.set_training_mode(False)
+    trained = policy.observation_space["costmap"].shape
+    here = decision_space(env)["costmap"].shape
+    if trained != here:
+        raise ValueError(f"the student of {run!r} was trained on costmaps of shape "
+                         f"{trained}, and this environment's are {here}: make it with the "
+                         f"training's costmap settings (costmap_ahead, costmap_behind, "
+                         f"costmap_cell; see {RECORD} in the run)")
+    return policy
+
+
+def is_residual(run) -> bool:
+    """Whether the run directory ``run`` holds a residual on the costmap
+    lattice (a fine-tuning with ``residual``, :mod:`agents.waypoint_rl`),
+    whose policy decides a correction to the lattice's decision, not the
+    decision itself."""
+    path = Path(run) / FINETUNE_RECORD
+    return path.is_file() and bool(
+        json.loads(path.read_text())["settings"].get("residual", False))
+
+
 class WaypointStudent(WaypointFollower):
     """The learned decision (sensor-only): an SB3 policy on
     :func:`decision_observation`, loaded from a run of :func:`agents.waypoints.train_student`
@@ -225,21 +267,11 @@ class WaypointStudent(WaypointFollower):
     reads_environment = "its costmap and its own pose"
 
     def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
-        from stable_baselines3.common.policies import MultiInputActorCriticPolicy
-
-        path = Path(run) / STUDENT
-        if not path.is_file():
-            raise FileNotFoundError(f"no student in {run!r}: {path} is missing (train one with "
-                                    f"python -m agents.waypoints train --out {run})")
-        policy = MultiInputActorCriticPolicy.load(str(path), device="cpu")
-        policy.set_training_mode(False)
-        trained = policy.observation_space["costmap"].shape
-        here = decision_space(env)["costmap"].shape
-        if trained != here:
-            raise ValueError(f"the student of {run!r} was trained on costmaps of shape "
-                             f"{trained}, and this environment's are {here}: make it with the "
-                             f"training's costmap settings (costmap_ahead, costmap_behind, "
-                             f"costmap_cell; see {RECORD} in the run)")
+        policy = load_student(run, env)
+        if is_residual(run):
+            raise ValueError(f"{run!r} holds a residual on the costmap lattice, which decides a "
+                             f"correction to the lattice's decision: play it with "
+                             f"agents.waypoints:WaypointResidual")
         shape = {"form": "stages"} if _is_choice(policy) else \
             {"points": int(policy.action_space.shape[0])}
         super().__init__(env, seed, **{**shape, **kwargs})
@@ -247,6 +279,88 @@ class WaypointStudent(WaypointFollower):
 
     def decide(self, obs):
         return student_decision(self.policy, decision_observation(self.env))
+
+
+#: the teachers of :class:`LatticeWaypoints`: the lattice on the floes
+#: (privileged), or on the environment's costmap (what the student sees)
+TEACHERS = ("lattice", "costmap-lattice")
+
+
+class LatticeWaypoints(WaypointFollower):
+    """The lattice planner's decision (privileged: it reads every floe
+    within 500 m): plan its route and take its points at the decision's
+    distances as the waypoints (form ``"stages"``: the choice of its first
+    two stages). With the defaults it sails the lattice planner's episode.
+
+    ``teacher="costmap-lattice"``: the lattice plans on the environment's
+    costmap instead (:class:`agents.planners.CostmapLatticePlanner`; not
+    privileged), whose episode it then sails: a decision that is a function
+    of what the student sees."""
+
+    reads_environment = "its floes"
+
+    def __init__(self, env, seed: int = 0, *, teacher: str = "lattice", **kwargs):
+        super().__init__(env, seed, **kwargs)
+        if teacher not in TEACHERS:
+            raise ValueError(f"teacher must be one of {TEACHERS}, got {teacher!r}")
+        self.teacher = teacher
+        if teacher == "costmap-lattice":
+            self.reads_environment = "its costmap"
+
+    def cost_grid(self, x, y0, nx, ny, reach):
+        if self.teacher == "costmap-lattice":
+            return costmap_cost_grid(self.unwrapped, y0, nx, ny, self.lateral_step)
+        return super().cost_grid(x, y0, nx, ny, reach)
+
+    def label(self):
+        """The lattice's decision from the episode now: w (unclipped), or
+        the choice of its route's first two stages (a route planned from a
+        straight heading, when none turns from the heading in time, is
+        given the nearest choice)."""
+        route = self.plan()
+        x, y = (float(v) for v in self.unwrapped.sim.ship.position)
+        d = self.distances
+        ahead = np.interp(x + d, route[:, 0], route[:, 1])
+        if self.form == "waypoints":
+            return (ahead - y) / (self.max_slope * d)
+        first = int(round((ahead[0] - y) / self.lateral_step))
+        second = int(round((ahead[1] - ahead[0]) / self.lateral_step))
+        start = self.start_slope(float(self.unwrapped.sim.ship.heading))
+        turns = (max(min(first - start, 1), -1), max(min(second - first, 1), -1))
+        return STAGE_CHOICES.index(turns)
+
+    def decide(self, obs):
+        return self.label()
+
+
+class WaypointResidual(LatticeWaypoints):
+    """The costmap lattice's decision corrected by a learned one (a residual
+    policy: Silver et al. 2018, Johannink et al. 2019; sensor-only): at each
+    decision, the lattice planning on the environment's costmap gives w₀
+    (clipped to [−1, 1]) and the policy of ``run`` (a fine-tuning with
+    ``residual``, :mod:`agents.waypoint_rl`) a correction δ from the costmap
+    and the ship's pose; the ship sails w₀ + δ (clipped). A zero correction
+    sails the costmap lattice's own episode.
+
+    ``run``: the fine-tuning's directory; the follower's settings as
+    :class:`LatticeWaypoints` (the teacher is the costmap lattice)."""
+
+    reads_environment = "its costmap and its own pose"
+
+    def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
+        if "teacher" in kwargs:
+            raise ValueError("a residual corrects the costmap lattice; it takes no teacher")
+        policy = load_student(run, env)
+        if not is_residual(run):
+            raise ValueError(f"{run!r} holds no residual (its policy decides the waypoints "
+                             f"themselves): play it with agents.waypoints:WaypointStudent")
+        super().__init__(env, seed, teacher="costmap-lattice",
+                         **{"points": int(policy.action_space.shape[0]), **kwargs})
+        self.policy = policy
+
+    def decide(self, obs):
+        base = np.clip(self.label(), -1.0, 1.0)
+        return base + student_decision(self.policy, decision_observation(self.env))
 
 
 def student_record(run) -> dict | None:

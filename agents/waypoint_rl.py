@@ -49,6 +49,15 @@ it decides in:
   advantages carry less of the field's luck. The actor, the policy
   played, still reads the costmap and its pose alone.
 
+* **A residual on the costmap lattice** (``residual``): the action is a
+  correction δ to the costmap lattice's own decision w₀ at that moment,
+  and the ship sails w₀ + δ (clipped); the policy starts as the student's
+  network with its last layer set to zero, so that it starts as the
+  costmap lattice exactly, not as the student that imitates it with an
+  error. With the paired reward, a zero correction earns exactly nothing,
+  and what is learned is where to leave the lattice's decision. Play it
+  with :class:`agents.waypoints.WaypointResidual`.
+
 The fields sailed are seeded ``field_seed`` + k, episode by episode, apart
 from the leaderboard's and the tuning fields. Run::
 
@@ -73,7 +82,8 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoint_follower import (FINETUNE_RECORD, PRIVILEGED, RECORD, STUDENT, WaypointFollower,
+from .waypoint_follower import (FINETUNE_RECORD, PRIVILEGED, RECORD, STUDENT, LatticeWaypoints,
+                                WaypointFollower,
                                 decision_observation, decision_space, gather_records,
                                 write_gathered)
 
@@ -89,7 +99,8 @@ ENV_REWARD = "the environment's"
 FINETUNE_DEFAULTS = dict(steps=20_000, critic_steps=4_096, n_steps=512, batch_size=128,
                          n_epochs=5, learning_rate=1e-4, critic_learning_rate=1e-3,
                          clip_range=0.1, target_kl=0.02, gamma=0.99, gae_lambda=0.95,
-                         field_seed=80_000, paired_horizon=0, privileged_critic=False)
+                         field_seed=80_000, paired_horizon=0, privileged_critic=False,
+                         residual=False)
 
 
 def privileged_observation(env, lattice) -> np.ndarray:
@@ -158,6 +169,12 @@ class WaypointDecisionEnv(gym.Env):
         Add :func:`privileged_observation` to the observation under
         :data:`PRIVILEGED`, for a privileged critic (:mod:`agents.privileged`);
         the student's own observation is unchanged beside it.
+    residual : bool
+        An action is a correction δ to the costmap lattice's decision w₀
+        (:class:`agents.waypoints.LatticeWaypoints` with teacher
+        ``"costmap-lattice"``, clipped to [−1, 1]) at the step's start: the
+        ship sails w₀ + δ, clipped (``info["base"]``: w₀). δ = 0 sails the
+        costmap lattice's episode.
     **follower : :class:`agents.waypoints.WaypointFollower`'s settings
         (``points``, ``distance``, ``interval``, ``max_slope``, ...; form
         ``"waypoints"`` only).
@@ -167,7 +184,7 @@ class WaypointDecisionEnv(gym.Env):
     metadata = {"render_modes": []}
 
     def __init__(self, env, field_seed: int | None = None, paired_horizon: int = 0,
-                 privileged: bool = False, **follower):
+                 privileged: bool = False, residual: bool = False, **follower):
         if follower.get("form", "waypoints") != "waypoints":
             raise ValueError("WaypointDecisionEnv decides lateral shifts (form 'waypoints'), "
                              f"got form {follower['form']!r}")
@@ -193,6 +210,13 @@ class WaypointDecisionEnv(gym.Env):
             self.observation_space = gym.spaces.Dict({
                 **self.observation_space.spaces,
                 PRIVILEGED: gym.spaces.Box(-10.0, 10.0, (2,), np.float32)})
+        if not isinstance(residual, (bool, np.bool_)):
+            raise TypeError(f"residual must be True or False, got {residual!r}")
+        self._base = None
+        if residual:
+            self._base = LatticeWaypoints(
+                env, 0, teacher="costmap-lattice", points=self.follower.points,
+                distance=self.follower.distance, interval=self.follower.interval)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (self.follower.points,), np.float32)
         self.field_seed = field_seed
         self._episodes = 0
@@ -221,6 +245,9 @@ class WaypointDecisionEnv(gym.Env):
             raise ValueError(f"a decision is {self.action_space.shape[0]} finite number(s) "
                              f"in [-1, 1], got {action!r}")
         paired = {}
+        if self._base is not None:
+            paired["base"] = np.clip(self._base.label(), -1.0, 1.0)
+            w = np.clip(paired["base"] + w, -1.0, 1.0)
         if self.paired_horizon:
             u = self.env.unwrapped
             snap = u.snapshot()
@@ -241,7 +268,8 @@ class WaypointDecisionEnv(gym.Env):
                 self.follower.predict(self._obs)[0])
             total += float(reward)
             steps += 1
-        reward = paired["decision_return"] - paired["lattice_return"] if paired else total
+        reward = paired["decision_return"] - paired["lattice_return"] \
+            if self.paired_horizon else total
         return (self._observation(), reward, terminated, truncated,
                 {**info, "env_steps": steps, "env_reward": total, **paired})
 
@@ -398,9 +426,12 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
         made.close()
         raise ValueError(f"privileged_critic must be True or False, got "
                          f"{s['privileged_critic']!r}")
+    if not isinstance(s["residual"], (bool, np.bool_)):
+        made.close()
+        raise ValueError(f"residual must be True or False, got {s['residual']!r}")
     env = WaypointDecisionEnv(made, field_seed=s["field_seed"],
                               paired_horizon=s["paired_horizon"],
-                              privileged=s["privileged_critic"],
+                              privileged=s["privileged_critic"], residual=s["residual"],
                               points=int(student.action_space.shape[0]))
     if env.observation_space["costmap"].shape != student.observation_space["costmap"].shape:
         env.close()
@@ -431,6 +462,11 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
                 target_kl=s["target_kl"], policy_kwargs=policy_kwargs,
                 device="cpu", verbose=0)
     _from_student(model.policy, student)
+    if s["residual"]:
+        # the correction starts at zero: the policy starts as the costmap lattice
+        with torch.no_grad():
+            model.policy.action_net.weight.zero_()
+            model.policy.action_net.bias.zero_()
     began = time.perf_counter()
     actor = _actor_parameters(model.policy)
     # the critic's explained variance, update by update
@@ -457,7 +493,9 @@ def finetune(run: str | Path, out: str | Path, seed: int, progress: bool = True,
     record = {"settings": {**s, "seed": seed, "run": str(run), "env_id": trained["env_id"],
                            "env_kwargs": trained["env_kwargs"]},
               "reward": (f"paired: advantage over the costmap lattice in {s['paired_horizon']} "
-                         f"steps" if s["paired_horizon"] else ENV_REWARD),
+                         f"steps" if s["paired_horizon"] else ENV_REWARD)
+              + ("; the action a correction to the costmap lattice's decision"
+                 if s["residual"] else ""),
               "episodes": len(returns),
               "mean_return_by_window": by_window(returns),
               "mean_env_return_by_window": by_window(own.returns[:len(returns)]),

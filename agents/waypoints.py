@@ -67,72 +67,22 @@ from pathlib import Path
 import numpy as np
 
 from .leaderboard import DEFAULT_ENV
-from .planners import costmap_cost_grid
-from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, STUDENT,
-                                WAYPOINT_DISTANCE, WaypointFollower, WaypointStudent,
-                                decision_observation, decision_space, gather_records,
-                                student_decision, write_gathered)
+from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, STUDENT, TEACHERS,
+                                WAYPOINT_DISTANCE, LatticeWaypoints, WaypointFollower,
+                                WaypointResidual, WaypointStudent, decision_observation,
+                                decision_space, gather_records, student_decision, write_gathered)
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
            "STUDENT", "RECORD", "WaypointFollower",
-           "LatticeWaypoints", "WaypointStudent", "decision_observation", "decision_space",
+           "LatticeWaypoints", "WaypointStudent", "WaypointResidual", "decision_observation",
+           "decision_space",
            "make_student", "mirrored", "with_mirror", "train_student", "fit_text", "report",
            "TRAIN_DEFAULTS", "main"]
 
-#: the teachers of :class:`LatticeWaypoints`: the lattice on the floes
-#: (privileged), or on the environment's costmap (what the student sees)
-TEACHERS = ("lattice", "costmap-lattice")
 #: how a DAgger round fits the student on all labels so far: from its weights
 #: after the round before (``warm``), or a new network seeded alike (``fresh``)
 REFITS = ("warm", "fresh")
-
-
-class LatticeWaypoints(WaypointFollower):
-    """The lattice planner's decision (privileged: it reads every floe
-    within 500 m): plan its route and take its points at the decision's
-    distances as the waypoints (form ``"stages"``: the choice of its first
-    two stages). With the defaults it sails the lattice planner's episode.
-
-    ``teacher="costmap-lattice"``: the lattice plans on the environment's
-    costmap instead (:class:`agents.planners.CostmapLatticePlanner`; not
-    privileged), whose episode it then sails: a decision that is a function
-    of what the student sees."""
-
-    reads_environment = "its floes"
-
-    def __init__(self, env, seed: int = 0, *, teacher: str = "lattice", **kwargs):
-        super().__init__(env, seed, **kwargs)
-        if teacher not in TEACHERS:
-            raise ValueError(f"teacher must be one of {TEACHERS}, got {teacher!r}")
-        self.teacher = teacher
-        if teacher == "costmap-lattice":
-            self.reads_environment = "its costmap"
-
-    def cost_grid(self, x, y0, nx, ny, reach):
-        if self.teacher == "costmap-lattice":
-            return costmap_cost_grid(self.unwrapped, y0, nx, ny, self.lateral_step)
-        return super().cost_grid(x, y0, nx, ny, reach)
-
-    def label(self):
-        """The lattice's decision from the episode now: w (unclipped), or
-        the choice of its route's first two stages (a route planned from a
-        straight heading, when none turns from the heading in time, is
-        given the nearest choice)."""
-        route = self.plan()
-        x, y = (float(v) for v in self.unwrapped.sim.ship.position)
-        d = self.distances
-        ahead = np.interp(x + d, route[:, 0], route[:, 1])
-        if self.form == "waypoints":
-            return (ahead - y) / (self.max_slope * d)
-        first = int(round((ahead[0] - y) / self.lateral_step))
-        second = int(round((ahead[1] - ahead[0]) / self.lateral_step))
-        start = self.start_slope(float(self.unwrapped.sim.ship.heading))
-        turns = (max(min(first - start, 1), -1), max(min(second - first, 1), -1))
-        return STAGE_CHOICES.index(turns)
-
-    def decide(self, obs):
-        return self.label()
 
 
 def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int = 128,
@@ -431,6 +381,8 @@ def main(argv=None) -> int:
     helps = {"paired_horizon": "0: the environment's reward (default); H: each decision's "
                                "advantage over the costmap lattice in H steps, paired on the "
                                "same episode from a snapshot (privileged; with --gamma 0)"}
+    helps["residual"] = ("the action corrects the costmap lattice's decision, starting at "
+                         "zero; play the run with agents.waypoints:WaypointResidual")
     helps["privileged_critic"] = ("the critic also reads the lattice's price of the ice ahead "
                                   "and the field's concentration (privileged; agents.privileged)")
     for name, value in FINETUNE_DEFAULTS.items():

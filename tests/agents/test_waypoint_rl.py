@@ -285,3 +285,74 @@ def decision_space_of(env_id):
     space = decision_space(env)
     env.close()
     return space
+
+
+def test_a_zero_residual_sails_the_costmap_lattice():
+    """With residual an action corrects the costmap lattice's decision: a
+    zero correction is the lattice's own decision, which the paired reward
+    scores exactly zero, and a correction c is sailed as the lattice's
+    decision plus c (clipped), as the same decision given unpaired is."""
+    env = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.3}),
+                              paired_horizon=15, residual=True)
+    env.reset(seed=4)
+    bases, done = [], False
+    while not done:
+        _, reward, terminated, truncated, info = env.step(np.zeros(2))
+        assert reward == 0.0 and info["decision_return"] == info["lattice_return"]
+        assert np.all(np.abs(info["base"]) <= 1.0)
+        bases.append(info["base"])
+        done = terminated or truncated
+    env.close()
+    assert len(bases) > 3 and any(np.any(b != 0.0) for b in bases)
+    corrected = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.3}),
+                                    residual=True)
+    given = WaypointDecisionEnv(gym.make(NAV, **{**KWARGS, "concentration": 0.3}))
+    corrected.reset(seed=4)
+    given.reset(seed=4)
+    for c in (np.array([0.3, -0.2]), np.array([-0.9, 0.9])):
+        _, r, *_, info = corrected.step(c)
+        _, r0, *_ = given.step(np.clip(info["base"] + c, -1.0, 1.0))
+        assert r == r0
+        np.testing.assert_array_equal(corrected.env.unwrapped.sim.ship.position,
+                                      given.env.unwrapped.sim.ship.position)
+    corrected.close()
+    given.close()
+    with pytest.raises(TypeError, match="residual must be True or False"):
+        WaypointDecisionEnv(gym.make(NAV, **KWARGS), residual="yes")
+
+
+def test_a_residual_finetuning_starts_as_the_costmap_lattice(student, tmp_path):
+    """The residual's policy starts at zero (its last layer zeroed), so that
+    with an actor's learning rate of 0 the run plays the costmap lattice's
+    decisions exactly; with a rate it learns a correction. Each player
+    refuses the other's runs, and the runs' loader picks the residual's."""
+    from agents.rollouts import trained_policy
+    from agents.waypoints import WaypointResidual
+
+    idle = finetune(student, tmp_path / "idle", 1, progress=False, steps=16, critic_steps=8,
+                    n_steps=8, batch_size=8, n_epochs=1, learning_rate=0.0, gamma=0.0,
+                    paired_horizon=10, residual=True)
+    assert idle["settings"]["residual"] is True and "correction" in idle["reward"]
+    env = gym.make(NAV, **{**KWARGS, "concentration": 0.3})
+    env.reset(seed=6)
+    residual = WaypointResidual(env, run=str(tmp_path / "idle"))
+    lattice = LatticeWaypoints(env, teacher="costmap-lattice")
+    for _ in range(3):
+        np.testing.assert_array_equal(residual.decide(None), np.clip(lattice.label(), -1, 1))
+        env.step(env.action_space.sample() * 0.0)
+    assert isinstance(trained_policy(tmp_path / "idle", env), WaypointResidual)
+    with pytest.raises(ValueError, match="WaypointResidual"):
+        WaypointStudent(env, run=str(tmp_path / "idle"))
+    with pytest.raises(ValueError, match="WaypointStudent"):
+        WaypointResidual(env, run=str(student))
+    with pytest.raises(ValueError, match="no teacher"):
+        WaypointResidual(env, run=str(tmp_path / "idle"), teacher="lattice")
+    learnt = finetune(student, tmp_path / "learnt", 1, progress=False, steps=48, critic_steps=24,
+                      n_steps=24, batch_size=8, n_epochs=2, residual=True)
+    seen = decision_observation(env)
+    correction = WaypointResidual(env, run=str(tmp_path / "learnt")).policy.predict(
+        seen, deterministic=True)[0]
+    env.close()
+    assert learnt["decisions"] <= 48 and np.any(correction != 0.0)
+    with pytest.raises(ValueError, match="residual must be True or False"):
+        finetune(student, tmp_path / "bad", 1, progress=False, residual=1)
