@@ -61,7 +61,8 @@ def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | st
     student's run (a :class:`agents.waypoints.WaypointResidual` for a
     residual on the costmap lattice), which reads ``env`` (made with the
     run's :func:`run_agent_kwargs`). Either has ``env_id`` and ``agent_kwargs``."""
-    from .waypoint_follower import WaypointStudent, is_residual, student_record
+    from .waypoint_follower import (WaypointResidual, WaypointStudent, is_residual,
+                                    student_record)
 
     student = student_record(run_dir)
     if student is None:
@@ -76,9 +77,8 @@ def trained_policy(run_dir: str | Path, env, seed: int = 0, checkpoint: int | st
     if differ:
         raise ValueError(f"the waypoint student of {run_dir} was trained with {differ}: make "
                          f"the environment with them (gymnasium.make(..., **agent_kwargs))")
-    if is_residual(run_dir):
-        from .waypoint_follower import WaypointResidual as WaypointStudent
-    policy = WaypointStudent(env, seed, run=str(run_dir))
+    player = WaypointResidual if is_residual(run_dir) else WaypointStudent
+    policy = player(env, seed, run=str(run_dir))
     policy.env_id, policy.agent_kwargs = student["settings"]["env_id"], agent
     return policy
 
