@@ -29,9 +29,11 @@ import numpy as np
 from .planners import LatticePlanner, costmap_cost_grid
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "FINETUNE_RECORD", "PRIVILEGED", "TEACHERS", "WaypointFollower", "WaypointStudent",
+           "FINETUNE_RECORD", "OFFSETS_RECORD", "PRIVILEGED", "TEACHERS", "WaypointFollower",
+           "Commanded", "WaypointStudent",
            "LatticeWaypoints", "WaypointResidual", "decision_observation", "decision_space",
-           "load_student", "is_residual", "student_decision", "student_record",
+           "load_student", "is_residual", "rollout_decision", "sail_fields", "student_decision",
+           "student_record",
            "gather_records", "write_gathered"]
 
 #: environment steps between decisions (10 s: the lattice planner's replan)
@@ -51,6 +53,8 @@ _OFFSET_SCALE, _HEADING_SCALE, _YAW_SCALE = 100.0, 0.5, 0.04
 STUDENT, RECORD = "student.zip", "waypoints.json"
 #: the record of a fine-tuned student's run (:mod:`agents.waypoint_rl`), in place of RECORD
 FINETUNE_RECORD = "finetune.json"
+#: the record of a run of an offset learner (:mod:`agents.route_offsets`), in place of RECORD
+OFFSETS_RECORD = "offsets.json"
 
 
 #: the key of a privileged critic's signals beside a decision's observation
@@ -207,6 +211,65 @@ class WaypointFollower(LatticePlanner):
         return self._pursue(self.route, obs)
 
 
+class Commanded(WaypointFollower):
+    """Follows the decision it is given (:attr:`command`, set before each
+    decision): what a driver of its own pace, or a rollout of a decision,
+    sails."""
+
+    def __init__(self, env, seed: int = 0, **kwargs):
+        super().__init__(env, seed, **kwargs)
+        self.command = None
+
+    def decide(self, obs):
+        return self.command
+
+
+def rollout_decision(env, obs, w, steps: int, *, points: int, distance: float,
+                     interval: int) -> float:
+    """The summed reward of ``steps`` steps of the episode of ``env`` as it
+    is now (``obs``: its observation): decision ``w`` followed for
+    ``interval`` steps, then the lattice planning on the costmap
+    (:class:`~agents.planners.CostmapLatticePlanner`); None: the costmap
+    lattice throughout. Stepped on ``env.unwrapped``, below any wrapper,
+    whose counters stay as they are; the caller snapshots and restores."""
+    from .planners import CostmapLatticePlanner
+
+    u = env.unwrapped
+    lattice = CostmapLatticePlanner(env, 0, show=False)
+    follower = Commanded(env, points=points, distance=distance, interval=interval)
+    follower.command = w
+    space = env.action_space
+    total = 0.0
+    for k in range(steps):
+        action = (follower if w is not None and k < interval else lattice).predict(obs)[0]
+        obs, reward, terminated, truncated, _ = u.step(
+            np.clip(action, space.low, space.high).astype(space.dtype))
+        total += float(reward)
+        if terminated or truncated:
+            break
+    return total
+
+
+def sail_fields(env, driver, first: int, episodes: int, desc: str,
+                progress: bool) -> list[float]:
+    """Sail ``episodes`` episodes of ``env`` under the policy ``driver``,
+    episode k seeded ``first`` + k (the driver reset alike), with a progress
+    bar unless not ``progress``; returns their returns."""
+    from tqdm.auto import tqdm
+
+    returns = []
+    for k in tqdm(range(episodes), desc=desc, unit="episode", disable=not progress):
+        obs, _ = env.reset(seed=first + k)
+        driver.reset(first + k)
+        done, total = False, 0.0
+        while not done:
+            obs, reward, terminated, truncated, _ = env.step(driver.predict(obs)[0])
+            total += float(reward)
+            done = terminated or truncated
+        returns.append(total)
+    return returns
+
+
 def student_decision(policy, seen: dict):
     """The decision of the SB3 ``policy`` on ``seen`` (:func:`decision_observation`)."""
     action, _ = policy.predict(seen, deterministic=True)
@@ -268,6 +331,10 @@ class WaypointStudent(WaypointFollower):
 
     def __init__(self, env, seed: int = 0, *, run: str, **kwargs):
         policy = load_student(run, env)
+        if (Path(run) / OFFSETS_RECORD).is_file():
+            raise ValueError(f"{run!r} holds an offset learner, which chooses an offset of the "
+                             f"costmap lattice's route: play it with "
+                             f"agents.route_offsets:OffsetStudent")
         if is_residual(run):
             raise ValueError(f"{run!r} holds a residual on the costmap lattice, which decides a "
                              f"correction to the lattice's decision: play it with "

@@ -82,10 +82,9 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from .waypoint_follower import (FINETUNE_RECORD, PRIVILEGED, RECORD, STUDENT, LatticeWaypoints,
-                                WaypointFollower,
-                                decision_observation, decision_space, gather_records,
-                                write_gathered)
+from .waypoint_follower import (FINETUNE_RECORD, PRIVILEGED, RECORD, STUDENT, Commanded,
+                                LatticeWaypoints, decision_observation, decision_space,
+                                gather_records, rollout_decision, write_gathered)
 
 __all__ = ["WaypointDecisionEnv", "finetune", "finetune_report", "FINETUNE_DEFAULTS",
            "FINETUNE_RECORD", "PPO_MODEL", "PRIVILEGED", "privileged_observation"]
@@ -119,17 +118,6 @@ def privileged_observation(env, lattice) -> np.ndarray:
     whole = u.goal_distance / (u.max_speed * u.control_interval)
     return np.clip(np.array([lattice.value_to_go() / whole, u.field_concentration],
                             dtype=np.float32), -10.0, 10.0)
-
-
-class _Commanded(WaypointFollower):
-    """Follows the decision it is given (:attr:`command`)."""
-
-    def __init__(self, env, seed: int = 0, **kwargs):
-        super().__init__(env, seed, **kwargs)
-        self.command = None
-
-    def decide(self, obs):
-        return self.command
 
 
 class WaypointDecisionEnv(gym.Env):
@@ -189,7 +177,7 @@ class WaypointDecisionEnv(gym.Env):
             raise ValueError("WaypointDecisionEnv decides lateral shifts (form 'waypoints'), "
                              f"got form {follower['form']!r}")
         self.env = env
-        self.follower = _Commanded(env, **follower)
+        self.follower = Commanded(env, **follower)
         if isinstance(paired_horizon, bool) or int(paired_horizon) != paired_horizon or not (
                 paired_horizon == 0 or paired_horizon >= self.follower.interval):
             raise ValueError(f"paired_horizon must be 0 (off) or an integer of at least the "
@@ -277,27 +265,10 @@ class WaypointDecisionEnv(gym.Env):
         """The summed reward of ``paired_horizon`` steps of the episode as it
         is now (the caller restores it): decision ``w`` for ``interval``
         steps, then the costmap lattice; None: the costmap lattice
-        throughout. Stepped below any wrapper, whose counters stay as they
-        are."""
-        from .planners import CostmapLatticePlanner
-
-        u = self.env.unwrapped
-        lattice = CostmapLatticePlanner(self.env, 0, show=False)
-        follower = _Commanded(self.env, points=self.follower.points,
-                              distance=self.follower.distance,
-                              interval=self.follower.interval)
-        follower.command = w
-        space = self.env.action_space
-        obs, total = self._obs, 0.0
-        for k in range(self.paired_horizon):
-            mine = w is not None and k < self.follower.interval
-            action = (follower if mine else lattice).predict(obs)[0]
-            obs, reward, terminated, truncated, _ = u.step(
-                np.clip(action, space.low, space.high).astype(space.dtype))
-            total += float(reward)
-            if terminated or truncated:
-                break
-        return total
+        throughout (:func:`agents.waypoints.rollout_decision`)."""
+        f = self.follower
+        return rollout_decision(self.env, self._obs, w, self.paired_horizon, points=f.points,
+                                distance=f.distance, interval=f.interval)
 
     def close(self):
         self.env.close()

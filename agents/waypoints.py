@@ -70,7 +70,8 @@ from .leaderboard import DEFAULT_ENV
 from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, STUDENT, TEACHERS,
                                 WAYPOINT_DISTANCE, LatticeWaypoints, WaypointFollower,
                                 WaypointResidual, WaypointStudent, decision_observation,
-                                decision_space, gather_records, student_decision, write_gathered)
+                                decision_space, gather_records, sail_fields, student_decision,
+                                write_gathered)
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
@@ -86,11 +87,14 @@ REFITS = ("warm", "fresh")
 
 
 def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int = 128,
-                 net_arch=(64, 64), learning_rate: float = 3e-4, seed: int = 0):
+                 net_arch=(64, 64), learning_rate: float = 3e-4, seed: int = 0,
+                 choices: int = 0):
     """A new SB3 ``MultiInputActorCriticPolicy`` on :func:`decision_space`
     with :class:`agents.extractors.CostmapCombined` (torch seeded by
     ``seed``); its action is the decision: w (``points`` numbers, a ``Box``)
-    or a stage choice (``Discrete(9)``)."""
+    or a stage choice (``Discrete(9)``); with ``choices`` > 0, a choice of
+    that many (``Discrete(choices)``, as :mod:`agents.route_offsets`
+    decides)."""
     import gymnasium as gym
     import torch
     from stable_baselines3.common.policies import MultiInputActorCriticPolicy
@@ -98,7 +102,8 @@ def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int 
     from .extractors import CostmapCombined
 
     torch.manual_seed(int(seed))
-    action = gym.spaces.Discrete(len(STAGE_CHOICES)) if form == "stages" else \
+    action = gym.spaces.Discrete(int(choices)) if choices else \
+        gym.spaces.Discrete(len(STAGE_CHOICES)) if form == "stages" else \
         gym.spaces.Box(-1.0, 1.0, (int(points),), np.float32)
     return MultiInputActorCriticPolicy(
         decision_space(env), action,
@@ -169,22 +174,11 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
     """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`;
     returns (observations, labels, student decisions, returns)."""
     import gymnasium as gym
-    from tqdm.auto import tqdm
-
     env = gym.make(env_id, **env_kwargs)
     driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points,
                      teacher)
-    returns = []
     try:
-        for k in tqdm(range(episodes), desc=label, unit="episode", disable=not progress):
-            obs, _ = env.reset(seed=seed + k)
-            driver.reset(seed + k)
-            done, total = False, 0.0
-            while not done:
-                obs, reward, terminated, truncated, _ = env.step(driver.predict(obs)[0])
-                total += float(reward)
-                done = terminated or truncated
-            returns.append(total)
+        returns = sail_fields(env, driver, seed, episodes, label, progress)
     finally:
         env.close()
     return driver.seen, np.asarray(driver.labels), np.asarray(driver.students), returns
