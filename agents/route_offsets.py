@@ -45,9 +45,11 @@ Train, then play on the leaderboard's fields::
         --policies "cm-rollout=agents.route_offsets:RolloutOffsets,\\
     offsets=agents.route_offsets:OffsetStudent?run=runs/offsets/seed_1"
 
-A run holds ``student.zip`` and ``offsets.json``: the settings, each
-round's decisions, the share of them the teacher moved, the mean return of
-its episodes and the fit.
+A run holds ``student.zip``, ``offsets.json`` (the settings, each round's
+decisions, the share of them the teacher moved, the mean return of its
+episodes and the fit) and ``labels.npz`` (:data:`LABELS`: every labelled
+decision, with each offset's rollout return, for fitting other learners
+on them without the rollouts' cost).
 """
 from __future__ import annotations
 
@@ -64,7 +66,7 @@ from .waypoint_follower import (OFFSETS_RECORD, STUDENT, LatticeWaypoints, decis
                                 gather_records, load_student, rollout_decision, sail_fields,
                                 student_decision, write_gathered)
 
-__all__ = ["OFFSETS", "OffsetChooser", "RolloutOffsets", "OffsetStudent", "train_offsets",
+__all__ = ["OFFSETS", "KEEP", "LABELS", "OffsetChooser", "RolloutOffsets", "OffsetStudent", "train_offsets",
            "OFFSET_DEFAULTS", "held_out", "report", "main"]
 
 #: the offsets [m] a decision chooses among (the rollout planner's
@@ -73,6 +75,10 @@ __all__ = ["OFFSETS", "OffsetChooser", "RolloutOffsets", "OffsetStudent", "train
 OFFSETS = (-12.0, -7.0, -3.0, 0.0, 3.0, 7.0, 12.0)
 #: the choice that keeps the costmap lattice's own waypoints
 KEEP = OFFSETS.index(0.0)
+#: the labelled decisions of a run, in its directory: ``costmap`` and
+#: ``vector`` (what the learner saw), ``labels`` (the teacher's choices),
+#: ``returns`` (every offset's rollout return) and ``round``, one row a decision
+LABELS = "labels.npz"
 
 
 class OffsetChooser(LatticeWaypoints):
@@ -267,7 +273,8 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
     env = gym.make(s["env_id"], **s["env_kwargs"])
     policy = None
     seen: dict | None = None
-    labels = np.empty(0, dtype=np.int64)
+    labels, made = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    gains = np.empty((0, len(OFFSETS)))
     rounds = []
     began = time.perf_counter()
     try:
@@ -283,6 +290,9 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
             seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
             wanted = np.asarray(driver.labels, dtype=np.int64)
             labels = np.concatenate([labels, wanted])
+            gains = np.concatenate([gains, np.asarray(driver.returns).reshape(-1, len(OFFSETS))])
+            made = np.concatenate([made, np.full(len(wanted), r)])
+            np.savez_compressed(out / LABELS, labels=labels, returns=gains, round=made, **seen)
             del new, driver
             policy = make_student(env, choices=len(OFFSETS), cnn_dim=s["cnn_dim"],
                                   learning_rate=s["learning_rate"], seed=seed)

@@ -77,6 +77,12 @@ def test_a_training_run_makes_a_learner_that_plays(tmp_path, capsys):
     assert all(0.0 <= r["moved"] <= 1.0 and 0.0 <= r["action_accuracy"] <= 1.0
                for r in record["rounds"])
     assert json.loads((out / "offsets.json").read_text())["settings"]["offsets"] == list(OFFSETS)
+    with np.load(out / "labels.npz") as saved:
+        n = sum(record["labels"])
+        assert saved["labels"].shape == (n,) and saved["returns"].shape == (n, len(OFFSETS))
+        assert saved["costmap"].shape[0] == n and sorted(set(saved["round"])) == [0, 1]
+        np.testing.assert_array_equal(np.bincount(saved["labels"], minlength=len(OFFSETS)),
+                                      record["labels"])
     rewards, _, learner = sail(OffsetStudent, 1, 0.4, run=str(out))
     assert len(learner.choices) == -(-len(rewards) // 5)
     assert all(0 <= c < len(OFFSETS) for c in learner.choices)
