@@ -67,7 +67,8 @@ from .waypoint_follower import (OFFSETS_RECORD, STUDENT, LatticeWaypoints, decis
                                 student_decision, write_gathered)
 
 __all__ = ["OFFSETS", "KEEP", "LABELS", "OffsetChooser", "RolloutOffsets", "OffsetStudent", "train_offsets",
-           "OFFSET_DEFAULTS", "held_out", "report", "main"]
+           "OFFSET_DEFAULTS", "FIT_SETTINGS", "fit_offsets", "load_labels", "choices_of",
+           "gains_of", "refit", "crossfit", "held_out", "report", "main"]
 
 #: the offsets [m] a decision chooses among (the rollout planner's
 #: ``rollout-margin-1`` search, and 0), sorted so that choice c mirrors into
@@ -219,12 +220,14 @@ class _Labeller(RolloutOffsets):
         self.policy, self.beta, self.coin = policy, float(beta), coin
         self.seen: list[dict] = []
         self.labels: list[int] = []
+        self.gains: list[tuple[float, ...]] = []   # every episode's (returns: this one's)
 
     def choose(self, obs, base):
         seen = decision_observation(self.env)
         wanted = super().choose(obs, base)
         self.seen.append(seen)
         self.labels.append(wanted)
+        self.gains.append(self.returns[-1])
         if self.policy is None or self.coin.random() < self.beta:
             return wanted
         return student_decision(self.policy, seen)
@@ -235,7 +238,168 @@ class _Labeller(RolloutOffsets):
 OFFSET_DEFAULTS = dict(env_id="iceenvs/ShipNavigation-v1",
                        env_kwargs={"costmap_ahead": 500.0}, episodes=12, rounds=1, beta=0.5,
                        epochs=20, batch_size=128, learning_rate=3e-4, cnn_dim=128,
-                       rollout_steps=30, margin=1.0, field_seed=100_000)
+                       rollout_steps=30, margin=1.0, field_seed=100_000, oversample=1)
+#: the settings of a fit (:func:`fit_offsets`), which :func:`refit` and
+#: :func:`crossfit` take
+FIT_SETTINGS = ("epochs", "batch_size", "learning_rate", "cnn_dim", "oversample")
+
+
+def _check_fit(s: dict) -> None:
+    for name in ("epochs", "batch_size", "cnn_dim", "oversample"):
+        if isinstance(s[name], bool) or int(s[name]) != s[name] or s[name] < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {s[name]!r}")
+
+
+def fit_offsets(env, seen: dict, labels: np.ndarray, seed: int, fit_seed: int, s: dict):
+    """A new learner's network (seeded ``seed``) fitted by cross-entropy on
+    the decisions ``seen`` and the teacher's ``labels``, with their mirror
+    images; each moved decision (a label other than :data:`KEEP`) is
+    repeated ``oversample`` times, so that a fit of rare moves does not
+    settle on keeping the route everywhere. Returns (policy, the fit's
+    record)."""
+    from .pretrain import fit_policy
+    from .waypoints import make_student, with_mirror
+
+    rows = np.concatenate([np.arange(len(labels)),
+                           np.repeat(np.flatnonzero(labels != KEEP), int(s["oversample"]) - 1)])
+    rows.sort()
+    chosen = {k: v[rows] for k, v in seen.items()} if len(rows) != len(labels) else seen
+    data, _ = with_mirror(chosen, np.zeros((len(rows), 1)))
+    targets = np.concatenate([labels[rows], len(OFFSETS) - 1 - labels[rows]])
+    policy = make_student(env, choices=len(OFFSETS), cnn_dim=s["cnn_dim"],
+                          learning_rate=s["learning_rate"], seed=seed)
+    fit = fit_policy(policy, data, targets, None, epochs=s["epochs"],
+                     batch_size=s["batch_size"], learning_rate=s["learning_rate"],
+                     seed=fit_seed)
+    return policy, fit
+
+
+def load_labels(run) -> dict:
+    """The labelled decisions of the run directory ``run`` (:data:`LABELS`);
+    without ``returns`` where the file holds none for some decisions."""
+    path = Path(run) / LABELS
+    if not path.is_file():
+        raise FileNotFoundError(f"{run}: no {LABELS} (not a run of python -m agents.route_offsets "
+                                f"train)")
+    with np.load(path) as saved:
+        labels = {k: saved[k] for k in saved.files}
+    if len(labels.get("returns", ())) != len(labels["labels"]):
+        labels.pop("returns", None)   # not one row a decision: not kept whole
+    return labels
+
+
+def choices_of(policy, seen: dict, batch: int = 256) -> np.ndarray:
+    """The most likely choice of ``policy`` on each decision of ``seen``."""
+    n = len(seen["vector"])
+    return np.concatenate([np.asarray(policy.predict(
+        {k: v[i:i + batch] for k, v in seen.items()}, deterministic=True)[0]).reshape(-1)
+        for i in range(0, n, batch)]).astype(np.int64)
+
+
+def gains_of(returns: np.ndarray, made: np.ndarray) -> np.ndarray:
+    """Each decision's rollout return of choice ``made`` minus that of
+    keeping the route: what the choice earned over the costmap lattice in
+    the rollout (a window of ``rollout_steps``)."""
+    n = np.arange(len(made))
+    return returns[n, made] - returns[n, KEEP]
+
+
+def refit(run, out, seed: int | None = None, **settings) -> dict:
+    """A learner fitted again on the labelled decisions of ``run``, with
+    the fit's ``settings`` (:data:`FIT_SETTINGS`) changed, into ``out`` (a
+    run directory :class:`OffsetStudent` plays, without ``labels.npz``):
+    no rollouts. ``seed``: the network's (default the run's)."""
+    import gymnasium as gym
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    unknown = sorted(set(settings) - set(FIT_SETTINGS))
+    if unknown:
+        raise ValueError(f"unknown settings {unknown}; valid: {', '.join(FIT_SETTINGS)}")
+    record = json.loads((Path(run) / OFFSETS_RECORD).read_text())
+    saved = load_labels(run)
+    s = {**OFFSET_DEFAULTS, **record["settings"], **settings}
+    _check_fit(s)
+    seed = int(s["seed"] if seed is None else seed)
+    env = gym.make(s["env_id"], **s["env_kwargs"])
+    began = time.perf_counter()
+    try:
+        policy, fit = fit_offsets(env, {k: saved[k] for k in ("costmap", "vector")},
+                                  saved["labels"], seed, seed * 1000 + 999, s)
+    finally:
+        env.close()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    policy.save(str(out / STUDENT))
+    new = {**record, "settings": {**s, "seed": seed}, "refit_of": Path(run).as_posix(),
+           "refit": {**{k: v for k, v in fit.items() if k.startswith("action_")},
+                     "seconds": round(time.perf_counter() - began, 1)}}
+    (out / OFFSETS_RECORD).write_text(json.dumps(new, indent=2) + "\n")
+    return new
+
+
+def crossfit(runs, out, oversample=(1,), progress: bool = True, **settings) -> dict:
+    """Whether the teacher's choices can be learned, run by run: for each
+    run of ``runs`` and each ``oversample``, a learner is fitted on the
+    labelled decisions of the others and chooses on the run's own, fields
+    it never saw. What its choices earn is read from the run's saved
+    rollouts (:func:`gains_of`): no rollouts are sailed. Writes
+    ``out/crossfit.json`` and the table ``out/crossfit.md``; returns the
+    record."""
+    import gymnasium as gym
+    from tqdm.auto import tqdm
+
+    import iceenvs  # noqa: F401  (registers the ids)
+
+    runs = [Path(r) for r in runs]
+    if len(runs) < 2:
+        raise ValueError("a cross-fit needs at least two runs")
+    unknown = sorted(set(settings) - set(FIT_SETTINGS))
+    if unknown or "oversample" in settings:
+        raise ValueError(f"unknown settings {unknown or ['oversample']}; valid: "
+                         f"{', '.join(f for f in FIT_SETTINGS if f != 'oversample')}")
+    first = {**OFFSET_DEFAULTS, **json.loads((runs[0] / OFFSETS_RECORD).read_text())["settings"]}
+    saved = [load_labels(r) for r in runs]
+    env = gym.make(first["env_id"], **first["env_kwargs"])
+    rows = []
+    try:
+        for m in tqdm(oversample, desc="oversample", disable=not progress):
+            s = {**first, **settings, "oversample": m}
+            _check_fit(s)
+            for k, run in enumerate(runs):
+                others = [d for j, d in enumerate(saved) if j != k]
+                seen = {key: np.concatenate([d[key] for d in others])
+                        for key in ("costmap", "vector")}
+                policy, _ = fit_offsets(env, seen, np.concatenate([d["labels"] for d in others]),
+                                        k + 1, k + 1, s)
+                mine = saved[k]
+                made = choices_of(policy, {key: mine[key] for key in ("costmap", "vector")})
+                wanted, moved = mine["labels"], made != KEEP
+                rows.append({"run": run.as_posix(), "oversample": m, "decisions": len(made),
+                             "teacher_moved": float(np.mean(wanted != KEEP)),
+                             "moved": float(np.mean(moved)),
+                             "moves_right": float(np.mean(made[moved] == wanted[moved]))
+                             if moved.any() else None,
+                             "teacher_moves_made": float(np.mean(made[wanted != KEEP] == wanted[
+                                 wanted != KEEP])) if np.any(wanted != KEEP) else None,
+                             **({"teacher_gain": float(np.mean(gains_of(mine["returns"], wanted))),
+                                 "gain": float(np.mean(gains_of(mine["returns"], made)))}
+                                if "returns" in mine else {"teacher_gain": None, "gain": None})})
+    finally:
+        env.close()
+    lines = ["| held-out run | oversample | decisions | moved by the teacher | moved by the "
+             "learner | the learner's moves the teacher's | the teacher's moves made | the "
+             "teacher's rollout gain per decision | the learner's |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['run']} | {r['oversample']} | {r['decisions']} | {_share(r['teacher_moved'])}"
+              f" | {_share(r['moved'])} | {_share(r['moves_right'])} | "
+              f"{_share(r['teacher_moves_made'])} | {_number(r['teacher_gain'])} | "
+              f"{_number(r['gain'])} |" for r in rows]
+    lines.append("")
+    record = {"settings": {**{k: first[k] for k in FIT_SETTINGS}, **settings,
+                           "oversample": list(oversample)}, "rows": rows}
+    write_gathered(out, "crossfit.json", record, "crossfit.md", lines)
+    return record
 
 
 def train_offsets(out, seed: int, progress: bool = True, command: str | None = None,
@@ -254,16 +418,15 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
     import iceenvs  # noqa: F401  (registers the ids)
 
     from . import observations as obs_rows
-    from .pretrain import fit_policy
-    from .waypoints import make_student, with_mirror
 
     unknown = sorted(set(settings) - set(OFFSET_DEFAULTS))
     if unknown:
         raise ValueError(f"unknown settings {unknown}; valid: {', '.join(OFFSET_DEFAULTS)}")
     s = {**OFFSET_DEFAULTS, **settings}
-    for name in ("episodes", "epochs", "batch_size", "cnn_dim"):
-        if isinstance(s[name], bool) or int(s[name]) != s[name] or s[name] < 1:
-            raise ValueError(f"{name} must be an integer >= 1, got {s[name]!r}")
+    _check_fit(s)
+    if isinstance(s["episodes"], bool) or int(s["episodes"]) != s["episodes"] \
+            or s["episodes"] < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {s['episodes']!r}")
     if isinstance(s["rounds"], bool) or int(s["rounds"]) != s["rounds"] or s["rounds"] < 0:
         raise ValueError(f"rounds must be an integer >= 0, got {s['rounds']!r}")
     if not 0.0 <= s["beta"] <= 1.0:
@@ -290,18 +453,11 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
             seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
             wanted = np.asarray(driver.labels, dtype=np.int64)
             labels = np.concatenate([labels, wanted])
-            gains = np.concatenate([gains, np.asarray(driver.returns).reshape(-1, len(OFFSETS))])
+            gains = np.concatenate([gains, np.asarray(driver.gains).reshape(-1, len(OFFSETS))])
             made = np.concatenate([made, np.full(len(wanted), r)])
             np.savez_compressed(out / LABELS, labels=labels, returns=gains, round=made, **seen)
             del new, driver
-            policy = make_student(env, choices=len(OFFSETS), cnn_dim=s["cnn_dim"],
-                                  learning_rate=s["learning_rate"], seed=seed)
-            data, _ = with_mirror(seen, np.zeros((len(labels), 1)))
-            targets = np.concatenate([labels, len(OFFSETS) - 1 - labels])
-            fit = fit_policy(policy, data, targets, None, epochs=s["epochs"],
-                             batch_size=s["batch_size"], learning_rate=s["learning_rate"],
-                             seed=seed * 1000 + r)
-            del data
+            policy, fit = fit_offsets(env, seen, labels, seed, seed * 1000 + r, s)
             rounds.append({"round": r, "beta": beta, "decisions": len(wanted),
                            "moved": float(np.mean(wanted != KEEP)),
                            "mean_return": float(np.mean(returns)),
@@ -354,6 +510,10 @@ def held_out(run, episodes: int, seed: int, progress: bool = False) -> dict:
 
 def _share(value) -> str:
     return "–" if value is None else f"{value:.1%}"
+
+
+def _number(value) -> str:
+    return "–" if value is None else f"{value:.3f}"
 
 
 def report(runs, out, held_out_episodes: int = 0, held_out_seed: int = 50_000,
@@ -431,6 +591,24 @@ def main(argv=None) -> int:
     train.add_argument("--env-kwargs", nargs="*", default=None, metavar="KEY=VALUE",
                        help="the environment's settings (default costmap_ahead=500)")
     train.add_argument("--no-progress", action="store_true")
+    ref = sub.add_parser("refit", help="fit a learner again on a run's labelled decisions, "
+                                       "into --out (no rollouts)")
+    ref.add_argument("--run", required=True)
+    ref.add_argument("--out", required=True)
+    ref.add_argument("--seed", type=int, help="the network's seed (default the run's)")
+    cross = sub.add_parser("crossfit", help="fit on all runs but one and choose on that one's "
+                                            "decisions, run by run (no rollouts)")
+    cross.add_argument("runs", nargs="+")
+    cross.add_argument("--out", required=True)
+    cross.add_argument("--oversample", default="1", metavar="M,M,...",
+                       help="the oversamplings of moved decisions to compare (default 1)")
+    cross.add_argument("--no-progress", action="store_true")
+    for p in (ref, cross):
+        for name in ("epochs", "batch_size", "cnn_dim"):
+            p.add_argument("--" + name.replace("_", "-"), type=int,
+                           help="(default the run's)")
+        p.add_argument("--learning-rate", type=float, help="(default the run's)")
+    ref.add_argument("--oversample", type=int, help="(default the run's)")
     rep = sub.add_parser("report", help="gather run directories' records into --out")
     rep.add_argument("runs", nargs="+")
     rep.add_argument("--out", required=True)
@@ -445,6 +623,21 @@ def main(argv=None) -> int:
             parser.error(f"--held-out must be >= 0, got {args.held_out}")
         report(args.runs, args.out, args.held_out, args.held_out_seed,
                progress=not args.no_progress)
+        print(f"wrote {args.out}")
+        return 0
+    if args.command in ("refit", "crossfit"):
+        fit = {k: getattr(args, k) for k in ("epochs", "batch_size", "cnn_dim", "learning_rate")
+               if getattr(args, k) is not None}
+        if args.command == "refit":
+            if args.oversample is not None:
+                fit["oversample"] = args.oversample
+            refit(args.run, args.out, args.seed, **fit)
+        else:
+            try:
+                ms = tuple(int(m) for m in args.oversample.split(","))
+            except ValueError:
+                parser.error(f"--oversample takes integers, got {args.oversample!r}")
+            crossfit(args.runs, args.out, ms, progress=not args.no_progress, **fit)
         print(f"wrote {args.out}")
         return 0
     from .envs import parse_key_values

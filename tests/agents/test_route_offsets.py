@@ -10,7 +10,8 @@ import pytest
 
 from agents.planners import CostmapLatticePlanner
 from agents.route_offsets import (KEEP, OFFSETS, OffsetChooser, OffsetStudent, RolloutOffsets,
-                                  main, report, train_offsets)
+                                  crossfit, gains_of, load_labels, main, refit, report,
+                                  train_offsets)
 from agents.waypoints import WaypointStudent
 from test_waypoints import KWARGS, NAV, sail
 
@@ -98,6 +99,50 @@ def test_a_training_run_makes_a_learner_that_plays(tmp_path, capsys):
     held = json.loads((gathered / "offsets.json").read_text())[out.as_posix()]["held_out"]
     assert held["decisions"] > 3 and 0.0 <= held["accuracy"] <= 1.0
     assert str(out) in (gathered / "held-out.md").read_text()
+
+
+def test_labels_are_the_rollouts_best_and_learners_are_fitted_on_them_again(tmp_path):
+    """The saved labels are the margin's rule on the saved rollout returns,
+    so each earns at least what keeping the route does (more than the
+    margin where it moves); a refit and a cross-fit need no rollouts."""
+    import shutil
+
+    out = tmp_path / "run"
+    train_offsets(out, 2, progress=False, quiet=True, episodes=2, rounds=0, epochs=1,
+                  rollout_steps=10, margin=0.2,
+                  env_kwargs={**KWARGS, "concentration": 0.4, "costmap_ahead": 300.0})
+    saved = load_labels(out)
+    expected = [int(np.argmax(r)) if max(r) - r[KEEP] > 0.2 else KEEP for r in saved["returns"]]
+    assert saved["labels"].tolist() == expected
+    gains = gains_of(saved["returns"], saved["labels"])
+    assert np.all(gains >= 0.0) and np.all(gains[saved["labels"] != KEEP] > 0.2)
+    assert main(["refit", "--run", str(out), "--out", str(tmp_path / "refit"),
+                 "--oversample", "3", "--epochs", "1"]) == 0
+    rewards, _, learner = sail(OffsetStudent, 1, 0.4, run=str(tmp_path / "refit"))
+    assert len(learner.choices) == -(-len(rewards) // 5)
+    again = json.loads((tmp_path / "refit" / "offsets.json").read_text())
+    assert again["settings"]["oversample"] == 3 and again["refit_of"] == out.as_posix()
+    shutil.copytree(out, tmp_path / "twin")
+    record = crossfit([out, tmp_path / "twin"], tmp_path / "cross", (1, 3), progress=False,
+                      epochs=1)
+    assert [(r["oversample"], r["decisions"]) for r in record["rows"]] == \
+        [(m, len(expected)) for m in (1, 3) for _ in range(2)]
+    assert all(r["teacher_gain"] >= 0.0 for r in record["rows"])
+    assert (tmp_path / "cross" / "crossfit.md").read_text().count("| 3 |") >= 2
+    with pytest.raises(ValueError, match="at least two runs"):
+        crossfit([out], tmp_path / "cross")
+    with pytest.raises(ValueError, match="unknown settings"):
+        refit(out, tmp_path / "r2", episodes=3)
+    with pytest.raises(ValueError, match="oversample must be"):
+        refit(out, tmp_path / "r2", oversample=0)
+    with pytest.raises(FileNotFoundError, match="labels.npz"):
+        load_labels(tmp_path)
+    # a file whose returns are not one row a decision is read without them
+    np.savez(tmp_path / "twin" / "labels.npz", **{**saved, "returns": saved["returns"][:1]})
+    assert "returns" not in load_labels(tmp_path / "twin")
+    record = crossfit([out, tmp_path / "twin"], tmp_path / "cross", (1,), progress=False,
+                      epochs=1)
+    assert record["rows"][1]["gain"] is None and record["rows"][0]["gain"] is not None
 
 
 def test_bad_input_is_refused(tmp_path):
