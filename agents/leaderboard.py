@@ -449,10 +449,19 @@ def grouped(board: dict, groups: dict) -> dict:
                                  f"(policies: {', '.join(policies)})")
             rows = [policies[m] for m in members]
             out[a][name] = [{"seed": e[0]["seed"], "final": {},
-                             **{key: float(np.mean([x[key] for x in e]))
+                             **{key: _mean_of_members([x[key] for x in e])
                                 for key in ("ret", "length", *EPISODE_COUNTS)
                                 if all(key in x for x in e)}} for e in zip(*rows)]
     return out
+
+
+def _mean_of_members(values) -> float:
+    """The mean of ``values`` as the first plus the mean of the others'
+    differences from it: members that sailed alike give their own return
+    exactly, so that a group of them paired with one of them shows 0 ± 0,
+    not the rounding of a sum (mean(a, a, a) need not be a in floats)."""
+    first = float(values[0])
+    return first + float(np.mean([float(v) - first for v in values]))
 
 
 def against_markdown(board: dict, reference: str, groups: dict | None = None) -> str:

@@ -281,6 +281,15 @@ def test_policies_are_paired_with_any_other_and_seeds_grouped():
     # ab at 0.3: differences 3 and 5, mean 4 ± 1: better by 4 standard errors
     assert "| 4.00 ± 1.0 beats |" in rows["ab"]
     assert "straight" not in rows
+    # members that sailed alike: the group is each of them exactly, and paired
+    # with one of them it shows no difference, not the rounding of a sum
+    alike = {"0.2": {"base": [_field(r, 1.0) for r in (147.23, 171.71, 0.1)],
+                     **{m: [_field(r, 1.0) for r in (147.23, 171.71, 0.1)] for m in "xyz"}}}
+    assert sum([0.1] * 3) / 3 != 0.1        # what a plain mean would give
+    assert [e["ret"] for e in leaderboard.grouped(alike, {"g": list("xyz")})["0.2"]["g"]] == \
+        [147.23, 171.71, 0.1]
+    text = leaderboard.against_markdown(alike, "base", {"g": list("xyz")})
+    assert "| g | 0 ± 0 | 0 ± 0 |" in text
     with pytest.raises(ValueError, match="group ab: c not on the board"):
         leaderboard.grouped(board, {"ab": ["a", "c"]})
     with pytest.raises(ValueError, match="--against swath: not on the board"):
