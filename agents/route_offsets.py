@@ -62,6 +62,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .leaderboard import DEFAULT_ENV
 from .waypoint_follower import (OFFSETS_RECORD, STUDENT, LatticeWaypoints, decision_observation,
                                 gather_records, load_student, rollout_decision, sail_fields,
                                 student_decision, write_gathered)
@@ -235,7 +236,7 @@ class _Labeller(RolloutOffsets):
 
 #: the settings of :func:`train_offsets` (a 500 m costmap, as the costmap
 #: lattice's best students were trained on)
-OFFSET_DEFAULTS = dict(env_id="iceenvs/ShipNavigation-v1",
+OFFSET_DEFAULTS = dict(env_id=DEFAULT_ENV,
                        env_kwargs={"costmap_ahead": 500.0}, episodes=12, rounds=1, beta=0.5,
                        epochs=20, batch_size=128, learning_rate=3e-4, cnn_dim=128,
                        rollout_steps=30, margin=1.0, field_seed=100_000, oversample=1)
