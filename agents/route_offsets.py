@@ -189,7 +189,7 @@ class RolloutOffsets(OffsetChooser):
     def _rollout(self, obs, w) -> float:
         """The summed reward of ``rollout_steps`` steps of the episode as it
         is now: decision ``w`` for ``interval`` steps, then the costmap
-        lattice (:func:`agents.waypoints.rollout_decision`)."""
+        lattice (:func:`agents.waypoint_follower.rollout_decision`)."""
         return rollout_decision(self.env, obs, w, self.rollout_steps, points=self.points,
                                 distance=self.distance, interval=self.interval)
 
@@ -221,14 +221,16 @@ class _Labeller(RolloutOffsets):
         self.policy, self.beta, self.coin = policy, float(beta), coin
         self.seen: list[dict] = []
         self.labels: list[int] = []
-        self.gains: list[tuple[float, ...]] = []   # every episode's (returns: this one's)
+        #: every labelled decision's rollout returns, of all episodes (``returns``
+        #: holds the episode's own only)
+        self.all_returns: list[tuple[float, ...]] = []
 
     def choose(self, obs, base):
         seen = decision_observation(self.env)
         wanted = super().choose(obs, base)
         self.seen.append(seen)
         self.labels.append(wanted)
-        self.gains.append(self.returns[-1])
+        self.all_returns.append(self.returns[-1])
         if self.policy is None or self.coin.random() < self.beta:
             return wanted
         return student_decision(self.policy, seen)
@@ -375,14 +377,8 @@ def crossfit(runs, out, oversample=(1,), progress: bool = True, **settings) -> d
                                         k + 1, k + 1, s)
                 mine = saved[k]
                 made = choices_of(policy, {key: mine[key] for key in ("costmap", "vector")})
-                wanted, moved = mine["labels"], made != KEEP
-                rows.append({"run": run.as_posix(), "oversample": m, "decisions": len(made),
-                             "teacher_moved": float(np.mean(wanted != KEEP)),
-                             "moved": float(np.mean(moved)),
-                             "moves_right": float(np.mean(made[moved] == wanted[moved]))
-                             if moved.any() else None,
-                             "teacher_moves_made": float(np.mean(made[wanted != KEEP] == wanted[
-                                 wanted != KEEP])) if np.any(wanted != KEEP) else None,
+                wanted = mine["labels"]
+                rows.append({"run": run.as_posix(), "oversample": m, **_agreement(made, wanted),
                              **({"teacher_gain": float(np.mean(gains_of(mine["returns"], wanted))),
                                  "gain": float(np.mean(gains_of(mine["returns"], made)))}
                                 if "returns" in mine else {"teacher_gain": None, "gain": None})})
@@ -437,8 +433,8 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
     env = gym.make(s["env_id"], **s["env_kwargs"])
     policy = None
     seen: dict | None = None
-    labels, made = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
-    gains = np.empty((0, len(OFFSETS)))
+    labels, round_of = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    rollout_returns = np.empty((0, len(OFFSETS)))
     rounds = []
     began = time.perf_counter()
     try:
@@ -454,9 +450,11 @@ def train_offsets(out, seed: int, progress: bool = True, command: str | None = N
             seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
             wanted = np.asarray(driver.labels, dtype=np.int64)
             labels = np.concatenate([labels, wanted])
-            gains = np.concatenate([gains, np.asarray(driver.gains).reshape(-1, len(OFFSETS))])
-            made = np.concatenate([made, np.full(len(wanted), r)])
-            np.savez_compressed(out / LABELS, labels=labels, returns=gains, round=made, **seen)
+            rollout_returns = np.concatenate(
+                [rollout_returns, np.asarray(driver.all_returns).reshape(-1, len(OFFSETS))])
+            round_of = np.concatenate([round_of, np.full(len(wanted), r)])
+            np.savez_compressed(out / LABELS, labels=labels, returns=rollout_returns,
+                                round=round_of, **seen)
             del new, driver
             policy, fit = fit_offsets(env, seen, labels, seed, seed * 1000 + r, s)
             rounds.append({"round": r, "beta": beta, "decisions": len(wanted),
@@ -501,12 +499,21 @@ def held_out(run, episodes: int, seed: int, progress: bool = False) -> dict:
         env.close()
     wanted = np.asarray(driver.labels)
     made = np.asarray(driver.choices)
-    moved, taught = made != KEEP, wanted != KEEP
-    return {"episodes": episodes, "seed": seed, "decisions": len(made),
-            "moved": float(np.mean(moved)), "teacher_moved": float(np.mean(taught)),
-            "moves_right": float(np.mean(made[moved] == wanted[moved])) if moved.any() else None,
-            "moves_made": float(np.mean(made[taught] == wanted[taught])) if taught.any() else None,
+    return {"episodes": episodes, "seed": seed, **_agreement(made, wanted),
             "accuracy": float(np.mean(made == wanted))}
+
+
+def _agreement(made: np.ndarray, wanted: np.ndarray) -> dict:
+    """How a learner's choices ``made`` agree with the teacher's ``wanted``
+    on the same decisions: their number, the share each moved the route,
+    the share of the learner's moves that were the teacher's choice and the
+    share of the teacher's moves the learner made (None: no move)."""
+    moved, taught = made != KEEP, wanted != KEEP
+    return {"decisions": len(made), "teacher_moved": float(np.mean(taught)),
+            "moved": float(np.mean(moved)),
+            "moves_right": float(np.mean(made[moved] == wanted[moved])) if moved.any() else None,
+            "teacher_moves_made": float(np.mean(made[taught] == wanted[taught]))
+            if taught.any() else None}
 
 
 def _share(value) -> str:
@@ -544,7 +551,7 @@ def report(runs, out, held_out_episodes: int = 0, held_out_seed: int = 50_000,
             h = rec["held_out"] = held_out(run, held_out_episodes, held_out_seed, progress)
             rows.append(f"| {run} | {h['decisions']} | {_share(h['moved'])} | "
                         f"{_share(h['teacher_moved'])} | {_share(h['moves_right'])} | "
-                        f"{_share(h['moves_made'])} | {_share(h['accuracy'])} |")
+                        f"{_share(h['teacher_moves_made'])} | {_share(h['accuracy'])} |")
         rows.append("")
         write_gathered(out, OFFSETS_RECORD, records, "held-out.md", rows)
     _plot(records, Path(out) / "offsets.png")

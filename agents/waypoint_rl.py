@@ -265,7 +265,7 @@ class WaypointDecisionEnv(gym.Env):
         """The summed reward of ``paired_horizon`` steps of the episode as it
         is now (the caller restores it): decision ``w`` for ``interval``
         steps, then the costmap lattice; None: the costmap lattice
-        throughout (:func:`agents.waypoints.rollout_decision`)."""
+        throughout (:func:`agents.waypoint_follower.rollout_decision`)."""
         f = self.follower
         return rollout_decision(self.env, self._obs, w, self.paired_horizon, points=f.points,
                                 distance=f.distance, interval=f.interval)
