@@ -201,6 +201,11 @@ class LatticePlanner(StraightLineController):
         it), so that a route is priced for a ship that strays from it by
         about b: a plan that keeps a margin an imperfect follower's errors
         do not cross.
+    fade : float [m] — f > 0 (default inf: no fade): the ice's cost a
+        distance s ahead of the ship is weighed by e^(−s/f) before the
+        search, so that ice the ship meets later, which will have drifted
+        and been pushed by then, and past which the route will be planned
+        again, counts for less than the ice just ahead.
     """
 
     reads_environment = "its floes"
@@ -216,7 +221,8 @@ class LatticePlanner(StraightLineController):
 
     def __init__(self, env, seed: int = 0, *, metre_cost: float | None = None, cone: bool = True,
                  horizon: float | None = None, replan_steps: int | None = None,
-                 show: bool = True, noise: float = 0.0, blur: float = 0.0, **geometry):
+                 show: bool = True, noise: float = 0.0, blur: float = 0.0,
+                 fade: float = math.inf, **geometry):
         super().__init__(env, seed)
         u = self.unwrapped
         if not hasattr(u, "ice_near"):
@@ -252,6 +258,9 @@ class LatticePlanner(StraightLineController):
         if isinstance(blur, bool) or not (math.isfinite(float(blur)) and blur >= 0.0):
             raise ValueError(f"blur must be a distance >= 0 [m], got {blur!r}")
         self.blur = float(blur)
+        if isinstance(fade, bool) or not (float(fade) > 0.0):
+            raise ValueError(f"fade must be a distance > 0 [m] (inf for none), got {fade!r}")
+        self.fade = float(fade)
         self.decision_times: list[float] = []
         self.route = None
         self._age = 0
@@ -357,7 +366,11 @@ class LatticePlanner(StraightLineController):
 
     def blurred(self, cost: np.ndarray) -> np.ndarray:
         """The cost grid ``cost`` (x index, y index) smoothed across the
-        channel by the ``blur`` of the class's text (itself when 0)."""
+        channel by the ``blur`` of the class's text, each cell first weighed
+        by its ``fade`` (itself when neither is set)."""
+        if math.isfinite(self.fade):
+            ahead = (np.arange(cost.shape[0]) + 0.5) * self.lateral_step
+            cost = cost * np.exp(-ahead / self.fade)[:, None]
         if not self.blur:
             return cost
         from scipy.ndimage import gaussian_filter1d

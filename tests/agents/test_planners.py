@@ -134,6 +134,9 @@ def test_with_cost_to_go_a_rollout_adds_the_value_to_go_from_where_it_ends():
     ({"noise": True}, "noise must be a standard deviation"),
     ({"blur": -1.0}, "blur must be a distance"),
     ({"blur": float("inf")}, "blur must be a distance"),
+    ({"fade": 0.0}, "fade must be a distance"),
+    ({"fade": float("nan")}, "fade must be a distance"),
+    ({"fade": True}, "fade must be a distance"),
 ])
 def test_refused_arguments(kwargs, message):
     env = gym.make(NAV, **KWARGS)
@@ -219,6 +222,25 @@ def test_a_blur_spreads_the_cost_across_the_channel_by_its_variance():
         # is (b / cell)² to within 0.5 % at b / cell = 2
         assert var_a - var_b == pytest.approx((3.0 / 1.5) ** 2, rel=5e-3)
     assert LatticePlanner(env, 0).blurred(cost) is cost
+    env.close()
+
+
+def test_a_fade_weighs_the_cost_down_by_its_distance_ahead():
+    """``fade`` f: the cost of the column whose centre lies s ahead of the
+    ship is multiplied by e^(−s/f), so that the ratio of two columns a
+    distance d apart is e^(−d/f) and a column f further ahead counts 1/e
+    as much; with a blur as well, each column is faded then blurred
+    (the blur keeps a column's total)."""
+    env = gym.make(NAV, **KWARGS)
+    planner = LatticePlanner(env, 0, fade=60.0)
+    cell = planner.lateral_step
+    cost = np.ones((81, 7))
+    faded = planner.blurred(cost)
+    np.testing.assert_allclose(faded[:, 3], np.exp(-(np.arange(81) + 0.5) * cell / 60.0),
+                               rtol=1e-12)
+    assert faded[40, 0] / faded[0, 0] == pytest.approx(np.exp(-40 * cell / 60.0), rel=1e-12)
+    both = LatticePlanner(env, 0, fade=60.0, blur=3.0).blurred(cost)
+    np.testing.assert_allclose(both.sum(axis=1), faded.sum(axis=1), rtol=1e-9)
     env.close()
 
 
