@@ -260,29 +260,63 @@ def report(directories, out) -> dict:
         raise ValueError("report needs at least one search directory")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    lines = ["| search | fields | trials | as it is | best (trial) | gain on its fields | "
-             + " | ".join(SPACE) + " |", "|---" * (6 + len(SPACE)) + "|"]
+    concentrations = next(iter(records.values()))["settings"]["concentrations"]
+    keys = [f"{a:g}" for a in concentrations]
+    lines = ["| search | fields | trials | wall [min] | as it is | best (trial) | "
+             + " | ".join(f"gain at A = {k}" for k in keys) + " | gain over all |",
+             "|---" * (7 + len(keys)) + "|"]
     for name, r in records.items():
         first, best = r["trials"][0], max(r["trials"], key=lambda t: t["value"])
         fields = r["settings"]["episodes"] * len(r["settings"]["concentrations"])
-        params = " | ".join(_shown(k, best["params"][k]) for k in SPACE)
+        gains = " | ".join(f"{best['by_concentration'][k] - first['by_concentration'][k]:+.1f}"
+                           for k in keys)
         lines.append(f"| {name} | {fields} | {len(r['trials'])} | "
-                     f"{first['value']:.1f} ± {first['standard_error']:.1f} | "
-                     f"{best['value']:.1f} ({best['number']}) | "
-                     f"{best['value'] - first['value']:+.1f} | {params} |")
-    lines += ["", "As it is: " + " | ".join(f"{k} {_shown(k, v)}" for k, v in DEFAULTS.items())
-              + " (metre_cost as a factor on the reward's own; fade_rate [1/m] = 1 / fade)."]
+                     f"{sum(t['wall_s'] for t in r['trials']) / 60:.0f} | "
+                     f"{first['value']:.1f} | {best['value']:.1f} ({best['number']}) | "
+                     f"{gains} | {best['value'] - first['value']:+.1f} |")
+    lines += ["", "The best trials' settings, beside the planner's own:", "",
+              "| search | " + " | ".join(_SHOWN) + " |", "|---" * (1 + len(_SHOWN)) + "|",
+              "| as it is | " + " | ".join(_setting(k, DEFAULTS) for k in _SHOWN) + " |"]
+    for name, r in records.items():
+        best = max(r["trials"], key=lambda t: t["value"])
+        lines.append(f"| {name} | " + " | ".join(_setting(k, best["params"]) for k in _SHOWN)
+                     + " |")
+    lines += ["", "Mean returns over the search's own fields (its trials are paired on "
+              "them); metre_cost as a factor on the reward's own trade-off."]
     (out / "search.md").write_text("\n".join(lines) + "\n")
-    summary = {name: dict(trials=r["trials"], best=r["best"], settings=r["settings"],
-                          command=r.get("command", ""), commit=r.get("commit"))
+    summary = {name: dict(trials=[_brief(t) for t in r["trials"]], best=r["best"],
+                          settings=r["settings"], command=r.get("command", ""),
+                          commit=r.get("commit"))
                for name, r in records.items()}
     (out / SEARCH).write_text(json.dumps(summary, indent=1) + "\n")
     _plot(records, out / "search.png")
     return summary
 
 
-def _shown(name: str, value) -> str:
-    return str(int(value)) if SPACE[name][3] else f"{float(value):.3g}"
+def _brief(trial: dict) -> dict:
+    """A trial as the report keeps it: its parameters and mean returns to
+    four significant figures (the search's own record keeps them whole)."""
+    def g(v):
+        return float(f"{v:.4g}")
+    return dict(number=trial["number"], value=g(trial["value"]),
+                by_concentration={a: g(v) for a, v in trial["by_concentration"].items()},
+                params={k: (v if isinstance(v, int) else g(v)) for k, v in trial["params"].items()},
+                wall_s=trial["wall_s"])
+
+
+#: the settings as the report shows them (fade [m] = 1 / fade_rate)
+_SHOWN = ("metre_cost", "blur [m]", "fade [m]", "max_slope", "lookahead [m]", "replan_steps",
+          "edge_margin [m]")
+
+
+def _setting(shown: str, params: dict) -> str:
+    name = shown.split(" ")[0]
+    if name == "fade":
+        return "none" if params["fade_rate"] <= 0 else f"{1.0 / params['fade_rate']:.0f}"
+    if SPACE[name][3]:
+        return str(int(params[name]))
+    return f"{float(params[name]):.2g}" if name in ("metre_cost", "max_slope") \
+        else f"{float(params[name]):.1f}"
 
 
 def _plot(records: dict, path: Path) -> None:
