@@ -29,8 +29,8 @@ from .runs import (checkpoint_paths_checked, run_env_id,  # noqa: F401  (re-expo
                    trained_argument)
 
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
-           "evaluate_in_processes", "policy_from_recipe", "rounded", "stats", "summarise", "compare",
-           "verdict",
+           "evaluate_in_processes", "worker_episode", "policy_from_recipe", "rounded", "stats",
+           "summarise", "compare", "verdict",
            "AGENT_KWARGS", "run_agent_kwargs", "run_env_id", "trained_policy"]
 
 #: environment arguments that set how an agent acts and what it sees rather
@@ -250,12 +250,13 @@ def _own_env(env, agent_kwargs: dict):
 _WORKER: dict = {}
 
 
-def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
+def worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
                     episode_seed: int) -> dict:
     """One episode in a worker process: the worker builds its environment
     once (``reset(seed=env_seed)``, as the evaluation's main process does)
-    and each policy once from its recipe, then runs
-    :func:`run_episode`."""
+    and each policy once from its recipe (kept by ``name``, so that a pool
+    kept between evaluations must give another policy another name), then
+    runs :func:`run_episode`."""
     from .envs import make_checked_env
 
     if not _WORKER:
@@ -327,7 +328,7 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
         kwargs = {name: {**env_kwargs, **(run_agent_kwargs(recipe[1])
                                           if recipe[0] == "trained" else {})}
                   for name, recipe in recipes.items()}
-        jobs = {pool.submit(_worker_episode, env_id, kwargs[name], seed, name, recipe, seed + k):
+        jobs = {pool.submit(worker_episode, env_id, kwargs[name], seed, name, recipe, seed + k):
                 (name, k) for name, recipe in recipes.items() for k in range(episodes)}
         for job in concurrent.futures.as_completed(jobs):
             name, k = jobs[job]

@@ -207,10 +207,10 @@ def _sail(pool, env_id: str, env_kwargs: dict, concentrations, name: str, policy
     seeded ``fields`` + k, in the worker processes of ``pool`` (each keeps
     its environments between trials; ``name`` is the trial's own, so that
     no worker plays an earlier trial's planner)."""
-    from .rollouts import _worker_episode, policy_recipe
+    from .rollouts import policy_recipe, worker_episode
 
     recipe = policy_recipe(policy)
-    jobs = {f"{float(a):g}": [pool.submit(_worker_episode, env_id,
+    jobs = {f"{float(a):g}": [pool.submit(worker_episode, env_id,
                                           {**env_kwargs, "concentration": float(a)}, fields,
                                           name, recipe, fields + k) for k in range(episodes)]
             for a in concentrations}
