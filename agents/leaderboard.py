@@ -80,9 +80,10 @@ DETOUR_LIMIT = 1.1
 
 def run_leaderboard(env_id: str, concentrations, recipes: dict, *, episodes: int, seed: int,
                     processes: int, env_kwargs: dict | None = None,
-                    progress: bool = True) -> dict:
+                    progress: bool = True, pool=None) -> dict:
     """``{concentration (str): {policy: [episode dicts]}}`` of
-    :func:`agents.rollouts.evaluate_in_processes` at each concentration."""
+    :func:`agents.rollouts.evaluate_in_processes` at each concentration
+    (in ``pool``, a :func:`agents.rollouts.process_pool`, where given)."""
     from .rollouts import evaluate_in_processes
 
     board = {}
@@ -90,7 +91,7 @@ def run_leaderboard(env_id: str, concentrations, recipes: dict, *, episodes: int
         kwargs = {**(env_kwargs or {}), "concentration": float(a)}
         board[f"{float(a):g}"] = evaluate_in_processes(
             env_id, kwargs, recipes, episodes=episodes, seed=seed, processes=processes,
-            progress=progress)
+            progress=progress, pool=pool)
     return board
 
 

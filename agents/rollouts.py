@@ -29,7 +29,7 @@ from .runs import (checkpoint_paths_checked, run_env_id,  # noqa: F401  (re-expo
                    trained_argument)
 
 __all__ = ["TrainedPolicy", "trained_argument", "episode_task", "run_episode", "evaluate",
-           "evaluate_in_processes", "worker_episode", "policy_from_recipe", "rounded", "stats",
+           "evaluate_in_processes", "process_pool", "policy_from_recipe", "rounded", "stats",
            "summarise", "compare", "verdict",
            "AGENT_KWARGS", "run_agent_kwargs", "run_env_id", "trained_policy"]
 
@@ -250,13 +250,12 @@ def _own_env(env, agent_kwargs: dict):
 _WORKER: dict = {}
 
 
-def worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
+def _worker_episode(env_id: str, env_kwargs: dict, env_seed: int, name: str, recipe: tuple,
                     episode_seed: int) -> dict:
     """One episode in a worker process: the worker builds its environment
     once (``reset(seed=env_seed)``, as the evaluation's main process does)
-    and each policy once from its recipe (kept by ``name``, so that a pool
-    kept between evaluations must give another policy another name), then
-    runs :func:`run_episode`."""
+    and each policy once from its recipe, then runs
+    :func:`run_episode`."""
     from .envs import make_checked_env
 
     if not _WORKER:
@@ -301,8 +300,22 @@ def policy_from_recipe(recipe: tuple, env, seed: int):
     return make_baseline(target, env, seed=seed, **kwargs)
 
 
+def process_pool(processes: int):
+    """A pool of ``processes`` worker processes for
+    :func:`evaluate_in_processes` (started by forkserver where there is
+    one), to keep between evaluations: each worker keeps its environments
+    and its policies, by name, from one evaluation to the next."""
+    import concurrent.futures
+    import multiprocessing
+
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    return concurrent.futures.ProcessPoolExecutor(
+        processes, mp_context=multiprocessing.get_context(method))
+
+
 def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episodes: int,
-                          seed: int, processes: int, progress: bool = True) -> dict:
+                          seed: int, processes: int, progress: bool = True,
+                          pool=None) -> dict:
     """:func:`evaluate` with the episodes shared among ``processes`` worker
     processes; the same results, since every episode starts from
     ``reset(seed=seed + k)`` and the policies are deterministic or, like
@@ -313,22 +326,23 @@ def evaluate_in_processes(env_id: str, env_kwargs: dict, recipes: dict, *, episo
     reference, {"search": directories})`` (:func:`policy_recipe`); every worker builds
     its own environment (``gymnasium.make(env_id, **env_kwargs)``, first
     reset with ``seed``; a trained run's with its :data:`AGENT_KWARGS`) and
-    policies from them."""
+    policies from them. ``pool`` (:func:`process_pool`, then left open)
+    runs them instead of a pool of ``processes`` made for this call; as its
+    workers keep each policy by its name, a policy played in an earlier
+    evaluation of the same pool must come under a name of its own."""
     import concurrent.futures
-    import multiprocessing
+    import contextlib
 
     from tqdm.auto import tqdm
 
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
     results = {name: [None] * episodes for name in recipes}
-    with concurrent.futures.ProcessPoolExecutor(
-            processes, mp_context=multiprocessing.get_context(method)) as pool, \
-            tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
-                 disable=not progress) as bar:
+    with (contextlib.nullcontext(pool) if pool is not None else process_pool(processes)) \
+            as pool, tqdm(total=episodes * len(recipes), unit="episode", desc="evaluating",
+                          disable=not progress) as bar:
         kwargs = {name: {**env_kwargs, **(run_agent_kwargs(recipe[1])
                                           if recipe[0] == "trained" else {})}
                   for name, recipe in recipes.items()}
-        jobs = {pool.submit(worker_episode, env_id, kwargs[name], seed, name, recipe, seed + k):
+        jobs = {pool.submit(_worker_episode, env_id, kwargs[name], seed, name, recipe, seed + k):
                 (name, k) for name, recipe in recipes.items() for k in range(episodes)}
         for job in concurrent.futures.as_completed(jobs):
             name, k = jobs[job]

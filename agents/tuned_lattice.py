@@ -141,7 +141,8 @@ def search(out, *, seed: int = 1, trials: int = 24, episodes: int = 8,
 
     from physics.provenance import source_commit
 
-    from .leaderboard import host_signature
+    from .leaderboard import host_signature, run_leaderboard
+    from .rollouts import policy_recipe, process_pool
 
     _check(trials, episodes, concentrations, processes, seed)
     env_kwargs = {"costmap_ahead": 500.0, **(env_kwargs or {})}
@@ -177,44 +178,23 @@ def search(out, *, seed: int = 1, trials: int = 24, episodes: int = 8,
     out.mkdir(parents=True, exist_ok=True)
     record = dict(settings=settings, metre_cost=metre_cost, trials=list(done),
                   command=command, commit=source_commit(), host=host_signature())
-    with _pool(processes) as pool:
+    with process_pool(processes) as pool:
         for n in tqdm(range(len(done), trials), desc="trials", unit="trial",
                       disable=not progress, initial=len(done), total=trials):
             trial = study.ask(distributions)
             policy = policy_of(trial.params, metre_cost)
             t0 = time.perf_counter()
-            board = _sail(pool, env_id, env_kwargs, concentrations, f"trial-{n}", policy,
-                          episodes, fields)
-            record["trials"].append(_trial_record(n, trial.params, policy, board,
-                                                  time.perf_counter() - t0))
+            # each trial's planner under a name of its own: the pool's workers keep policies by name
+            name = f"trial-{n}"
+            board = run_leaderboard(env_id, concentrations, {name: policy_recipe(policy)},
+                                    episodes=episodes, seed=fields, processes=processes,
+                                    env_kwargs=env_kwargs, progress=False, pool=pool)
+            record["trials"].append(_trial_record(
+                n, trial.params, policy, {a: played[name] for a, played in board.items()},
+                time.perf_counter() - t0))
             study.tell(trial, record["trials"][-1]["value"])
             _write(out, record)
     return _write(out, record)
-
-
-def _pool(processes: int):
-    import concurrent.futures
-    import multiprocessing
-
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    return concurrent.futures.ProcessPoolExecutor(
-        processes, mp_context=multiprocessing.get_context(method))
-
-
-def _sail(pool, env_id: str, env_kwargs: dict, concentrations, name: str, policy: str,
-          episodes: int, fields: int) -> dict:
-    """``{concentration: [episode dicts]}`` of ``policy`` on the fields
-    seeded ``fields`` + k, in the worker processes of ``pool`` (each keeps
-    its environments between trials; ``name`` is the trial's own, so that
-    no worker plays an earlier trial's planner)."""
-    from .rollouts import policy_recipe, worker_episode
-
-    recipe = policy_recipe(policy)
-    jobs = {f"{float(a):g}": [pool.submit(worker_episode, env_id,
-                                          {**env_kwargs, "concentration": float(a)}, fields,
-                                          name, recipe, fields + k) for k in range(episodes)]
-            for a in concentrations}
-    return {a: [job.result() for job in js] for a, js in jobs.items()}
 
 
 def _trial_record(n: int, params: dict, policy: str, board: dict, wall: float) -> dict:
@@ -228,8 +208,13 @@ def _trial_record(n: int, params: dict, policy: str, board: dict, wall: float) -
                 wall_s=round(wall, 1))
 
 
+def _best_trial(record: dict) -> dict:
+    """The trial of the highest mean return of a search's ``record``."""
+    return max(record["trials"], key=lambda t: t["value"])
+
+
 def _write(out: Path, record: dict) -> dict:
-    best = max(record["trials"], key=lambda t: t["value"])
+    best = _best_trial(record)
     record["best"] = dict(number=best["number"], value=best["value"], policy=best["policy"],
                           gain_over_first=best["value"] - record["trials"][0]["value"])
     (out / SEARCH).write_text(json.dumps(record, indent=1) + "\n")
@@ -266,7 +251,7 @@ def report(directories, out) -> dict:
              + " | ".join(f"gain at A = {k}" for k in keys) + " | gain over all |",
              "|---" * (7 + len(keys)) + "|"]
     for name, r in records.items():
-        first, best = r["trials"][0], max(r["trials"], key=lambda t: t["value"])
+        first, best = r["trials"][0], _best_trial(r)
         fields = r["settings"]["episodes"] * len(r["settings"]["concentrations"])
         gains = " | ".join(f"{best['by_concentration'][k] - first['by_concentration'][k]:+.1f}"
                            for k in keys)
@@ -278,7 +263,7 @@ def report(directories, out) -> dict:
               "| search | " + " | ".join(_SHOWN) + " |", "|---" * (1 + len(_SHOWN)) + "|",
               "| as it is | " + " | ".join(_setting(k, DEFAULTS) for k in _SHOWN) + " |"]
     for name, r in records.items():
-        best = max(r["trials"], key=lambda t: t["value"])
+        best = _best_trial(r)
         lines.append(f"| {name} | " + " | ".join(_setting(k, best["params"]) for k in _SHOWN)
                      + " |")
     lines += ["", "Mean returns over the search's own fields (its trials are paired on "
@@ -365,16 +350,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import yaml
+    from .envs import parse_key_values
 
     args = build_parser().parse_args(argv)
     if args.command == "search":
-        kwargs = {}
-        for item in args.env_kwargs:
-            key, eq, value = item.partition("=")
-            if not eq:
-                raise SystemExit(f"--env-kwargs takes key=value, got {item!r}")
-            kwargs[key] = yaml.safe_load(value)
+        try:
+            kwargs = parse_key_values(args.env_kwargs)
+        except ValueError as err:
+            raise SystemExit(str(err)) from None
         command = "python -m agents.tuned_lattice " + shlex.join(
             sys.argv[1:] if argv is None else argv)
         try:
