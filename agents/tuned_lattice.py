@@ -49,9 +49,10 @@ from pathlib import Path
 import numpy as np
 
 from .leaderboard import DEFAULT_ENV
+from .planners import CostmapLatticePlanner
 
 __all__ = ["SPACE", "DEFAULTS", "SEARCH_SEED", "SEARCH", "policy_of", "search", "read_search",
-           "best_policy", "report", "main"]
+           "best_policy", "ByConcentration", "by_concentration_policy", "report", "main"]
 
 #: each parameter's range: (low, high, log scale, integer); ``metre_cost`` is
 #: a factor on the environment's own trade-off, ``fade_rate`` [1/m] is
@@ -235,6 +236,79 @@ def best_policy(directory) -> str:
     return read_search(directory)["best"]["policy"]
 
 
+def _bounds(bounds) -> list[float]:
+    """The concentrations ``bounds`` checked: a list increasing within (0, 1)."""
+    if isinstance(bounds, (str, bytes)) or not hasattr(bounds, "__len__") or not len(bounds):
+        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}")
+    try:
+        edges = [float(b) for b in bounds]
+    except (TypeError, ValueError):
+        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}") from None
+    if any(not 0.0 < b < 1.0 for b in edges) or any(b >= c for b, c in zip(edges, edges[1:])):
+        raise ValueError(f"bounds must increase within (0, 1), got {bounds!r}")
+    return edges
+
+
+class ByConcentration(CostmapLatticePlanner):
+    """The costmap lattice with settings of its own for each range of the
+    episode's ice concentration (not privileged): the planner of
+    ``settings[i]`` (keyword arguments of
+    :class:`agents.planners.CostmapLatticePlanner`) sails an episode whose
+    concentration lies below ``bounds[i]`` (and at or above ``bounds[i - 1]``);
+    the last sails those at or above the last bound. The concentration is
+    the observation's ``concentration`` entry at the episode's first step,
+    an entry every learner of the environment sees too.
+
+    It joins searches made at different concentrations, as
+    :func:`by_concentration_policy` writes it from their directories."""
+
+    reads_environment = "its costmap"
+
+    def __init__(self, env, seed: int = 0, *, bounds, settings):
+        edges = _bounds(bounds)
+        if not isinstance(settings, (list, tuple)) or len(settings) != len(edges) + 1 \
+                or not all(isinstance(s, dict) for s in settings):
+            raise ValueError(f"settings must be {len(edges) + 1} mappings of the planner's "
+                             f"arguments (one more than the bounds), got {settings!r}")
+        super().__init__(env, seed)
+        if "concentration" not in self._index:
+            raise ValueError(f"ByConcentration reads the observation's concentration entry, "
+                             f"which {type(self.unwrapped).__name__} has not")
+        self.bounds = edges
+        self.planners = [CostmapLatticePlanner(env, seed, **s) for s in settings]
+        self.chosen = None
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        for planner in self.planners:
+            planner.reset(seed)
+        self.chosen = None
+
+    def act(self, obs):
+        if self.chosen is None:
+            a = self._reader(obs)("concentration")
+            self.chosen = self.planners[int(np.searchsorted(self.bounds, a, side="right"))]
+            # the episode's plans are the chosen planner's
+            self.decision_times = self.chosen.decision_times
+        return self.chosen.act(obs)
+
+
+def by_concentration_policy(bounds, directories) -> str:
+    """The :class:`ByConcentration` policy of the best trials of the
+    searches in ``directories``, one more than ``bounds``: the first
+    search's settings below the first bound, and so on."""
+    from .policy import parse_reference
+
+    bounds = _bounds(bounds)
+    if len(directories) != len(bounds) + 1:
+        raise ValueError(f"{len(bounds)} bounds take {len(bounds) + 1} searches, "
+                         f"got {len(directories)}")
+    settings = [parse_reference(best_policy(d))[2] for d in directories]
+    text = ", ".join("{" + ", ".join(f"{k}: {v}" for k, v in s.items()) + "}" for s in settings)
+    return (f"agents.tuned_lattice:ByConcentration?bounds=[{','.join(f'{b:g}' for b in bounds)}]"
+            f"&settings=[{text}]")
+
+
 def report(directories, out) -> dict:
     """``out``/``search.md`` and ``search.png``: each search's first trial
     (the planner as it is), its best, and the best's parameters; the mean
@@ -346,6 +420,11 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--out", required=True)
     b = sub.add_parser("best", help="print a search's best policy")
     b.add_argument("directory")
+    c = sub.add_parser("combine", help="print the policy that sails each range of concentration "
+                                       "with the best settings of a search of its own")
+    c.add_argument("--bounds", required=True,
+                   help="comma-separated concentrations between the searches' ranges")
+    c.add_argument("directories", nargs="+", help="the searches, one more than the bounds")
     return parser
 
 
@@ -374,6 +453,12 @@ def main(argv: list[str] | None = None) -> int:
     elif args.command == "report":
         report(args.directories, args.out)
         print(Path(args.out, "search.md").read_text())
+    elif args.command == "combine":
+        try:
+            bounds = [float(b) for b in args.bounds.split(",")]
+            print(by_concentration_policy(bounds, args.directories))
+        except (ValueError, FileNotFoundError) as err:
+            raise SystemExit(str(err)) from None
     else:
         print(best_policy(args.directory))
     return 0

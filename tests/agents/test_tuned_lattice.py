@@ -97,3 +97,54 @@ def test_bad_settings_are_refused(tmp_path, kwargs, message):
 def test_a_missing_search_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="no search"):
         tuned_lattice.best_policy(tmp_path)
+
+
+def _rewards(concentration, policy_of_env, seed=7):
+    env = gym.make(NAV, **{**KWARGS, "concentration": concentration})
+    rewards = run_episode(env, policy_of_env(env), seed, None)["rewards"]
+    env.close()
+    return np.asarray(rewards)
+
+
+def test_by_concentration_sails_each_episode_with_the_settings_of_its_range():
+    """Below the bound the first settings' planner sails the episode step
+    for step, at or above it the second's; the two differ, so the choice
+    is seen."""
+    low, high = {"metre_cost": 500.0, "replan_steps": 3}, {"metre_cost": 50_000.0}
+    reference = ("agents.tuned_lattice:ByConcentration?bounds=[0.35]"
+                 "&settings=[{metre_cost: 500.0, replan_steps: 3}, {metre_cost: 50000.0}]")
+    for a, own, other in ((0.3, low, high), (0.4, high, low)):
+        joined = _rewards(a, lambda env: make_policy(reference, env))
+        mine = _rewards(a, lambda env, s=own: CostmapLatticePlanner(env, 0, **s))
+        theirs = _rewards(a, lambda env, s=other: CostmapLatticePlanner(env, 0, **s))
+        np.testing.assert_array_equal(joined, mine)
+        assert not np.array_equal(joined, theirs)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"bounds": [0.5, 0.3], "settings": [{}, {}, {}]}, "bounds must increase"),
+    ({"bounds": [1.2], "settings": [{}, {}]}, "bounds must increase"),
+    ({"bounds": "0.4", "settings": [{}, {}]}, "bounds must be a list"),
+    ({"bounds": [0.4], "settings": [{}]}, "settings must be 2 mappings"),
+    ({"bounds": [0.4], "settings": [{}, 3]}, "settings must be 2 mappings"),
+])
+def test_by_concentration_refuses_bad_ranges(kwargs, message):
+    env = gym.make(NAV, **KWARGS)
+    with pytest.raises(ValueError, match=message):
+        tuned_lattice.ByConcentration(env, 0, **kwargs)
+    env.close()
+
+
+def test_the_joined_policy_of_two_searches(tmp_path):
+    for name, cost in (("low", 100), ("high", 200)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "search.json").write_text(json.dumps({"best": {
+            "policy": f"agents.planners:CostmapLatticePlanner?metre_cost={cost}&blur=1.5"}}))
+    policy = tuned_lattice.by_concentration_policy([0.45], [tmp_path / "low", tmp_path / "high"])
+    env = gym.make(NAV, **KWARGS)
+    planner = make_policy(policy, env)
+    assert planner.bounds == [0.45]
+    assert [(p.metre_cost, p.blur) for p in planner.planners] == [(100.0, 1.5), (200.0, 1.5)]
+    env.close()
+    with pytest.raises(ValueError, match="1 bounds take 2 searches"):
+        tuned_lattice.by_concentration_policy([0.45], [tmp_path / "low"])
