@@ -48,6 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
+from iceenvs.ship_controllers import StraightLineController
+
 from .leaderboard import DEFAULT_ENV
 from .planners import CostmapLatticePlanner
 
@@ -249,7 +251,7 @@ def _bounds(bounds) -> list[float]:
     return edges
 
 
-class ByConcentration(CostmapLatticePlanner):
+class ByConcentration(StraightLineController):
     """The costmap lattice with settings of its own for each range of the
     episode's ice concentration (not privileged): the planner of
     ``settings[i]`` (keyword arguments of
@@ -278,6 +280,11 @@ class ByConcentration(CostmapLatticePlanner):
         self.planners = [CostmapLatticePlanner(env, seed, **s) for s in settings]
         self.chosen = None
 
+    @property
+    def decision_times(self) -> list[float]:
+        """The episode's plan times: the chosen planner's."""
+        return [] if self.chosen is None else self.chosen.decision_times
+
     def reset(self, seed: int | None = None) -> None:
         super().reset(seed)
         for planner in self.planners:
@@ -288,8 +295,6 @@ class ByConcentration(CostmapLatticePlanner):
         if self.chosen is None:
             a = self._reader(obs)("concentration")
             self.chosen = self.planners[int(np.searchsorted(self.bounds, a, side="right"))]
-            # the episode's plans are the chosen planner's
-            self.decision_times = self.chosen.decision_times
         return self.chosen.act(obs)
 
 
@@ -304,7 +309,8 @@ def by_concentration_policy(bounds, directories) -> str:
         raise ValueError(f"{len(bounds)} bounds take {len(bounds) + 1} searches, "
                          f"got {len(directories)}")
     settings = [parse_reference(best_policy(d))[2] for d in directories]
-    text = ", ".join("{" + ", ".join(f"{k}: {v}" for k, v in s.items()) + "}" for s in settings)
+    text = ", ".join("{" + ", ".join(f"{k}: {_text(v)}" for k, v in s.items()) + "}"
+                     for s in settings)
     return (f"agents.tuned_lattice:ByConcentration?bounds=[{','.join(f'{b:g}' for b in bounds)}]"
             f"&settings=[{text}]")
 
