@@ -93,7 +93,33 @@ from iceenvs.costmap import impulse_costmap
 from iceenvs.ship_controllers import StraightLineController
 
 __all__ = ["LatticePlanner", "CostmapLatticePlanner", "RolloutPlanner", "ON_REQUEST",
-           "costmap_cost_grid", "impulse_costmap", "lattice_route", "PLANNERS"]
+           "costmap_cost_grid", "impulse_costmap", "lattice_route", "concentration_bounds",
+           "planner_for", "PLANNERS"]
+
+
+def concentration_bounds(bounds) -> list[float]:
+    """``bounds`` checked as the edges of ranges of the ice concentration, by
+    which a planner takes settings of its own for each range: a list
+    increasing within (0, 1)."""
+    if isinstance(bounds, (str, bytes)) or not hasattr(bounds, "__len__") or not len(bounds):
+        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}")
+    try:
+        edges = [float(b) for b in bounds]
+    except (TypeError, ValueError):
+        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}") from None
+    if any(not 0.0 < b < 1.0 for b in edges) or any(b >= c for b, c in zip(edges, edges[1:])):
+        raise ValueError(f"bounds must increase within (0, 1), got {bounds!r}")
+    return edges
+
+
+def planner_for(bounds, planners, read):
+    """The one of ``planners`` (one more than ``bounds``) for the episode's
+    concentration, read by ``read("concentration")`` (an observation's
+    reader) where there are bounds: the first below ``bounds[0]``, and so on,
+    the last at or above the last bound."""
+    if not bounds:
+        return planners[0]
+    return planners[int(np.searchsorted(bounds, read("concentration"), side="right"))]
 
 
 @njit(cache=True)

@@ -51,7 +51,7 @@ import numpy as np
 from iceenvs.ship_controllers import StraightLineController
 
 from .leaderboard import DEFAULT_ENV
-from .planners import CostmapLatticePlanner
+from .planners import CostmapLatticePlanner, concentration_bounds, planner_for
 
 __all__ = ["SPACE", "DEFAULTS", "SEARCH_SEED", "SEARCH", "policy_of", "search", "read_search",
            "best_policy", "ByConcentration", "by_concentration_policy", "report", "main"]
@@ -238,19 +238,6 @@ def best_policy(directory) -> str:
     return read_search(directory)["best"]["policy"]
 
 
-def _bounds(bounds) -> list[float]:
-    """The concentrations ``bounds`` checked: a list increasing within (0, 1)."""
-    if isinstance(bounds, (str, bytes)) or not hasattr(bounds, "__len__") or not len(bounds):
-        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}")
-    try:
-        edges = [float(b) for b in bounds]
-    except (TypeError, ValueError):
-        raise ValueError(f"bounds must be a list of concentrations, got {bounds!r}") from None
-    if any(not 0.0 < b < 1.0 for b in edges) or any(b >= c for b, c in zip(edges, edges[1:])):
-        raise ValueError(f"bounds must increase within (0, 1), got {bounds!r}")
-    return edges
-
-
 class ByConcentration(StraightLineController):
     """The costmap lattice with settings of its own for each range of the
     episode's ice concentration (not privileged): the planner of
@@ -267,7 +254,7 @@ class ByConcentration(StraightLineController):
     reads_environment = "its costmap"
 
     def __init__(self, env, seed: int = 0, *, bounds, settings):
-        edges = _bounds(bounds)
+        edges = concentration_bounds(bounds)
         if not isinstance(settings, (list, tuple)) or len(settings) != len(edges) + 1 \
                 or not all(isinstance(s, dict) for s in settings):
             raise ValueError(f"settings must be {len(edges) + 1} mappings of the planner's "
@@ -293,8 +280,7 @@ class ByConcentration(StraightLineController):
 
     def act(self, obs):
         if self.chosen is None:
-            a = self._reader(obs)("concentration")
-            self.chosen = self.planners[int(np.searchsorted(self.bounds, a, side="right"))]
+            self.chosen = planner_for(self.bounds, self.planners, self._reader(obs))
         return self.chosen.act(obs)
 
 
@@ -304,7 +290,7 @@ def by_concentration_policy(bounds, directories) -> str:
     search's settings below the first bound, and so on."""
     from .policy import parse_reference
 
-    bounds = _bounds(bounds)
+    bounds = concentration_bounds(bounds)
     if len(directories) != len(bounds) + 1:
         raise ValueError(f"{len(bounds)} bounds take {len(bounds) + 1} searches, "
                          f"got {len(directories)}")

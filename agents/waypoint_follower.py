@@ -26,10 +26,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .planners import LatticePlanner, costmap_cost_grid
+from .planners import LatticePlanner, costmap_cost_grid, planner_for
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
-           "FINETUNE_RECORD", "OFFSETS_RECORD", "PRIVILEGED", "TEACHERS", "WaypointFollower",
+           "FINETUNE_RECORD", "OFFSETS_RECORD", "PRIVILEGED", "TEACHERS", "ROUTE_SETTINGS",
+           "PACE_SETTINGS", "ROUTE_TEACHERS", "route_planners", "teacher_route", "WaypointFollower",
            "Commanded", "WaypointStudent",
            "LatticeWaypoints", "WaypointResidual", "decision_observation", "decision_space",
            "load_student", "is_residual", "rollout_decision", "sail_fields", "student_decision",
@@ -351,6 +352,65 @@ class WaypointStudent(WaypointFollower):
 #: the teachers of :class:`LatticeWaypoints`: the lattice on the floes
 #: (privileged), or on the environment's costmap (what the student sees)
 TEACHERS = ("lattice", "costmap-lattice")
+#: a route's own settings in :class:`LatticeWaypoints`'s ``settings``; the
+#: follower's pace and pursuit are its own
+ROUTE_SETTINGS = ("metre_cost", "blur", "fade", "max_slope", "edge_margin", "horizon")
+#: settings of a tuned planner that a waypoint follower sets itself
+PACE_SETTINGS = ("lookahead", "replan_steps")
+
+
+def route_planners(env, seed: int, teacher: str, bounds, settings):
+    """(bounds, planners) of :class:`LatticeWaypoints`'s ``bounds`` and
+    ``settings``: ([], []) for none; one planner a mapping otherwise (the
+    lattice on the floes or on the costmap, as ``teacher``), planning only
+    (it draws nothing)."""
+    from .planners import CostmapLatticePlanner, concentration_bounds
+
+    if settings is None:
+        if bounds is not None:
+            raise ValueError("bounds choose among settings: give settings too")
+        return [], []
+    edges = [] if bounds is None else concentration_bounds(bounds)
+    if not isinstance(settings, (list, tuple)) or len(settings) != len(edges) + 1 \
+            or not all(isinstance(s, dict) for s in settings):
+        raise ValueError(f"settings must be {len(edges) + 1} mapping(s) of the planner's "
+                         f"arguments (one more than the bounds), got {settings!r}")
+    kind = CostmapLatticePlanner if teacher == "costmap-lattice" else LatticePlanner
+    planners = []
+    for s in settings:
+        unknown = sorted(set(s) - set(ROUTE_SETTINGS) - set(PACE_SETTINGS))
+        if unknown:
+            raise ValueError(f"a route's settings are {ROUTE_SETTINGS} (and {PACE_SETTINGS}, "
+                             f"which the follower sets itself), got {unknown}")
+        route = {k: v for k, v in s.items() if k in ROUTE_SETTINGS}
+        planners.append(kind(env, seed, show=False, **route))
+    return edges, planners
+
+
+#: the planners whose settings a teacher's routes may take (:func:`teacher_route`),
+#: by class name: the teacher each plans as
+ROUTE_TEACHERS = {"LatticePlanner": "lattice", "CostmapLatticePlanner": "costmap-lattice",
+                  "ByConcentration": "costmap-lattice"}
+
+
+def teacher_route(policy: str) -> tuple[str, dict]:
+    """(teacher, {"bounds": ..., "settings": ...}) of a planner's policy
+    string (``module:Class?key=value&...``): a lattice planner's settings,
+    or :class:`agents.tuned_lattice.ByConcentration`'s by concentration, as
+    :class:`LatticeWaypoints` takes them."""
+    from .policy import parse_reference
+
+    _, name, kwargs = parse_reference(policy)
+    if name not in ROUTE_TEACHERS:
+        raise ValueError(f"a teacher's routes are a planner's of {sorted(ROUTE_TEACHERS)}, "
+                         f"got {name!r} in {policy!r}")
+    if name == "ByConcentration":
+        unknown = sorted(set(kwargs) - {"bounds", "settings"})
+        if unknown:
+            raise ValueError(f"ByConcentration takes bounds and settings, got {unknown}")
+        return ROUTE_TEACHERS[name], {"bounds": kwargs.get("bounds"),
+                                      "settings": kwargs.get("settings")}
+    return ROUTE_TEACHERS[name], {"bounds": None, "settings": [kwargs]}
 
 
 class LatticeWaypoints(WaypointFollower):
@@ -362,17 +422,48 @@ class LatticeWaypoints(WaypointFollower):
     ``teacher="costmap-lattice"``: the lattice plans on the environment's
     costmap instead (:class:`agents.planners.CostmapLatticePlanner`; not
     privileged), whose episode it then sails: a decision that is a function
-    of what the student sees."""
+    of what the student sees.
+
+    ``settings``: the route is planned with settings of its own (a list of
+    mappings of :class:`agents.planners.CostmapLatticePlanner`'s arguments,
+    one more than ``bounds``, as :class:`agents.tuned_lattice.ByConcentration`
+    takes them; the first where the episode's concentration, read from the
+    observation at its first step, lies below ``bounds[0]``, and so on): a
+    tuned planner's routes, at the follower's pace. Only the route's
+    settings (``metre_cost``, ``blur``, ``fade``, ``max_slope``,
+    ``edge_margin``, ``horizon``) are the teacher's; ``lookahead`` and
+    ``replan_steps`` among them are not used, since the follower pursues
+    every route by its own ``lookahead`` and decides every ``interval``
+    steps, and a decision w_k = 1 is still a slope of the follower's
+    ``max_slope``. The waypoints are kept the follower's ``edge_margin``
+    inside the channel."""
 
     reads_environment = "its floes"
 
-    def __init__(self, env, seed: int = 0, *, teacher: str = "lattice", **kwargs):
+    def __init__(self, env, seed: int = 0, *, teacher: str = "lattice", bounds=None,
+                 settings=None, **kwargs):
         super().__init__(env, seed, **kwargs)
         if teacher not in TEACHERS:
             raise ValueError(f"teacher must be one of {TEACHERS}, got {teacher!r}")
         self.teacher = teacher
         if teacher == "costmap-lattice":
             self.reads_environment = "its costmap"
+        self.bounds, self.route_planners = route_planners(env, seed, teacher, bounds, settings)
+        if self.bounds and "concentration" not in self._index:
+            raise ValueError(f"settings by concentration read the observation's concentration "
+                             f"entry, which {type(self.unwrapped).__name__} has not")
+        self._chosen = None
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        for planner in self.route_planners:
+            planner.reset(seed)
+        self._chosen = None
+
+    def act(self, obs):
+        if self.route_planners and self._chosen is None:
+            self._chosen = planner_for(self.bounds, self.route_planners, self._reader(obs))
+        return super().act(obs)
 
     def cost_grid(self, x, y0, nx, ny, reach):
         if self.teacher == "costmap-lattice":
@@ -384,7 +475,7 @@ class LatticeWaypoints(WaypointFollower):
         the choice of its route's first two stages (a route planned from a
         straight heading, when none turns from the heading in time, is
         given the nearest choice)."""
-        route = self.plan()
+        route = self.plan() if self._chosen is None else self._chosen.plan()
         x, y = (float(v) for v in self.unwrapped.sim.ship.position)
         d = self.distances
         ahead = np.interp(x + d, route[:, 0], route[:, 1])

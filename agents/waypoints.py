@@ -27,7 +27,12 @@ terms:
   decision the pursuit's target stays on those two stages, so the teacher
   sails the lattice planner's own episode, step for step (tested). Its
   decision is a function of the ship's pose and the floes at the decision
-  alone.
+  alone. With ``--teacher costmap-lattice`` it plans on the costmap the
+  student sees, and with ``--teacher-policy`` its routes take a tuned
+  planner's settings (:mod:`agents.tuned_lattice`: ``best`` or ``combine``
+  prints one), by the episode's concentration where the policy has
+  settings for each range of it; the pace and the pursuit stay the
+  follower's own.
 * **The student**, :class:`WaypointStudent`, decides from what a ship's
   own sensors give (:func:`decision_observation`): the environment's
   costmap (:meth:`iceenvs.ship_env.ShipEnv.costmap`; floes within 300 m
@@ -71,7 +76,7 @@ from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, ST
                                 WAYPOINT_DISTANCE, LatticeWaypoints, WaypointFollower,
                                 WaypointResidual, WaypointStudent, decision_observation,
                                 decision_space, gather_records, sail_fields, student_decision,
-                                write_gathered)
+                                teacher_route, write_gathered)
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
@@ -150,8 +155,8 @@ class _Dagger(LatticeWaypoints):
     probability ``beta``, the student's (``policy``; None: never) otherwise."""
 
     def __init__(self, env, seed: int, policy, beta: float, coin, form: str, points: int,
-                 teacher: str = "lattice"):
-        super().__init__(env, seed, form=form, points=points, teacher=teacher)
+                 teacher: str = "lattice", route: dict | None = None):
+        super().__init__(env, seed, form=form, points=points, teacher=teacher, **(route or {}))
         self.policy, self.beta, self.coin = policy, float(beta), coin
         self.seen: list[dict] = []
         self.labels: list = []
@@ -170,13 +175,14 @@ class _Dagger(LatticeWaypoints):
 
 def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed: int,
          label: str, progress: bool, form: str = "waypoints", points: int = 2,
-         teacher: str = "lattice"):
-    """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`;
+         teacher: str = "lattice", route: dict | None = None):
+    """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`
+    (``route``: the teacher's route settings, :func:`teacher_route`);
     returns (observations, labels, student decisions, returns)."""
     import gymnasium as gym
     env = gym.make(env_id, **env_kwargs)
     driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points,
-                     teacher)
+                     teacher, route)
     try:
         returns = sail_fields(env, driver, seed, episodes, label, progress)
     finally:
@@ -187,7 +193,7 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
 #: the settings of :func:`train_student`
 #: (the environment is the leaderboard's, on whose fields a student is judged)
 TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints", teacher="lattice",
-                      points=2, episodes=60,
+                      teacher_policy=None, points=2, episodes=60,
                       rounds=4, beta=0.5, epochs=20, refit="warm", mirror=True, batch_size=256,
                       learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
                       held_out_seed=50000)
@@ -234,6 +240,12 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         raise ValueError(f"refit must be one of {REFITS}, got {s['refit']!r}")
     if s["teacher"] not in TEACHERS:
         raise ValueError(f"teacher must be one of {TEACHERS}, got {s['teacher']!r}")
+    route = None
+    if s["teacher_policy"] is not None:
+        kind, route = teacher_route(s["teacher_policy"])
+        if kind != s["teacher"]:
+            raise ValueError(f"the teacher's policy plans as the {kind}: give teacher {kind!r}, "
+                             f"got {s['teacher']!r}")
     if s["form"] == "stages" and s["points"] != 2:
         raise ValueError(f"form 'stages' decides two waypoints, got points {s['points']!r}")
     choices = s["form"] == "stages"
@@ -256,7 +268,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         new, wanted, _, returns = sail(
             s["env_id"], s["env_kwargs"], policy if r else None, beta, s["episodes"],
             s["field_seed"] + r * s["episodes"], f"round {r} (beta {beta:.3g})", progress,
-            s["form"], s["points"], s["teacher"])
+            s["form"], s["points"], s["teacher"], route)
         new = obs_rows.stack(new)
         seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
         del new
@@ -281,7 +293,7 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     probe.close()
     _, wanted, students, _ = sail(s["env_id"], s["env_kwargs"], policy, 1.0,
                                   s["held_out_episodes"], s["held_out_seed"], "held out",
-                                  progress, s["form"], s["points"], s["teacher"])
+                                  progress, s["form"], s["points"], s["teacher"], route)
     if choices:
         held = {"action_accuracy": float(np.mean(students == wanted))}
     else:
@@ -327,7 +339,8 @@ def report(runs, out: Path) -> dict:
         held, s = record["held_out"], record["settings"]
         fitted = sum(r["decisions"] for r in record["rounds"]) * (2 if s.get("mirror") else 1)
         lines.append(f"| {name} | {s['seed']} | {s.get('form', 'waypoints')} "
-                     f"| {s.get('teacher', 'lattice')} "
+                     f"| {s.get('teacher', 'lattice')}"
+                     f"{' (its own settings)' if s.get('teacher_policy') else ''} "
                      f"| {s.get('refit', 'warm')}, {s['epochs']} epochs | {held['decisions']} "
                      f"| {fit_text(held)} | {fitted} | {record['seconds'] / 60:.1f} |")
     first = next(iter(records.values()))["settings"]
@@ -356,6 +369,11 @@ def main(argv=None) -> int:
     t.add_argument("--teacher", choices=TEACHERS, default=TRAIN_DEFAULTS["teacher"],
                    help="the lattice on the floes (lattice, default; privileged) or on the "
                         "environment's costmap (costmap-lattice; what the student sees)")
+    t.add_argument("--teacher-policy", default=None, metavar="POLICY",
+                   help="plan the teacher's routes with a planner's own settings: a lattice "
+                        "planner's policy string, or agents.tuned_lattice:ByConcentration's "
+                        "(python -m agents.tuned_lattice best or combine prints one); the "
+                        "follower's pace and pursuit stay its own")
     t.add_argument("--refit", choices=REFITS, default=TRAIN_DEFAULTS["refit"],
                    help="fit each round's student from the last round's weights (warm, "
                         "default) or from a new network (fresh)")
@@ -423,7 +441,8 @@ def main(argv=None) -> int:
                   f"; reward {record['reward']}, its sums {record['mean_return_by_window']}"
                   if record["settings"]["paired_horizon"] else ""))
         return 0
-    settings = {k: getattr(args, k) for k in ("form", "teacher", "refit", "points", "episodes",
+    settings = {k: getattr(args, k) for k in ("form", "teacher", "teacher_policy", "refit",
+                                              "points", "episodes",
                                               "rounds", "epochs",
                                               "field_seed",
                                               "held_out_episodes", "held_out_seed", "beta",

@@ -69,6 +69,64 @@ def test_the_costmap_teacher_sails_the_costmap_lattices_episode(form, blur):
         sail(LatticeWaypoints, 1, 0.4, teacher="oracle")
 
 
+def test_a_teacher_with_settings_of_its_own_plans_with_them_at_the_followers_pace():
+    """``settings``: the teacher's routes are planned with a tuned planner's
+    route settings (its pace and pursuit settings are the follower's own),
+    by the episode's concentration when ``bounds`` are given; so it sails
+    the episode of a follower whose own settings they are."""
+    own = {"blur": 2.5, "metre_cost": 30000.0}
+    other = {"blur": 0.0, "metre_cost": 300.0, "fade": 150.0}
+    pace = {"lookahead": 20.0, "replan_steps": 7}
+    for a, setting in ((0.2, own), (0.4, other)):
+        ref, ship_r, _ = sail(LatticeWaypoints, 1, a, teacher="costmap-lattice", **setting)
+        one, ship_1, _ = sail(LatticeWaypoints, 1, a, teacher="costmap-lattice",
+                              settings=[{**setting, **pace}])
+        both, ship_b, policy = sail(LatticeWaypoints, 1, a, teacher="costmap-lattice",
+                                    bounds=[0.3], settings=[{**own, **pace}, other])
+        for rewards, ship in ((one, ship_1), (both, ship_b)):
+            np.testing.assert_array_equal(rewards, ref)
+            np.testing.assert_array_equal(ship, ship_r)
+        assert len(policy.decisions) == -(-len(ref) // 5)     # the follower's pace
+    # the two settings sail apart, so the comparisons above can fail
+    _, apart, _ = sail(LatticeWaypoints, 1, 0.4, teacher="costmap-lattice", **own)
+    assert abs(apart[-1, 1] - ship_r[-1, 1]) > 1.0
+    env = gym.make(NAV, **KWARGS)
+    for bad, match in ((dict(settings=[own], bounds=[0.3]), "2 mapping"),
+                       (dict(settings=[{"cone": False}]), "a route's settings"),
+                       (dict(bounds=[0.3]), "give settings too"),
+                       (dict(settings=[own, own], bounds=[1.5]), "bounds must increase"),
+                       (dict(settings=own), "1 mapping")):
+        with pytest.raises(ValueError, match=match):
+            LatticeWaypoints(env, teacher="costmap-lattice", **bad)
+    env.close()
+
+
+def test_a_tuned_planners_policy_string_gives_the_teachers_routes(tmp_path):
+    """``teacher_route``: a planner's policy string as the teacher's route
+    settings; a DAgger run keeps it in its record, and a teacher of the
+    other kind is refused."""
+    from agents.waypoint_follower import teacher_route
+
+    joined = ("agents.tuned_lattice:ByConcentration?bounds=[0.45]&settings=[{metre_cost: 4000, "
+              "blur: 2, lookahead: 25, replan_steps: 6}, {metre_cost: 7000, max_slope: 0.3}]")
+    assert teacher_route(joined) == ("costmap-lattice", {
+        "bounds": [0.45], "settings": [{"metre_cost": 4000, "blur": 2, "lookahead": 25,
+                                        "replan_steps": 6},
+                                       {"metre_cost": 7000, "max_slope": 0.3}]})
+    assert teacher_route("agents.planners:LatticePlanner?blur=1.5") == (
+        "lattice", {"bounds": None, "settings": [{"blur": 1.5}]})
+    with pytest.raises(ValueError, match="a teacher's routes are a planner's"):
+        teacher_route("agents.planners:RolloutPlanner?margin=1")
+    record = train_student(tmp_path / "run", 0, progress=False, quiet=True, env_kwargs=KWARGS,
+                           episodes=1, rounds=0, epochs=1, held_out_episodes=1,
+                           teacher="costmap-lattice", teacher_policy=joined)
+    assert record["settings"]["teacher_policy"] == joined
+    report([tmp_path / "run"], tmp_path / "report")
+    assert "costmap-lattice (its own settings)" in (tmp_path / "report" / "waypoints.md").read_text()
+    with pytest.raises(ValueError, match="give teacher 'costmap-lattice'"):
+        train_student(tmp_path / "bad", 0, progress=False, teacher_policy=joined)
+
+
 def test_a_noisy_teacher_sails_its_labels_plus_seeded_normal_errors(monkeypatch):
     """``noise`` σ: each decision sailed is the teacher's label plus normal
     errors of σ drawn from a generator seeded by the episode, then clipped;
