@@ -94,7 +94,7 @@ from iceenvs.ship_controllers import StraightLineController
 
 __all__ = ["LatticePlanner", "CostmapLatticePlanner", "RolloutPlanner", "ON_REQUEST",
            "costmap_cost_grid", "impulse_costmap", "lattice_route", "concentration_bounds",
-           "planner_for", "PLANNERS"]
+           "check_settings", "planner_for", "PLANNERS"]
 
 
 def concentration_bounds(bounds) -> list[float]:
@@ -110,6 +110,17 @@ def concentration_bounds(bounds) -> list[float]:
     if any(not 0.0 < b < 1.0 for b in edges) or any(b >= c for b, c in zip(edges, edges[1:])):
         raise ValueError(f"bounds must increase within (0, 1), got {bounds!r}")
     return edges
+
+
+def check_settings(edges, settings) -> None:
+    """``settings`` checked as one mapping of a planner's arguments for each
+    range of the concentration that ``edges`` (checked bounds) make: one more
+    than the bounds."""
+    n = len(edges) + 1
+    if not isinstance(settings, (list, tuple)) or len(settings) != n \
+            or not all(isinstance(s, dict) for s in settings):
+        raise ValueError(f"settings must be {n} mapping{'s' if n > 1 else ''} of the planner's "
+                         f"arguments (one more than the bounds), got {settings!r}")
 
 
 def planner_for(bounds, planners, read):

@@ -51,7 +51,8 @@ import numpy as np
 from iceenvs.ship_controllers import StraightLineController
 
 from .leaderboard import DEFAULT_ENV
-from .planners import CostmapLatticePlanner, concentration_bounds, planner_for
+from .planners import (CostmapLatticePlanner, check_settings, concentration_bounds,
+                       planner_for)
 
 __all__ = ["SPACE", "DEFAULTS", "SEARCH_SEED", "SEARCH", "policy_of", "search", "read_search",
            "best_policy", "ByConcentration", "by_concentration_policy", "report", "main"]
@@ -255,10 +256,7 @@ class ByConcentration(StraightLineController):
 
     def __init__(self, env, seed: int = 0, *, bounds, settings):
         edges = concentration_bounds(bounds)
-        if not isinstance(settings, (list, tuple)) or len(settings) != len(edges) + 1 \
-                or not all(isinstance(s, dict) for s in settings):
-            raise ValueError(f"settings must be {len(edges) + 1} mappings of the planner's "
-                             f"arguments (one more than the bounds), got {settings!r}")
+        check_settings(edges, settings)
         super().__init__(env, seed)
         if "concentration" not in self._index:
             raise ValueError(f"ByConcentration reads the observation's concentration entry, "

@@ -26,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .planners import LatticePlanner, costmap_cost_grid, planner_for
+from .planners import (CostmapLatticePlanner, LatticePlanner, check_settings,
+                       concentration_bounds, costmap_cost_grid, planner_for)
 
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "STAGE_CHOICES", "STUDENT", "RECORD",
            "FINETUNE_RECORD", "OFFSETS_RECORD", "PRIVILEGED", "TEACHERS", "ROUTE_SETTINGS",
@@ -233,7 +234,6 @@ def rollout_decision(env, obs, w, steps: int, *, points: int, distance: float,
     (:class:`~agents.planners.CostmapLatticePlanner`); None: the costmap
     lattice throughout. Stepped on ``env.unwrapped``, below any wrapper,
     whose counters stay as they are; the caller snapshots and restores."""
-    from .planners import CostmapLatticePlanner
 
     u = env.unwrapped
     lattice = CostmapLatticePlanner(env, 0, show=False)
@@ -364,17 +364,12 @@ def route_planners(env, seed: int, teacher: str, bounds, settings):
     ``settings``: ([], []) for none; one planner a mapping otherwise (the
     lattice on the floes or on the costmap, as ``teacher``), planning only
     (it draws nothing)."""
-    from .planners import CostmapLatticePlanner, concentration_bounds
-
     if settings is None:
         if bounds is not None:
             raise ValueError("bounds choose among settings: give settings too")
         return [], []
     edges = [] if bounds is None else concentration_bounds(bounds)
-    if not isinstance(settings, (list, tuple)) or len(settings) != len(edges) + 1 \
-            or not all(isinstance(s, dict) for s in settings):
-        raise ValueError(f"settings must be {len(edges) + 1} mapping(s) of the planner's "
-                         f"arguments (one more than the bounds), got {settings!r}")
+    check_settings(edges, settings)
     kind = CostmapLatticePlanner if teacher == "costmap-lattice" else LatticePlanner
     planners = []
     for s in settings:
