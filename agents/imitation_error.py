@@ -78,9 +78,9 @@ def decision_spread(env_id: str, env_kwargs: dict, concentrations, episodes: int
         raise ValueError("give at least one noise level")
     out = {}
     for c in concentrations:
-        _, labels, _, returns = sail(env_id, {**env_kwargs, "concentration": float(c)}, None,
-                                     1.0, episodes, seed, f"A = {c:g}", progress,
-                                     "waypoints", 2, teacher)
+        _, labels, _, returns, _ = sail(env_id, {**env_kwargs, "concentration": float(c)}, None,
+                                        1.0, episodes, seed, f"A = {c:g}", progress,
+                                        "waypoints", 2, teacher)
         labels = np.asarray(labels, dtype=float)
         rng = np.random.default_rng(seed)
         out[f"{float(c):g}"] = {

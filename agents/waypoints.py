@@ -57,7 +57,11 @@ Train, then play the student on the leaderboard's fields::
 A run holds ``student.zip`` (the SB3 policy, about 0.5 MB) and
 ``waypoints.json``: the settings, each round's decisions, the mean return
 of its episodes and the fit, and the imitation error on fields of no
-round (seeded ``held_out_seed`` + k). ``report`` gathers the runs' records
+round (seeded ``held_out_seed`` + k). With ``--keep-labels`` it also holds
+``labels.npz`` (:data:`LABELS`): every labelled decision, of the rounds
+and of the held-out fields, with its round and its field, so that
+students of other fits can be judged on them without sailing again
+(:mod:`agents.imitation_scaling`). ``report`` gathers the runs' records
 into one record and a table.
 """
 from __future__ import annotations
@@ -80,7 +84,7 @@ from .waypoint_follower import (DECISION_STEPS, FORMS, RECORD, STAGE_CHOICES, ST
 
 # the decision and its follower (agents.waypoint_follower) are named here too
 __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS", "STAGE_CHOICES",
-           "STUDENT", "RECORD", "WaypointFollower",
+           "STUDENT", "RECORD", "LABELS", "WaypointFollower",
            "LatticeWaypoints", "WaypointStudent", "WaypointResidual", "decision_observation",
            "decision_space",
            "make_student", "mirrored", "with_mirror", "train_student", "fit_text", "report",
@@ -89,6 +93,12 @@ __all__ = ["DECISION_STEPS", "WAYPOINT_DISTANCE", "FORMS", "TEACHERS", "REFITS",
 #: how a DAgger round fits the student on all labels so far: from its weights
 #: after the round before (``warm``), or a new network seeded alike (``fresh``)
 REFITS = ("warm", "fresh")
+
+#: a run's labelled decisions (``train --keep-labels``): the arrays
+#: ``costmap``, ``vector`` (the decisions' observations), ``labels`` (the
+#: teacher's decisions, unclipped), ``round`` and ``field`` (the seed of the
+#: decision's field), and the same of the held-out fields prefixed ``held_``
+LABELS = "labels.npz"
 
 
 def make_student(env, *, form: str = "waypoints", points: int = 2, cnn_dim: int = 128,
@@ -161,12 +171,19 @@ class _Dagger(LatticeWaypoints):
         self.seen: list[dict] = []
         self.labels: list = []
         self.students: list = []
+        self.fields: list[int] = []
+        self._field = -1
+
+    def reset(self, seed: int | None = None) -> None:
+        super().reset(seed)
+        self._field = -1 if seed is None else int(seed)
 
     def decide(self, obs):
         seen = decision_observation(self.env)
         wanted = self.label()
         self.seen.append(seen)
         self.labels.append(wanted)
+        self.fields.append(self._field)
         student = student_decision(self.policy, seen) if self.policy is not None \
             else (-1 if self.form == "stages" else np.full(self.points, np.nan))
         self.students.append(student)
@@ -178,7 +195,8 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
          teacher: str = "lattice", route: dict | None = None):
     """Sail ``episodes`` episodes (seeded ``seed`` + k) under :class:`_Dagger`
     (``route``: the teacher's route settings, :func:`teacher_route`);
-    returns (observations, labels, student decisions, returns)."""
+    returns (observations, labels, student decisions, returns, the seed of
+    each decision's field)."""
     import gymnasium as gym
     env = gym.make(env_id, **env_kwargs)
     driver = _Dagger(env, seed, policy, beta, np.random.default_rng(seed), form, points,
@@ -187,7 +205,8 @@ def sail(env_id: str, env_kwargs: dict, policy, beta: float, episodes: int, seed
         returns = sail_fields(env, driver, seed, episodes, label, progress)
     finally:
         env.close()
-    return driver.seen, np.asarray(driver.labels), np.asarray(driver.students), returns
+    return (driver.seen, np.asarray(driver.labels), np.asarray(driver.students), returns,
+            np.asarray(driver.fields, dtype=np.int64))
 
 
 #: the settings of :func:`train_student`
@@ -196,7 +215,7 @@ TRAIN_DEFAULTS = dict(env_id=DEFAULT_ENV, env_kwargs={}, form="waypoints", teach
                       teacher_policy=None, points=2, episodes=60,
                       rounds=4, beta=0.5, epochs=20, refit="warm", mirror=True, batch_size=256,
                       learning_rate=3e-4, cnn_dim=128, field_seed=30000, held_out_episodes=8,
-                      held_out_seed=50000)
+                      held_out_seed=50000, keep_labels=False)
 
 
 def train_student(out: Path, seed: int, progress: bool = True, command: str | None = None,
@@ -212,7 +231,9 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     seeded alike (``"fresh"``), so that the first rounds' labels are not
     passed over again in every round. ``seed`` seeds the network and the
     fits. The imitation error is then measured on ``held_out_episodes`` fields seeded
-    ``held_out_seed`` + k, which the teacher sails. ``command``: the
+    ``held_out_seed`` + k, which the teacher sails. With ``keep_labels``
+    every labelled decision is kept in ``out/labels.npz`` (:data:`LABELS`);
+    the training is the same with or without it. ``command``: the
     command line the record names (None: none). Each round prints a line
     unless ``quiet``.
     """
@@ -260,12 +281,13 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
     policy = new_student()
     seen: dict | None = None  # every decision so far, one float32 array per key
     labels = np.empty(0, dtype=np.int64) if choices else np.empty((0, s["points"]))
+    round_of, field_of = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
     rounds = []
     began = time.perf_counter()
     for r in range(s["rounds"] + 1):
         start = time.perf_counter()
         beta = 1.0 if r == 0 else float(s["beta"]) ** r
-        new, wanted, _, returns = sail(
+        new, wanted, _, returns, fields = sail(
             s["env_id"], s["env_kwargs"], policy if r else None, beta, s["episodes"],
             s["field_seed"] + r * s["episodes"], f"round {r} (beta {beta:.3g})", progress,
             s["form"], s["points"], s["teacher"], route)
@@ -273,6 +295,8 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
         seen = new if seen is None else {k: np.concatenate([seen[k], new[k]]) for k in seen}
         del new
         labels = np.concatenate([labels, wanted])
+        round_of = np.concatenate([round_of, np.full(len(wanted), r)])
+        field_of = np.concatenate([field_of, fields])
         if r and s["refit"] == "fresh":
             policy = new_student()
         data, targets = seen, labels if choices else np.clip(labels, -1.0, 1.0)
@@ -291,9 +315,15 @@ def train_student(out: Path, seed: int, progress: bool = True, command: str | No
                   f"{np.mean(returns):.1f}, {fit_text(rounds[-1])}, "
                   f"{rounds[-1]['seconds']:.0f} s", flush=True)
     probe.close()
-    _, wanted, students, _ = sail(s["env_id"], s["env_kwargs"], policy, 1.0,
-                                  s["held_out_episodes"], s["held_out_seed"], "held out",
-                                  progress, s["form"], s["points"], s["teacher"], route)
+    held_seen, wanted, students, _, held_fields = sail(
+        s["env_id"], s["env_kwargs"], policy, 1.0, s["held_out_episodes"], s["held_out_seed"],
+        "held out", progress, s["form"], s["points"], s["teacher"], route)
+    if s["keep_labels"]:
+        held_seen = obs_rows.stack(held_seen)
+        np.savez_compressed(out / LABELS, labels=labels, round=round_of, field=field_of, **seen,
+                            held_labels=wanted, held_field=held_fields,
+                            **{"held_" + k: v for k, v in held_seen.items()})
+    del held_seen
     if choices:
         held = {"action_accuracy": float(np.mean(students == wanted))}
     else:
@@ -382,6 +412,9 @@ def main(argv=None) -> int:
                    help="fit on the decisions seen only, not also on their mirror images")
     t.add_argument("--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE",
                    help="gymnasium.make keywords of the fields sailed (YAML values)")
+    t.add_argument("--keep-labels", action="store_true",
+                   help=f"keep every labelled decision in OUT/{LABELS}, of the rounds and of "
+                        "the held-out fields (about 0.2 GB a run on a 500 m costmap)")
     t.add_argument("--no-progress", action="store_true")
     from .waypoint_rl import FINETUNE_DEFAULTS
 
@@ -446,7 +479,7 @@ def main(argv=None) -> int:
                                               "rounds", "epochs",
                                               "field_seed",
                                               "held_out_episodes", "held_out_seed", "beta",
-                                              "mirror")}
+                                              "mirror", "keep_labels")}
     from .envs import parse_key_values
 
     try:
