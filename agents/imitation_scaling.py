@@ -31,17 +31,21 @@ can be answered from one labelling:
   (clipped), as a share of the teacher's decisions' variance: the
   measure of the training tables.
 * **The law.** A straight line fitted to log error against log labelled
-  decisions, over the shares, gives the exponent α of error ∝ n^−α and
-  the decisions at which the line reaches each of ``targets``. Read them
-  as an extrapolation beyond the data, not a measurement.
+  decisions gives the exponent α of error ∝ n^−α: over all the shares,
+  and over the two largest alone (where the error has fallen least, the
+  line to follow further), with the decisions at which the latter
+  reaches each of ``targets``. Read them as an extrapolation beyond the
+  data, not a measurement.
 
 Run, on runs trained with ``--keep-labels``::
 
     python -m agents.imitation_scaling RUN [RUN ...] --out DIR
 
 It writes ``DIR/scaling.json`` (settings, each fit's error on both tests,
-each run's law), ``DIR/scaling.md`` (tables) and ``DIR/scaling.png``
+each run's laws), ``DIR/scaling.md`` (tables) and ``DIR/scaling.png``
 (error against labelled decisions, the laws and the targets).
+``--render --out DIR`` writes the laws, tables and figure again from
+``DIR/scaling.json``, without fitting.
 """
 from __future__ import annotations
 
@@ -56,7 +60,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["SCALING_DEFAULTS", "load_labels", "split_fields", "refit_error", "power_law",
-           "scaling", "scaling_markdown", "plot_scaling", "main", "RECORD"]
+           "laws_of", "scaling", "render", "scaling_markdown", "plot_scaling", "main", "RECORD"]
 
 #: the record, its tables and its figure, in the output directory
 RECORD, TABLE, FIGURE = "scaling.json", "scaling.md", "scaling.png"
@@ -275,22 +279,51 @@ def scaling(runs, out: Path, progress: bool = True, command: str | None = None,
                 results[run][key] = result
                 bar.update()
     bar.close()
-    laws = {}
-    for run in runs:
-        shares = [results[run][f"share {f:g}"] for f in fractions]
-        laws[run] = {test: power_law([r["decisions"] for r in shares], [r[test] for r in shares],
-                                     targets) for test in ("test", "held")}
-        laws[run]["decisions_a_second"] = _labelling_rate(run)
-    record = {"settings": {**s, "fractions": fractions, "extra_epochs": extra,
-                           "targets": targets},
-              "runs": results, "laws": laws,
+    settings = {**s, "fractions": fractions, "extra_epochs": extra, "targets": targets}
+    record = {"settings": settings, "runs": results,
+              "laws": laws_of(results, settings, {run: _labelling_rate(run) for run in runs}),
               "seconds": round(time.perf_counter() - began, 1), "command": command}
+    return _write(record, out)
+
+
+def laws_of(results: dict, settings: dict, rates: dict) -> dict:
+    """Each run's laws (:func:`power_law`) on both tests, over all the shares
+    (``test``, ``held``) and over the two largest (``test_last``,
+    ``held_last``), with its pace of labelling (``rates``: decisions a
+    second, by run)."""
+    fractions = sorted(settings["fractions"])
+    laws = {}
+    for run, fits in results.items():
+        shares = [fits[f"share {f:g}"] for f in fractions]
+        laws[run] = {}
+        for test in ("test", "held"):
+            n, e = [r["decisions"] for r in shares], [r[test] for r in shares]
+            laws[run][test] = power_law(n, e, settings["targets"])
+            laws[run][test + "_last"] = power_law(n[-2:], e[-2:], settings["targets"])
+        laws[run]["decisions_a_second"] = float(rates[run])
+    return laws
+
+
+def _write(record: dict, out) -> dict:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     (out / RECORD).write_text(json.dumps(record, indent=1) + "\n")
     (out / TABLE).write_text(scaling_markdown(record))
     plot_scaling(record, out / FIGURE)
     return record
+
+
+def render(out) -> dict:
+    """Write the laws, tables and figure of ``out/scaling.json`` again (by
+    this module's reading of its fits); returns the record."""
+    path = Path(out) / RECORD
+    if not path.is_file():
+        raise FileNotFoundError(f"{out}: no {RECORD} (not a study of python -m "
+                                "agents.imitation_scaling)")
+    record = json.loads(path.read_text())
+    rates = {run: law["decisions_a_second"] for run, law in record["laws"].items()}
+    record["laws"] = laws_of(record["runs"], record["settings"], rates)
+    return _write(record, out)
 
 
 def _labelling_rate(run) -> float:
@@ -322,28 +355,33 @@ def scaling_markdown(record: dict) -> str:
             lines.append(f"| {run} | {key} | {r['decisions']} | {r['epochs']} | {r['own']:.3f} "
                          f"| {r['test']:.3f} | {r['held']:.3f} |")
     head = " | ".join(f"decisions for {t:g} (labelling hours)" for t in s["targets"])
-    lines += ["", f"| run | test | α | {head} |",
-              "|---|---|---|" + "---|" * len(s["targets"])]
+    lines += ["", f"| run | test | α over all shares | α over the two largest | {head} |",
+              "|---|---|---|---|" + "---|" * len(s["targets"])]
+    names = {"test": "test fields", "held": "held-out fields"}
     for run, law in record["laws"].items():
         for test in ("test", "held"):
-            cells = " | ".join(_hours(law[test]["decisions_for"][f"{t:g}"],
-                                      law["decisions_a_second"]) for t in s["targets"])
-            lines.append(f"| {run} | {test} | {law[test]['alpha']:.2f} | {cells} |")
+            last = law[test + "_last"]
+            cells = " | ".join(_hours(last["decisions_for"][f"{t:g}"], law["decisions_a_second"])
+                               for t in s["targets"])
+            lines.append(f"| {run} | {names[test]} | {law[test]['alpha']:.2f} "
+                         f"| {last['alpha']:.2f} | {cells} |")
     lines += ["", f"Errors are shares of the teacher's decisions' variance (decisions clipped "
               f"to [−1, 1]). Test: {s['test_fields']} fields a round kept from every fit; "
               f"held-out: the run's own held-out fields, sailed by the teacher. Shares "
               f"{', '.join(f'{f:g}' for f in s['fractions'])} of the other fields, fitted "
               + (f"for {s['epochs']} / share epochs" if s["scale_epochs"] else
                  f"for {s['epochs']} epochs")
-              + ". The law (error ∝ n^−α over the shares) is an extrapolation; its hours "
-              "are at the run's own pace of labelling (its rounds' decisions over their "
-              f"seconds). {record['seconds']:.0f} s.", ""]
+              + ". The laws (error ∝ n^−α) are extrapolations; the decisions for each "
+              "error are read on the line through the two largest shares, and their hours "
+              "at the run's own pace of labelling (its rounds' decisions over their "
+              f"seconds, fits included). {record['seconds']:.0f} s.", ""]
     return "\n".join(lines)
 
 
 def plot_scaling(record: dict, path: Path) -> None:
     """Error against labelled decisions, log-log: each run's shares on both
-    tests, its law on the test fields, and the targets."""
+    tests, its law through the two largest shares on the test fields
+    (dashed), and the targets."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -357,13 +395,12 @@ def plot_scaling(record: dict, path: Path) -> None:
         ax.plot(n, [r["test"] for r in shares], "o-", color=colour, label=f"{run}: test fields")
         ax.plot(n, [r["held"] for r in shares], "s:", color=colour, alpha=0.6,
                 label=f"{run}: held-out fields")
-        law = record["laws"][run]["test"]
+        law = record["laws"][run]["test_last"]
         far = max([n.max(), *[v for v in law["decisions_for"].values() if v]])
-        grid = np.geomspace(n.min(), min(far, 1e3 * n.max()), 50)
+        grid = np.geomspace(n[-2], min(far, 1e3 * n.max()), 50)
         ax.plot(grid, law["c"] * grid ** -law["alpha"], "--", color=colour, lw=0.8)
-    for t in s["targets"]:
-        ax.axhline(t, color="k", lw=0.6, ls="-.")
-        ax.annotate(f"{t:g}", (ax.get_xlim()[0], t), fontsize=8, va="bottom")
+    for t, style in zip(s["targets"], ["-.", ":", "--", "-"] * len(s["targets"])):
+        ax.axhline(t, color="k", lw=0.7, ls=style, label=f"an error of {t:g}")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("labelled decisions fitted (without mirror images)")
@@ -384,8 +421,11 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m agents.imitation_scaling",
                                 description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("runs", nargs="+", type=Path,
+    p.add_argument("runs", nargs="*", type=Path,
                    help="run directories of python -m agents.waypoints train --keep-labels")
+    p.add_argument("--render", action="store_true",
+                   help="write the laws, tables and figure of OUT/scaling.json again, without "
+                        "fitting")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--fractions", type=_floats,
                    default=list(SCALING_DEFAULTS["fractions"]),
@@ -403,6 +443,17 @@ def main(argv=None) -> int:
     p.add_argument("--processes", type=int, default=1)
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
+    if args.render:
+        if args.runs:
+            p.error("--render reads OUT/scaling.json alone: give no runs")
+        try:
+            render(args.out)
+        except FileNotFoundError as exc:
+            p.error(str(exc))
+        print(f"wrote {args.out}")
+        return 0
+    if not args.runs:
+        p.error("give one or more run directories (or --render)")
     try:
         record = scaling(args.runs, args.out, progress=not args.no_progress,
                          command=shlex.join(["python", "-m", "agents.imitation_scaling", *argv]),
@@ -413,7 +464,8 @@ def main(argv=None) -> int:
     except (ValueError, FileNotFoundError) as exc:
         p.error(str(exc))
     for run, law in record["laws"].items():
-        print(f"{run}: error ∝ n^-{law['test']['alpha']:.2f} on the test fields, "
+        print(f"{run}: error ∝ n^-{law['test']['alpha']:.2f} on the test fields "
+              f"(n^-{law['test_last']['alpha']:.2f} over the two largest shares), "
               f"n^-{law['held']['alpha']:.2f} on the held-out fields")
     print(f"wrote {args.out}")
     return 0

@@ -7,7 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from agents.imitation_scaling import main, power_law, refit_error, scaling, split_fields
+from agents.imitation_scaling import (main, power_law, refit_error, render, scaling,
+                                      split_fields)
 from agents.imitation_scaling import load_labels
 from agents.waypoints import train_student
 from small_envs import SMALL
@@ -84,6 +85,14 @@ def test_a_runs_kept_labels_refit_its_own_student(tmp_path):
     assert json.loads((tmp_path / "study" / "scaling.json").read_text()) == record
     assert "| share 0.5 |" in (tmp_path / "study" / "scaling.md").read_text()
     assert (tmp_path / "study" / "scaling.png").stat().st_size > 0
+    laws = record["laws"][(tmp_path / "kept").as_posix()]
+    assert set(laws) == {"test", "held", "test_last", "held_last", "decisions_a_second"}
+    # two shares: the line through all is the line through the two largest
+    assert laws["test"]["alpha"] == pytest.approx(laws["test_last"]["alpha"], rel=1e-9)
+    # rendered again from the record alone, the tables are the same
+    table = (tmp_path / "study" / "scaling.md").read_text()
+    assert render(tmp_path / "study")["laws"] == record["laws"]
+    assert (tmp_path / "study" / "scaling.md").read_text() == table
 
 
 def test_bad_input_is_refused(tmp_path, capsys):
@@ -94,6 +103,12 @@ def test_bad_input_is_refused(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main([str(tmp_path), "--out", str(tmp_path / "out"), "--no-progress"])
     assert "--keep-labels" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--render", "--out", str(tmp_path / "nothing")])
+    assert "no scaling.json" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--out", str(tmp_path / "out")])
+    assert "give one or more run directories" in capsys.readouterr().err
     with pytest.raises(ValueError, match="two or more different shares"):
         scaling([tmp_path], tmp_path / "out", fractions=[1.0])
     with pytest.raises(ValueError, match="unknown settings"):
