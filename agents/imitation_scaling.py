@@ -71,10 +71,11 @@ SCALING_DEFAULTS = dict(fractions=(0.125, 0.25, 0.5, 1.0), test_fields=10, epoch
                         processes=1)
 
 
-def load_labels(run) -> dict:
+def load_labels(run, keys=None) -> dict:
     """The labelled decisions of the run directory ``run``
     (:data:`agents.waypoints.LABELS`) and its record's settings, as a dict
-    of arrays and ``settings``."""
+    of arrays and ``settings``; ``keys``: only those arrays (None: all;
+    the costmaps are most of a run's labels)."""
     from .waypoints import LABELS, RECORD as TRAIN_RECORD
 
     path, record = Path(run) / LABELS, Path(run) / TRAIN_RECORD
@@ -88,7 +89,7 @@ def load_labels(run) -> dict:
         raise ValueError(f"{run}: a run of form {settings['form']!r}; the error's share of the "
                          "variance is defined for waypoint decisions only")
     with np.load(path) as data:
-        out = {k: data[k] for k in data.files}
+        out = {k: data[k] for k in (data.files if keys is None else keys)}
     return {**out, "settings": settings}
 
 
@@ -241,6 +242,9 @@ def scaling(runs, out: Path, progress: bool = True, command: str | None = None,
     extra = [int(e) for e in s["extra_epochs"]]
     if any(e < 1 for e in extra):
         raise ValueError(f"extra_epochs must be integers >= 1, got {s['extra_epochs']}")
+    if extra and fractions[-1] != 1.0:
+        raise ValueError(f"extra_epochs fit all the training fields: give the share 1 among "
+                         f"the fractions, got {s['fractions']}")
     targets = [float(t) for t in s["targets"]]
     if any(not 0.0 < t < 1.0 for t in targets):
         raise ValueError(f"targets must be shares in (0, 1), got {s['targets']}")
@@ -249,7 +253,7 @@ def scaling(runs, out: Path, progress: bool = True, command: str | None = None,
         raise ValueError("scaling needs at least one run")
     jobs = []
     for run in runs:
-        data = load_labels(run)      # checks each run before any fit
+        data = load_labels(run, keys=("round", "field"))  # checks each run before any fit
         seed = int(data["settings"]["seed"])
         last = max(int(r) for r in np.unique(data["round"]))
         split_fields(data["round"], data["field"], s["test_fields"], fractions, seed)

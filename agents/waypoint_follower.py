@@ -234,7 +234,6 @@ def rollout_decision(env, obs, w, steps: int, *, points: int, distance: float,
     (:class:`~agents.planners.CostmapLatticePlanner`); None: the costmap
     lattice throughout. Stepped on ``env.unwrapped``, below any wrapper,
     whose counters stay as they are; the caller snapshots and restores."""
-
     u = env.unwrapped
     lattice = CostmapLatticePlanner(env, 0, show=False)
     follower = Commanded(env, points=points, distance=distance, interval=interval)

@@ -111,5 +111,7 @@ def test_bad_input_is_refused(tmp_path, capsys):
     assert "give one or more run directories" in capsys.readouterr().err
     with pytest.raises(ValueError, match="two or more different shares"):
         scaling([tmp_path], tmp_path / "out", fractions=[1.0])
+    with pytest.raises(ValueError, match="give the share 1 among the fractions"):
+        scaling([tmp_path], tmp_path / "out", fractions=[0.25, 0.5], extra_epochs=[10])
     with pytest.raises(ValueError, match="unknown settings"):
         scaling([tmp_path], tmp_path / "out", epocs=3)
